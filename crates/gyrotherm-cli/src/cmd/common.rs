@@ -1,0 +1,1 @@
+//! Options shared by every command that reads a test log (column mapping, units, gaps).

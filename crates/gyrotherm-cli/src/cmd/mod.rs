@@ -1,0 +1,12 @@
+//! One file per subcommand: a clap `Args` struct and `run(args) -> anyhow::Result<ExitCode>`.
+//! `common` holds the options shared by every command that reads a log.
+
+pub mod allan;
+pub mod common;
+pub mod compare;
+pub mod compensate;
+pub mod demo;
+pub mod evaluate;
+pub mod report;
+pub mod simulate;
+pub mod train;

@@ -1,0 +1,68 @@
+//! `gyrotherm`: thin command-line front end. Parses arguments, calls the library, prints.
+//!
+//! Exit codes: 0 success; 1 ran fine but a requested threshold was missed; 2 error.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod cmd;
+
+/// Remove temperature-induced errors from fiber optic gyroscope (FOG) test logs.
+#[derive(Debug, Parser)]
+#[command(name = "gyrotherm", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Simulate, train, compare and print the results table on built-in defaults.
+    Demo(cmd::demo::DemoArgs),
+    /// Simulate a thermal-chamber test of a FOG and write the log as CSV.
+    Simulate(cmd::simulate::SimulateArgs),
+    /// Allan deviation (ADEV, OADEV, MDEV, HDEV) of a rate column, with noise terms.
+    Allan(cmd::allan::AllanArgs),
+    /// Bias, bias stability and (rate-table logs) scale-factor figures of a log.
+    Evaluate(cmd::evaluate::EvaluateArgs),
+    /// Fit a compensation model (LSTM, linear or polynomial) to test logs.
+    Train(cmd::train::TrainArgs),
+    /// Apply a fitted model to a log (batch, or --stream on stdin/stdout).
+    Compensate(cmd::compensate::CompensateArgs),
+    /// Fit every method on training logs and judge them on a held-out log.
+    Compare(cmd::compare::CompareArgs),
+    /// Write an HTML report with figures for a held-out comparison.
+    Report(cmd::report::ReportArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(a) => cmd::demo::run(a),
+        Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Allan(a) => cmd::allan::run(a),
+        Command::Evaluate(a) => cmd::evaluate::run(a),
+        Command::Train(a) => cmd::train::run(a),
+        Command::Compensate(a) => cmd::compensate::run(a),
+        Command::Compare(a) => cmd::compare::run(a),
+        Command::Report(a) => cmd::report::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(err) => {
+            if is_broken_pipe(&err) {
+                return ExitCode::SUCCESS;
+            }
+            eprintln!("gyrotherm: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| {
+        e.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
