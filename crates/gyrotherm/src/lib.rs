@@ -12,6 +12,7 @@ pub mod allan;
 pub mod atomic_file;
 pub mod baseline;
 pub mod csvlog;
+pub mod features;
 pub mod metrics;
 pub mod model;
 pub mod report;
