@@ -13,11 +13,7 @@ impl ZScore {
     /// Fit to `rows` of `channels` values each (row-major `data`, `data.len() % channels == 0`).
     /// A channel with zero spread gets std 1 so that it maps to 0 instead of dividing by zero.
     pub fn fit(data: &[f64], channels: usize) -> ZScore {
-        let n = if channels == 0 {
-            0
-        } else {
-            data.len() / channels
-        };
+        let n = data.len().checked_div(channels).unwrap_or(0);
         let mut mean = vec![0.0; channels];
         let mut std = vec![1.0; channels];
         if n == 0 {
