@@ -1,10 +1,130 @@
-//! `gyrotherm simulate`.
+//! `gyrotherm simulate`: write a simulated thermal-chamber test log (see `gyrotherm::sim`).
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct SimulateArgs {}
+use anyhow::Context;
+use gyrotherm::sim::{self, FogUnit, Profile, SimConfig, BUILTIN_PROFILES};
 
-pub fn run(_args: SimulateArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`gyrotherm simulate` is not implemented yet")
+#[derive(Debug, clap::Args)]
+pub struct SimulateArgs {
+    /// Built-in chamber profile (see --list-profiles).
+    #[arg(long, default_value = "seed-shock", conflicts_with = "profile_file")]
+    profile: String,
+    /// User profile: text file of `duration_s,target_c` rows (set point starts at the first
+    /// row's target; each later row ramps linearly to its target; `#` comments).
+    #[arg(long, value_name = "FILE")]
+    profile_file: Option<PathBuf>,
+    /// Random seed (same seed, same bytes).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Rate-table test at this rate, °/s: +rate / stop / -rate / stop segments.
+    #[arg(long, value_name = "DPS")]
+    table_rate: Option<f64>,
+    /// Length of each rate-table segment, s.
+    #[arg(long, default_value_t = sim::DEFAULT_TABLE_SEGMENT_S, value_name = "S")]
+    table_segment: f64,
+    /// Add truth columns (true bias, true scale factor, noise-only part, node temperatures).
+    #[arg(long)]
+    truth: bool,
+    /// Output sample rate, Hz.
+    #[arg(long, default_value_t = 1.0, value_name = "HZ")]
+    rate_hz: f64,
+    /// Unit parameter file (JSON); fields given override the default unit's.
+    #[arg(long, value_name = "FILE")]
+    unit: Option<PathBuf>,
+    /// Latitude, degrees north (Earth-rate component).
+    #[arg(long, default_value_t = sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
+    latitude: f64,
+    /// Output CSV file.
+    #[arg(long, value_name = "FILE", required_unless_present_any = ["list_profiles", "print_unit"])]
+    out: Option<PathBuf>,
+    /// List the built-in profiles and exit.
+    #[arg(long)]
+    list_profiles: bool,
+    /// Print the unit's parameters (default, or --unit applied) as JSON and exit.
+    #[arg(long)]
+    print_unit: bool,
+}
+
+pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
+    if args.list_profiles {
+        for (name, what) in BUILTIN_PROFILES {
+            println!("{name:<12} {what}");
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let unit = match &args.unit {
+        Some(path) => FogUnit::load(path)?,
+        None => FogUnit::default(),
+    };
+    if args.print_unit {
+        println!("{}", serde_json::to_string_pretty(&unit)?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let profile = match &args.profile_file {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read profile file {}", path.display()))?;
+            Profile::parse(&text, &path.display().to_string())?
+        }
+        None => Profile::builtin(&args.profile)?,
+    };
+    let cfg = SimConfig {
+        seed: args.seed,
+        sample_rate_hz: args.rate_hz,
+        table_rate_dps: args.table_rate,
+        table_segment_s: args.table_segment,
+        truth: args.truth,
+        unit,
+        latitude_deg: args.latitude,
+        ..SimConfig::new(profile)
+    };
+    let out = args.out.context("--out is required")?;
+    let log = sim::simulate(&cfg)?;
+    gyrotherm::csvlog::write_log(&out, &log)?;
+
+    let (tmin, tmax) = log
+        .temp_c
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+            (a.min(t), b.max(t))
+        });
+    let stability = if cfg.table_rate_dps.is_none() {
+        match bias_stability_dph(&log.gyro_dps, cfg.sample_rate_hz, 100.0) {
+            Some(v) => format!("raw bias stability {v:.5} °/h (1σ of 100 s means)"),
+            None => "run too short for a 100 s bias stability".into(),
+        }
+    } else {
+        format!("rate table ±{} °/s", cfg.table_rate_dps.unwrap_or(0.0))
+    };
+    eprintln!(
+        "simulated {} samples ({:.0} s at {} Hz) of `{}` with unit `{}`, seed {}: temperature \
+         {tmin:.2} to {tmax:.2} °C (sensor), {stability}; wrote {}",
+        log.len(),
+        cfg.profile.duration_s(),
+        cfg.sample_rate_hz,
+        cfg.profile.name,
+        cfg.unit.name,
+        cfg.seed,
+        out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Bias stability, °/h: sample standard deviation (n-1) of consecutive non-overlapping
+/// `tau_s` means (IEEE Std 952 / GJB 2426A); None with fewer than two means.
+// Local stand-in until the metrics module lands.
+fn bias_stability_dph(x_dps: &[f64], rate_hz: f64, tau_s: f64) -> Option<f64> {
+    let m = (tau_s * rate_hz).round().max(1.0) as usize;
+    let means: Vec<f64> = x_dps
+        .chunks_exact(m)
+        .map(|c| c.iter().sum::<f64>() / m as f64)
+        .collect();
+    if means.len() < 2 {
+        return None;
+    }
+    let mu = means.iter().sum::<f64>() / means.len() as f64;
+    let var = means.iter().map(|v| (v - mu).powi(2)).sum::<f64>() / (means.len() - 1) as f64;
+    Some(var.sqrt() * 3600.0)
 }

@@ -8,16 +8,18 @@
 //! - sensor T_sens: lag of the case, τ = `sensor_tau_s` (DS18B20 on the case).
 //!
 //! Bias, °/h, with ΔT = T_coil - `ref_temp_c` (He et al. 2024 eq. (3): B = B0 - Be):
-//! B = `bias0_dph` + Ω_e·sin φ                       (constant + Earth rate, Ω_e = 15.041 °/h)
-//!   + c1·ΔT + c2·ΔT² + c3·ΔT³                        (stress-induced, static in T)
-//!   + `shupe_dph_per_c_per_s` · (1 + `shupe_tc_per_c`·ΔT) · dT_coil/dt
-//!                                                    (Shupe 1980: ∝ time derivative of the
-//!                                                     coil temperature, zero when steady; the
-//!                                                     factor in ΔT models the potting's
-//!                                                     temperature-dependent stiffness, which
-//!                                                     changes the thermally induced
-//!                                                     nonreciprocity, Mohr 1996)
-//!   + `stress_dph_per_c` · (T_coil - S)              (stress relaxation / hysteresis)
+//! ```text
+//! B = bias0_dph + Ω_e·sin φ                        constant + Earth rate (Ω_e = 15.041 °/h,
+//!                                                   input axis up, latitude φ)
+//!   + c1·ΔT + c2·ΔT² + c3·ΔT³                        stress-induced, static in T (°/h/°C^k)
+//!   + shupe_dph_per_c_per_s·(1 + shupe_tc_per_c·ΔT)·dT_coil/dt
+//!                                                    Shupe term (Shupe 1980, Appl. Opt. 19(5)):
+//!                                                    ∝ the coil temperature rate, zero when
+//!                                                    steady; the ΔT factor models the
+//!                                                    potting's temperature-dependent stiffness
+//!                                                    (elasto-optic part, Mohr 1996)
+//!   + stress_dph_per_c·(T_coil - S)                  stress relaxation / hysteresis (°/h/°C)
+//! ```
 //! For a first-order coil node dT_coil/dt = (T_case - T_coil)/τ_coil, so the Shupe term is
 //! also the case-to-coil gradient term; it is evaluated from that formula (no numerical
 //! differentiation).
@@ -98,20 +100,20 @@ impl Default for FogUnit {
             name: "default (navigation-grade FOG, no thermostat)".into(),
             case_tau_s: 180.0,
             coil_tau_s: 300.0,
-            stress_tau_s: 1500.0,
+            stress_tau_s: 2500.0,
             ref_temp_c: 20.0,
             bias0_dph: 0.5,
-            bias_c1_dph_per_c: 0.002,
-            bias_c2_dph_per_c2: 5e-6,
+            bias_c1_dph_per_c: 0.0033,
+            bias_c2_dph_per_c2: 8e-6,
             bias_c3_dph_per_c3: 0.0,
-            shupe_dph_per_c_per_s: 2.0,
-            shupe_tc_per_c: 0.008,
-            stress_dph_per_c: 0.002,
+            shupe_dph_per_c_per_s: 1.0,
+            shupe_tc_per_c: 0.012,
+            stress_dph_per_c: 0.0012,
             sf_offset_ppm: 150.0,
             sf_c1_ppm_per_c: 1.0,
             sf_c2_ppm_per_c2: 0.08,
             arw_deg_rt_h: 0.0008,
-            bias_instability_dph: 0.006,
+            bias_instability_dph: 0.0055,
             rrw_dph_rt_h: 0.001,
             pulse_arcsec: 0.02,
             sensor_offset_c: 0.3,
@@ -127,7 +129,9 @@ impl FogUnit {
     pub fn from_json_str(text: &str, source: &str) -> Result<FogUnit, SimError> {
         let unit: FogUnit = serde_json::from_str(text).map_err(|e| SimError::Unit {
             field: source.to_owned(),
-            message: format!("{e} (fields are those of FogUnit; see `gyrotherm simulate --print-unit`)"),
+            message: format!(
+                "{e} (fields are those of FogUnit; see `gyrotherm simulate --print-unit`)"
+            ),
         })?;
         unit.validate()?;
         Ok(unit)

@@ -127,7 +127,7 @@ impl SimConfig {
                 self.sample_rate_hz
             )));
         }
-        if !(self.latitude_deg.abs() <= 90.0) {
+        if !(self.latitude_deg.is_finite() && self.latitude_deg.abs() <= 90.0) {
             return Err(SimError::Config(format!(
                 "latitude {} ° must be between -90 and 90",
                 self.latitude_deg
@@ -301,7 +301,8 @@ pub fn simulate_series(cfg: &SimConfig) -> Result<SimSeries, SimError> {
         let mut reading_c =
             thermal.sensor_c + unit.sensor_offset_c + unit.sensor_noise_c * g_sensor.normal();
         if unit.sensor_resolution_c > 0.0 {
-            reading_c = libm::round(reading_c / unit.sensor_resolution_c) * unit.sensor_resolution_c;
+            reading_c =
+                libm::round(reading_c / unit.sensor_resolution_c) * unit.sensor_resolution_c;
         }
 
         s.time_s.push(t_s);

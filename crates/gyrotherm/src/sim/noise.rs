@@ -74,7 +74,9 @@ impl GaussMarkov {
 /// half-decade spacing from 10 s to 10^4 s, equal variances, so their summed spectrum is close
 /// to 1/f between about 1/(2π·10^4) and 1/(2π·10) Hz (the usual sum-of-GM approximation of
 /// flicker noise, e.g. Kasdin 1995, Proc. IEEE 83(5) sec. V).
-pub const FLICKER_TAUS_S: [f64; 7] = [10.0, 31.6227766, 100.0, 316.227766, 1000.0, 3162.27766, 10000.0];
+pub const FLICKER_TAUS_S: [f64; 7] = [
+    10.0, 31.6227766, 100.0, 316.227766, 1000.0, 3162.27766, 10000.0,
+];
 
 /// Flicker floor of the Allan deviation for bias instability B: σ_min = 0.6643·B
 /// (IEEE Std 952-1997 C.1.3: σ = √(2 ln2 / π)·B).

@@ -261,8 +261,7 @@ impl Profile {
             return bad("start_c is not finite".into());
         }
         for (i, s) in self.segments.iter().enumerate() {
-            if !(s.duration_s > 0.0 && s.duration_s <= MAX_SEGMENT_S) || !s.target_c.is_finite()
-            {
+            if !(s.duration_s > 0.0 && s.duration_s <= MAX_SEGMENT_S && s.target_c.is_finite()) {
                 return bad(format!(
                     "segment {i}: duration_s {} must be in (0, {MAX_SEGMENT_S}] and target_c {} finite",
                     s.duration_s, s.target_c

@@ -1,0 +1,265 @@
+//! Simulator tests: determinism, physics sanity, profile parsing, unit files.
+
+use gyrotherm::csvlog::{write_log, NOISE_COL, TRUE_BIAS_COL, TRUE_SCALE_COL};
+use gyrotherm::sim::{
+    simulate, simulate_series, ChamberParams, FogUnit, Profile, SimConfig, SimError, EARTH_RATE_DPH,
+};
+
+fn short_cfg(seed: u64) -> SimConfig {
+    let profile = Profile::parse("600,22\n600,10\n600,10\n", "short").unwrap();
+    SimConfig {
+        seed,
+        truth: true,
+        table_rate_dps: Some(20.0),
+        ..SimConfig::new(profile)
+    }
+}
+
+/// Issue 2: same seed, same bytes; different seeds differ.
+#[test]
+fn same_seed_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, seed: u64| {
+        let path = dir.path().join(name);
+        write_log(&path, &simulate(&short_cfg(seed)).unwrap()).unwrap();
+        std::fs::read(path).unwrap()
+    };
+    let a = write("a.csv", 7);
+    let b = write("b.csv", 7);
+    let c = write("c.csv", 8);
+    assert!(a == b, "two runs with seed 7 wrote different bytes");
+    assert!(a != c, "seeds 7 and 8 wrote identical files");
+    let header =
+        String::from_utf8_lossy(&a[..a.iter().position(|&x| x == b'\n').unwrap()]).to_string();
+    for col in ["table_dps", TRUE_BIAS_COL, TRUE_SCALE_COL, NOISE_COL] {
+        assert!(header.contains(col), "header {header:?} lacks {col}");
+    }
+}
+
+/// The truth columns decompose the output exactly: gyro = B + K·Ω + noise.
+#[test]
+fn truth_columns_add_up() {
+    let s = simulate_series(&short_cfg(3)).unwrap();
+    let table = s.table_dps.unwrap();
+    for (i, &omega) in table.iter().enumerate() {
+        let sum = s.true_bias_dps[i] + s.true_scale[i] * omega + s.noise_dps[i];
+        // Rounding of three f64 additions on values up to 20 °/s: a few ulps of 20.
+        assert!(
+            (sum - s.gyro_dps[i]).abs() < 1e-13,
+            "sample {i}: gyro {} want B+KΩ+n {sum}",
+            s.gyro_dps[i]
+        );
+    }
+}
+
+/// A unit with only the Shupe term (and no chamber ripple), so the thermal bias is that term.
+fn shupe_only() -> (FogUnit, ChamberParams) {
+    let unit = FogUnit {
+        bias_c1_dph_per_c: 0.0,
+        bias_c2_dph_per_c2: 0.0,
+        bias_c3_dph_per_c3: 0.0,
+        stress_dph_per_c: 0.0,
+        shupe_tc_per_c: 0.0,
+        ..FogUnit::default()
+    };
+    let chamber = ChamberParams {
+        ripple_amp_c: 0.0,
+        fluct_sigma_c: 0.0,
+        ..ChamberParams::default()
+    };
+    (unit, chamber)
+}
+
+/// Issue 2 physics sanity: steady temperature gives no Shupe term; its sign follows the coil
+/// temperature rate (positive coefficient: cooling < 0, heating > 0).
+#[test]
+fn shupe_zero_when_steady_and_follows_rate_sign() {
+    let (unit, chamber) = shupe_only();
+    let constant_dph = unit.bias0_dph + EARTH_RATE_DPH * 39.1_f64.to_radians().sin();
+    let steady = SimConfig {
+        unit: unit.clone(),
+        chamber,
+        ..SimConfig::builtin("room-steady").unwrap()
+    };
+    let s = simulate_series(&steady).unwrap();
+    for (i, b) in s.true_bias_dps.iter().enumerate() {
+        let thermal = b * 3600.0 - constant_dph;
+        // Everything starts in equilibrium and nothing drives it: zero up to rounding.
+        assert!(
+            thermal.abs() < 1e-12,
+            "sample {i}: Shupe term {thermal} °/h at steady temperature"
+        );
+    }
+    let shock = SimConfig {
+        unit,
+        chamber,
+        ..SimConfig::builtin("seed-shock").unwrap()
+    };
+    let s = simulate_series(&shock).unwrap();
+    let mut checked = 0;
+    for i in 1..s.coil_c.len() {
+        let rate = s.coil_c[i] - s.coil_c[i - 1];
+        let thermal = s.true_bias_dps[i - 1] * 3600.0 - constant_dph;
+        if rate.abs() > 0.01 {
+            checked += 1;
+            assert!(
+                thermal.signum() == rate.signum(),
+                "t={} s: coil rate {rate} °C/s but Shupe term {thermal} °/h",
+                s.time_s[i]
+            );
+        }
+    }
+    assert!(
+        checked > 1000,
+        "only {checked} samples with a fast coil rate"
+    );
+}
+
+/// Issue 2 physics sanity: the coil lags the case, which lags the chamber air: on the first
+/// cool-down each crosses 0 °C later than the node outside it.
+#[test]
+fn coil_lags_case_lags_air() {
+    let s = simulate_series(&SimConfig::builtin("seed-shock").unwrap()).unwrap();
+    let crossing = |x: &[f64]| x.iter().position(|&v| v < 0.0).unwrap() as f64;
+    let (air, case, coil) = (
+        crossing(&s.chamber_c),
+        crossing(&s.case_c),
+        crossing(&s.coil_c),
+    );
+    // At a steady ramp a first-order lag of τ trails by τ s; require at least half of it.
+    let unit = FogUnit::default();
+    assert!(
+        case - air > 0.5 * unit.case_tau_s,
+        "case crosses 0 °C at {case} s, air at {air} s"
+    );
+    assert!(
+        coil - case > 0.5 * unit.coil_tau_s,
+        "coil crosses 0 °C at {coil} s, case at {case} s"
+    );
+}
+
+/// The chamber overshoots its set point when a ramp ends (design value ~1 °C for a 3 °C/min
+/// ramp; accept 0.3-2 °C, the range of chamber data sheets), with ripple off.
+#[test]
+fn chamber_overshoots_after_ramp() {
+    let cfg = SimConfig {
+        chamber: ChamberParams {
+            ripple_amp_c: 0.0,
+            fluct_sigma_c: 0.0,
+            ..ChamberParams::default()
+        },
+        ..SimConfig::builtin("seed-shock").unwrap()
+    };
+    let s = simulate_series(&cfg).unwrap();
+    let min_air = s.chamber_c.iter().cloned().fold(f64::INFINITY, f64::min);
+    let overshoot = -40.0 - min_air;
+    assert!(
+        (0.3..=2.0).contains(&overshoot),
+        "overshoot below -40 °C: {overshoot} °C"
+    );
+}
+
+/// The logged temperature is on the DS18B20's 0.0625 °C grid (He et al. 2024).
+#[test]
+fn sensor_reading_on_resolution_grid() {
+    let s = simulate_series(&short_cfg(1)).unwrap();
+    for t in &s.temp_c {
+        let k = t / 0.0625;
+        assert!(
+            (k - k.round()).abs() < 1e-9,
+            "temp {t} not a multiple of 0.0625"
+        );
+    }
+}
+
+fn profile_err(text: &str) -> (usize, String) {
+    match Profile::parse(text, "p.csv") {
+        Err(SimError::Profile { line, message, .. }) => (line, message),
+        other => panic!("want a profile error for {text:?}, got {other:?}"),
+    }
+}
+
+#[test]
+fn profile_file_errors_name_the_line() {
+    let (line, msg) = profile_err("# c\n100,22\n100,x\n");
+    assert_eq!(line, 3, "{msg}");
+    assert!(msg.contains("not a number"), "{msg}");
+    let (line, msg) = profile_err("100,22\n100\n");
+    assert_eq!(line, 2, "{msg}");
+    assert!(msg.contains("2 fields"), "{msg}");
+    let (line, msg) = profile_err("100,22\n60,-40\n");
+    assert_eq!(line, 2, "{msg}");
+    assert!(msg.contains("°C/min"), "{msg}");
+    let (line, msg) = profile_err("0,22\n");
+    assert_eq!(line, 1, "{msg}");
+    let (line, msg) = profile_err("100,inf\n");
+    assert_eq!(line, 1, "{msg}");
+    let (line, msg) = profile_err("100,500\n");
+    assert_eq!(line, 1, "{msg}");
+    assert!(msg.contains("range"), "{msg}");
+    let (line, msg) = profile_err("# only comments\n\n");
+    assert_eq!(line, 0, "{msg}");
+    assert!(msg.contains("no segments"), "{msg}");
+}
+
+#[test]
+fn profile_file_ramps_and_soaks() {
+    let p = Profile::parse("duration_s,target_c\n100 20 # hold\n1200, -40\n", "p").unwrap();
+    assert_eq!(p.start_c, 20.0);
+    assert_eq!(p.duration_s(), 1300.0);
+    // Independent: halfway through a linear ramp from 20 to -40 is -10.
+    assert_eq!(p.setpoint_c(50.0), 20.0);
+    assert_eq!(p.setpoint_c(700.0), -10.0);
+    assert_eq!(p.setpoint_c(5000.0), -40.0);
+}
+
+#[test]
+fn builtin_profiles_exist_and_unknown_is_an_error() {
+    for (name, _) in gyrotherm::sim::BUILTIN_PROFILES {
+        let p = Profile::builtin(name).unwrap();
+        p.validate().unwrap();
+    }
+    // Issue 2: seed-shock is about 30,000 s and spans -40..+60 °C.
+    let p = Profile::builtin("seed-shock").unwrap();
+    assert_eq!(p.duration_s(), 30000.0);
+    let targets: Vec<f64> = p.segments.iter().map(|s| s.target_c).collect();
+    assert!(targets.contains(&-40.0) && targets.contains(&60.0));
+    assert!(matches!(Profile::builtin("nope"), Err(SimError::Config(_))));
+}
+
+#[test]
+fn unit_json_partial_override_and_errors() {
+    let u = FogUnit::from_json_str(r#"{"bias0_dph": 1.5}"#, "u.json").unwrap();
+    assert_eq!(u.bias0_dph, 1.5);
+    assert_eq!(u.coil_tau_s, FogUnit::default().coil_tau_s);
+    let e = FogUnit::from_json_str(r#"{"bias_zero": 1.5}"#, "u.json").unwrap_err();
+    assert!(e.to_string().contains("bias_zero"), "{e}");
+    let e = FogUnit::from_json_str(r#"{"coil_tau_s": -1}"#, "u.json").unwrap_err();
+    assert!(e.to_string().contains("coil_tau_s"), "{e}");
+    // Round trip of the default through JSON.
+    let j = serde_json::to_string(&FogUnit::default()).unwrap();
+    assert_eq!(FogUnit::from_json_str(&j, "d").unwrap(), FogUnit::default());
+}
+
+#[test]
+fn bad_config_is_an_error_not_a_panic() {
+    let mut c = short_cfg(0);
+    c.sample_rate_hz = 0.0;
+    assert!(simulate(&c).is_err());
+    let mut c = short_cfg(0);
+    c.table_rate_dps = Some(f64::NAN);
+    assert!(simulate(&c).is_err());
+    let mut c = short_cfg(0);
+    c.latitude_deg = 95.0;
+    assert!(simulate(&c).is_err());
+}
+
+/// Higher sample rates work and keep the physics: at 10 Hz the run has 10× the samples.
+#[test]
+fn ten_hz_run() {
+    let mut c = short_cfg(2);
+    c.sample_rate_hz = 10.0;
+    let s = simulate_series(&c).unwrap();
+    assert_eq!(s.time_s.len(), 18000);
+    assert!((s.time_s[10] - 1.0).abs() < 1e-12);
+}
