@@ -263,3 +263,57 @@ fn ten_hz_run() {
     assert_eq!(s.time_s.len(), 18000);
     assert!((s.time_s[10] - 1.0).abs() < 1e-12);
 }
+
+/// The example files shipped next to the simulator parse and run.
+#[test]
+fn example_files_parse() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/sim");
+    let unit = FogUnit::load(&dir.join("example_unit.json")).unwrap();
+    assert_eq!(unit.coil_tau_s, 420.0);
+    assert_eq!(unit.case_tau_s, FogUnit::default().case_tau_s);
+    let text = std::fs::read_to_string(dir.join("example_profile.csv")).unwrap();
+    let p = Profile::parse(&text, "example_profile.csv").unwrap();
+    assert_eq!(p.start_c, 25.0);
+    assert_eq!(p.duration_s(), 23000.0);
+    let cfg = SimConfig {
+        unit,
+        ..SimConfig::new(p)
+    };
+    assert_eq!(simulate(&cfg).unwrap().len(), 23000);
+}
+
+/// Faults: dropouts leave time gaps, stuck readings repeat; off by default changes nothing.
+#[test]
+fn fault_injection() {
+    let clean = simulate_series(&short_cfg(5)).unwrap();
+    let mut cfg = short_cfg(5);
+    cfg.faults = gyrotherm::sim::FaultParams {
+        dropouts_per_hour: 20.0,
+        dropout_s: 5.0,
+        stuck_temp_per_hour: 20.0,
+        stuck_temp_s: 30.0,
+    };
+    let f = simulate_series(&cfg).unwrap();
+    let gaps = f.time_s.windows(2).filter(|w| w[1] - w[0] > 1.5).count();
+    assert!(gaps > 0, "20 dropouts/h over 0.5 h made no gap");
+    assert_eq!(
+        clean.time_s.len() - f.time_s.len(),
+        gaps * 5,
+        "each 5 s dropout removes 5 samples at 1 Hz"
+    );
+    // Gyro values of kept samples are the clean run's (faults touch only the log).
+    for (t, g) in f.time_s.iter().zip(&f.gyro_dps) {
+        assert_eq!(clean.gyro_dps[*t as usize], *g);
+    }
+    let stuck = f
+        .temp_c
+        .windows(31)
+        .filter(|w| w.iter().all(|&v| v == w[0]))
+        .count();
+    assert!(stuck > 0, "no 30 s stuck-temperature run found");
+    cfg.faults.dropout_s = 0.0;
+    assert!(
+        simulate(&cfg).is_err(),
+        "dropout rate without a length must be refused"
+    );
+}

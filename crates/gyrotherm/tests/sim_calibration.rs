@@ -185,3 +185,60 @@ fn default_unit_history_matters_beyond_t_and_dt() {
         );
     }
 }
+
+#[test]
+#[ignore = "probe: prints numbers for the report"]
+fn report_probe() {
+    fn rich(s: &SimSeries) -> Vec<Vec<f64>> {
+        let t = &s.temp_c;
+        let d = dtemp(t, 1.0);
+        let mut f = vec![
+            vec![1.0; t.len()],
+            t.clone(),
+            t.iter().map(|v| v * v).collect(),
+            d.clone(),
+        ];
+        f.push(t.iter().zip(&d).map(|(a, b)| a * b).collect());
+        for tau in [300.0, 1000.0, 3000.0] {
+            f.push(lag(t, 1.0, tau));
+        }
+        let l300 = lag(t, 1.0, 300.0);
+        f.push(t.iter().zip(&l300).map(|(a, b)| a * (a - b)).collect());
+        f
+    }
+    fn fit(tr: &SimSeries, te: &SimSeries) -> f64 {
+        let ftr = rich(tr);
+        let n = tr.gyro_dps.len();
+        let a = DMatrix::from_fn(n, ftr.len(), |i, j| ftr[j][i]);
+        let y = DVector::from_column_slice(&tr.gyro_dps);
+        let coef = a.svd(true, true).solve(&y, 1e-12).unwrap();
+        let fte = rich(te);
+        let r: Vec<f64> = (0..te.gyro_dps.len())
+            .map(|i| te.gyro_dps[i] - (0..fte.len()).map(|j| coef[j] * fte[j][i]).sum::<f64>())
+            .collect();
+        bias_stability_dph(&r, 1.0, 100.0)
+    }
+    let runs: Vec<(&str, SimSeries)> = [("seed-shock", 7), ("slow-ramp", 8), ("fast-cycle", 9)]
+        .iter()
+        .map(|&(p, s)| (p, run(p, s)))
+        .collect();
+    for (p, s) in &runs {
+        println!(
+            "{p}: raw {:.5} floor {:.5}",
+            bias_stability_dph(&s.gyro_dps, 1.0, 100.0),
+            bias_stability_dph(&s.noise_dps, 1.0, 100.0)
+        );
+    }
+    for (ptr, tr) in &runs {
+        for (pte, seed) in [("seed-shock", 11), ("slow-ramp", 12), ("fast-cycle", 13)] {
+            let te = run(pte, seed);
+            let floor = bias_stability_dph(&te.noise_dps, 1.0, 100.0);
+            println!(
+                "train {ptr} test {pte}#{seed}: floor {floor:.5} linear {:.5} thermal {:.5} rich {:.5}",
+                held_out_residual_dph(tr, &te, false),
+                held_out_residual_dph(tr, &te, true),
+                fit(tr, &te)
+            );
+        }
+    }
+}

@@ -36,6 +36,18 @@ pub struct SimulateArgs {
     /// Latitude, degrees north (Earth-rate component).
     #[arg(long, default_value_t = sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     latitude: f64,
+    /// Fault injection: mean dropouts (missing samples, a time gap) per hour.
+    #[arg(long, default_value_t = 0.0, value_name = "N")]
+    dropouts_per_hour: f64,
+    /// Length of each dropout, s.
+    #[arg(long, default_value_t = 5.0, value_name = "S")]
+    dropout_s: f64,
+    /// Fault injection: mean stuck-temperature episodes per hour.
+    #[arg(long, default_value_t = 0.0, value_name = "N")]
+    stuck_temp_per_hour: f64,
+    /// Length of each stuck-temperature episode, s.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    stuck_temp_s: f64,
     /// Output CSV file.
     #[arg(long, value_name = "FILE", required_unless_present_any = ["list_profiles", "print_unit"])]
     out: Option<PathBuf>,
@@ -78,6 +90,12 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         truth: args.truth,
         unit,
         latitude_deg: args.latitude,
+        faults: sim::FaultParams {
+            dropouts_per_hour: args.dropouts_per_hour,
+            dropout_s: args.dropout_s,
+            stuck_temp_per_hour: args.stuck_temp_per_hour,
+            stuck_temp_s: args.stuck_temp_s,
+        },
         ..SimConfig::new(profile)
     };
     let out = args.out.context("--out is required")?;

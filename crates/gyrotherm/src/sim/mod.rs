@@ -18,11 +18,14 @@
 //! transcendental function from `libm`, so the same config gives the same bytes on every
 //! platform.
 //!
-//! Not modelled: faults (dropouts, stuck readings), table acceleration and wobble,
+//! Optional faults ([`fault`]): dropouts (time gaps) and stuck temperature readings.
+//!
+//! Not modelled: table acceleration and wobble,
 //! magnetic sensitivity, vibration, temperature-dependent noise levels, the sensor's
 //! conversion time, and non-vertical mounting (the Earth-rate term assumes the input axis up).
 
 pub mod chamber;
+pub mod fault;
 pub mod fog;
 pub mod noise;
 pub mod profile;
@@ -31,6 +34,7 @@ pub mod table;
 use std::path::PathBuf;
 
 pub use chamber::ChamberParams;
+pub use fault::FaultParams;
 pub use fog::{FogUnit, ThermalState, EARTH_RATE_DPH};
 pub use profile::{Profile, Segment, BUILTIN_PROFILES};
 
@@ -75,6 +79,8 @@ pub struct SimConfig {
     pub chamber: ChamberParams,
     /// Latitude, degrees north (default 39.1); sets the Earth-rate component Ω_e·sin φ.
     pub latitude_deg: f64,
+    /// Fault injection (default: none).
+    pub faults: FaultParams,
 }
 
 impl Default for SimConfig {
@@ -97,6 +103,7 @@ impl SimConfig {
             unit: FogUnit::default(),
             chamber: ChamberParams::default(),
             latitude_deg: DEFAULT_LATITUDE_DEG,
+            faults: FaultParams::default(),
         }
     }
 
@@ -120,6 +127,7 @@ impl SimConfig {
         self.profile.validate()?;
         self.unit.validate()?;
         self.chamber.validate().map_err(SimError::Config)?;
+        self.faults.validate().map_err(SimError::Config)?;
         let (lo, hi) = SAMPLE_RATE_RANGE_HZ;
         if !(self.sample_rate_hz >= lo && self.sample_rate_hz <= hi) {
             return Err(SimError::Config(format!(
@@ -327,6 +335,7 @@ pub fn simulate_series(cfg: &SimConfig) -> Result<SimSeries, SimError> {
             chamber.advance(setpoint.at(tj), h_s);
         }
     }
+    fault::apply(&mut s, &cfg.faults, dt_s, cfg.seed);
     Ok(s)
 }
 
