@@ -176,7 +176,9 @@ impl RateNoise {
 /// Angle quantization of a pulse-counting (digital) FOG output: the integrated angle is
 /// counted in pulses of `pulse_arcsec`, and each sample outputs (pulses this period)·q/Δt.
 /// The error is white in angle, which gives the -1 Allan slope of quantization noise,
-/// Q = q/√12 (IEEE Std 952-1997 C.1.2). `pulse_arcsec = 0` switches it off.
+/// Q = q/√12 (IEEE Std 952-1997 C.1.2), as long as the other noise randomises the pulse phase
+/// (with a noiseless constant rate the error is a deterministic pattern instead).
+/// `pulse_arcsec = 0` switches it off.
 #[derive(Debug, Clone)]
 pub(crate) struct Quantizer {
     q_deg: f64,
