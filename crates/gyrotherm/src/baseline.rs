@@ -279,9 +279,14 @@ impl std::fmt::Display for FitError {
                 } else {
                     format!("a range of {what}")
                 };
+                let spread = if *std == 0.0 {
+                    "0".to_owned()
+                } else {
+                    format!("{std:.1e}")
+                };
                 write!(
                     f,
-                    "the training log's {what} is constant ({mean:.1} {unit} ± {std:.3}): cannot fit the {term} coefficient; use a log that spans {range}"
+                    "the training log's {what} is constant ({mean:.1} {unit} ± {spread}): cannot fit the {term} coefficient; use a log that spans {range}"
                 )
             }
             FitError::RankDeficient { ratio, terms } => write!(
