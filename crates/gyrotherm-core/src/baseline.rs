@@ -160,7 +160,10 @@ impl BaselineModel {
     /// Powers of term `j` (over all MAX_FEATURES slots) and its coefficient.
     pub fn term(&self, j: usize) -> Option<(&[u8], f64)> {
         if j < self.n_terms as usize {
-            Some((&self.powers[j][..self.n_features as usize], self.coefficients[j]))
+            Some((
+                &self.powers[j][..self.n_features as usize],
+                self.coefficients[j],
+            ))
         } else {
             None
         }

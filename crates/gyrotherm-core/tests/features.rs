@@ -73,9 +73,15 @@ fn time_stamps_with_round_off_step_on_the_same_boundaries() {
     let below = (1..=300)
         .filter(|&k| accumulated[100 * k] < k as f64)
         .count();
-    assert!(below > 0, "the accumulated time stamps should include some below whole seconds");
+    assert!(
+        below > 0,
+        "the accumulated time stamps should include some below whole seconds"
+    );
     let a = run(spec, (0..=30_000).map(|i| (accumulated[i], 1.0 + i as f64)));
-    let b = run(spec, (0..=30_000).map(|i| (i as f64 / 100.0, 1.0 + i as f64)));
+    let b = run(
+        spec,
+        (0..=30_000).map(|i| (i as f64 / 100.0, 1.0 + i as f64)),
+    );
     assert_eq!(a.len(), 301);
     assert_eq!(a, b);
     // The value at step k is the sample at t = k s, i.e. sample 100·k (value 1 + 100k).
@@ -143,7 +149,10 @@ fn lag_filter_matches_closed_form_step_response() {
         );
         let diff = s.features.as_slice()[3];
         let want_diff = if s.index == 0 { 0.0 } else { 1.0 - want };
-        assert!((diff - want_diff).abs() < TOL, "t={t}: T - y want {want_diff}, got {diff}");
+        assert!(
+            (diff - want_diff).abs() < TOL,
+            "t={t}: T - y want {want_diff}, got {diff}"
+        );
     }
 }
 
@@ -160,11 +169,18 @@ fn lag_across_a_gap_advances_by_the_elapsed_time() {
         spec,
         times.map(|k| (k as f64, if k == 0 { 0.0 } else { 1.0 })),
     );
-    let s = steps.iter().find(|s| s.index == 50).expect("step 50 emitted");
+    let s = steps
+        .iter()
+        .find(|s| s.index == 50)
+        .expect("step 50 emitted");
     let want = 1.0 - (-50.0f64 / tau).exp();
     let got = s.features.as_slice()[2];
     assert!((got - want).abs() < 1e-12, "want {want}, got {got}");
-    assert_eq!(steps.len(), 20, "one step per sample, none invented for the gap");
+    assert_eq!(
+        steps.len(),
+        20,
+        "one step per sample, none invented for the gap"
+    );
 }
 
 #[test]
@@ -225,10 +241,7 @@ fn bad_input_is_refused_and_leaves_the_state_untouched() {
                 Err(InputError::NonFinite(Channel::Time))
             );
             if k > 0 {
-                assert_eq!(
-                    dirty.push(t - 0.5, c),
-                    Err(InputError::TimeNotIncreasing)
-                );
+                assert_eq!(dirty.push(t - 0.5, c), Err(InputError::TimeNotIncreasing));
             }
         }
         assert_eq!(dirty.push(t, c).unwrap(), want, "sample {k}");
@@ -253,7 +266,12 @@ fn reset_starts_over() {
                 .map(|s| s.features)
         })
         .collect();
-    assert_eq!(a.into_iter().map(|s| s.map(|s| s.features)).collect::<Vec<_>>(), b);
+    assert_eq!(
+        a.into_iter()
+            .map(|s| s.map(|s| s.features))
+            .collect::<Vec<_>>(),
+        b
+    );
 }
 
 #[test]
@@ -288,19 +306,15 @@ fn bad_specs_are_refused_with_the_field() {
             },
             SpecError::SmoothingWindow(65.0),
         ),
-        (
-            FeatureSpec {
-                n_lags: 5,
-                ..p
-            },
-            SpecError::TooManyLags(5),
-        ),
+        (FeatureSpec { n_lags: 5, ..p }, SpecError::TooManyLags(5)),
     ];
     for (spec, want) in cases {
         assert_eq!(spec.validate(), Err(want));
         assert!(FeaturePipeline::new(spec).is_err());
     }
-    let e = p.with_lags(&[300.0, f64::NAN], LagOutputs::Level).unwrap_err();
+    let e = p
+        .with_lags(&[300.0, f64::NAN], LagOutputs::Level)
+        .unwrap_err();
     assert!(matches!(e, SpecError::LagTau { index: 1, .. }), "{e:?}");
     assert!(p.with_lags(&[1.0; 5], LagOutputs::Level).is_err());
     assert!(e.to_string().contains("lag time constant #1"));

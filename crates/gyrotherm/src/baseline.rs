@@ -129,7 +129,9 @@ impl Terms {
                 ));
             }
             if let Some(&q) = p.iter().find(|&&q| q > MAX_POWER) {
-                return Err(format!("term {j} has power {q}, at most {MAX_POWER} supported"));
+                return Err(format!(
+                    "term {j} has power {q}, at most {MAX_POWER} supported"
+                ));
             }
             if self.powers[..j].contains(p) {
                 return Err(format!("term {j} repeats an earlier term"));
@@ -357,9 +359,7 @@ pub fn fit_rows(
             )));
         }
     }
-    let used: Vec<usize> = (0..n_rows)
-        .filter(|&r| mask.is_none_or(|m| m[r]))
-        .collect();
+    let used: Vec<usize> = (0..n_rows).filter(|&r| mask.is_none_or(|m| m[r])).collect();
     for &r in &used {
         if !target[r].is_finite() {
             return Err(FitError::NonFiniteTarget {
@@ -399,8 +399,8 @@ pub fn fit_rows(
         }
         if hi - lo <= 1e-12 * hi.abs().max(lo.abs()) {
             let mean = sum / used.len() as f64;
-            let std = (col.map(|v| (v - mean) * (v - mean)).sum::<f64>() / used.len() as f64)
-                .sqrt();
+            let std =
+                (col.map(|v| (v - mean) * (v - mean)).sum::<f64>() / used.len() as f64).sqrt();
             return Err(FitError::ConstantFeature {
                 feature: name(i),
                 unit: units.get(i).copied().unwrap_or("").to_owned(),
@@ -450,7 +450,7 @@ pub fn fit_rows(
             let v = vt.row(kmin);
             let vmax = v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
             for (j, c) in v.iter().enumerate() {
-                if c.abs() > 0.1 * vmax {
+                if c.abs() > 1e-4 * vmax {
                     dep.push(terms.name(j, names));
                 }
             }
@@ -461,11 +461,7 @@ pub fn fit_rows(
         .solve(&y, 0.0)
         .map_err(|e| FitError::Shape(format!("SVD solve failed: {e}")))?;
     let resid = &x * &c_scaled - &y;
-    let coefficients: Vec<f64> = c_scaled
-        .iter()
-        .zip(&scale)
-        .map(|(c, s)| c / s)
-        .collect();
+    let coefficients: Vec<f64> = c_scaled.iter().zip(&scale).map(|(c, s)| c / s).collect();
     Ok(BaselineFit {
         terms: terms.clone(),
         coefficients,

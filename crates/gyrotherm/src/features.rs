@@ -4,10 +4,10 @@
 //! target (100 s in He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004).
 
 use crate::csvlog::TestLog;
+use gyrotherm_core::error::InputError;
 pub use gyrotherm_core::features::{
     FeatureKind, FeaturePipeline, FeatureSpec, LagOutputs, SpecError, MAX_FEATURES, MAX_LAGS,
 };
-use gyrotherm_core::error::InputError;
 
 /// Per-step model inputs of one log.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,9 +52,12 @@ impl FeatureTable {
         if col.is_empty() {
             return None;
         }
-        Some(col.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        }))
+        Some(
+            col.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                }),
+        )
     }
     /// For every log sample (of a log with `n_samples` samples), the row whose value it holds:
     /// the latest step made at or before it. Flight code holds the same way.

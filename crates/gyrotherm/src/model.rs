@@ -352,14 +352,16 @@ impl ModelFile {
         if !SUPPORTED_VERSIONS.contains(&self.format_version) {
             return Err(unsupported(self.format_version));
         }
-        let spec = self.features.to_spec().map_err(|e| format!("features: {e}"))?;
+        let spec = self
+            .features
+            .to_spec()
+            .map_err(|e| format!("features: {e}"))?;
         let nf = spec.n_features();
         if self.bias.is_none() && self.scale.is_none() {
             return Err("neither a bias nor a scale model: nothing to compensate".to_owned());
         }
         for (name, sub) in [("bias", &self.bias), ("scale", &self.scale)] {
             let Some(sub) = sub else { continue };
-            sub.validate(nf).map_err(|e| format!("{name}: {e}"))?;
             if matches!(self.method, Method::Linear | Method::Poly)
                 && matches!(sub, SubModel::Lstm { .. })
             {
@@ -368,6 +370,7 @@ impl ModelFile {
                     self.method.as_str()
                 ));
             }
+            sub.validate(nf).map_err(|e| format!("{name}: {e}"))?;
         }
         let t = &self.training;
         for (name, r) in [
