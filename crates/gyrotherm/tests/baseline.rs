@@ -204,7 +204,7 @@ fn shape_errors() {
         },
     );
     assert!(too_many.validate().unwrap_err().contains("terms"));
-    let e = fit(&tab, &vec![0.0; 2], Some(&[true, false]), &Terms::linear(2)).unwrap_err();
+    let e = fit(&tab, &[0.0; 2], Some(&[true, false]), &Terms::linear(2)).unwrap_err();
     assert!(matches!(e, FitError::Shape(_)));
 }
 

@@ -127,14 +127,9 @@ fn centred_average_matches_brute_force_on_irregular_times() {
     let x: Vec<f64> = (0..3000).map(|_| rng.gen_range(-1.0..1.0) + 5.0).collect();
     let got = centred_moving_average(&time_s, &x, 100.0).unwrap();
     let want = brute(&time_s, &x, 100.0);
-    for i in 0..x.len() {
-        let err = (got.values[i] - want[i]).abs();
-        assert!(
-            err < TOL,
-            "sample {i}: want {}, got {}, error {err}",
-            want[i],
-            got.values[i]
-        );
+    for (i, (w, g)) in want.iter().zip(&got.values).enumerate() {
+        let err = (g - w).abs();
+        assert!(err < TOL, "sample {i}: want {w}, got {g}, error {err}");
     }
 }
 
@@ -144,8 +139,8 @@ fn centred_average_passes_a_linear_trend_and_marks_edges() {
     let time_s: Vec<f64> = (0..1000).map(|i| i as f64).collect();
     let x: Vec<f64> = time_s.iter().map(|t| 0.25 + 1e-3 * t).collect();
     let s = centred_moving_average(&time_s, &x, 100.0).unwrap();
-    for i in 0..x.len() {
-        assert!((s.values[i] - x[i]).abs() < 1e-12, "sample {i}");
+    for (i, (g, w)) in s.values.iter().zip(&x).enumerate() {
+        assert!((g - w).abs() < 1e-12, "sample {i}: want {w}, got {g}");
     }
     // Full window (t ± 50 s inside 0..999 s) for samples 50..=949.
     let full: Vec<usize> = (0..1000).filter(|&i| s.full_window[i]).collect();
