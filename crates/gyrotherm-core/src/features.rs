@@ -392,7 +392,13 @@ impl FeaturePipeline {
 
     /// The `i`-th newest stored step (0 = newest).
     fn hist_back(&self, i: usize) -> (u64, f64) {
-        let idx = (self.hist_head + HISTORY_STEPS - 1 - i) % HISTORY_STEPS;
+        // hist_head < HISTORY_STEPS and i < HISTORY_STEPS, so one wrap is enough.
+        let back = self.hist_head + HISTORY_STEPS - 1 - i.min(HISTORY_STEPS - 1);
+        let idx = if back >= HISTORY_STEPS {
+            back - HISTORY_STEPS
+        } else {
+            back
+        };
         self.hist[idx]
     }
 
@@ -450,16 +456,31 @@ impl FeaturePipeline {
         }
         // History ring.
         self.hist[self.hist_head] = (k, t);
-        self.hist_head = (self.hist_head + 1) % HISTORY_STEPS;
+        self.hist_head = if self.hist_head + 1 == HISTORY_STEPS {
+            0
+        } else {
+            self.hist_head + 1
+        };
         self.hist_len = (self.hist_len + 1).min(HISTORY_STEPS);
         // Rate: latest stored step at or before k - L, else the oldest stored.
         let mut earlier = self.hist_back(self.hist_len - 1);
         if let Some(target) = k.checked_sub(self.rate_lag_steps) {
-            for i in 1..self.hist_len {
-                let e = self.hist_back(i);
-                if e.0 <= target {
-                    earlier = e;
-                    break;
+            // Without gaps the entry L back is the one (O(1)); else search back.
+            let l = self.rate_lag_steps as usize;
+            let direct = if l < self.hist_len {
+                Some(self.hist_back(l))
+            } else {
+                None
+            };
+            if let Some(e) = direct.filter(|e| e.0 == target) {
+                earlier = e;
+            } else {
+                for i in 1..self.hist_len {
+                    let e = self.hist_back(i);
+                    if e.0 <= target {
+                        earlier = e;
+                        break;
+                    }
                 }
             }
         }
