@@ -46,6 +46,15 @@ impl FeatureTable {
             .copied()
             .collect()
     }
+    /// A per-sample series (e.g. the smoothed gyro output as bias target) picked at the sample
+    /// each step came from, one value per row. None if `series` is shorter than the log the
+    /// table was made from.
+    pub fn at_steps(&self, series: &[f64]) -> Option<Vec<f64>> {
+        self.sample_index
+            .iter()
+            .map(|&i| series.get(i).copied())
+            .collect()
+    }
     /// (min, max) of column `c` over all steps (None when there are no steps).
     pub fn range(&self, c: usize) -> Option<(f64, f64)> {
         let col = self.column(c);

@@ -20,6 +20,7 @@
 use crate::atomic_file::write_bytes_atomically;
 use crate::baseline::{self, Terms};
 use crate::csvlog::TestLog;
+use crate::features::FeatureTable;
 use crate::train::params::LstmParams;
 use crate::train::zscore::ZScore;
 use gyrotherm_core::baseline::BaselineModel;
@@ -142,6 +143,14 @@ pub enum SubModel {
 }
 
 impl SubModel {
+    /// A baseline sub-model from a fit.
+    pub fn from_fit(fit: &baseline::BaselineFit) -> SubModel {
+        SubModel::Baseline {
+            terms: fit.terms.clone(),
+            coefficients: fit.coefficients.clone(),
+        }
+    }
+
     /// The flight evaluator of a baseline sub-model (None for an LSTM).
     pub fn baseline_core(&self) -> Option<Result<BaselineModel, String>> {
         match self {
@@ -243,6 +252,20 @@ impl Range {
     pub fn contains(&self, v: f64) -> bool {
         v >= self.min && v <= self.max
     }
+}
+
+/// Training temperature range (feature 0, °C) and rate range (feature 1, °C/s) over the
+/// steps of `tables` (None if there are no steps).
+pub fn training_ranges(tables: &[&FeatureTable]) -> Option<(Range, Range)> {
+    let mut t = Vec::new();
+    let mut r = Vec::new();
+    for tab in tables {
+        if tab.n_features >= 2 {
+            t.extend(tab.column(0));
+            r.extend(tab.column(1));
+        }
+    }
+    Some((Range::of(&t)?, Range::of(&r)?))
 }
 
 /// How the model was trained.

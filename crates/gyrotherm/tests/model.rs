@@ -315,3 +315,65 @@ fn digest_is_sha256_of_the_documented_bytes() {
     other.temp_c[1] = 20.25;
     assert_ne!(data_digest(&[&log]), data_digest(&[&other]));
 }
+
+#[test]
+fn fitted_baseline_saves_and_flies() {
+    // End to end: features → fit → model file → load → core evaluator, equal to the fit.
+    use gyrotherm::baseline::fit;
+    use gyrotherm::features::extract;
+    use gyrotherm::model::training_ranges;
+    let n = 2000;
+    let time_s: Vec<f64> = (0..n).map(|i| i as f64 * 0.5).collect();
+    let temp_c: Vec<f64> = time_s
+        .iter()
+        .map(|t| 25.0 + 20.0 * (t / 300.0).sin())
+        .collect();
+    let log = TestLog {
+        gyro_dps: vec![0.0; n],
+        time_s,
+        temp_c,
+        ..TestLog::default()
+    };
+    let spec = FeatureSpec::PUBLISHED;
+    let tab = extract(&log, &spec).unwrap();
+    assert_eq!(tab.n_rows(), 1000);
+    // Bias target per sample, picked at the steps: 1e-3 + 1e-5·T (°/s).
+    let per_sample: Vec<f64> = log.temp_c.iter().map(|t| 1e-3 + 1e-5 * t).collect();
+    let y = tab.at_steps(&per_sample).unwrap();
+    assert!(tab.at_steps(&per_sample[..10]).is_none());
+    let f = fit(&tab, &y, None, &Terms::linear(2)).unwrap();
+    let (temp_range_c, rate_range_c_per_s) = training_ranges(&[&tab]).unwrap();
+    assert!(temp_range_c.min >= 5.0 && temp_range_c.max <= 45.0);
+    assert!(rate_range_c_per_s.contains(0.0));
+    let m = ModelFile {
+        format_version: 1,
+        method: Method::Linear,
+        features: FeatureDef::from_spec(&spec),
+        bias: Some(SubModel::from_fit(&f)),
+        scale: None,
+        training: TrainingInfo {
+            temp_range_c,
+            rate_range_c_per_s,
+            data_digest_sha256: data_digest(&[&log]),
+            epochs: None,
+            final_loss: Some(f.rms_residual),
+            seed: None,
+            created_by: gyrotherm::model::created_by(),
+            inputs: vec!["synthetic".into()],
+        },
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("linear.json");
+    m.save(&path).unwrap();
+    let back = ModelFile::load(&path).unwrap();
+    let core = back.bias.unwrap().baseline_core().unwrap().unwrap();
+    for r in 0..tab.n_rows() {
+        let got = core.eval(tab.row(r)).unwrap();
+        assert!((got - f.predict_row(tab.row(r))).abs() < 1e-15, "row {r}");
+        assert!(
+            (got - y[r]).abs() < 1e-12,
+            "row {r}: want {}, got {got}",
+            y[r]
+        );
+    }
+}
