@@ -367,13 +367,12 @@ fn fitted_baseline_saves_and_flies() {
     m.save(&path).unwrap();
     let back = ModelFile::load(&path).unwrap();
     let core = back.bias.unwrap().baseline_core().unwrap().unwrap();
-    for r in 0..tab.n_rows() {
+    for (r, want) in y.iter().enumerate() {
         let got = core.eval(tab.row(r)).unwrap();
         assert!((got - f.predict_row(tab.row(r))).abs() < 1e-15, "row {r}");
         assert!(
-            (got - y[r]).abs() < 1e-12,
-            "row {r}: want {}, got {got}",
-            y[r]
+            (got - want).abs() < 1e-12,
+            "row {r}: want {want}, got {got}"
         );
     }
 }
