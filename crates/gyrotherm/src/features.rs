@@ -1,1 +1,291 @@
-//! TODO: ground-side feature extraction over a whole log (runs the core pipeline).
+//! Ground-side features over a whole log: the flight pipeline
+//! ([`gyrotherm_core::features::FeaturePipeline`]) run sample by sample, so training and
+//! flight see bit-identical numbers; plus the centred moving average used to smooth the bias
+//! target (100 s in He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004).
+
+use crate::csvlog::TestLog;
+use gyrotherm_core::error::InputError;
+pub use gyrotherm_core::features::{
+    FeatureKind, FeaturePipeline, FeatureSpec, LagOutputs, SpecError, MAX_FEATURES, MAX_LAGS,
+};
+
+/// Per-step model inputs of one log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureTable {
+    /// The definition that made them.
+    pub spec: FeatureSpec,
+    /// Features per row (`spec.n_features()`).
+    pub n_features: usize,
+    /// Short name of each feature (`T`, `dT`, `T_ma20`, `T_lag300`, `T-T_lag300`).
+    pub names: Vec<String>,
+    /// Unit of each feature (`°C` or `°C/s`).
+    pub units: Vec<&'static str>,
+    /// Step boundary time `t0 + k·P`, s, per row.
+    pub step_time_s: Vec<f64>,
+    /// Index of the log sample that made each step (its value is held until the next row's).
+    pub sample_index: Vec<usize>,
+    /// Row-major features, `rows.len() == n_rows() · n_features`.
+    pub rows: Vec<f64>,
+}
+
+impl FeatureTable {
+    /// Number of steps.
+    pub fn n_rows(&self) -> usize {
+        self.step_time_s.len()
+    }
+    /// Features of step `r`.
+    pub fn row(&self, r: usize) -> &[f64] {
+        &self.rows[r * self.n_features..(r + 1) * self.n_features]
+    }
+    /// Column `c` over all steps.
+    pub fn column(&self, c: usize) -> Vec<f64> {
+        self.rows
+            .iter()
+            .skip(c)
+            .step_by(self.n_features.max(1))
+            .copied()
+            .collect()
+    }
+    /// A per-sample series (e.g. the smoothed gyro output as bias target) picked at the sample
+    /// each step came from, one value per row. None if `series` is shorter than the log the
+    /// table was made from.
+    pub fn at_steps(&self, series: &[f64]) -> Option<Vec<f64>> {
+        self.sample_index
+            .iter()
+            .map(|&i| series.get(i).copied())
+            .collect()
+    }
+    /// (min, max) of column `c` over all steps (None when there are no steps).
+    pub fn range(&self, c: usize) -> Option<(f64, f64)> {
+        let col = self.column(c);
+        if col.is_empty() {
+            return None;
+        }
+        Some(
+            col.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                }),
+        )
+    }
+    /// For every log sample (of a log with `n_samples` samples), the row whose value it holds:
+    /// the latest step made at or before it. Flight code holds the same way.
+    pub fn row_of_sample(&self, n_samples: usize) -> Vec<usize> {
+        let mut out = Vec::with_capacity(n_samples);
+        let mut r = 0usize;
+        for i in 0..n_samples {
+            while r + 1 < self.sample_index.len() && self.sample_index[r + 1] <= i {
+                r += 1;
+            }
+            out.push(r);
+        }
+        out
+    }
+}
+
+/// Why features could not be made.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FeatureError {
+    /// The spec is unusable.
+    Spec(SpecError),
+    /// Sample `index` (time `time_s`) was refused by the pipeline.
+    Sample {
+        index: usize,
+        time_s: f64,
+        error: InputError,
+    },
+    /// `time_s` and `temp_c` have different lengths.
+    Length { time: usize, temp: usize },
+}
+
+impl std::fmt::Display for FeatureError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FeatureError::Spec(e) => write!(f, "feature definition: {e}"),
+            FeatureError::Sample {
+                index,
+                time_s,
+                error,
+            } => write!(
+                f,
+                "sample {index} (time_s {time_s}): {error}; fix or remove that sample (time must increase, values must be finite)"
+            ),
+            FeatureError::Length { time, temp } => write!(
+                f,
+                "{time} time stamps but {temp} temperatures: the columns must have the same length"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for FeatureError {}
+
+impl From<SpecError> for FeatureError {
+    fn from(e: SpecError) -> Self {
+        FeatureError::Spec(e)
+    }
+}
+
+/// Name and unit of each feature of `spec`.
+pub fn feature_names(spec: &FeatureSpec) -> (Vec<String>, Vec<&'static str>) {
+    let mut names = Vec::new();
+    let mut units = Vec::new();
+    for i in 0..spec.n_features() {
+        let (n, u) = match spec.kind(i) {
+            Some(FeatureKind::Temperature) => ("T".to_owned(), "°C"),
+            Some(FeatureKind::Rate) => ("dT".to_owned(), "°C/s"),
+            Some(FeatureKind::MovingAverage) => (format!("T_ma{}", spec.smoothing_window_s), "°C"),
+            Some(FeatureKind::Lag(j)) => (format!("T_lag{}", spec.lag_tau_s[j as usize]), "°C"),
+            Some(FeatureKind::LagDiff(j)) => {
+                (format!("T-T_lag{}", spec.lag_tau_s[j as usize]), "°C")
+            }
+            None => (format!("x{i}"), ""),
+        };
+        names.push(n);
+        units.push(u);
+    }
+    (names, units)
+}
+
+/// Run the core pipeline over `time_s`/`temp_c` sample by sample.
+pub fn extract_series(
+    time_s: &[f64],
+    temp_c: &[f64],
+    spec: &FeatureSpec,
+) -> Result<FeatureTable, FeatureError> {
+    if time_s.len() != temp_c.len() {
+        return Err(FeatureError::Length {
+            time: time_s.len(),
+            temp: temp_c.len(),
+        });
+    }
+    let mut pipe = FeaturePipeline::new(*spec)?;
+    let nf = spec.n_features();
+    let (names, units) = feature_names(spec);
+    let mut table = FeatureTable {
+        spec: *spec,
+        n_features: nf,
+        names,
+        units,
+        step_time_s: Vec::new(),
+        sample_index: Vec::new(),
+        rows: Vec::new(),
+    };
+    for (i, (&t, &c)) in time_s.iter().zip(temp_c).enumerate() {
+        match pipe.push(t, c) {
+            Ok(Some(step)) => {
+                table.step_time_s.push(step.time_s);
+                table.sample_index.push(i);
+                table.rows.extend_from_slice(step.features.as_slice());
+            }
+            Ok(None) => {}
+            Err(error) => {
+                return Err(FeatureError::Sample {
+                    index: i,
+                    time_s: t,
+                    error,
+                })
+            }
+        }
+    }
+    Ok(table)
+}
+
+/// Run the core pipeline over a whole log.
+pub fn extract(log: &TestLog, spec: &FeatureSpec) -> Result<FeatureTable, FeatureError> {
+    extract_series(&log.time_s, &log.temp_c, spec)
+}
+
+/// A centred moving average and where it had its full window.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Smoothed {
+    /// The smoothed series, one value per input sample.
+    pub values: Vec<f64>,
+    /// True where the whole window `t ± W/2` lay inside the log.
+    pub full_window: Vec<bool>,
+}
+
+/// Centred moving average on the time axis: `y_i` = mean of the `x_j` with
+/// `|t_j - t_i| ≤ h_i` (inclusive, with a 1e-9·W tolerance for time-stamp round-off), where
+/// `h_i = min(W/2, t_i - t_0, t_end - t_i)`: near the ends the window **shrinks symmetrically**
+/// so it stays centred (a linear trend passes through unbiased; the first and last values are
+/// the raw samples). [`Smoothed::full_window`] marks the samples with the whole window, for
+/// callers that prefer to mask the edges out of a loss.
+///
+/// At 1 Hz, `W = 100 s` averages 101 samples (t-50 … t+50). O(N): two pointers over prefix
+/// sums of `x - x_0` (the offset keeps the sums small).
+///
+/// Errors: window not finite and > 0, different lengths, non-finite values, time not
+/// strictly increasing (each message names the sample).
+pub fn centred_moving_average(
+    time_s: &[f64],
+    x: &[f64],
+    window_s: f64,
+) -> Result<Smoothed, String> {
+    if !(window_s.is_finite() && window_s > 0.0) {
+        return Err(format!(
+            "moving-average window {window_s} s: must be finite and > 0"
+        ));
+    }
+    if time_s.len() != x.len() {
+        return Err(format!(
+            "{} time stamps but {} values: the columns must have the same length",
+            time_s.len(),
+            x.len()
+        ));
+    }
+    let n = x.len();
+    if n == 0 {
+        return Ok(Smoothed {
+            values: Vec::new(),
+            full_window: Vec::new(),
+        });
+    }
+    for i in 0..n {
+        if !time_s[i].is_finite() || !x[i].is_finite() {
+            return Err(format!("sample {i}: non-finite time or value"));
+        }
+        if i > 0 && time_s[i] <= time_s[i - 1] {
+            return Err(format!(
+                "sample {i}: time {} s does not increase from {} s",
+                time_s[i],
+                time_s[i - 1]
+            ));
+        }
+    }
+    let x0 = x[0];
+    let mut prefix = Vec::with_capacity(n + 1);
+    prefix.push(0.0);
+    let mut acc = 0.0;
+    for &v in x {
+        acc += v - x0;
+        prefix.push(acc);
+    }
+    let half = window_s / 2.0;
+    let tol = 1e-9 * window_s;
+    let (t_first, t_last) = (time_s[0], time_s[n - 1]);
+    let mut values = Vec::with_capacity(n);
+    let mut full_window = Vec::with_capacity(n);
+    // Window [lo, hi) in indices; both bounds are non-decreasing in i.
+    let (mut lo, mut hi) = (0usize, 0usize);
+    for i in 0..n {
+        let t = time_s[i];
+        let h = half.min(t - t_first).min(t_last - t);
+        while time_s[lo] < t - h - tol {
+            lo += 1;
+        }
+        if hi < i + 1 {
+            hi = i + 1;
+        }
+        while hi < n && time_s[hi] <= t + h + tol {
+            hi += 1;
+        }
+        let count = (hi - lo) as f64;
+        values.push(x0 + (prefix[hi] - prefix[lo]) / count);
+        full_window.push(h >= half);
+    }
+    Ok(Smoothed {
+        values,
+        full_window,
+    })
+}

@@ -1,1 +1,492 @@
-//! TODO: filled in by its issue.
+//! Model files: one JSON file per fitted compensation model.
+//!
+//! ```json
+//! {
+//!   "format_version": 1,
+//!   "method": "linear",
+//!   "features": {"step_period_s": 1.0, "rate_lag_s": 20.0, "smoothing_window_s": 0.0,
+//!                "lag_tau_s": [], "lag_outputs": "diff_from_t"},
+//!   "bias": {"baseline": {"terms": {"n_features": 2, "powers": [[0,0],[1,0],[0,1]]},
+//!                         "coefficients": [0.001, 2e-5, 0.01]}},
+//!   "scale": {"lstm": {"params": {…LstmParams…}, "input_norm": {…}, "target_norm": {…}}},
+//!   "training": {"temp_range_c": {"min": -40.0, "max": 60.0}, …}
+//! }
+//! ```
+//! `bias` predicts the bias B in °/s, `scale` the scale factor K (dimensionless, ≈1) of
+//! `G = (Ĝ - B) / K` (eq. 4 of He et al. 2024); either may be absent. Floats are written in
+//! shortest round-trip form, so save → load is bit-exact. [`ModelFile::load`] checks the
+//! version first, then the fields (unknown fields are refused), then shapes and finiteness.
+
+use crate::atomic_file::write_bytes_atomically;
+use crate::baseline::{self, Terms};
+use crate::csvlog::TestLog;
+use crate::features::FeatureTable;
+use crate::train::params::LstmParams;
+use crate::train::zscore::ZScore;
+use gyrotherm_core::baseline::BaselineModel;
+use gyrotherm_core::features::{FeatureSpec, LagOutputs, MAX_LAGS};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+/// The format version this build writes.
+pub const FORMAT_VERSION: u32 = 1;
+/// The format versions this build reads.
+pub const SUPPORTED_VERSIONS: &[u32] = &[1];
+
+/// How the model was fitted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// LSTM networks (He et al. 2024).
+    Lstm,
+    /// Linear baseline `c0 + c1·T + c2·dT (+ further features)`.
+    Linear,
+    /// Polynomial baseline.
+    Poly,
+}
+
+impl Method {
+    /// The name used in files and on the command line.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Method::Lstm => "lstm",
+            Method::Linear => "linear",
+            Method::Poly => "poly",
+        }
+    }
+}
+
+/// [`LagOutputs`] in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LagOutputsDef {
+    /// Lag outputs y_j.
+    Level,
+    /// T - y_j.
+    DiffFromT,
+    /// Both.
+    Both,
+}
+
+/// The feature definition in the file (the core's [`FeatureSpec`], with the lags as a list).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FeatureDef {
+    /// Model step period, s.
+    pub step_period_s: f64,
+    /// Rate lag, s (dT = (T(t) - T(t - lag)) / lag).
+    pub rate_lag_s: f64,
+    /// Moving-average window of T, s (0: none).
+    pub smoothing_window_s: f64,
+    /// Thermal-state lag time constants, s.
+    pub lag_tau_s: Vec<f64>,
+    /// Which lag outputs are features.
+    pub lag_outputs: LagOutputsDef,
+}
+
+impl FeatureDef {
+    /// The file form of `spec`.
+    pub fn from_spec(spec: &FeatureSpec) -> FeatureDef {
+        FeatureDef {
+            step_period_s: spec.step_period_s,
+            rate_lag_s: spec.rate_lag_s,
+            smoothing_window_s: spec.smoothing_window_s,
+            lag_tau_s: spec.lags().to_vec(),
+            lag_outputs: match spec.lag_outputs {
+                LagOutputs::Level => LagOutputsDef::Level,
+                LagOutputs::DiffFromT => LagOutputsDef::DiffFromT,
+                LagOutputs::Both => LagOutputsDef::Both,
+            },
+        }
+    }
+
+    /// The core spec, checked.
+    pub fn to_spec(&self) -> Result<FeatureSpec, String> {
+        if self.lag_tau_s.len() > MAX_LAGS {
+            return Err(format!(
+                "{} lag time constants, at most {MAX_LAGS} supported",
+                self.lag_tau_s.len()
+            ));
+        }
+        let base = FeatureSpec {
+            step_period_s: self.step_period_s,
+            rate_lag_s: self.rate_lag_s,
+            smoothing_window_s: self.smoothing_window_s,
+            ..FeatureSpec::PUBLISHED
+        };
+        let outputs = match self.lag_outputs {
+            LagOutputsDef::Level => LagOutputs::Level,
+            LagOutputsDef::DiffFromT => LagOutputs::DiffFromT,
+            LagOutputsDef::Both => LagOutputs::Both,
+        };
+        base.with_lags(&self.lag_tau_s, outputs)
+            .map_err(|e| e.to_string())
+    }
+}
+
+/// One target's model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum SubModel {
+    /// An LSTM with z-score normalisation of its inputs (one channel per feature) and target.
+    Lstm {
+        params: LstmParams,
+        input_norm: ZScore,
+        target_norm: ZScore,
+    },
+    /// A baseline: Σ coefficients[j] · monomial j of the raw features.
+    Baseline {
+        terms: Terms,
+        coefficients: Vec<f64>,
+    },
+}
+
+impl SubModel {
+    /// A baseline sub-model from a fit.
+    pub fn from_fit(fit: &baseline::BaselineFit) -> SubModel {
+        SubModel::Baseline {
+            terms: fit.terms.clone(),
+            coefficients: fit.coefficients.clone(),
+        }
+    }
+
+    /// The flight evaluator of a baseline sub-model (None for an LSTM).
+    pub fn baseline_core(&self) -> Option<Result<BaselineModel, String>> {
+        match self {
+            SubModel::Baseline {
+                terms,
+                coefficients,
+            } => Some(baseline::to_core(terms, coefficients).map_err(|e| e.to_string())),
+            SubModel::Lstm { .. } => None,
+        }
+    }
+
+    /// Shapes and finiteness for `n_features` inputs; the message names the tensor at fault.
+    pub fn validate(&self, n_features: usize) -> Result<(), String> {
+        match self {
+            SubModel::Lstm {
+                params,
+                input_norm,
+                target_norm,
+            } => {
+                params.validate()?;
+                if params.input_size != n_features {
+                    return Err(format!(
+                        "params.input_size is {} but the feature definition gives {n_features} features",
+                        params.input_size
+                    ));
+                }
+                check_norm("input_norm", input_norm, n_features)?;
+                check_norm("target_norm", target_norm, 1)
+            }
+            SubModel::Baseline {
+                terms,
+                coefficients,
+            } => {
+                terms.validate().map_err(|e| format!("terms: {e}"))?;
+                if terms.n_features != n_features {
+                    return Err(format!(
+                        "terms.n_features is {} but the feature definition gives {n_features} features",
+                        terms.n_features
+                    ));
+                }
+                if coefficients.len() != terms.len() {
+                    return Err(format!(
+                        "coefficients has {} values for {} terms",
+                        coefficients.len(),
+                        terms.len()
+                    ));
+                }
+                if let Some(k) = coefficients.iter().position(|c| !c.is_finite()) {
+                    return Err(format!("coefficients[{k}] is not finite"));
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+fn check_norm(name: &str, z: &ZScore, channels: usize) -> Result<(), String> {
+    if z.mean.len() != channels || z.std.len() != channels {
+        return Err(format!(
+            "{name} has {} means and {} stds, expected {channels} each",
+            z.mean.len(),
+            z.std.len()
+        ));
+    }
+    if let Some(k) = z.mean.iter().position(|v| !v.is_finite()) {
+        return Err(format!("{name}.mean[{k}] is not finite"));
+    }
+    if let Some(k) = z.std.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+        return Err(format!(
+            "{name}.std[{k}] is {}: must be finite and > 0",
+            z.std[k]
+        ));
+    }
+    Ok(())
+}
+
+/// A closed range.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
+}
+
+impl Range {
+    /// (min, max) of `x` (None if empty).
+    pub fn of(x: &[f64]) -> Option<Range> {
+        if x.is_empty() {
+            return None;
+        }
+        let (min, max) = x
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        Some(Range { min, max })
+    }
+    /// True when `v` lies inside.
+    pub fn contains(&self, v: f64) -> bool {
+        v >= self.min && v <= self.max
+    }
+}
+
+/// Training temperature range (feature 0, °C) and rate range (feature 1, °C/s) over the
+/// steps of `tables` (None if there are no steps).
+pub fn training_ranges(tables: &[&FeatureTable]) -> Option<(Range, Range)> {
+    let mut t = Vec::new();
+    let mut r = Vec::new();
+    for tab in tables {
+        if tab.n_features >= 2 {
+            t.extend(tab.column(0));
+            r.extend(tab.column(1));
+        }
+    }
+    Some((Range::of(&t)?, Range::of(&r)?))
+}
+
+/// How the model was trained.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainingInfo {
+    /// Temperature range seen in training, °C.
+    pub temp_range_c: Range,
+    /// Temperature-rate (dT) range seen in training, °C/s.
+    pub rate_range_c_per_s: Range,
+    /// SHA-256 (lower-case hex) of the training inputs, see [`data_digest`].
+    pub data_digest_sha256: String,
+    /// Training epochs (None for a least-squares fit).
+    #[serde(default)]
+    pub epochs: Option<u64>,
+    /// Final training loss (normalised MSE for LSTMs; RMS residual for baselines).
+    #[serde(default)]
+    pub final_loss: Option<f64>,
+    /// Random seed (None when nothing was random).
+    #[serde(default)]
+    pub seed: Option<u64>,
+    /// Program and version that wrote the file, e.g. `gyrotherm 0.1.0`.
+    pub created_by: String,
+    /// Names of the training input files.
+    pub inputs: Vec<String>,
+}
+
+/// A model file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// [`FORMAT_VERSION`].
+    pub format_version: u32,
+    /// How it was fitted.
+    pub method: Method,
+    /// The model inputs.
+    pub features: FeatureDef,
+    /// Bias model, output °/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias: Option<SubModel>,
+    /// Scale-factor model, output dimensionless (K ≈ 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<SubModel>,
+    /// Training facts.
+    pub training: TrainingInfo,
+}
+
+/// A model file that cannot be read or written: the file and what is wrong.
+#[derive(Debug)]
+pub struct ModelError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+impl std::fmt::Display for ModelError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.path.display(), self.message)
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+/// `gyrotherm <version>`, for [`TrainingInfo::created_by`].
+pub fn created_by() -> String {
+    format!("gyrotherm {}", env!("CARGO_PKG_VERSION"))
+}
+
+/// SHA-256 hex of `bytes`.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    let d = Sha256::digest(bytes);
+    d.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Digest of training logs: SHA-256 over, per log in order, the sample count (u64 LE), then
+/// `time_s`, `gyro_dps`, `temp_c` as f64 LE bytes, then a table flag byte and `table_dps` if
+/// present. Pass-through columns are not included. Same numbers, same digest.
+pub fn data_digest(logs: &[&TestLog]) -> String {
+    let mut h = Sha256::new();
+    for log in logs {
+        h.update((log.len() as u64).to_le_bytes());
+        for col in [&log.time_s, &log.gyro_dps, &log.temp_c] {
+            for v in col.iter() {
+                h.update(v.to_le_bytes());
+            }
+        }
+        match &log.table_dps {
+            Some(t) => {
+                h.update([1u8]);
+                for v in t {
+                    h.update(v.to_le_bytes());
+                }
+            }
+            None => h.update([0u8]),
+        }
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+impl ModelFile {
+    /// The core feature spec of this model.
+    pub fn feature_spec(&self) -> Result<FeatureSpec, String> {
+        self.features.to_spec()
+    }
+
+    /// Check everything [`load`](Self::load) checks after parsing; the message names the field.
+    pub fn validate(&self) -> Result<(), String> {
+        if !SUPPORTED_VERSIONS.contains(&self.format_version) {
+            return Err(unsupported(self.format_version));
+        }
+        let spec = self
+            .features
+            .to_spec()
+            .map_err(|e| format!("features: {e}"))?;
+        let nf = spec.n_features();
+        if self.bias.is_none() && self.scale.is_none() {
+            return Err("neither a bias nor a scale model: nothing to compensate".to_owned());
+        }
+        for (name, sub) in [("bias", &self.bias), ("scale", &self.scale)] {
+            let Some(sub) = sub else { continue };
+            if matches!(self.method, Method::Linear | Method::Poly)
+                && matches!(sub, SubModel::Lstm { .. })
+            {
+                return Err(format!(
+                    "{name}: an lstm sub-model in a model whose method is {}",
+                    self.method.as_str()
+                ));
+            }
+            sub.validate(nf).map_err(|e| format!("{name}: {e}"))?;
+        }
+        let t = &self.training;
+        for (name, r) in [
+            ("temp_range_c", t.temp_range_c),
+            ("rate_range_c_per_s", t.rate_range_c_per_s),
+        ] {
+            if !(r.min.is_finite() && r.max.is_finite() && r.min <= r.max) {
+                return Err(format!(
+                    "training.{name}: min {} and max {} must be finite with min ≤ max",
+                    r.min, r.max
+                ));
+            }
+        }
+        let d = &t.data_digest_sha256;
+        if d.len() != 64 || !d.bytes().all(|b| b.is_ascii_hexdigit()) {
+            return Err(format!(
+                "training.data_digest_sha256 {d:?} is not 64 hexadecimal digits"
+            ));
+        }
+        if let Some(l) = t.final_loss {
+            if !l.is_finite() {
+                return Err(format!("training.final_loss is {l}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The JSON text (pretty, shortest round-trip floats), after [`validate`](Self::validate).
+    pub fn to_json(&self) -> Result<String, String> {
+        self.validate()?;
+        serde_json::to_string_pretty(self).map_err(|e| e.to_string())
+    }
+
+    /// Parse and check JSON text.
+    pub fn from_json(text: &str) -> Result<ModelFile, String> {
+        // Version first, so that a newer file gets "unsupported version", not a field error.
+        let v: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format!("not valid JSON: {e}"))?;
+        match v.get("format_version") {
+            None => return Err("missing field `format_version`".to_owned()),
+            Some(fv) => match fv.as_u64() {
+                Some(n) if SUPPORTED_VERSIONS.contains(&(n as u32)) && n <= u32::MAX as u64 => {}
+                _ => return Err(unsupported_value(fv)),
+            },
+        }
+        let m: ModelFile = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Write to `path` atomically (temporary file + rename), after validating.
+    pub fn save(&self, path: &Path) -> Result<(), ModelError> {
+        let err = |message: String| ModelError {
+            path: path.to_path_buf(),
+            message,
+        };
+        let mut text = self.to_json().map_err(|e| err(format!("not saved: {e}")))?;
+        text.push('\n');
+        write_bytes_atomically(path, text.as_bytes()).map_err(|e| err(e.to_string()))
+    }
+
+    /// Read and check a model file.
+    pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
+        let err = |message: String| ModelError {
+            path: path.to_path_buf(),
+            message,
+        };
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| err(format!("cannot read model file: {e}")))?;
+        Self::from_json(&text).map_err(err)
+    }
+}
+
+fn supported_list() -> String {
+    SUPPORTED_VERSIONS
+        .iter()
+        .map(|v| v.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn unsupported(v: u32) -> String {
+    format!(
+        "unsupported format_version {v}: this gyrotherm ({}) reads version {}; use a matching gyrotherm or re-train",
+        env!("CARGO_PKG_VERSION"),
+        supported_list()
+    )
+}
+
+fn unsupported_value(v: &serde_json::Value) -> String {
+    format!(
+        "unsupported format_version {v}: this gyrotherm ({}) reads version {}; use a matching gyrotherm or re-train",
+        env!("CARGO_PKG_VERSION"),
+        supported_list()
+    )
+}
