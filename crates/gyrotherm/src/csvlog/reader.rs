@@ -58,7 +58,7 @@ struct Columns {
 
 /// The CSV side: parses and validates one record at a time (numbers, field count, time order).
 struct Source<R> {
-    csv: csv::Reader<R>,
+    csv: csv::Reader<Tail<R>>,
     path: PathBuf,
     headers: Vec<String>,
     header_line: u64,
@@ -133,7 +133,13 @@ impl<R: Read> LogReader<R> {
             .flexible(true)
             .comment(Some(b'#'))
             .buffer_capacity(64 * 1024)
-            .from_reader(reader);
+            .from_reader(Tail {
+                inner: reader,
+                total: 0,
+                last: b'\n',
+                crlf: false,
+                crlf_known: false,
+            });
         let mut header = ByteRecord::new();
         let got = csv
             .read_byte_record(&mut header)
@@ -148,7 +154,7 @@ impl<R: Read> LogReader<R> {
                  the columns, e.g. time_s,gyro_dps,temp_c",
             ));
         }
-        let header_line = header.position().map_or(1, |p| p.line());
+        let header_line = record_line(&csv, &header);
         let header_end_byte = csv.position().byte();
         let mut headers = Vec::with_capacity(header.len());
         for (i, raw) in header.iter().enumerate() {
@@ -322,7 +328,7 @@ impl<R: Read> LogReader<R> {
             std::mem::swap(&mut self.record, &mut rec);
             return Ok(Some((s, line)));
         }
-        self.src.read(&mut self.record)
+        self.src.read(&mut self.record).map_err(|e| *e)
     }
 
     /// Read ahead to estimate the period (unless given) and check there is data at all.
@@ -336,7 +342,7 @@ impl<R: Read> LogReader<R> {
         };
         while self.pending.len() < want {
             let mut rec = ByteRecord::with_capacity(64, self.src.headers.len());
-            match self.src.read(&mut rec)? {
+            match self.src.read(&mut rec).map_err(|e| *e)? {
                 Some((s, line)) => self.pending.push_back((rec, s, line)),
                 None => break,
             }
@@ -475,17 +481,17 @@ impl<R: Read> LogReader<R> {
 impl<R: Read> Source<R> {
     /// Read and check one data row into `rec`.
     #[inline]
-    fn read(&mut self, rec: &mut ByteRecord) -> Result<Option<(Sample, u64)>, LogError> {
+    fn read(&mut self, rec: &mut ByteRecord) -> Result<Option<(Sample, u64)>, Box<LogError>> {
         let more = self
             .csv
             .read_byte_record(rec)
-            .map_err(|e| csv_error(&self.path, e))?;
+            .map_err(|e| Box::new(csv_error(&self.path, e)))?;
         if !more {
             return Ok(None);
         }
-        let line = rec.position().map_or(0, |p| p.line());
+        let line = record_line(&self.csv, rec);
         if rec.len() != self.headers.len() {
-            return Err(self.field_count_error(rec.len(), line));
+            return Err(Box::new(self.field_count_error(rec.len(), line)));
         }
         let time_s = self.number(rec, self.cols.time, line)?;
         let gyro_dps = self.number(rec, self.cols.gyro, line)? * self.gyro_scale;
@@ -497,7 +503,7 @@ impl<R: Read> Source<R> {
         if let Some((t0, line0)) = self.last {
             // Written so that it holds for the common case; NaN cannot occur (checked above).
             if time_s <= t0 {
-                return Err(self.order_error(time_s, t0, line, line0));
+                return Err(Box::new(self.order_error(time_s, t0, line, line0)));
             }
         }
         self.last = Some((time_s, line));
@@ -513,11 +519,11 @@ impl<R: Read> Source<R> {
         )))
     }
 
-    #[inline]
-    fn number(&self, rec: &ByteRecord, i: usize, line: u64) -> Result<f64, LogError> {
+    #[inline(always)]
+    fn number(&self, rec: &ByteRecord, i: usize, line: u64) -> Result<f64, Box<LogError>> {
         match parse_f64(&rec[i]) {
             Some(v) if v.is_finite() => Ok(v),
-            _ => Err(self.number_error(&rec[i], i, line)),
+            _ => Err(Box::new(self.number_error(&rec[i], i, line))),
         }
     }
 
@@ -617,11 +623,115 @@ impl<R: Read> Source<R> {
 }
 
 /// Parse a numeric field: ASCII spaces around it allowed, Rust float syntax (which also
-/// accepts `NaN` and `inf`; the caller rejects those).
-#[inline]
+/// accepts `NaN` and `inf`; the caller rejects those). Gives the same f64 as `str::parse`.
+#[inline(always)]
 pub(crate) fn parse_f64(raw: &[u8]) -> Option<f64> {
+    match parse_plain_decimal(raw) {
+        Some(v) => Some(v),
+        None => parse_f64_std(raw),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn parse_f64_std(raw: &[u8]) -> Option<f64> {
     let t = raw.trim_ascii();
     std::str::from_utf8(t).ok()?.parse().ok()
+}
+
+/// Exact powers of ten representable in f64 (10^22 is the largest, Clinger 1990).
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// Fast path for the usual log field `[+-]digits[.digits]`: when the digits form an integer
+/// `m ≤ 2^53` and there are at most 22 decimals, `m` and `10^d` are exact f64 values and one
+/// IEEE division rounds `m / 10^d` correctly, so the result equals `str::parse`'s (Clinger's
+/// fast path: W. D. Clinger, "How to read floating point numbers accurately", PLDI 1990).
+/// Anything else (exponent, spaces, 20+ digits, NaN, inf) gives None.
+#[inline(always)]
+pub(crate) fn parse_plain_decimal(s: &[u8]) -> Option<f64> {
+    let (neg, s) = match s.first() {
+        Some(b'-') => (true, &s[1..]),
+        Some(b'+') => (false, &s[1..]),
+        _ => (false, s),
+    };
+    let mut m: u64 = 0;
+    let mut i = 0;
+    while i < s.len() && s[i].is_ascii_digit() {
+        m = m.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
+        i += 1;
+    }
+    let int_digits = i;
+    let mut frac_digits = 0;
+    if i < s.len() && s[i] == b'.' {
+        i += 1;
+        let start = i;
+        while i < s.len() && s[i].is_ascii_digit() {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
+            i += 1;
+        }
+        frac_digits = i - start;
+    }
+    let digits = int_digits + frac_digits;
+    // 19 digits cannot overflow u64, so `m` is exact when digits <= 19.
+    if i != s.len() || digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
+        return None;
+    }
+    let v = m as f64 / POW10[frac_digits];
+    Some(if neg { -v } else { v })
+}
+
+/// 1-based physical line where `rec`, just read, starts.
+///
+/// The csv crate stamps a record with the position where reading began, which is before
+/// any comment or blank lines it skipped (and, in a CRLF file, before the previous line's
+/// LF). So count back from the line after the record: less the newlines inside quoted
+/// fields, less one for the record's own LF terminator (a CRLF record ends at its CR, and
+/// the last record of a file may have no terminator).
+#[inline]
+fn record_line<R: Read>(csv: &csv::Reader<Tail<R>>, rec: &ByteRecord) -> u64 {
+    let start = rec.position().map_or(1, |p| p.line());
+    let pos = csv.position();
+    let end = pos.line();
+    let tail = csv.get_ref();
+    let unterminated = pos.byte() == tail.total && tail.last != b'\n';
+    let terminator = u64::from(!unterminated && !tail.crlf);
+    if end <= start + terminator {
+        return start;
+    }
+    let inside = rec.as_slice().iter().filter(|&&b| b == b'\n').count() as u64;
+    end.saturating_sub(inside + terminator).max(start)
+}
+
+/// The input, remembering how many bytes were read, the last one (to tell whether the
+/// last record ended with a newline) and whether lines end in CRLF (judged by the first
+/// line; a file mixing LF and CRLF lines may get line numbers off by one in errors).
+struct Tail<R> {
+    inner: R,
+    total: u64,
+    last: u8,
+    crlf: bool,
+    crlf_known: bool,
+}
+
+impl<R: Read> Read for Tail<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        if n > 0 {
+            if !self.crlf_known {
+                if let Some(k) = buf[..n].iter().position(|&b| b == b'\n') {
+                    let before = if k > 0 { buf[k - 1] } else { self.last };
+                    self.crlf = before == b'\r';
+                    self.crlf_known = true;
+                }
+            }
+            self.total += n as u64;
+            self.last = buf[n - 1];
+        }
+        Ok(n)
+    }
 }
 
 #[inline]
@@ -773,4 +883,46 @@ fn missing_column(
         message.push_str(" (the first line looks like data: add a header row such as time_s,gyro_dps,temp_c)");
     }
     LogError::new(Kind::MissingColumn, path, Some(line), Some(name), message)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The fast path must agree bit for bit with `str::parse` (the independent reference).
+    fn same_as_std(s: &str) {
+        let want: Option<f64> = s.trim_ascii().parse().ok();
+        let got = parse_f64(s.as_bytes());
+        assert_eq!(
+            got.map(f64::to_bits),
+            want.map(f64::to_bits),
+            "{s:?}: want {want:?} got {got:?}"
+        );
+    }
+
+    #[test]
+    fn decimal_parse_edge_cases() {
+        for s in [
+            "0", "-0", "+0", "1.", ".5", ".", "-", "", " 1.5 ", "12345.000", "0.0012345678901",
+            "23.4375", "9007199254740993", "9007199254740992", "0.1", "1e5", "nan", "inf",
+            "-infinity", "1,5", "00000000000000000001.5", "1.00000000000000000000001",
+            "123456789012345678901234", "4.9e-324", "1.7976931348623157e308", "0x10", "1_0",
+        ] {
+            same_as_std(s);
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn decimal_parse_matches_std(s in "[+-]?[0-9]{0,20}(\\.[0-9]{0,25})?") {
+            same_as_std(&s);
+        }
+
+        #[test]
+        fn decimal_parse_of_printed_f64_round_trips(v in any::<f64>().prop_filter("finite", |v| v.is_finite()), d in 0usize..17) {
+            same_as_std(&format!("{v}"));
+            same_as_std(&format!("{v:.d$}"));
+        }
+    }
 }
