@@ -15,7 +15,12 @@ use gyrotherm::csvlog::{read_log, LogReader, ReadOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    match args.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+    match args
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>()
+        .as_slice()
+    {
         ["gen", path, rows, rest @ ..] => gen(Path::new(path), rows.parse()?, rest == ["--table"]),
         ["read", path] => read(Path::new(path)),
         ["stream", path] => stream(Path::new(path)),
@@ -54,10 +59,25 @@ fn gen(path: &Path, rows: u64, table: bool) -> Result<(), Box<dyn std::error::Er
     Ok(())
 }
 
-fn report(what: &str, path: &Path, rows: usize, secs: f64) -> Result<(), Box<dyn std::error::Error>> {
+fn report(
+    what: &str,
+    path: &Path,
+    rows: usize,
+    secs: f64,
+    cpu0: Option<f64>,
+) -> Result<(), Box<dyn std::error::Error>> {
     let bytes = std::fs::metadata(path)?.len() as f64;
+    let cpu = match (cpu0, cpu_s()) {
+        (Some(a), Some(b)) => format!(
+            "; on-CPU {:.3} s = {:.0} MB/s",
+            b - a,
+            bytes / 1e6 / (b - a)
+        ),
+        _ => String::new(),
+    };
     println!(
-        "{what}: {rows} rows, {:.1} MB in {secs:.3} s = {:.0} MB/s, {:.2} M rows/s; peak RSS {}",
+        "{what}: {rows} rows, {:.1} MB in {secs:.3} s wall = {:.0} MB/s, {:.2} M rows/s{cpu}; \
+         peak RSS {}",
         bytes / 1e6,
         bytes / 1e6 / secs,
         rows as f64 / 1e6 / secs,
@@ -66,14 +86,24 @@ fn report(what: &str, path: &Path, rows: usize, secs: f64) -> Result<(), Box<dyn
     Ok(())
 }
 
+/// Time this (single-threaded) process has spent on a CPU, s: the first field of
+/// `/proc/self/schedstat` (ns). Unlike wall time it excludes waiting for a busy machine.
+fn cpu_s() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
+}
+
 fn read(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let cpu0 = cpu_s();
     let t0 = Instant::now();
     let (log, _) = read_log(path, &ReadOptions::default())?;
     let secs = t0.elapsed().as_secs_f64();
-    report("read_log", path, log.len(), secs)
+    report("read_log", path, log.len(), secs, cpu0)
 }
 
 fn stream(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let cpu0 = cpu_s();
     let t0 = Instant::now();
     let file = std::fs::File::open(path)?;
     let mut rdr = LogReader::new(file, path, &ReadOptions::default())?;
@@ -84,7 +114,7 @@ fn stream(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     }
     let secs = t0.elapsed().as_secs_f64();
     std::hint::black_box(sum);
-    report("LogReader", path, n, secs)
+    report("LogReader", path, n, secs, cpu0)
 }
 
 /// `VmHWM` (peak resident set) from `/proc/self/status`.

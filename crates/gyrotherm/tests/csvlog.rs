@@ -60,7 +60,10 @@ fn rows_1hz(n: usize) -> String {
 
 #[test]
 fn reads_standard_columns() {
-    let (log, report) = ok("time_s,gyro_dps,temp_c\n0,0.5,20\n1,0.25,20.0625\n", &default());
+    let (log, report) = ok(
+        "time_s,gyro_dps,temp_c\n0,0.5,20\n1,0.25,20.0625\n",
+        &default(),
+    );
     assert_eq!(log.time_s, [0.0, 1.0]);
     assert_eq!(log.gyro_dps, [0.5, 0.25]);
     assert_eq!(log.temp_c, [20.0, 20.0625]);
@@ -116,7 +119,8 @@ fn write_log_refuses_bad_logs() {
 
 #[test]
 fn comments_anywhere_and_line_numbers_count_them() {
-    let text = "# chamber run 2\n# unit 7\ntime_s,gyro_dps,temp_c\n0,0,20\n# paused\n1,0,20\n2,0,x\n";
+    let text =
+        "# chamber run 2\n# unit 7\ntime_s,gyro_dps,temp_c\n0,0,20\n# paused\n1,0,20\n2,0,x\n";
     let (log, _) = ok(&text.replace("2,0,x\n", ""), &default());
     assert_eq!(log.len(), 2);
     // The bad row is the 7th physical line.
@@ -151,7 +155,9 @@ fn gyro_unit_conversion() {
         gyro_unit: GyroUnit::RadPerS,
         ..default()
     };
-    let g = ok(&format!("time_s,gyro_dps,temp_c\n0,{pi},20\n"), &rad).0.gyro_dps;
+    let g = ok(&format!("time_s,gyro_dps,temp_c\n0,{pi},20\n"), &rad)
+        .0
+        .gyro_dps;
     const TOL_DPS: f64 = 1e-12; // one multiplication's rounding on 180
     assert!((g[0] - 180.0).abs() < TOL_DPS, "want 180 got {}", g[0]);
     assert_eq!("rad/s".parse::<GyroUnit>(), Ok(GyroUnit::RadPerS));
@@ -209,7 +215,10 @@ fn missing_required_column_lists_columns_and_flag() {
         Some("gyro_dps"),
         "required column not found",
     );
-    assert!(e.message.contains("\"time_s\", \"rate\", \"temp_c\""), "{e}");
+    assert!(
+        e.message.contains("\"time_s\", \"rate\", \"temp_c\""),
+        "{e}"
+    );
     assert!(e.message.contains("--gyro-col NAME"), "{e}");
     for (col, flag) in [("time_s", "--time-col"), ("temp_c", "--temp-col")] {
         let header = "time_s,gyro_dps,temp_c".replace(col, "x");
@@ -403,9 +412,21 @@ fn gap_filling_interpolates_and_counts() {
         let i = 11 + k;
         let want_gyro = 0.4 * (t - 10.0) / 4.0;
         let want_temp = 20.0 + 4.0 * (t - 10.0) / 4.0;
-        assert!((log.time_s[i] - t).abs() < TOL, "t: want {t} got {}", log.time_s[i]);
-        assert!((log.gyro_dps[i] - want_gyro).abs() < TOL, "gyro at {t}: want {want_gyro} got {}", log.gyro_dps[i]);
-        assert!((log.temp_c[i] - want_temp).abs() < TOL, "temp at {t}: want {want_temp} got {}", log.temp_c[i]);
+        assert!(
+            (log.time_s[i] - t).abs() < TOL,
+            "t: want {t} got {}",
+            log.time_s[i]
+        );
+        assert!(
+            (log.gyro_dps[i] - want_gyro).abs() < TOL,
+            "gyro at {t}: want {want_gyro} got {}",
+            log.gyro_dps[i]
+        );
+        assert!(
+            (log.temp_c[i] - want_temp).abs() < TOL,
+            "temp at {t}: want {want_temp} got {}",
+            log.temp_c[i]
+        );
         // Table holds the previous value; pass-through fields are empty.
         assert_eq!(log.table_dps.as_ref().unwrap()[i], 5.0);
         assert_eq!(log.extra[0].values[i], "");
@@ -478,7 +499,11 @@ fn bad_options_are_refused() {
 fn missing_file_is_an_io_error_naming_it() {
     let e = read_log(Path::new("/nonexistent/run9.csv"), &default()).unwrap_err();
     assert_eq!(e.kind, LogErrorKind::Io);
-    assert!(e.to_string().starts_with("/nonexistent/run9.csv: cannot open"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("/nonexistent/run9.csv: cannot open"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -494,7 +519,12 @@ fn streaming_reader_gives_samples_and_raw_fields() {
     let mut got = Vec::new();
     while let Some(s) = rdr.next_sample().unwrap() {
         let id = rdr.extra_fields().next().unwrap().to_vec();
-        got.push((s.time_s, rdr.is_filled(), String::from_utf8(id).unwrap(), rdr.line()));
+        got.push((
+            s.time_s,
+            rdr.is_filled(),
+            String::from_utf8(id).unwrap(),
+            rdr.line(),
+        ));
     }
     let want = [
         (0.0, false, "a", 3),
@@ -502,11 +532,19 @@ fn streaming_reader_gives_samples_and_raw_fields() {
         (2.0, true, "", 4),
         (3.0, false, "c", 5),
     ];
-    let want: Vec<_> = want.iter().map(|(t, f, s, l)| (*t, *f, s.to_string(), *l as u64)).collect();
+    let want: Vec<_> = want
+        .iter()
+        .map(|(t, f, s, l)| (*t, *f, s.to_string(), *l as u64))
+        .collect();
     assert_eq!(got, want);
     assert_eq!(rdr.report().filled_samples, 1);
-    let e = LogReader::new("x\n".as_bytes(), "<stdin>", &default()).err().unwrap();
-    assert!(e.to_string().starts_with("<stdin>:1: column time_s:"), "{e}");
+    let e = LogReader::new("x\n".as_bytes(), "<stdin>", &default())
+        .err()
+        .unwrap();
+    assert!(
+        e.to_string().starts_with("<stdin>:1: column time_s:"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -589,9 +627,15 @@ fn line_numbers_after_comments_blank_lines_and_quoted_newlines() {
         ("time_s,gyro_dps,temp_c\n0,0,20\n# c\nx,0,20\n", 4),
         ("time_s,gyro_dps,temp_c\n0,0,20\n\n\n1,0,y\n", 5),
         ("time_s,gyro_dps,temp_c,n\n0,0,20,\"a\nb\"\n1,0,z,q\n", 4),
-        ("time_s,gyro_dps,temp_c,n\n0,0,20,q\n# c\n1,0,w,\"a\nb\"\n", 4),
+        (
+            "time_s,gyro_dps,temp_c,n\n0,0,20,q\n# c\n1,0,w,\"a\nb\"\n",
+            4,
+        ),
         ("time_s,gyro_dps,temp_c\n0,0,20\n# c\n1,0,v", 4),
-        ("time_s,gyro_dps,temp_c\r\n0,0,20\r\n# c\r\n1,0,u\r\n2,0,0\r\n", 4),
+        (
+            "time_s,gyro_dps,temp_c\r\n0,0,20\r\n# c\r\n1,0,u\r\n2,0,0\r\n",
+            4,
+        ),
         ("time_s,gyro_dps,temp_c\r\n0,0,20\r\n# c\r\n\r\n1,0,t", 5),
         ("# a\r\n# b\r\ntime_s,gyro_dps,temp_c\r\n0,0,s\r\n", 4),
     ];

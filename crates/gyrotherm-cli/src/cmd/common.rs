@@ -135,7 +135,11 @@ mod tests {
         .unwrap();
         let o = cli.log.read_options();
         assert_eq!(
-            (o.time_col.as_str(), o.gyro_col.as_str(), o.temp_col.as_str()),
+            (
+                o.time_col.as_str(),
+                o.gyro_col.as_str(),
+                o.temp_col.as_str()
+            ),
             ("t", "w", "T")
         );
         assert_eq!(o.table_col, "rt");

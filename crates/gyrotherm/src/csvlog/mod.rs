@@ -21,9 +21,7 @@ pub mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
-pub use reader::{
-    LogReader, Sample, GAP_FACTOR, MAX_FILL_SAMPLES_PER_GAP, PERIOD_ESTIMATE_STEPS,
-};
+pub use reader::{LogReader, Sample, GAP_FACTOR, MAX_FILL_SAMPLES_PER_GAP, PERIOD_ESTIMATE_STEPS};
 pub use writer::{format_f64, LogWriter};
 
 use std::fs::File;
@@ -172,7 +170,13 @@ pub struct ReadReport {
 /// from the file length and the bytes per row of the first rows.
 pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport), LogError> {
     let file = File::open(path).map_err(|e| {
-        LogError::new(LogErrorKind::Io, path, None, None, format!("cannot open: {e}"))
+        LogError::new(
+            LogErrorKind::Io,
+            path,
+            None,
+            None,
+            format!("cannot open: {e}"),
+        )
     })?;
     let file_len = file.metadata().map(|m| m.len()).unwrap_or(0);
     let mut rdr = LogReader::new(file, path, opts)?;
@@ -252,7 +256,13 @@ pub fn write_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
         out.flush()
     })
     .map_err(|e| {
-        LogError::new(LogErrorKind::Io, path, None, None, format!("cannot write: {e}"))
+        LogError::new(
+            LogErrorKind::Io,
+            path,
+            None,
+            None,
+            format!("cannot write: {e}"),
+        )
     })
 }
 
@@ -279,7 +289,11 @@ fn check_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
         if let Some(i) = v.iter().position(|x| !x.is_finite()) {
             return Err(bad(
                 Some(name),
-                format!("row {} holds {}, not a finite number; not written", i + 1, v[i]),
+                format!(
+                    "row {} holds {}, not a finite number; not written",
+                    i + 1,
+                    v[i]
+                ),
             ));
         }
     }

@@ -559,14 +559,21 @@ impl<R: Read> Source<R> {
                 ),
             )
         };
-        LogError::new(kind, &self.path, Some(line), Some(&self.headers[i]), message)
+        LogError::new(
+            kind,
+            &self.path,
+            Some(line),
+            Some(&self.headers[i]),
+            message,
+        )
     }
 
     #[cold]
     fn field_count_error(&mut self, found: usize, line: u64) -> LogError {
         let want = self.headers.len();
         // A short row followed by nothing is a file cut mid-write.
-        let is_last = found < want && matches!(self.csv.read_byte_record(&mut self.peek), Ok(false));
+        let is_last =
+            found < want && matches!(self.csv.read_byte_record(&mut self.peek), Ok(false));
         if is_last {
             LogError::new(
                 Kind::TruncatedLine,
@@ -658,20 +665,12 @@ pub(crate) fn parse_plain_decimal(s: &[u8]) -> Option<f64> {
         _ => (false, s),
     };
     let mut m: u64 = 0;
-    let mut i = 0;
-    while i < s.len() && s[i].is_ascii_digit() {
-        m = m.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
-        i += 1;
-    }
+    let mut i = digits(s, 0, &mut m);
     let int_digits = i;
     let mut frac_digits = 0;
     if i < s.len() && s[i] == b'.' {
-        i += 1;
-        let start = i;
-        while i < s.len() && s[i].is_ascii_digit() {
-            m = m.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
-            i += 1;
-        }
+        let start = i + 1;
+        i = digits(s, start, &mut m);
         frac_digits = i - start;
     }
     let digits = int_digits + frac_digits;
@@ -732,6 +731,43 @@ impl<R: Read> Read for Tail<R> {
         }
         Ok(n)
     }
+}
+
+/// Accumulate the decimal digits of `s` from `i` into `m` (wrapping; the caller bounds the
+/// count), eight at a time where it can; returns the index after the last digit.
+#[inline(always)]
+fn digits(s: &[u8], mut i: usize, m: &mut u64) -> usize {
+    while let Some(chunk) = s.get(i..i + 8) {
+        let mut word = [0u8; 8];
+        word.copy_from_slice(chunk);
+        let v = u64::from_le_bytes(word);
+        // All eight bytes in b'0'..=b'9' (SWAR test as in simdjson / fast_float).
+        let all_digits = (v.wrapping_add(0x4646_4646_4646_4646)
+            | v.wrapping_sub(0x3030_3030_3030_3030))
+            & 0x8080_8080_8080_8080
+            == 0;
+        if !all_digits {
+            break;
+        }
+        *m = m.wrapping_mul(100_000_000).wrapping_add(eight_digits(v));
+        i += 8;
+    }
+    while i < s.len() && s[i].is_ascii_digit() {
+        *m = m.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
+        i += 1;
+    }
+    i
+}
+
+/// Value of eight ASCII digits packed little-endian in `v` (first digit in the low byte).
+#[inline(always)]
+fn eight_digits(v: u64) -> u64 {
+    const MASK: u64 = 0x0000_00FF_0000_00FF;
+    const MUL1: u64 = 0x000F_4240_0000_0064; // 100 + (1_000_000 << 32)
+    const MUL2: u64 = 0x0000_2710_0000_0001; // 1 + (10_000 << 32)
+    let v = v.wrapping_sub(0x3030_3030_3030_3030);
+    let v = v.wrapping_mul(10).wrapping_add(v >> 8);
+    (((v & MASK).wrapping_mul(MUL1)).wrapping_add(((v >> 16) & MASK).wrapping_mul(MUL2))) >> 32
 }
 
 #[inline]
@@ -802,8 +838,7 @@ fn map_columns(
         Ok(first)
     };
     let require = |name: &str, flag: &str, what: &str| -> Result<usize, LogError> {
-        find(name, flag, what)?
-            .ok_or_else(|| missing_column(path, line, headers, name, flag, what))
+        find(name, flag, what)?.ok_or_else(|| missing_column(path, line, headers, name, flag, what))
     };
     let time = require(&opts.time_col, "--time-col", "time")?;
     let gyro = require(&opts.gyro_col, "--gyro-col", "gyro")?;
@@ -880,7 +915,9 @@ fn missing_column(
         }
     }
     if !headers.is_empty() && headers.iter().all(|h| parse_f64(h.as_bytes()).is_some()) {
-        message.push_str(" (the first line looks like data: add a header row such as time_s,gyro_dps,temp_c)");
+        message.push_str(
+            " (the first line looks like data: add a header row such as time_s,gyro_dps,temp_c)",
+        );
     }
     LogError::new(Kind::MissingColumn, path, Some(line), Some(name), message)
 }
@@ -904,10 +941,33 @@ mod tests {
     #[test]
     fn decimal_parse_edge_cases() {
         for s in [
-            "0", "-0", "+0", "1.", ".5", ".", "-", "", " 1.5 ", "12345.000", "0.0012345678901",
-            "23.4375", "9007199254740993", "9007199254740992", "0.1", "1e5", "nan", "inf",
-            "-infinity", "1,5", "00000000000000000001.5", "1.00000000000000000000001",
-            "123456789012345678901234", "4.9e-324", "1.7976931348623157e308", "0x10", "1_0",
+            "0",
+            "-0",
+            "+0",
+            "1.",
+            ".5",
+            ".",
+            "-",
+            "",
+            " 1.5 ",
+            "12345.000",
+            "0.0012345678901",
+            "23.4375",
+            "9007199254740993",
+            "9007199254740992",
+            "0.1",
+            "1e5",
+            "nan",
+            "inf",
+            "-infinity",
+            "1,5",
+            "00000000000000000001.5",
+            "1.00000000000000000000001",
+            "123456789012345678901234",
+            "4.9e-324",
+            "1.7976931348623157e308",
+            "0x10",
+            "1_0",
         ] {
             same_as_std(s);
         }
