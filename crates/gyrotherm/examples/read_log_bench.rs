@@ -4,6 +4,7 @@
 //! read_log_bench gen PATH ROWS [--table]   write a realistic 100 Hz log
 //! read_log_bench read PATH                 read_log into a TestLog: MB/s, peak RSS
 //! read_log_bench stream PATH               LogReader only (nothing kept): MB/s, peak RSS
+//! read_log_bench copy PATH > OUT           LogReader -> LogWriter, like `compensate --stream`
 //! ```
 //! Driven by `bench/read_log.sh`. Peak RSS is `VmHWM` of `/proc/self/status` (Linux).
 
@@ -11,7 +12,7 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use gyrotherm::csvlog::{read_log, LogReader, ReadOptions};
+use gyrotherm::csvlog::{read_log, LogReader, LogWriter, ReadOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -24,6 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ["gen", path, rows, rest @ ..] => gen(Path::new(path), rows.parse()?, rest == ["--table"]),
         ["read", path] => read(Path::new(path)),
         ["stream", path] => stream(Path::new(path)),
+        ["copy", path] => copy(Path::new(path)),
         _ => Err("usage: read_log_bench gen PATH ROWS [--table] | read PATH | stream PATH".into()),
     }
 }
@@ -115,6 +117,38 @@ fn stream(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let secs = t0.elapsed().as_secs_f64();
     std::hint::black_box(sum);
     report("LogReader", path, n, secs, cpu0)
+}
+
+/// Read and write every sample back out with its pass-through fields plus one computed
+/// column: the per-line work of `compensate --stream` without the model.
+fn copy(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let cpu0 = cpu_s();
+    let t0 = Instant::now();
+    let file = std::fs::File::open(path)?;
+    let mut rdr = LogReader::new(file, path, &ReadOptions::default())?;
+    let mut header = vec!["time_s", "gyro_dps", "temp_c", "corrected_dps"];
+    header.extend(rdr.extra_names().collect::<Vec<_>>());
+    let header: Vec<String> = header.iter().map(|s| s.to_string()).collect();
+    let mut out = LogWriter::new(std::io::stdout().lock(), &header)?;
+    let mut n = 0usize;
+    while let Some(s) = rdr.next_sample()? {
+        out.push_f64(s.time_s);
+        out.push_f64(s.gyro_dps);
+        out.push_f64(s.temp_c);
+        out.push_f64(s.gyro_dps - 0.0012);
+        out.push_extras(rdr.extra_fields());
+        out.end_row()?;
+        n += 1;
+    }
+    out.flush()?;
+    let secs = t0.elapsed().as_secs_f64();
+    eprintln!(
+        "copy: {n} lines in {secs:.3} s wall = {:.2} M lines/s; on-CPU {:.2} M lines/s",
+        n as f64 / 1e6 / secs,
+        cpu0.zip(cpu_s())
+            .map_or(f64::NAN, |(a, b)| n as f64 / 1e6 / (b - a))
+    );
+    Ok(())
 }
 
 /// `VmHWM` (peak resident set) from `/proc/self/status`.

@@ -117,6 +117,14 @@ impl<W: Write> LogWriter<W> {
         }
     }
 
+    /// Append pass-through fields, e.g. [`LogReader::extra_fields`](super::LogReader::extra_fields).
+    #[inline]
+    pub fn push_extras<'a>(&mut self, fields: impl IntoIterator<Item = &'a [u8]>) {
+        for f in fields {
+            self.push_raw(f);
+        }
+    }
+
     /// End the row. A row with another number of fields than the header is dropped and
     /// reported as `InvalidInput`.
     #[inline]
