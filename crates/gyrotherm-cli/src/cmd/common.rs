@@ -149,6 +149,23 @@ mod tests {
     }
 
     #[test]
+    fn read_log_reporting_fills_gaps_and_names_the_file_on_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("gap.csv");
+        // 1 Hz, one sample missing at t = 2.
+        std::fs::write(&path, "time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n").unwrap();
+        let cli = Cli::try_parse_from(["t", "--fill-gaps", "2"]).unwrap();
+        let log = read_log_reporting(&path, &cli.log).unwrap();
+        assert_eq!(log.time_s, [0.0, 1.0, 2.0, 3.0]);
+        let cli = Cli::try_parse_from(["t"]).unwrap();
+        let err = format!("{:#}", read_log_reporting(&path, &cli.log).unwrap_err());
+        assert!(
+            err.contains("gap.csv:4: column time_s: gap of 2 s"),
+            "{err}"
+        );
+    }
+
+    #[test]
     fn bad_values_are_refused() {
         assert!(Cli::try_parse_from(["t", "--gyro-unit", "mrad"]).is_err());
         assert!(Cli::try_parse_from(["t", "--fill-gaps", "-1"]).is_err());

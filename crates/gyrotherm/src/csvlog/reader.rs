@@ -4,8 +4,8 @@
 //! costs no allocation per row; pass-through fields are handed out as raw bytes of that record.
 //!
 //! # Nominal sample period and gaps
-//! The nominal period is the median of the first [`PERIOD_ESTIMATE_STEPS`] time steps (fewer
-//! if the log is shorter), unless [`ReadOptions::sample_period_s`] gives it. The median ignores
+//! The nominal period is the median (the lower middle value for an even count) of the first
+//! [`PERIOD_ESTIMATE_STEPS`] time steps (fewer if the log is shorter), unless [`ReadOptions::sample_period_s`] gives it. The median ignores
 //! a few gaps or jittered stamps among those steps. To know it before the first sample goes
 //! out, the reader reads up to `PERIOD_ESTIMATE_STEPS + 1` rows ahead at the start (a live
 //! 1 Hz stream therefore starts answering after 100 s unless the period is given).
@@ -369,12 +369,9 @@ impl<R: Read> LogReader<R> {
                 .collect();
             if !steps.is_empty() {
                 steps.sort_by(f64::total_cmp);
-                let m = steps.len() / 2;
-                let median = if steps.len() % 2 == 1 {
-                    steps[m]
-                } else {
-                    0.5 * (steps[m - 1] + steps[m])
-                };
+                // Lower median: for an even count the smaller middle step, so that gaps
+                // (long steps) never raise the period (3 rows with steps 1 s, 2 s: 1 s).
+                let median = steps[(steps.len() - 1) / 2];
                 self.period_s = Some(median);
                 self.report.sample_period_estimated = true;
             }
