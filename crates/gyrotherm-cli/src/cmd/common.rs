@@ -1,1 +1,174 @@
 //! Options shared by every command that reads a test log (column mapping, units, gaps).
+//!
+//! Flatten into a command's arguments with `#[command(flatten)] log: LogArgs`.
+
+use std::path::Path;
+
+use anyhow::Context as _;
+use clap::{Args, ValueEnum};
+use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
+
+/// How to read test logs: which columns hold what, the gyro unit, the gap policy.
+#[derive(Debug, Clone, Args)]
+pub struct LogArgs {
+    /// Header of the time column (seconds).
+    #[arg(long, value_name = "NAME", default_value = csvlog::TIME_COL)]
+    pub time_col: String,
+    /// Header of the gyro-output column (unit: --gyro-unit).
+    #[arg(long, value_name = "NAME", default_value = csvlog::GYRO_COL)]
+    pub gyro_col: String,
+    /// Header of the temperature column (°C).
+    #[arg(long, value_name = "NAME", default_value = csvlog::TEMP_COL)]
+    pub temp_col: String,
+    /// Header of the rate-table column (°/s); optional unless renamed here.
+    #[arg(long, value_name = "NAME", default_value = csvlog::DEFAULT_TABLE_COL)]
+    pub table_col: String,
+    /// Unit of the gyro column; converted to °/s on reading.
+    #[arg(long, value_enum, value_name = "UNIT", default_value_t = GyroUnitArg::Dps)]
+    pub gyro_unit: GyroUnitArg,
+    /// Interpolate gaps (steps over 1.5 sample periods) up to MAX_S seconds long, instead of
+    /// stopping with an error.
+    #[arg(long, value_name = "MAX_S", value_parser = positive_seconds)]
+    pub fill_gaps: Option<f64>,
+    /// Nominal sample period in seconds (default: median of the first 100 time steps).
+    #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
+    pub sample_period: Option<f64>,
+}
+
+/// `--gyro-unit` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GyroUnitArg {
+    /// degrees per second
+    Dps,
+    /// degrees per hour
+    Dph,
+    /// radians per second
+    #[value(name = "rad/s")]
+    RadPerS,
+}
+
+impl From<GyroUnitArg> for GyroUnit {
+    fn from(u: GyroUnitArg) -> Self {
+        match u {
+            GyroUnitArg::Dps => GyroUnit::Dps,
+            GyroUnitArg::Dph => GyroUnit::Dph,
+            GyroUnitArg::RadPerS => GyroUnit::RadPerS,
+        }
+    }
+}
+
+#[allow(dead_code)]
+impl LogArgs {
+    /// The library's read options for these arguments.
+    pub fn read_options(&self) -> ReadOptions {
+        ReadOptions {
+            time_col: self.time_col.clone(),
+            gyro_col: self.gyro_col.clone(),
+            temp_col: self.temp_col.clone(),
+            table_col: self.table_col.clone(),
+            gyro_unit: self.gyro_unit.into(),
+            fill_gaps_max_s: self.fill_gaps,
+            sample_period_s: self.sample_period,
+        }
+    }
+}
+
+/// Read a log with these options; say on stderr how many samples gap filling made.
+#[allow(dead_code)]
+pub fn read_log_reporting(path: &Path, args: &LogArgs) -> anyhow::Result<TestLog> {
+    let (log, report) = csvlog::read_log(path, &args.read_options())
+        .with_context(|| format!("cannot use log {}", path.display()))?;
+    if report.filled_gaps > 0 {
+        eprintln!(
+            "gyrotherm: {}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps)",
+            path.display(),
+            report.filled_gaps,
+            report.filled_samples
+        );
+    }
+    Ok(log)
+}
+
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a positive number of seconds")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Cli {
+        #[command(flatten)]
+        log: LogArgs,
+    }
+
+    #[test]
+    fn defaults_are_the_standard_names() {
+        let cli = Cli::try_parse_from(["t"]).unwrap();
+        assert_eq!(cli.log.read_options(), ReadOptions::default());
+    }
+
+    #[test]
+    fn flags_map_to_read_options() {
+        let cli = Cli::try_parse_from([
+            "t",
+            "--time-col",
+            "t",
+            "--gyro-col",
+            "w",
+            "--temp-col",
+            "T",
+            "--table-col",
+            "rt",
+            "--gyro-unit",
+            "rad/s",
+            "--fill-gaps",
+            "5",
+            "--sample-period",
+            "0.01",
+        ])
+        .unwrap();
+        let o = cli.log.read_options();
+        assert_eq!(
+            (
+                o.time_col.as_str(),
+                o.gyro_col.as_str(),
+                o.temp_col.as_str()
+            ),
+            ("t", "w", "T")
+        );
+        assert_eq!(o.table_col, "rt");
+        assert_eq!(o.gyro_unit, GyroUnit::RadPerS);
+        assert_eq!(o.fill_gaps_max_s, Some(5.0));
+        assert_eq!(o.sample_period_s, Some(0.01));
+    }
+
+    #[test]
+    fn read_log_reporting_fills_gaps_and_names_the_file_on_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("gap.csv");
+        // 1 Hz, one sample missing at t = 2.
+        std::fs::write(&path, "time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n").unwrap();
+        let cli = Cli::try_parse_from(["t", "--fill-gaps", "2"]).unwrap();
+        let log = read_log_reporting(&path, &cli.log).unwrap();
+        assert_eq!(log.time_s, [0.0, 1.0, 2.0, 3.0]);
+        let cli = Cli::try_parse_from(["t"]).unwrap();
+        let err = format!("{:#}", read_log_reporting(&path, &cli.log).unwrap_err());
+        assert!(
+            err.contains("gap.csv:4: column time_s: gap of 2 s"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn bad_values_are_refused() {
+        assert!(Cli::try_parse_from(["t", "--gyro-unit", "mrad"]).is_err());
+        assert!(Cli::try_parse_from(["t", "--fill-gaps", "-1"]).is_err());
+        assert!(Cli::try_parse_from(["t", "--fill-gaps", "nan"]).is_err());
+    }
+}

@@ -1,0 +1,315 @@
+//! The test-log CSV format, read and written by every command.
+//!
+//! A header row, then one row per sample. Required columns `time_s` (s), `gyro_dps` (°/s),
+//! `temp_c` (°C); optional `table_dps` (rate-table input rate, °/s; absent means a static
+//! test). Every other column is kept and passed through as raw text. Lines starting with `#`
+//! are comments, before the header too. Fields are comma-separated; numbers may carry spaces
+//! around them. [`ReadOptions`] maps other header names and converts the gyro unit.
+//!
+//! - [`read_log`]: a whole file into a [`TestLog`] (columns of f64), validated.
+//! - [`LogReader`]: the same checks, one [`Sample`] at a time, for streams of any length.
+//! - [`write_log`] / [`LogWriter`]: the same layout back out, numbers round-trip exact.
+//!
+//! Checks (each a [`LogError`] naming file, 1-based physical line, column and the fix, see
+//! [`LogErrorKind`]): missing columns, non-numeric or non-finite fields, empty file, short
+//! or long rows (a short last row is a truncated file), time not strictly increasing,
+//! duplicate timestamps, and gaps longer than [`GAP_FACTOR`] nominal sample periods (the
+//! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`reader`]).
+
+mod error;
+pub mod reader;
+mod writer;
+
+pub use error::{LogError, LogErrorKind};
+pub use reader::{LogReader, Sample, GAP_FACTOR, MAX_FILL_SAMPLES_PER_GAP, PERIOD_ESTIMATE_STEPS};
+pub use writer::{format_f64, LogWriter};
+
+use std::fs::File;
+use std::path::Path;
+
+/// Standard column names.
+pub const TIME_COL: &str = "time_s";
+/// Gyro output, °/s.
+pub const GYRO_COL: &str = "gyro_dps";
+/// Temperature, °C.
+pub const TEMP_COL: &str = "temp_c";
+/// Rate-table input rate, °/s (optional).
+pub const DEFAULT_TABLE_COL: &str = "table_dps";
+
+/// Names of the simulator's truth columns (written with `simulate --truth`).
+pub const TRUE_BIAS_COL: &str = "true_bias_dps";
+/// True scale factor K (dimensionless, 1.0 nominal) in Ĝ = B + K·G.
+pub const TRUE_SCALE_COL: &str = "true_scale";
+/// Noise-only part of the gyro output, °/s.
+pub const NOISE_COL: &str = "noise_dps";
+
+/// One test log in memory. `gyro_dps` is always in °/s, whatever the file's unit.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TestLog {
+    /// Time, s, strictly increasing.
+    pub time_s: Vec<f64>,
+    /// Gyro output, °/s.
+    pub gyro_dps: Vec<f64>,
+    /// Temperature, °C.
+    pub temp_c: Vec<f64>,
+    /// Rate-table input rate, °/s (None: static test).
+    pub table_dps: Option<Vec<f64>>,
+    /// Other columns, passed through to outputs unchanged (raw text of each field).
+    pub extra: Vec<ExtraColumn>,
+}
+
+/// A pass-through column.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ExtraColumn {
+    pub name: String,
+    pub values: Vec<String>,
+}
+
+impl TestLog {
+    pub fn len(&self) -> usize {
+        self.time_s.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.time_s.is_empty()
+    }
+    /// Median of the time steps, s (NaN for fewer than two samples).
+    pub fn sample_period_s(&self) -> f64 {
+        let mut d: Vec<f64> = self.time_s.windows(2).map(|w| w[1] - w[0]).collect();
+        if d.is_empty() {
+            return f64::NAN;
+        }
+        d.sort_by(f64::total_cmp);
+        d[d.len() / 2]
+    }
+    /// A pass-through column parsed as numbers (None if absent or not all numeric).
+    pub fn extra_f64(&self, name: &str) -> Option<Vec<f64>> {
+        let col = self.extra.iter().find(|c| c.name == name)?;
+        col.values.iter().map(|v| v.trim().parse().ok()).collect()
+    }
+}
+
+/// Unit of the gyro column in the file; converted to °/s on read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GyroUnit {
+    /// °/s
+    #[default]
+    Dps,
+    /// °/h (1 °/h = 1/3600 °/s)
+    Dph,
+    /// rad/s (1 rad/s = 180/π °/s)
+    RadPerS,
+}
+
+impl std::str::FromStr for GyroUnit {
+    type Err = String;
+    /// `dps`, `dph` or `rad/s`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "dps" => Ok(GyroUnit::Dps),
+            "dph" => Ok(GyroUnit::Dph),
+            "rad/s" => Ok(GyroUnit::RadPerS),
+            _ => Err(format!(
+                "unknown gyro unit {s:?}; use dps (°/s), dph (°/h) or rad/s"
+            )),
+        }
+    }
+}
+
+/// How to read a log: column names, unit, gap policy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReadOptions {
+    /// Header of the time column (s).
+    pub time_col: String,
+    /// Header of the gyro column (unit: `gyro_unit`).
+    pub gyro_col: String,
+    /// Header of the temperature column (°C).
+    pub temp_col: String,
+    /// Header of the table-rate column (°/s). Optional when left at `table_dps`; a column
+    /// mapped to another name must exist.
+    pub table_col: String,
+    /// Unit of the gyro column.
+    pub gyro_unit: GyroUnit,
+    /// Interpolate gaps up to this many seconds (None: a gap is an error). A gap's length is
+    /// the time between the real samples on either side of it.
+    pub fill_gaps_max_s: Option<f64>,
+    /// Nominal sample period, s (None: median of the first [`PERIOD_ESTIMATE_STEPS`] steps,
+    /// which the streaming reader reads ahead before its first sample).
+    pub sample_period_s: Option<f64>,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            time_col: TIME_COL.into(),
+            gyro_col: GYRO_COL.into(),
+            temp_col: TEMP_COL.into(),
+            table_col: DEFAULT_TABLE_COL.into(),
+            gyro_unit: GyroUnit::Dps,
+            fill_gaps_max_s: None,
+            sample_period_s: None,
+        }
+    }
+}
+
+/// What reading did besides returning data.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ReadReport {
+    /// Samples made by gap filling.
+    pub filled_samples: usize,
+    /// Gaps filled.
+    pub filled_gaps: usize,
+    /// Data rows read from the file (final once reading has ended).
+    pub rows: u64,
+    /// Nominal sample period used for the gap check, s (None: fewer than two rows).
+    pub sample_period_s: Option<f64>,
+    /// Whether that period was estimated from the data (false: given in the options).
+    pub sample_period_estimated: bool,
+}
+
+/// Read and validate a whole log. The file is read once, streaming; the columns are sized
+/// from the file length and the bytes per row of the first rows.
+pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport), LogError> {
+    let file = File::open(path).map_err(|e| {
+        LogError::new(
+            LogErrorKind::Io,
+            path,
+            None,
+            None,
+            format!("cannot open: {e}"),
+        )
+    })?;
+    let file_len = file.metadata().map(|m| m.len()).unwrap_or(0);
+    let mut rdr = LogReader::new(file, path, opts)?;
+    let mut log = TestLog::default();
+    let mut table: Vec<f64> = Vec::new();
+    let mut extra: Vec<Vec<String>> = vec![Vec::new(); rdr.extra_count()];
+    let mut sized = false;
+    while let Some(s) = rdr.next_sample()? {
+        if !sized {
+            sized = true;
+            // Rows = file length / bytes per row, +1 % for longer rows later on.
+            let rows = rdr
+                .bytes_per_row()
+                .filter(|b| *b > 0.0)
+                .map_or(0, |b| (file_len as f64 / b * 1.01) as usize + 16)
+                .min(usize::MAX / 64);
+            log.time_s.reserve_exact(rows);
+            log.gyro_dps.reserve_exact(rows);
+            log.temp_c.reserve_exact(rows);
+            if rdr.has_table() {
+                table.reserve_exact(rows);
+            }
+            for col in &mut extra {
+                col.reserve_exact(rows);
+            }
+        }
+        log.time_s.push(s.time_s);
+        log.gyro_dps.push(s.gyro_dps);
+        log.temp_c.push(s.temp_c);
+        if let Some(t) = s.table_dps {
+            table.push(t);
+        }
+        for (k, col) in extra.iter_mut().enumerate() {
+            col.push(rdr.extra_text(k)?.to_owned());
+        }
+    }
+    if rdr.has_table() {
+        log.table_dps = Some(table);
+    }
+    log.extra = rdr
+        .extra_names()
+        .zip(extra)
+        .map(|(name, values)| ExtraColumn {
+            name: name.to_owned(),
+            values,
+        })
+        .collect();
+    Ok((log, rdr.report().clone()))
+}
+
+/// Write a log as CSV (`time_s,gyro_dps,temp_c[,table_dps],extra...`), atomically (a
+/// temporary file renamed into place). Numbers round-trip exactly: [`read_log`] of the
+/// file gives back an equal [`TestLog`] (for a valid log: at least one row, time strictly
+/// increasing without gaps). Refuses columns of unequal length, non-finite values and
+/// extra columns named like a standard one.
+pub fn write_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
+    check_log(path, log)?;
+    crate::atomic_file::write_atomically(path, |w| -> std::io::Result<()> {
+        let mut header = vec![TIME_COL, GYRO_COL, TEMP_COL];
+        if log.table_dps.is_some() {
+            header.push(DEFAULT_TABLE_COL);
+        }
+        header.extend(log.extra.iter().map(|c| c.name.as_str()));
+        let mut out = LogWriter::new(w, header)?;
+        for i in 0..log.len() {
+            out.push_f64(log.time_s[i]);
+            out.push_f64(log.gyro_dps[i]);
+            out.push_f64(log.temp_c[i]);
+            if let Some(t) = &log.table_dps {
+                out.push_f64(t[i]);
+            }
+            for c in &log.extra {
+                out.push_raw(c.values[i].as_bytes());
+            }
+            out.end_row()?;
+        }
+        out.flush()
+    })
+    .map_err(|e| {
+        LogError::new(
+            LogErrorKind::Io,
+            path,
+            None,
+            None,
+            format!("cannot write: {e}"),
+        )
+    })
+}
+
+fn check_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
+    let bad = |column: Option<&str>, message: String| {
+        LogError::new(LogErrorKind::BadLog, path, None, column, message)
+    };
+    let n = log.len();
+    let mut numeric = vec![
+        (GYRO_COL, &log.gyro_dps),
+        (TEMP_COL, &log.temp_c),
+        (TIME_COL, &log.time_s),
+    ];
+    if let Some(t) = &log.table_dps {
+        numeric.push((DEFAULT_TABLE_COL, t));
+    }
+    for (name, v) in numeric {
+        if v.len() != n {
+            return Err(bad(
+                Some(name),
+                format!("{} values but {n} timestamps; not written", v.len()),
+            ));
+        }
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(bad(
+                Some(name),
+                format!(
+                    "row {} holds {}, not a finite number; not written",
+                    i + 1,
+                    v[i]
+                ),
+            ));
+        }
+    }
+    for c in &log.extra {
+        if c.values.len() != n {
+            return Err(bad(
+                Some(&c.name),
+                format!("{} values but {n} timestamps; not written", c.values.len()),
+            ));
+        }
+        if [TIME_COL, GYRO_COL, TEMP_COL, DEFAULT_TABLE_COL].contains(&c.name.as_str()) {
+            return Err(bad(
+                Some(&c.name),
+                "a pass-through column has a standard column's name; rename it".to_owned(),
+            ));
+        }
+    }
+    Ok(())
+}
