@@ -140,6 +140,15 @@ pub enum SubModel {
         terms: Terms,
         coefficients: Vec<f64>,
     },
+    /// A baseline plus an LSTM fitted to its residual: y = baseline(x) + lstm(x) (a residual
+    /// LSTM on top of a physical fit, issue 5).
+    Residual {
+        terms: Terms,
+        coefficients: Vec<f64>,
+        params: LstmParams,
+        input_norm: ZScore,
+        target_norm: ZScore,
+    },
 }
 
 impl SubModel {
@@ -157,6 +166,11 @@ impl SubModel {
             SubModel::Baseline {
                 terms,
                 coefficients,
+            }
+            | SubModel::Residual {
+                terms,
+                coefficients,
+                ..
             } => Some(baseline::to_core(terms, coefficients).map_err(|e| e.to_string())),
             SubModel::Lstm { .. } => None,
         }
@@ -165,6 +179,25 @@ impl SubModel {
     /// Shapes and finiteness for `n_features` inputs; the message names the tensor at fault.
     pub fn validate(&self, n_features: usize) -> Result<(), String> {
         match self {
+            SubModel::Residual {
+                terms,
+                coefficients,
+                params,
+                input_norm,
+                target_norm,
+            } => {
+                SubModel::Baseline {
+                    terms: terms.clone(),
+                    coefficients: coefficients.clone(),
+                }
+                .validate(n_features)?;
+                SubModel::Lstm {
+                    params: params.clone(),
+                    input_norm: input_norm.clone(),
+                    target_norm: target_norm.clone(),
+                }
+                .validate(n_features)
+            }
             SubModel::Lstm {
                 params,
                 input_norm,
@@ -386,7 +419,7 @@ impl ModelFile {
         for (name, sub) in [("bias", &self.bias), ("scale", &self.scale)] {
             let Some(sub) = sub else { continue };
             if matches!(self.method, Method::Linear | Method::Poly)
-                && matches!(sub, SubModel::Lstm { .. })
+                && matches!(sub, SubModel::Lstm { .. } | SubModel::Residual { .. })
             {
                 return Err(format!(
                     "{name}: an lstm sub-model in a model whose method is {}",
