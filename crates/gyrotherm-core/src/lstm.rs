@@ -293,14 +293,18 @@ pub fn exp(x: f32) -> f32 {
     let n = t - SHIFT;
     let r = (x - n * LN2_HI) - n * LN2_LO;
     let mut p = 1.0 / 5_040.0;
-    for c in [1.0 / 720.0, 1.0 / 120.0, 1.0 / 24.0, 1.0 / 6.0, 0.5, 1.0, 1.0] {
+    for c in [
+        1.0 / 720.0,
+        1.0 / 120.0,
+        1.0 / 24.0,
+        1.0 / 6.0,
+        0.5,
+        1.0,
+        1.0,
+    ] {
         p = p * r + c;
     }
-    let bits = t
-        .to_bits()
-        .wrapping_sub(SHIFT.to_bits())
-        .wrapping_add(127)
-        << 23;
+    let bits = t.to_bits().wrapping_sub(SHIFT.to_bits()).wrapping_add(127) << 23;
     p * f32::from_bits(bits)
 }
 
@@ -336,6 +340,7 @@ pub struct Lstm<const I: usize, const H: usize = 8> {
 
 impl<const I: usize, const H: usize> Lstm<I, H> {
     /// A network with zero state. The weights were checked by their constructor.
+    #[allow(clippy::needless_range_loop)] // a transpose reads clearest with indices
     pub fn new(weights: &LstmWeights<I, H>) -> Self {
         let mut w_x = [[[0.0; H]; GATES]; I];
         let mut w_h = [[[0.0; H]; GATES]; H];
@@ -372,6 +377,7 @@ impl<const I: usize, const H: usize> Lstm<I, H> {
     ///
     /// With finite weights, the state stays finite: |h| ≤ 1 and |c| grows by at most 1 a step.
     #[inline]
+    #[allow(clippy::needless_range_loop)] // const bounds: no checks, and the loops vectorise
     pub fn step(&mut self, x: &[f32; I]) -> Result<f32, InputError> {
         if let Some(k) = x.iter().position(|v| !v.is_finite()) {
             return Err(InputError::NonFinite(Channel::Feature(feature_index(k))));
@@ -426,7 +432,9 @@ impl<const I: usize, const H: usize> Lstm<I, H> {
                     k_max = k;
                 }
             }
-            return Err(InputError::NonFinite(Channel::Feature(feature_index(k_max))));
+            return Err(InputError::NonFinite(Channel::Feature(feature_index(
+                k_max,
+            ))));
         }
         self.h = h;
         self.c = c;
@@ -481,12 +489,17 @@ mod tests {
         const REL_TOL: f64 = 4.0 * f32::EPSILON as f64;
         const SIGMOID_ABS_TOL: f64 = 1e-37;
         const TANH_ABS_TOL: f64 = 3e-7;
-        let (mut w_exp, mut w_sig, mut w_tanh) = ((0.0f64, 0.0f32), (0.0f64, 0.0f32), (0.0f64, 0.0f32));
+        let (mut w_exp, mut w_sig, mut w_tanh) =
+            ((0.0f64, 0.0f32), (0.0f64, 0.0f32), (0.0f64, 0.0f32));
         for k in -87 * 1024..=88 * 1024 {
             let x = k as f32 / 1024.0;
             let want = (x as f64).exp();
             let rel = (exp(x) as f64 - want).abs() / want;
-            assert!(rel <= REL_TOL, "exp({x}): want {want}, got {}, rel {rel:e}", exp(x));
+            assert!(
+                rel <= REL_TOL,
+                "exp({x}): want {want}, got {}, rel {rel:e}",
+                exp(x)
+            );
             if rel > w_exp.0 {
                 w_exp = (rel, x);
             }
@@ -508,7 +521,11 @@ mod tests {
             }
             let want = xd.tanh();
             let err = (tanh(x) as f64 - want).abs();
-            assert!(err <= TANH_ABS_TOL, "tanh({x}): want {want}, got {}, err {err:e}", tanh(x));
+            assert!(
+                err <= TANH_ABS_TOL,
+                "tanh({x}): want {want}, got {}, err {err:e}",
+                tanh(x)
+            );
             if err > w_tanh.0 {
                 w_tanh = (err, x);
             }
@@ -516,7 +533,12 @@ mod tests {
         assert!(exp(f32::NAN).is_nan() && sigmoid(f32::NAN).is_nan());
         std::println!(
             "worst: exp rel {:e} at {}, sigmoid rel {:e} at {}, tanh abs {:e} at {}",
-            w_exp.0, w_exp.1, w_sig.0, w_sig.1, w_tanh.0, w_tanh.1
+            w_exp.0,
+            w_exp.1,
+            w_sig.0,
+            w_sig.1,
+            w_tanh.0,
+            w_tanh.1
         );
     }
 
@@ -558,19 +580,17 @@ mod tests {
 
     #[test]
     fn non_finite_input_leaves_state() {
-        let w: LstmWeights<2, 1> = LstmWeights::from_slices(
-            &[0.1; 8],
-            &[0.2; 4],
-            &[0.0; 4],
-            &[0.0; 4],
-            &[1.0],
-            0.0,
-        )
-        .unwrap();
+        let w: LstmWeights<2, 1> =
+            LstmWeights::from_slices(&[0.1; 8], &[0.2; 4], &[0.0; 4], &[0.0; 4], &[1.0], 0.0)
+                .unwrap();
         let mut net = Lstm::new(&w);
         net.step(&[1.0, 2.0]).unwrap();
         let before = net.clone();
-        for bad in [[f32::NAN, 0.0], [0.0, f32::INFINITY], [0.0, f32::NEG_INFINITY]] {
+        for bad in [
+            [f32::NAN, 0.0],
+            [0.0, f32::INFINITY],
+            [0.0, f32::NEG_INFINITY],
+        ] {
             let k = bad.iter().position(|v| !v.is_finite()).unwrap() as u8;
             assert_eq!(
                 net.step(&bad),
@@ -579,9 +599,15 @@ mod tests {
             assert_eq!(net, before);
         }
         // Finite inputs whose weighted sum overflows: 2·MAX - 2·MAX = inf - inf = NaN.
-        let w: LstmWeights<2, 1> =
-            LstmWeights::from_slices(&[2.0, -2.0].repeat(4), &[0.2; 4], &[0.0; 4], &[0.0; 4], &[1.0], 0.0)
-                .unwrap();
+        let w: LstmWeights<2, 1> = LstmWeights::from_slices(
+            &[2.0, -2.0].repeat(4),
+            &[0.2; 4],
+            &[0.0; 4],
+            &[0.0; 4],
+            &[1.0],
+            0.0,
+        )
+        .unwrap();
         let mut net = Lstm::new(&w);
         net.step(&[1.0, 2.0]).unwrap();
         let before = net.clone();
@@ -596,7 +622,14 @@ mod tests {
 
     #[test]
     fn constructors_refuse_bad_weights() {
-        let e = LstmWeights::<2, 1>::from_slices(&[0.1; 7], &[0.2; 4], &[0.0; 4], &[0.0; 4], &[1.0], 0.0);
+        let e = LstmWeights::<2, 1>::from_slices(
+            &[0.1; 7],
+            &[0.2; 4],
+            &[0.0; 4],
+            &[0.0; 4],
+            &[1.0],
+            0.0,
+        );
         assert_eq!(
             e,
             Err(WeightError::Shape {
@@ -607,7 +640,8 @@ mod tests {
         );
         let mut w_hh = [0.2; 4];
         w_hh[3] = f32::NAN;
-        let e = LstmWeights::<2, 1>::from_slices(&[0.1; 8], &w_hh, &[0.0; 4], &[0.0; 4], &[1.0], 0.0);
+        let e =
+            LstmWeights::<2, 1>::from_slices(&[0.1; 8], &w_hh, &[0.0; 4], &[0.0; 4], &[1.0], 0.0);
         assert_eq!(
             e,
             Err(WeightError::NonFinite {
@@ -615,7 +649,14 @@ mod tests {
                 index: 3
             })
         );
-        let e = LstmWeights::<2, 1>::from_slices(&[0.1; 8], &[0.2; 4], &[0.0; 4], &[0.0; 4], &[1.0], f32::INFINITY);
+        let e = LstmWeights::<2, 1>::from_slices(
+            &[0.1; 8],
+            &[0.2; 4],
+            &[0.0; 4],
+            &[0.0; 4],
+            &[1.0],
+            f32::INFINITY,
+        );
         assert_eq!(
             e,
             Err(WeightError::NonFinite {

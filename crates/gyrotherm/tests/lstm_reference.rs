@@ -93,15 +93,33 @@ fn compare(what: &str, got: &[f64], want: &[f64], tol: f64) -> f64 {
 #[test]
 fn forward_matches_pytorch() {
     let Some(r) = load() else { return };
-    let (i, h) = (r["input_size"].as_u64().unwrap() as usize, r["hidden_size"].as_u64().unwrap() as usize);
+    let (i, h) = (
+        r["input_size"].as_u64().unwrap() as usize,
+        r["hidden_size"].as_u64().unwrap() as usize,
+    );
     let p = params(&r["params"], i, h);
     for case in r["cases"].as_array().unwrap() {
         let name = case["name"].as_str().unwrap();
-        let out = predict_with_state(&p, &flat(&case["x"]), &flat(&case["h0"]), &flat(&case["c0"]))
-            .unwrap();
+        let out = predict_with_state(
+            &p,
+            &flat(&case["x"]),
+            &flat(&case["h0"]),
+            &flat(&case["c0"]),
+        )
+        .unwrap();
         compare(&format!("{name} y"), &out.y, &flat(&case["y"]), OUT_REL_TOL);
-        compare(&format!("{name} h_n"), &out.h_n, &flat(&case["h_n"]), OUT_REL_TOL);
-        compare(&format!("{name} c_n"), &out.c_n, &flat(&case["c_n"]), OUT_REL_TOL);
+        compare(
+            &format!("{name} h_n"),
+            &out.h_n,
+            &flat(&case["h_n"]),
+            OUT_REL_TOL,
+        );
+        compare(
+            &format!("{name} c_n"),
+            &out.c_n,
+            &flat(&case["c_n"]),
+            OUT_REL_TOL,
+        );
     }
 }
 
@@ -112,14 +130,39 @@ fn loss_and_gradients_match_pytorch() {
     let case = &r["cases"][0];
     let (x, target) = (flat(&case["x"]), flat(&case["target"]));
     let (loss, grad) = loss_and_grad(&p, &[Sequence::new(&x, &target)]).unwrap();
-    compare("loss", &[loss], &[case["loss"].as_f64().unwrap()], OUT_REL_TOL);
+    compare(
+        "loss",
+        &[loss],
+        &[case["loss"].as_f64().unwrap()],
+        OUT_REL_TOL,
+    );
     let g = &case["grad"];
-    compare("grad w_ih", &grad.w_ih, &flat(&g["weight_ih"]), GRAD_REL_TOL);
-    compare("grad w_hh", &grad.w_hh, &flat(&g["weight_hh"]), GRAD_REL_TOL);
+    compare(
+        "grad w_ih",
+        &grad.w_ih,
+        &flat(&g["weight_ih"]),
+        GRAD_REL_TOL,
+    );
+    compare(
+        "grad w_hh",
+        &grad.w_hh,
+        &flat(&g["weight_hh"]),
+        GRAD_REL_TOL,
+    );
     compare("grad b_ih", &grad.b_ih, &flat(&g["bias_ih"]), GRAD_REL_TOL);
     compare("grad b_hh", &grad.b_hh, &flat(&g["bias_hh"]), GRAD_REL_TOL);
-    compare("grad w_out", &grad.w_out, &flat(&g["head_weight"]), GRAD_REL_TOL);
-    compare("grad b_out", &[grad.b_out], &flat(&g["head_bias"]), GRAD_REL_TOL);
+    compare(
+        "grad w_out",
+        &grad.w_out,
+        &flat(&g["head_weight"]),
+        GRAD_REL_TOL,
+    );
+    compare(
+        "grad b_out",
+        &[grad.b_out],
+        &flat(&g["head_bias"]),
+        GRAD_REL_TOL,
+    );
 }
 
 #[test]
@@ -143,6 +186,11 @@ fn adam_steps_match_pytorch() {
         adam.step(&mut theta, &flatten(&grad));
         p = gyrotherm::train::unflatten(&theta, 2, 8);
         let want = flatten(&params(&step["params"], 2, 8));
-        compare(&format!("adam step {n} params"), &theta, &want, GRAD_REL_TOL);
+        compare(
+            &format!("adam step {n} params"),
+            &theta,
+            &want,
+            GRAD_REL_TOL,
+        );
     }
 }

@@ -2,8 +2,8 @@
 //! and the exported f32 flight network against the f64 training forward pass.
 
 use gyrotherm::train::{
-    evaluate_mse, init_params, loss_and_grad, predict, train_lstm, train_normalised,
-    train_pair, Bptt, Precision, Sequence, StopReason, TrainConfig, WindowStart,
+    evaluate_mse, init_params, loss_and_grad, predict, train_lstm, train_normalised, train_pair,
+    Bptt, Precision, Sequence, StopReason, TrainConfig, WindowStart,
 };
 use gyrotherm_core::lstm::Lstm;
 
@@ -69,7 +69,10 @@ fn loss_drops_mostly_in_first_100_epochs() {
     assert!(lend < 0.05, "final normalised MSE {lend} not below 0.05");
     // He et al. 2024 (§3, loss curve): most of the drop within the first 100 iterations.
     let share = (l0 - l100) / (l0 - lend);
-    assert!(share > 0.8, "only {share:.3} of the drop in the first 100 epochs (want > 0.8)");
+    assert!(
+        share > 0.8,
+        "only {share:.3} of the drop in the first 100 epochs (want > 0.8)"
+    );
 }
 
 #[test]
@@ -129,8 +132,17 @@ fn same_seed_same_params_bit_for_bit() {
         let a = train_lstm(&runs, &[], 2, &cfg, &mut |_, _| {}).unwrap();
         let b = train_lstm(&runs, &[], 2, &cfg, &mut |_, _| {}).unwrap();
         assert_eq!(a, b, "{precision:?} {bptt:?}: two trainings differ");
-        let c = train_lstm(&runs, &[], 2, &TrainConfig { seed: 43, ..cfg.clone() }, &mut |_, _| {})
-            .unwrap();
+        let c = train_lstm(
+            &runs,
+            &[],
+            2,
+            &TrainConfig {
+                seed: 43,
+                ..cfg.clone()
+            },
+            &mut |_, _| {},
+        )
+        .unwrap();
         assert_ne!(a.params, c.params, "seed has no effect");
         // On two threads, each network exactly as on its own.
         let (pa, pb) = train_pair(
@@ -166,7 +178,11 @@ fn masked_steps_contribute_nothing() {
         n += 1;
     }
     let want = sum / n as f64;
-    assert!((a.0 - want).abs() <= 1e-12 * want, "loss want {want}, got {}", a.0);
+    assert!(
+        (a.0 - want).abs() <= 1e-12 * want,
+        "loss want {want}, got {}",
+        a.0
+    );
 }
 
 #[test]
@@ -185,7 +201,10 @@ fn validation_keeps_best_and_target_loss_stops() {
     let out = train_lstm(&runs, &val, 2, &cfg, &mut |e, l| seen.push((e, l))).unwrap();
     let best = out.best_epoch.unwrap();
     let vh = &out.val_loss_history;
-    assert!(vh.iter().all(|v| *v >= vh[best]), "best epoch {best} is not the minimum of {vh:?}");
+    assert!(
+        vh.iter().all(|v| *v >= vh[best]),
+        "best epoch {best} is not the minimum of {vh:?}"
+    );
     let got = evaluate_mse(&out.params, &val, Precision::F64).unwrap();
     assert_eq!(got, vh[best], "returned params are not the best epoch's");
     assert_eq!(seen.len(), out.loss_history.len());
@@ -199,7 +218,10 @@ fn validation_keeps_best_and_target_loss_stops() {
         ..TrainConfig::default()
     };
     let free = train_lstm(&runs, &[], 2, &cfg, &mut |_, _| {}).unwrap();
-    let target = free.loss_history[..=10].iter().copied().fold(f64::INFINITY, f64::min);
+    let target = free.loss_history[..=10]
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
     let cfg = TrainConfig {
         epochs: 40,
         target_loss: Some(target),
@@ -255,8 +277,16 @@ fn core_f32_matches_training_forward_over_30000_steps() {
         }
     }
     let t = worst.1;
-    println!("max rel err {:e} at step {t} (y {}, rms {rms})", worst.0, want[t]);
-    assert!(worst.0 <= REL_TOL, "step {t}: want {}, rel err {:e}", want[t], worst.0);
+    println!(
+        "max rel err {:e} at step {t} (y {}, rms {rms})",
+        worst.0, want[t]
+    );
+    assert!(
+        worst.0 <= REL_TOL,
+        "step {t}: want {}, rel err {:e}",
+        want[t],
+        worst.0
+    );
 }
 
 #[test]

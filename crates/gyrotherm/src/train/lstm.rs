@@ -25,6 +25,10 @@
 //! 4H gates vectorise: tanh so computed has an absolute error of a few ulps (its relative
 //! error grows near 0, which costs nothing here).
 
+// The const-size kernels index fixed arrays in nested loops on purpose: the bounds are
+// compile-time constants (no checks) and the loops vectorise.
+#![allow(clippy::needless_range_loop)]
+
 use core::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 /// The float type the kernel runs in: f64 (exact enough for the PyTorch test vector) or f32
@@ -97,8 +101,9 @@ impl Real for f32 {
 #[inline(always)]
 pub fn exp_f64(x: f64) -> f64 {
     const LOG2E: f64 = core::f64::consts::LOG2_E;
-    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
-    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+    // fdlibm's split: ln2_hi has 32 trailing zero bits, so n·LN2_HI is exact.
+    const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+    const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
     // 1.5·2^52: adding it rounds to an integer held in the low mantissa bits.
     const SHIFT: f64 = 6_755_399_441_055_744.0;
     let x = x.clamp(-708.0, 709.0);
@@ -141,7 +146,15 @@ pub fn exp_f32(x: f32) -> f32 {
     let n = t - SHIFT;
     let r = (x - n * LN2_HI) - n * LN2_LO;
     let mut p = 1.0 / 5_040.0;
-    for c in [1.0 / 720.0, 1.0 / 120.0, 1.0 / 24.0, 1.0 / 6.0, 0.5, 1.0, 1.0] {
+    for c in [
+        1.0 / 720.0,
+        1.0 / 120.0,
+        1.0 / 24.0,
+        1.0 / 6.0,
+        0.5,
+        1.0,
+        1.0,
+    ] {
         p = p * r + c;
     }
     let bits = t.to_bits().wrapping_sub(SHIFT.to_bits()).wrapping_add(127) << 23;
@@ -241,7 +254,12 @@ impl<T: Real> Packed<T> {
                 self.wh[m * g4 + r] = T::from_f64(w_hh[r * nh + m]);
             }
         }
-        for ((b, bi), bh) in self.b.iter_mut().zip(&theta[lay.b_ih()]).zip(&theta[lay.b_hh()]) {
+        for ((b, bi), bh) in self
+            .b
+            .iter_mut()
+            .zip(&theta[lay.b_ih()])
+            .zip(&theta[lay.b_hh()])
+        {
             *b = T::from_f64(bi + bh);
         }
         for (w, v) in self.w_out.iter_mut().zip(&theta[lay.w_out()]) {
@@ -325,7 +343,14 @@ pub(crate) fn tape_stride(h: usize) -> usize {
 
 /// Forward over `y.len()` steps from state (h0, c0); writes the tape (7H per step) and y.
 /// `x` holds `y.len()·I` inputs, row-major.
-pub(crate) fn forward<T: Real>(p: &Packed<T>, x: &[T], h0: &[T], c0: &[T], tape: &mut [T], y: &mut [T]) {
+pub(crate) fn forward<T: Real>(
+    p: &Packed<T>,
+    x: &[T],
+    h0: &[T],
+    c0: &[T],
+    tape: &mut [T],
+    y: &mut [T],
+) {
     // Constant sizes for the published network let the compiler unroll and vectorise.
     match (p.lay.i, p.lay.h) {
         (2, 8) => forward_const::<T, 2, 8>(p, x, h0, c0, tape, y),
@@ -348,7 +373,12 @@ fn forward_impl<T: Real>(
 ) {
     let g4 = 4 * nh;
     let s = tape_stride(nh);
-    let (b, wx, wh, w_out) = (&p.b[..g4], &p.wx[..g4 * ni], &p.wh[..g4 * nh], &p.w_out[..nh]);
+    let (b, wx, wh, w_out) = (
+        &p.b[..g4],
+        &p.wx[..g4 * ni],
+        &p.wh[..g4 * nh],
+        &p.w_out[..nh],
+    );
     let steps = y.len();
     for t in 0..steps {
         let (before, rest) = tape.split_at_mut(t * s);
@@ -588,7 +618,11 @@ fn forward_const<T: Real, const I: usize, const H: usize>(
     let mut h: [T; H] = array_from(h0);
     let mut c: [T; H] = array_from(c0);
     let s = tape_stride(H);
-    for ((slot, xt), yt) in tape.chunks_exact_mut(s).zip(x.chunks_exact(I)).zip(y.iter_mut()) {
+    for ((slot, xt), yt) in tape
+        .chunks_exact_mut(s)
+        .zip(x.chunks_exact(I))
+        .zip(y.iter_mut())
+    {
         let xt: [T; I] = array_from(xt);
         let mut z = w.b;
         for k in 0..I {
@@ -743,7 +777,11 @@ mod tests {
             let xc = x.clamp(-708.0, 709.0);
             let want = xc.exp();
             let rel = (exp_f64(x) - want).abs() / want;
-            assert!(rel <= 4.0 * f64::EPSILON, "f64 x {x}: want {want}, got {}, rel {rel:e}", exp_f64(x));
+            assert!(
+                rel <= 4.0 * f64::EPSILON,
+                "f64 x {x}: want {want}, got {}, rel {rel:e}",
+                exp_f64(x)
+            );
             if rel > worst.0 {
                 worst = (rel, x);
             }
@@ -754,7 +792,11 @@ mod tests {
             let x = k as f32 / 64.0;
             let want = (x.clamp(-87.0, 88.0) as f64).exp();
             let rel = (exp_f32(x) as f64 - want).abs() / want;
-            assert!(rel <= 4.0 * f32::EPSILON as f64, "f32 x {x}: want {want}, got {}, rel {rel:e}", exp_f32(x));
+            assert!(
+                rel <= 4.0 * f32::EPSILON as f64,
+                "f32 x {x}: want {want}, got {}, rel {rel:e}",
+                exp_f32(x)
+            );
             if rel > worst.0 {
                 worst = (rel, x as f64);
             }

@@ -319,7 +319,11 @@ fn check_problem(
         return err("every validation step is masked out".into());
     }
     let pos = |v: f64| v.is_finite() && v > 0.0;
-    if !pos(cfg.lr) || !pos(cfg.eps) || !(0.0..1.0).contains(&cfg.beta1) || !(0.0..1.0).contains(&cfg.beta2) {
+    if !pos(cfg.lr)
+        || !pos(cfg.eps)
+        || !(0.0..1.0).contains(&cfg.beta1)
+        || !(0.0..1.0).contains(&cfg.beta2)
+    {
         return err(format!(
             "Adam settings out of range: lr {} and eps {} must be > 0, beta1 {} and beta2 {} in [0, 1)",
             cfg.lr, cfg.eps, cfg.beta1, cfg.beta2
@@ -368,11 +372,22 @@ pub fn train_lstm(
 /// as deterministic as [`train_lstm`] alone.
 #[allow(clippy::type_complexity)]
 pub fn train_pair(
-    a: (&[Sequence<'_>], &[Sequence<'_>], &mut (dyn FnMut(usize, f64) + Send)),
-    b: (&[Sequence<'_>], &[Sequence<'_>], &mut (dyn FnMut(usize, f64) + Send)),
+    a: (
+        &[Sequence<'_>],
+        &[Sequence<'_>],
+        &mut (dyn FnMut(usize, f64) + Send),
+    ),
+    b: (
+        &[Sequence<'_>],
+        &[Sequence<'_>],
+        &mut (dyn FnMut(usize, f64) + Send),
+    ),
     input_size: usize,
     cfg: &TrainConfig,
-) -> (Result<TrainOutput, TrainError>, Result<TrainOutput, TrainError>) {
+) -> (
+    Result<TrainOutput, TrainError>,
+    Result<TrainOutput, TrainError>,
+) {
     std::thread::scope(|s| {
         let (runs_b, val_b, prog_b) = b;
         let hb = s.spawn(move || train_lstm(runs_b, val_b, input_size, cfg, prog_b));
@@ -511,7 +526,12 @@ pub fn predict_with_state(
             c0.len()
         ));
     }
-    if let Some(k) = inputs.iter().chain(h0).chain(c0).position(|v| !v.is_finite()) {
+    if let Some(k) = inputs
+        .iter()
+        .chain(h0)
+        .chain(c0)
+        .position(|v| !v.is_finite())
+    {
         return err(format!("input or initial state value {k} is not finite"));
     }
     let steps = inputs.len() / ni;
@@ -623,7 +643,14 @@ impl<T: Real> Kernel<T> {
             let steps = r.steps();
             let s = steps * tape_stride(self.lay.h);
             let tape = &mut self.tape[..s];
-            forward(&self.packed, x, &self.zeros, &self.zeros, tape, &mut self.y[..steps]);
+            forward(
+                &self.packed,
+                x,
+                &self.zeros,
+                &self.zeros,
+                tape,
+                &mut self.y[..steps],
+            );
             for t in 0..steps {
                 self.dy[t] = if r.counts(t) {
                     let e = self.y[t].to_f64() - r.target[t];
@@ -702,11 +729,19 @@ impl<'r, 'a, T: Real> Trainer<'r, 'a, T> {
         }
     }
 
-    fn adam_step(&mut self) {
+    fn adam_step(&mut self) -> Result<(), TrainError> {
         if let Some(max) = self.cfg.clip_grad_norm {
             clip_grad_norm(&mut self.grad, max);
         }
         self.adam.step(&mut self.theta, &self.grad);
+        if self.theta.iter().any(|v| !v.is_finite()) {
+            return err(format!(
+                "training diverged at Adam step {} (non-finite parameters); lower the \
+                 learning rate or set clip_grad_norm",
+                self.adam.steps()
+            ));
+        }
+        Ok(())
     }
 
     fn run(mut self, progress: &mut dyn FnMut(usize, f64)) -> Result<TrainOutput, TrainError> {
@@ -732,18 +767,20 @@ impl<'r, 'a, T: Real> Trainer<'r, 'a, T> {
             let loss = match cfg.bptt {
                 Bptt::Full => {
                     self.grad.fill(0.0);
-                    let loss = self.kernel.full_grad(&self.theta, self.runs, &mut self.grad);
+                    let loss = self
+                        .kernel
+                        .full_grad(&self.theta, self.runs, &mut self.grad);
                     loss_history.push(loss);
                     progress(epoch, loss);
                     if cfg.target_loss.is_some_and(|t| loss <= t) {
                         stop = StopReason::TargetLoss;
                         break;
                     }
-                    self.adam_step();
+                    self.adam_step()?;
                     loss
                 }
                 Bptt::Truncated { batch, start, .. } => {
-                    let loss = self.truncated_epoch(&windows, batch, start);
+                    let loss = self.truncated_epoch(&windows, batch, start)?;
                     loss_history.push(loss);
                     progress(epoch, loss);
                     loss
@@ -806,7 +843,12 @@ impl<'r, 'a, T: Real> Trainer<'r, 'a, T> {
     }
 
     /// One pass over all windows; returns the mean squared error over the counted steps.
-    fn truncated_epoch(&mut self, windows: &[Window], batch: usize, start: WindowStart) -> f64 {
+    fn truncated_epoch(
+        &mut self,
+        windows: &[Window],
+        batch: usize,
+        start: WindowStart,
+    ) -> Result<f64, TrainError> {
         let nh = self.lay.h;
         let ni = self.lay.i;
         let s = tape_stride(nh);
@@ -886,8 +928,8 @@ impl<'r, 'a, T: Real> Trainer<'r, 'a, T> {
             total_n += n;
             self.grad.fill(0.0);
             self.kernel.grads.add_to_flat(&mut self.grad);
-            self.adam_step();
+            self.adam_step()?;
         }
-        total / total_n.max(1) as f64
+        Ok(total / total_n.max(1) as f64)
     }
 }
