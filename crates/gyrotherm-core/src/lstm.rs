@@ -426,14 +426,14 @@ impl<const I: usize, const H: usize> Lstm<I, H> {
         // A NaN anywhere in h (only from an overflowing gate sum) reaches y, since the
         // read-out weights are finite and 0·NaN is NaN; |h| ≤ 1 so y cannot overflow.
         if !y.is_finite() {
-            let mut k_max = 0;
+            let mut k_max = (0, 0.0f32);
             for (k, v) in x.iter().enumerate() {
-                if v.abs() > x[k_max].abs() {
-                    k_max = k;
+                if v.abs() > k_max.1 {
+                    k_max = (k, v.abs());
                 }
             }
             return Err(InputError::NonFinite(Channel::Feature(feature_index(
-                k_max,
+                k_max.0,
             ))));
         }
         self.h = h;

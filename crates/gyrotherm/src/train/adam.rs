@@ -82,3 +82,36 @@ pub fn clip_grad_norm(grad: &mut [f64], max_norm: f64) -> f64 {
     }
     norm
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clip_scales_to_max_norm_only_when_above() {
+        // ‖(3, 4)‖ = 5: clipped to 1 gives (0.6, 0.8) up to the 1e-6 guard of torch's formula.
+        let mut g = [3.0, 4.0];
+        assert_eq!(clip_grad_norm(&mut g, 1.0), 5.0);
+        let want = [0.6, 0.8];
+        for (got, want) in g.iter().zip(want) {
+            assert!((got - want).abs() < 1e-6, "want {want}, got {got}");
+        }
+        let mut g = [0.3, 0.4];
+        clip_grad_norm(&mut g, 1.0);
+        assert_eq!(g, [0.3, 0.4]);
+    }
+
+    #[test]
+    fn first_step_moves_each_parameter_by_lr() {
+        // Kingma & Ba 2015, §2.1: with bias correction, the first step is lr·g/(|g| + ε'),
+        // i.e. lr·sign(g) for |g| ≫ ε.
+        let mut p = [1.0, -2.0, 0.5];
+        let mut adam = Adam::new(3, 0.01, 0.9, 0.999, 1e-8);
+        adam.step(&mut p, &[0.5, -3.0, 1e-3]);
+        let want = [0.99, -1.99, 0.49];
+        for (got, want) in p.iter().zip(want) {
+            assert!((got - want).abs() < 1e-7, "want {want}, got {got}");
+        }
+        assert_eq!(adam.steps(), 1);
+    }
+}
