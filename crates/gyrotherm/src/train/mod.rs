@@ -16,8 +16,8 @@ pub mod zscore;
 
 pub use params::LstmParams;
 pub use trainer::{
-    evaluate_mse, flatten, init_params, loss_and_grad, predict, predict_with_state, train_lstm,
-    train_normalised, train_pair, unflatten, Bptt, NormalisedFit, Precision, RunOutput, Sequence,
-    StopReason, TrainConfig, TrainError, TrainOutput, WindowStart,
+    evaluate_mse, flatten, init_params, loss_and_grad, loss_and_grad_in, predict,
+    predict_with_state, train_lstm, train_normalised, train_pair, unflatten, Bptt, NormalisedFit,
+    Precision, RunOutput, Sequence, StopReason, TrainConfig, TrainError, TrainOutput, WindowStart,
 };
 pub use zscore::ZScore;

@@ -556,16 +556,27 @@ pub fn loss_and_grad(
     params: &LstmParams,
     runs: &[Sequence<'_>],
 ) -> Result<(f64, LstmParams), TrainError> {
+    loss_and_grad_in(params, runs, Precision::F64)
+}
+
+/// [`loss_and_grad`] with the kernel in the given precision (what training uses per epoch).
+pub fn loss_and_grad_in(
+    params: &LstmParams,
+    runs: &[Sequence<'_>],
+    precision: Precision,
+) -> Result<(f64, LstmParams), TrainError> {
     params.validate().map_err(TrainError)?;
     check_runs("training", runs, params.input_size)?;
     let lay = Layout {
         i: params.input_size,
         h: params.hidden_size,
     };
-    let mut k = Kernel::<f64>::new(lay, runs);
     let theta = flatten(params);
     let mut grad = vec![0.0; lay.len()];
-    let loss = k.full_grad(&theta, runs, &mut grad);
+    let loss = match precision {
+        Precision::F64 => Kernel::<f64>::new(lay, runs).full_grad(&theta, runs, &mut grad),
+        Precision::F32 => Kernel::<f32>::new(lay, runs).full_grad(&theta, runs, &mut grad),
+    };
     Ok((loss, unflatten(&grad, lay.i, lay.h)))
 }
 
