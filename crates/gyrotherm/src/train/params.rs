@@ -81,3 +81,29 @@ impl LstmParams {
         Ok(())
     }
 }
+
+impl LstmParams {
+    /// Export to the flight crate's f32 weights (values rounded to nearest f32). Refuses
+    /// sizes other than I × H, and values that are not finite or overflow f32.
+    pub fn to_core<const I: usize, const H: usize>(
+        &self,
+    ) -> Result<gyrotherm_core::lstm::LstmWeights<I, H>, String> {
+        if self.input_size != I || self.hidden_size != H {
+            return Err(format!(
+                "model has input_size {}, hidden_size {}; the flight network was built for {I}, {H}",
+                self.input_size, self.hidden_size
+            ));
+        }
+        self.validate()?;
+        let f = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<f32>>();
+        gyrotherm_core::lstm::LstmWeights::from_slices(
+            &f(&self.w_ih),
+            &f(&self.w_hh),
+            &f(&self.b_ih),
+            &f(&self.b_hh),
+            &f(&self.w_out),
+            self.b_out as f32,
+        )
+        .map_err(|e| format!("{e} after conversion to f32 (value beyond ±3.4e38)"))
+    }
+}
