@@ -11,10 +11,13 @@
 pub mod allan;
 pub mod atomic_file;
 pub mod baseline;
+pub mod compensate;
 pub mod csvlog;
 pub mod features;
+pub mod fit;
 pub mod metrics;
 pub mod model;
 pub mod report;
 pub mod sim;
+pub mod targets;
 pub mod train;

@@ -1,0 +1,257 @@
+//! Fit a compensation model from test logs: targets, features, the chosen method, the file.
+//!
+//! Static logs train the bias model, rate-table logs the scale-factor model (He et al. 2024,
+//! DOI 10.19452/j.issn1007-5453.2024.02.004, §2: two separate networks, because the
+//! magnitudes differ). Methods: `linear` (bias = c0 + c1·T + c2·dT, the paper's comparison),
+//! `poly` (degree n in T, m in dT, optional T·dT), `lstm` (see [`lstm`]).
+
+pub mod lstm;
+
+use crate::baseline::{self, PolyDegrees, Terms};
+use crate::csvlog::TestLog;
+use crate::features::{FeatureSpec, FeatureTable};
+use crate::model::{self, FeatureDef, Method, ModelFile, SubModel, TrainingInfo};
+use crate::targets::{self, TargetSet};
+
+pub use lstm::{LstmRecipe, RecipeKind, TrainSummary};
+
+/// A training log and the name it is reported under (its file name).
+#[derive(Debug, Clone, Copy)]
+pub struct NamedLog<'a> {
+    pub name: &'a str,
+    pub log: &'a TestLog,
+}
+
+/// Which of the two models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    /// Bias, °/s.
+    Bias,
+    /// Scale factor K, dimensionless.
+    Scale,
+}
+
+impl Target {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Target::Bias => "bias",
+            Target::Scale => "scale",
+        }
+    }
+}
+
+/// How to fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitConfig {
+    pub method: Method,
+    /// LSTM recipe (method `lstm` only).
+    pub recipe: LstmRecipe,
+    /// Degrees of the `poly` method's bias model.
+    pub poly: PolyDegrees,
+    /// Bias target smoothing window, s (100 s as published).
+    pub bias_window_s: f64,
+    /// Settle time excluded at each table segment start, s.
+    pub settle_s: f64,
+    /// Output smoothing inside a rate segment for the scale-factor target, s.
+    pub scale_window_s: f64,
+    /// Random seed (LSTM initialisation and window order).
+    pub seed: u64,
+}
+
+impl FitConfig {
+    pub fn new(method: Method) -> Self {
+        FitConfig {
+            method,
+            recipe: LstmRecipe::default(),
+            poly: PolyDegrees::default(),
+            bias_window_s: targets::BIAS_WINDOW_S,
+            settle_s: targets::SETTLE_S,
+            scale_window_s: targets::SCALE_WINDOW_S,
+            seed: 0,
+        }
+    }
+}
+
+/// A fitted model and how training went.
+#[derive(Debug, Clone)]
+pub struct FitOutcome {
+    pub model: ModelFile,
+    /// LSTM training summaries (None for least-squares fits or an absent target).
+    pub bias_training: Option<TrainSummary>,
+    pub scale_training: Option<TrainSummary>,
+}
+
+/// The feature specification a method reads.
+pub fn feature_spec(cfg: &FitConfig) -> FeatureSpec {
+    match cfg.method {
+        Method::Linear | Method::Poly => FeatureSpec::PUBLISHED,
+        Method::Lstm => lstm::feature_spec(&cfg.recipe),
+    }
+}
+
+/// Least-squares terms of a baseline method for one target.
+fn baseline_terms(cfg: &FitConfig, target: Target, n_features: usize) -> Terms {
+    match (cfg.method, target) {
+        (Method::Poly, Target::Bias) => Terms::poly(n_features, cfg.poly),
+        (Method::Poly, Target::Scale) => Terms::poly(
+            n_features,
+            PolyDegrees {
+                temp: 2,
+                rate: 1,
+                cross: false,
+            },
+        ),
+        _ => Terms::linear(n_features),
+    }
+}
+
+/// Fit a baseline on the labelled steps of all runs.
+fn fit_baseline(sets: &[TargetSet], terms: &Terms) -> Result<SubModel, String> {
+    let first = &sets[0].table;
+    let mut rows = Vec::new();
+    let mut target = Vec::new();
+    let mut mask = Vec::new();
+    for s in sets {
+        rows.extend_from_slice(&s.table.rows);
+        target.extend_from_slice(&s.target);
+        mask.extend_from_slice(&s.mask);
+    }
+    let fit = baseline::fit_rows(
+        &rows,
+        first.n_features,
+        &first.names,
+        &first.units,
+        &target,
+        Some(&mask),
+        terms,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(SubModel::from_fit(&fit))
+}
+
+/// Fit one target with the configured method.
+fn fit_one(
+    sets: &[TargetSet],
+    cfg: &FitConfig,
+    target: Target,
+    progress: &mut dyn FnMut(usize, f64),
+) -> Result<(SubModel, Option<TrainSummary>), String> {
+    match cfg.method {
+        Method::Linear | Method::Poly => {
+            let terms = baseline_terms(cfg, target, sets[0].table.n_features);
+            Ok((fit_baseline(sets, &terms)?, None))
+        }
+        Method::Lstm => {
+            let seed = cfg.seed.wrapping_add(match target {
+                Target::Bias => 0,
+                Target::Scale => 1,
+            });
+            let (sub, summary) = lstm::fit_target(sets, &cfg.recipe, seed, progress)?;
+            Ok((sub, Some(summary)))
+        }
+    }
+}
+
+/// Fit bias (from static logs) and scale factor (from rate-table logs). The two targets train
+/// on two threads. `progress(target, epoch, loss)` is called from both threads.
+pub fn fit_model(
+    logs: &[NamedLog],
+    cfg: &FitConfig,
+    progress: &(dyn Fn(Target, usize, f64) + Sync),
+) -> Result<FitOutcome, String> {
+    if logs.is_empty() {
+        return Err("no training logs given".into());
+    }
+    let spec = feature_spec(cfg);
+    let mut bias_sets = Vec::new();
+    let mut scale_sets = Vec::new();
+    for l in logs {
+        if targets::is_static(l.log) {
+            bias_sets.push(
+                targets::bias_targets(l.log, &spec, cfg.bias_window_s)
+                    .map_err(|e| format!("{}: {e}", l.name))?,
+            );
+        } else {
+            let s = targets::scale_targets(l.log, &spec, cfg.settle_s, cfg.scale_window_s)
+                .map_err(|e| format!("{}: {e}", l.name))?;
+            if s.labelled() == 0 {
+                return Err(format!(
+                    "{}: no rate segment has a stop segment on both sides, so no scale factor can be measured; log stop segments between the table rates",
+                    l.name
+                ));
+            }
+            scale_sets.push(s);
+        }
+    }
+    if bias_sets.is_empty() && scale_sets.is_empty() {
+        return Err("no usable training logs".into());
+    }
+    let (bias, scale) = std::thread::scope(|s| {
+        let bias = s.spawn(|| {
+            (!bias_sets.is_empty())
+                .then(|| {
+                    fit_one(&bias_sets, cfg, Target::Bias, &mut |e, l| {
+                        progress(Target::Bias, e, l)
+                    })
+                })
+                .transpose()
+        });
+        let scale = (!scale_sets.is_empty())
+            .then(|| {
+                fit_one(&scale_sets, cfg, Target::Scale, &mut |e, l| {
+                    progress(Target::Scale, e, l)
+                })
+            })
+            .transpose();
+        let bias = bias
+            .join()
+            .unwrap_or_else(|_| Err("bias training thread panicked".into()));
+        (bias, scale)
+    });
+    let bias = bias.map_err(|e| format!("bias model: {e}"))?;
+    let scale = scale.map_err(|e| format!("scale-factor model: {e}"))?;
+    let tables: Vec<&FeatureTable> = bias_sets
+        .iter()
+        .chain(&scale_sets)
+        .map(|s| &s.table)
+        .collect();
+    let (temp_range_c, rate_range_c_per_s) =
+        model::training_ranges(&tables).ok_or("the training logs have no feature steps")?;
+    let lstm_summary = bias
+        .as_ref()
+        .and_then(|b| b.1.as_ref())
+        .or(scale.as_ref().and_then(|s| s.1.as_ref()));
+    let all_logs: Vec<&TestLog> = logs.iter().map(|l| l.log).collect();
+    let training = TrainingInfo {
+        temp_range_c,
+        rate_range_c_per_s,
+        data_digest_sha256: model::data_digest(&all_logs),
+        epochs: lstm_summary.map(|s| s.epochs as u64),
+        final_loss: lstm_summary.map(|s| s.final_loss),
+        seed: (cfg.method == Method::Lstm).then_some(cfg.seed),
+        created_by: model::created_by(),
+        inputs: logs.iter().map(|l| l.name.to_owned()).collect(),
+    };
+    let (bias_model, bias_training) = match bias {
+        Some((m, t)) => (Some(m), t),
+        None => (None, None),
+    };
+    let (scale_model, scale_training) = match scale {
+        Some((m, t)) => (Some(m), t),
+        None => (None, None),
+    };
+    let model = ModelFile {
+        format_version: model::FORMAT_VERSION,
+        method: cfg.method,
+        features: FeatureDef::from_spec(&spec),
+        bias: bias_model,
+        scale: scale_model,
+        training,
+    };
+    model.validate()?;
+    Ok(FitOutcome {
+        model,
+        bias_training,
+        scale_training,
+    })
+}
