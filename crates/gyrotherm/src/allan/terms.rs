@@ -9,9 +9,11 @@
 //! - quantization Q: σ = √3·Q/τ (slope −1), Q = σ(τ = √3 s) in °; reported in arcsec.
 //! - rate ramp R: σ = R·τ/√2 (slope +1), R = σ(τ = √2 s) in °/s²; reported in °/h².
 //!
-//! Each line is fitted with its slope fixed (least squares in log σ) over the points whose
-//! local slope (of the two neighbouring segments, averaged) is within ±[`SLOPE_TOL`] of the
-//! term's slope; a term with no such point is None.
+//! Each line is fitted with its slope fixed (least squares in log σ, weighted by each point's
+//! EDF) over the contiguous run of points whose local slope (mean of the two neighbouring
+//! segments) is within ±[`SLOPE_TOL`] of the term's slope; of several runs the one with the
+//! largest total EDF is used. B is read at the minimum of the best flat run. A term with no
+//! such point is None.
 
 use super::AllanPoint;
 
@@ -46,10 +48,10 @@ pub struct NoiseTerms {
 }
 
 /// Local slope at each point: mean of the slopes of the segments touching it.
-fn local_slopes(pts: &[(f64, f64)]) -> Vec<f64> {
+fn local_slopes(pts: &[LogPoint]) -> Vec<f64> {
     let seg: Vec<f64> = pts
         .windows(2)
-        .map(|w| (w[1].1 - w[0].1) / (w[1].0 - w[0].0))
+        .map(|w| (w[1].ln_sigma - w[0].ln_sigma) / (w[1].ln_tau - w[0].ln_tau))
         .collect();
     (0..pts.len())
         .map(|i| {
@@ -64,41 +66,75 @@ fn local_slopes(pts: &[(f64, f64)]) -> Vec<f64> {
         .collect()
 }
 
-/// Fits log σ = slope·log τ + c over points whose local slope is near `slope`; returns σ at
-/// `tau_read_s` on that line and the fitted τ range (natural logs throughout).
+/// A point of the curve in natural logs, with its fit weight (EDF, or terms when no EDF).
+#[derive(Debug, Clone, Copy)]
+struct LogPoint {
+    ln_tau: f64,
+    ln_sigma: f64,
+    weight: f64,
+}
+
+/// Contiguous runs of points whose local slope is near `slope`; the heaviest run (largest
+/// total weight, i.e. the best-determined part of the curve) is kept.
+fn best_run(pts: &[LogPoint], local: &[f64], slope: f64) -> Option<std::ops::Range<usize>> {
+    let mut best: Option<(f64, std::ops::Range<usize>)> = None;
+    let mut i = 0;
+    while i < pts.len() {
+        if (local[i] - slope).abs() > SLOPE_TOL {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < pts.len() && (local[i] - slope).abs() <= SLOPE_TOL {
+            i += 1;
+        }
+        let w: f64 = pts[start..i].iter().map(|p| p.weight).sum();
+        if best.as_ref().is_none_or(|(bw, _)| w > *bw) {
+            best = Some((w, start..i));
+        }
+    }
+    best.map(|(_, r)| r)
+}
+
+/// Fits log σ = slope·log τ + c (weighted least squares with the slope fixed) over the best
+/// run of points near `slope`; returns σ at `tau_read_s` on that line and the fitted τ range.
 fn fixed_slope_read(
-    pts: &[(f64, f64)],
+    pts: &[LogPoint],
     local: &[f64],
     slope: f64,
     tau_read_s: f64,
 ) -> Option<(f64, f64, f64)> {
-    let sel: Vec<&(f64, f64)> = pts
+    let run = best_run(pts, local, slope)?;
+    let sel = &pts[run];
+    let wsum: f64 = sel.iter().map(|p| p.weight).sum();
+    let c = sel
         .iter()
-        .zip(local)
-        .filter(|(_, s)| (**s - slope).abs() <= SLOPE_TOL)
-        .map(|(p, _)| p)
-        .collect();
-    if sel.is_empty() {
-        return None;
-    }
-    let c = sel.iter().map(|(lt, ls)| ls - slope * lt).sum::<f64>() / sel.len() as f64;
+        .map(|p| p.weight * (p.ln_sigma - slope * p.ln_tau))
+        .sum::<f64>()
+        / wsum;
     let sigma = (c + slope * tau_read_s.ln()).exp();
-    let tmin = sel.iter().map(|p| p.0).fold(f64::INFINITY, f64::min).exp();
-    let tmax = sel.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max).exp();
-    Some((sigma, tmin, tmax))
+    Some((sigma, sel[0].ln_tau.exp(), sel[sel.len() - 1].ln_tau.exp()))
 }
 
 /// Noise terms from an ADEV/OADEV curve. `to_dph` converts the curve's unit to °/h
 /// (3600 for °/s, 1 for °/h, 3600·180/π for rad/s). Points with non-finite or non-positive
 /// σ are ignored.
 pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
-    let mut pts: Vec<(f64, f64)> = points
+    let mut pts: Vec<LogPoint> = points
         .iter()
         .filter(|p| p.dev.is_finite() && p.dev > 0.0 && p.tau_s > 0.0)
-        .map(|p| (p.tau_s.ln(), (p.dev * to_dph).ln()))
+        .map(|p| LogPoint {
+            ln_tau: p.tau_s.ln(),
+            ln_sigma: (p.dev * to_dph).ln(),
+            weight: if p.edf.is_finite() && p.edf > 0.0 {
+                p.edf
+            } else {
+                p.n.max(1) as f64
+            },
+        })
         .collect();
-    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-    pts.dedup_by(|a, b| a.0 == b.0);
+    pts.sort_by(|a, b| a.ln_tau.total_cmp(&b.ln_tau));
+    pts.dedup_by(|a, b| a.ln_tau == b.ln_tau);
     if pts.len() < 2 {
         return NoiseTerms::default();
     }
@@ -116,23 +152,17 @@ pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
     let rrw = term(0.5, 3.0, 60.0);
     let quant = term(-1.0, 3f64.sqrt(), 1.0); // σ[°/h at √3 s] = Q[°]·3600 = Q[arcsec]
     let ramp = term(1.0, 2f64.sqrt(), 3600.0); // R[°/h²] = σ[°/s²]·3600² = σ[°/h]·3600
-    let flat: Vec<usize> = (0..pts.len())
-        .filter(|&i| local[i].abs() <= SLOPE_TOL)
-        .collect();
-    let bias = flat
-        .iter()
-        .copied()
-        .min_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1))
-        .map(|i| {
-            let tmin = flat.iter().map(|&j| pts[j].0).fold(f64::INFINITY, f64::min).exp();
-            let tmax = flat.iter().map(|&j| pts[j].0).fold(f64::NEG_INFINITY, f64::max).exp();
-            NoiseTerm {
-                value: pts[i].1.exp() / (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt(),
-                tau_read_s: pts[i].0.exp(),
-                fit_tau_min_s: tmin,
-                fit_tau_max_s: tmax,
-            }
-        });
+    // Bias instability: the minimum of the best flat run.
+    let bias = best_run(&pts, &local, 0.0).and_then(|run| {
+        let sel = &pts[run];
+        let min = sel.iter().min_by(|a, b| a.ln_sigma.total_cmp(&b.ln_sigma))?;
+        Some(NoiseTerm {
+            value: min.ln_sigma.exp() / (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt(),
+            tau_read_s: min.ln_tau.exp(),
+            fit_tau_min_s: sel[0].ln_tau.exp(),
+            fit_tau_max_s: sel[sel.len() - 1].ln_tau.exp(),
+        })
+    });
     NoiseTerms {
         arw_deg_rt_h: arw,
         bias_instability_dph: bias,
