@@ -25,7 +25,7 @@ mod noise_id;
 mod terms;
 
 pub use edf::{chi2_inv, edf_greenhall, edf_simple, regularized_gamma_p, ONE_SIGMA_CI};
-pub use noise_id::{lag1_noise_id, NoiseId};
+pub use noise_id::{lag1_noise_id, lag1_noise_id_from_phase, NoiseId};
 pub use terms::{noise_terms, NoiseTerm, NoiseTerms};
 
 use std::fmt;
@@ -346,19 +346,17 @@ fn overlapping_second_diff_sums(x: &[f64], ms: &[usize]) -> Vec<f64> {
             let b = &x[k0 + m..end + m];
             let c = &x[k0 + 2 * m..end + 2 * m];
             let mut acc = [0.0f64; 4];
-            let mut i = 0;
-            let n = a.len();
-            while i + 4 <= n {
+            let (ac, bc, cc) = (a.chunks_exact(4), b.chunks_exact(4), c.chunks_exact(4));
+            let (ar, br, cr) = (ac.remainder(), bc.remainder(), cc.remainder());
+            for ((a4, b4), c4) in ac.zip(bc).zip(cc) {
                 for l in 0..4 {
-                    let d = c[i + l] - 2.0 * b[i + l] + a[i + l];
+                    let d = c4[l] - 2.0 * b4[l] + a4[l];
                     acc[l] += d * d;
                 }
-                i += 4;
             }
-            while i < n {
-                let d = c[i] - 2.0 * b[i] + a[i];
+            for ((a1, b1), c1) in ar.iter().zip(br).zip(cr) {
+                let d = c1 - 2.0 * b1 + a1;
                 acc[0] += d * d;
-                i += 1;
             }
             *sum += (acc[0] + acc[1]) + (acc[2] + acc[3]);
         }
@@ -475,16 +473,14 @@ pub fn deviation(
             .map(|&m| deviation_from_phase(&x, kind, m).unwrap_or((f64::NAN, 0)))
             .collect()
     };
-    drop(x);
     let mut last_alpha = 0i32;
     let mut points = Vec::with_capacity(ms.len());
     for (&m, (dev, n)) in ms.iter().zip(devs) {
         let alpha = match noise {
             NoiseModel::Alpha(a) => a,
             NoiseModel::Identify => {
-                match lag1_noise_id(samples, m, kind.diff_order()) {
-                    Some(id) => last_alpha = id.alpha,
-                    None => {}
+                if let Some(id) = lag1_noise_id_from_phase(&x, m, kind.diff_order()) {
+                    last_alpha = id.alpha;
                 }
                 last_alpha
             }
