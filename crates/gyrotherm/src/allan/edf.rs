@@ -62,7 +62,11 @@ fn basic_sum(j_terms: f64, m_terms: f64, s: f64, f: Option<f64>, alpha: i32, d: 
 /// Table 1 (modified variances), (a0, a1) by α = 2..−4 and d = 1..3; None where undefined.
 fn table1(alpha: i32, d: u32) -> Option<(f64, f64)> {
     const T: [[(f64, f64); 3]; 7] = [
-        [(2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5), (22.0 / 25.0, 2.0 / 3.0)],
+        [
+            (2.0 / 3.0, 1.0 / 3.0),
+            (7.0 / 9.0, 0.5),
+            (22.0 / 25.0, 2.0 / 3.0),
+        ],
         [(0.840, 0.345), (0.997, 0.616), (1.141, 0.843)],
         [(1.079, 0.368), (1.033, 0.607), (1.184, 0.848)],
         [(f64::NAN, 0.0), (1.048, 0.534), (1.180, 0.816)],
@@ -78,7 +82,11 @@ fn table2(alpha: i32, d: u32) -> Option<(f64, f64)> {
     const T: [[(f64, f64); 3]; 7] = [
         [(1.5, 0.5), (35.0 / 18.0, 1.0), (231.0 / 100.0, 1.5)],
         [(78.6, 25.2), (790.0, 410.0), (9950.0, 6520.0)],
-        [(2.0 / 3.0, 1.0 / 6.0), (2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5)],
+        [
+            (2.0 / 3.0, 1.0 / 6.0),
+            (2.0 / 3.0, 1.0 / 3.0),
+            (7.0 / 9.0, 0.5),
+        ],
         [(f64::NAN, 0.0), (0.852, 0.375), (0.997, 0.617)],
         [(f64::NAN, 0.0), (1.079, 0.368), (1.033, 0.607)],
         [(f64::NAN, 0.0), (f64::NAN, 0.0), (1.053, 0.553)],
@@ -145,14 +153,19 @@ pub fn edf_greenhall(
         }
     } else if alpha <= 0 {
         if j_terms <= J_MAX {
-            let fp = if mf * (df + 1.0) <= J_MAX { Some(mf) } else { None };
+            let fp = if mf * (df + 1.0) <= J_MAX {
+                Some(mf)
+            } else {
+                None
+            };
             basic_sum(j_terms, m_terms, s, fp, alpha, d) / (sz(0.0, fp, alpha, d).powi(2) * m_terms)
         } else if r > df + 1.0 {
             let (a0, a1) = table2(alpha, d)?;
             (a0 - a1 / r) / r
         } else {
             let m_prime = J_MAX / r;
-            basic_sum(J_MAX, J_MAX, m_prime, None, alpha, d) / (sz(0.0, None, alpha, d).powi(2) * J_MAX)
+            basic_sum(J_MAX, J_MAX, m_prime, None, alpha, d)
+                / (sz(0.0, None, alpha, d).powi(2) * J_MAX)
         }
     } else if alpha == 1 {
         if j_terms <= J_MAX {
@@ -173,7 +186,8 @@ pub fn edf_greenhall(
         if r.ceil() <= df {
             return None;
         }
-        let binom = |n: u32, k: u32| (0..k).fold(1.0, |acc, i| acc * f64::from(n - i) / f64::from(i + 1));
+        let binom =
+            |n: u32, k: u32| (0..k).fold(1.0, |acc, i| acc * f64::from(n - i) / f64::from(i + 1));
         let a0 = binom(4 * d, 2 * d) / binom(2 * d, d).powi(2);
         let a1 = df / 2.0;
         (a0 - a1 / r) / m_terms
@@ -194,7 +208,10 @@ pub fn edf_simple(n_phase: usize, m: usize, alpha: i32) -> Option<f64> {
             let b = (2.0 * m + 1.0) * (n - 1.0) / 4.0;
             (a.ln() * b.ln()).sqrt().exp()
         }
-        0 => (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n) * (4.0 * m * m / (4.0 * m * m + 5.0)),
+        0 => {
+            (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n)
+                * (4.0 * m * m / (4.0 * m * m + 5.0))
+        }
         -1 if m == 1.0 => 2.0 * (n - 2.0) / (2.3 * n - 4.9),
         -1 => 5.0 * n * n / (4.0 * m * (n + 3.0 * m)),
         -2 => {
@@ -342,7 +359,10 @@ mod tests {
         for (p, k, want) in cases {
             let got = chi2_inv(p, k);
             let err = (got - want).abs() / want;
-            assert!(err < TOL, "chi2_inv({p}, {k}): want {want}, got {got}, rel err {err:e}");
+            assert!(
+                err < TOL,
+                "chi2_inv({p}, {k}): want {want}, got {got}, rel err {err:e}"
+            );
         }
     }
 
@@ -353,7 +373,10 @@ mod tests {
         for n in 1..30 {
             let got = ln_gamma(n as f64);
             let want = fact.ln();
-            assert!((got - want).abs() < 1e-12 * want.abs().max(1.0), "n={n} want {want} got {got}");
+            assert!(
+                (got - want).abs() < 1e-12 * want.abs().max(1.0),
+                "n={n} want {want} got {got}"
+            );
             fact *= n as f64;
         }
         let want = std::f64::consts::PI.sqrt().ln();

@@ -18,14 +18,17 @@
 //! unchanged in exact arithmetic and keeps θ small for precision on long logs.
 //!
 //! Memory: one extra f64 array (θ) of N + 1 values. OADEV for a set of τ runs in one blocked
-//! pass over θ (O(N) per τ, cache-friendly for octave sets).
+//! pass over θ (O(N) per τ, cache-friendly for octave sets). [`StreamingOadev`] computes OADEV
+//! over a stream of chunks (a log larger than memory) in O(m_max) memory.
 
 mod edf;
 mod noise_id;
+mod streaming;
 mod terms;
 
 pub use edf::{chi2_inv, edf_greenhall, edf_simple, regularized_gamma_p, ONE_SIGMA_CI};
 pub use noise_id::{lag1_noise_id, lag1_noise_id_from_phase, NoiseId};
+pub use streaming::StreamingOadev;
 pub use terms::{noise_terms, NoiseTerm, NoiseTerms};
 
 use std::fmt;
@@ -325,15 +328,49 @@ pub fn phase_from_rate(samples: &[f64]) -> Vec<f64> {
     x
 }
 
-/// Σ over the given k of the squared second difference, for each m of a set, in one blocked
-/// pass (each block of θ is read once for all m; octave offsets share cache lines).
+/// Σ_k (θ_{k+2m} − 2θ_{k+m} + θ_k)² for each m of a set. The k range is split across up to
+/// `available_parallelism` threads (at least 1e6 k per thread); each thread makes one blocked
+/// pass (each block of θ is read once for all m, and octave offsets share cache lines).
 fn overlapping_second_diff_sums(x: &[f64], ms: &[usize]) -> Vec<f64> {
+    const MIN_PER_THREAD: usize = 1_000_000;
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(8)
+        .min(x.len() / MIN_PER_THREAD)
+        .max(1);
+    if threads == 1 {
+        return second_diff_sums_range(x, ms, 0, x.len());
+    }
+    let step = x.len().div_ceil(threads);
+    let parts: Vec<Vec<f64>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                let (k0, k1) = (t * step, ((t + 1) * step).min(x.len()));
+                s.spawn(move || second_diff_sums_range(x, ms, k0, k1))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    let mut sums = vec![0.0; ms.len()];
+    for p in parts {
+        for (s, v) in sums.iter_mut().zip(p) {
+            *s += v;
+        }
+    }
+    sums
+}
+
+/// The sums of [`overlapping_second_diff_sums`] over k in [k_start, k_end).
+fn second_diff_sums_range(x: &[f64], ms: &[usize], k_start: usize, k_end: usize) -> Vec<f64> {
     const BLOCK: usize = 2048;
     let len = x.len();
     let mut sums = vec![0.0f64; ms.len()];
-    let mut k0 = 0;
-    while k0 < len {
-        let k1 = (k0 + BLOCK).min(len);
+    let mut k0 = k_start;
+    while k0 < k_end {
+        let k1 = (k0 + BLOCK).min(k_end);
         let mut any = false;
         for (sum, &m) in sums.iter_mut().zip(ms) {
             let kmax = len.saturating_sub(2 * m); // k < len − 2m
@@ -502,7 +539,13 @@ pub fn deviation(
 
 /// EDF and 68.3 % bounds of one deviation: Greenhall's EDF for α clamped to the range the
 /// estimator converges for (α + 2d > 1, α ≤ 2); NaN bounds when no EDF is defined.
-pub fn confidence(kind: DevKind, dev: f64, alpha: i32, m: usize, n_samples: usize) -> (f64, f64, f64) {
+pub fn confidence(
+    kind: DevKind,
+    dev: f64,
+    alpha: i32,
+    m: usize,
+    n_samples: usize,
+) -> (f64, f64, f64) {
     let d = kind.diff_order();
     let alpha = alpha.clamp(2 - 2 * d as i32, 2);
     let (overlapping, modified) = match kind {

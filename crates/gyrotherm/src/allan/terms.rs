@@ -152,12 +152,15 @@ pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
     let rrw = term(0.5, 3.0, 60.0);
     let quant = term(-1.0, 3f64.sqrt(), 1.0); // σ[°/h at √3 s] = Q[°]·3600 = Q[arcsec]
     let ramp = term(1.0, 2f64.sqrt(), 3600.0); // R[°/h²] = σ[°/s²]·3600² = σ[°/h]·3600
-    // Bias instability: the minimum of the best flat run.
+                                               // Bias instability: the minimum of the best flat run.
     let bias = best_run(&pts, &local, 0.0).and_then(|run| {
         let sel = &pts[run];
-        let min = sel.iter().min_by(|a, b| a.ln_sigma.total_cmp(&b.ln_sigma))?;
+        let min = sel
+            .iter()
+            .min_by(|a, b| a.ln_sigma.total_cmp(&b.ln_sigma))?;
         Some(NoiseTerm {
-            value: min.ln_sigma.exp() / (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt(),
+            value: min.ln_sigma.exp()
+                / (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt(),
             tau_read_s: min.ln_tau.exp(),
             fit_tau_min_s: sel[0].ln_tau.exp(),
             fit_tau_max_s: sel[sel.len() - 1].ln_tau.exp(),
