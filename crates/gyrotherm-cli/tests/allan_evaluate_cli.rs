@@ -35,25 +35,41 @@ fn allan_json_matches_nist_oadev() {
     let log = dir.path().join("nbs.csv");
     write_nbs_log(&log);
     let (code, out, err) = gyrotherm(&[
-        "allan", "--input", log.to_str().unwrap(), "--taus", "1,10,100", "--json",
+        "allan",
+        "--input",
+        log.to_str().unwrap(),
+        "--taus",
+        "1,10,100",
+        "--json",
     ]);
     assert_eq!(code, 0, "stderr: {err}");
     let v: Value = serde_json::from_str(&out).expect("JSON");
     assert_eq!(v["kind"], "oadev");
     let pts = v["points"].as_array().unwrap();
     // NIST SP 1065 OADEV of the NBS set (METHOD.md); terms N + 1 − 2m.
-    let want = [(1.0, 2.922319e-01, 999), (10.0, 9.159953e-02, 981), (100.0, 3.241343e-02, 801)];
+    let want = [
+        (1.0, 2.922319e-01, 999),
+        (10.0, 9.159953e-02, 981),
+        (100.0, 3.241343e-02, 801),
+    ];
     assert_eq!(pts.len(), 3);
     for (p, (tau, dev, n)) in pts.iter().zip(want) {
         assert_eq!(p["tau_s"].as_f64().unwrap(), tau);
         let got = p["dev"].as_f64().unwrap();
-        assert!((got - dev).abs() / dev < 1e-6, "τ={tau}: want {dev} got {got}");
+        assert!(
+            (got - dev).abs() / dev < 1e-6,
+            "τ={tau}: want {dev} got {got}"
+        );
         assert_eq!(p["n"].as_u64().unwrap(), n);
         let (lo, hi) = (p["lo"].as_f64().unwrap(), p["hi"].as_f64().unwrap());
         assert!(lo < got && got < hi, "bounds {lo} {got} {hi}");
     }
     for key in ["arw_deg_rt_h", "bias_instability_dph", "rrw_deg_h_rt_h"] {
-        assert!(v["noise"].get(key).is_some(), "noise.{key} missing: {}", v["noise"]);
+        assert!(
+            v["noise"].get(key).is_some(),
+            "noise.{key} missing: {}",
+            v["noise"]
+        );
     }
 }
 
@@ -65,7 +81,10 @@ fn allan_human_table_and_errors() {
     let p = log.to_str().unwrap();
     let (code, out, _) = gyrotherm(&["allan", "--input", p, "--kind", "hdev"]);
     assert_eq!(code, 0);
-    assert!(out.contains("HDEV") && out.contains("angle random walk"), "{out}");
+    assert!(
+        out.contains("HDEV") && out.contains("angle random walk"),
+        "{out}"
+    );
     let (code, _, err) = gyrotherm(&["allan", "--input", p, "--taus", "2.5"]);
     assert_eq!(code, 2);
     assert!(err.contains("not an integer multiple"), "{err}");
@@ -84,7 +103,12 @@ fn evaluate_json_static_and_table() {
     let log = dir.path().join("nbs.csv");
     write_nbs_log(&log);
     let (code, out, err) = gyrotherm(&[
-        "evaluate", "--input", log.to_str().unwrap(), "--tau", "10", "--json",
+        "evaluate",
+        "--input",
+        log.to_str().unwrap(),
+        "--tau",
+        "10",
+        "--json",
     ]);
     assert_eq!(code, 0, "{err}");
     let v: Value = serde_json::from_str(&out).unwrap();
@@ -107,7 +131,12 @@ fn evaluate_json_static_and_table() {
     }
     std::fs::write(&tlog, s).unwrap();
     let (code, out, err) = gyrotherm(&[
-        "evaluate", "--input", tlog.to_str().unwrap(), "--tau", "10", "--json",
+        "evaluate",
+        "--input",
+        tlog.to_str().unwrap(),
+        "--tau",
+        "10",
+        "--json",
     ]);
     assert_eq!(code, 0, "{err}");
     let v: Value = serde_json::from_str(&out).unwrap();

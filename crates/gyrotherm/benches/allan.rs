@@ -21,26 +21,64 @@ fn white(n: usize) -> Vec<f64> {
 fn bench_oadev(c: &mut Criterion) {
     let y = white(1_000_000);
     c.bench_function("oadev_octave_1e6", |b| {
-        b.iter(|| deviation(&y, 1.0, DevKind::Oadev, &TauSet::Octave, NoiseModel::Identify).unwrap())
+        b.iter(|| {
+            deviation(
+                &y,
+                1.0,
+                DevKind::Oadev,
+                &TauSet::Octave,
+                NoiseModel::Identify,
+            )
+            .unwrap()
+        })
     });
     c.bench_function("mdev_octave_1e6", |b| {
-        b.iter(|| deviation(&y, 1.0, DevKind::Mdev, &TauSet::Octave, NoiseModel::Identify).unwrap())
+        b.iter(|| {
+            deviation(
+                &y,
+                1.0,
+                DevKind::Mdev,
+                &TauSet::Octave,
+                NoiseModel::Identify,
+            )
+            .unwrap()
+        })
     });
 }
 
 criterion_group!(benches, bench_oadev);
 
 fn main() {
-    if let Some(n) = std::env::var("GYROTHERM_ALLAN_N").ok().and_then(|s| s.parse::<usize>().ok()) {
+    if let Some(n) = std::env::var("GYROTHERM_ALLAN_N")
+        .ok()
+        .and_then(|s| s.parse::<usize>().ok())
+    {
         let y = white(n);
         let t = Instant::now();
-        let pts = deviation(&y, 1.0, DevKind::Oadev, &TauSet::Octave, NoiseModel::Identify).unwrap();
+        let pts = deviation(
+            &y,
+            1.0,
+            DevKind::Oadev,
+            &TauSet::Octave,
+            NoiseModel::Identify,
+        )
+        .unwrap();
         let s = t.elapsed().as_secs_f64();
         println!("gyrotherm_oadev_octave_s={s:.3} n={n} taus={}", pts.len());
         let t = Instant::now();
-        let pts = deviation(&y, 1.0, DevKind::Oadev, &TauSet::Octave, NoiseModel::Alpha(0)).unwrap();
+        let pts = deviation(
+            &y,
+            1.0,
+            DevKind::Oadev,
+            &TauSet::Octave,
+            NoiseModel::Alpha(0),
+        )
+        .unwrap();
         let s = t.elapsed().as_secs_f64();
-        println!("gyrotherm_oadev_octave_fixed_alpha_s={s:.3} n={n} taus={}", pts.len());
+        println!(
+            "gyrotherm_oadev_octave_fixed_alpha_s={s:.3} n={n} taus={}",
+            pts.len()
+        );
         return;
     }
     benches();

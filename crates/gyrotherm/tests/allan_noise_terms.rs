@@ -95,21 +95,40 @@ fn recovers_arw_and_bias_instability() {
     let white_std_dps = arw_deg_rt_h / 60.0 / tau0_s.sqrt();
     let white = Normal::new(0.0, white_std_dps).unwrap();
     let fl = flicker(n, bias_instability_dph / 3600.0, &mut rng);
-    let rate_dps: Vec<f64> = fl.iter().map(|f| 0.3 + f + white.sample(&mut rng)).collect();
+    let rate_dps: Vec<f64> = fl
+        .iter()
+        .map(|f| 0.3 + f + white.sample(&mut rng))
+        .collect();
 
-    let pts = deviation(&rate_dps, tau0_s, DevKind::Oadev, &TauSet::Octave, NoiseModel::Identify)
-        .unwrap();
+    let pts = deviation(
+        &rate_dps,
+        tau0_s,
+        DevKind::Oadev,
+        &TauSet::Octave,
+        NoiseModel::Identify,
+    )
+    .unwrap();
     let terms = noise_terms(&pts, 3600.0);
     let arw = terms.arw_deg_rt_h.expect("ARW region on the curve");
-    let b = terms.bias_instability_dph.expect("flat region on the curve");
+    let b = terms
+        .bias_instability_dph
+        .expect("flat region on the curve");
     let e_arw = (arw.value - arw_deg_rt_h).abs() / arw_deg_rt_h;
     let e_b = (b.value - bias_instability_dph).abs() / bias_instability_dph;
     eprintln!(
         "ARW want {arw_deg_rt_h} got {:.5} (fit τ {}..{} s), B want {bias_instability_dph} got {:.5} at τ {} s",
         arw.value, arw.fit_tau_min_s, arw.fit_tau_max_s, b.value, b.tau_read_s
     );
-    assert!(e_arw < RECOVERY_TOL, "ARW: want {arw_deg_rt_h} got {} (rel err {e_arw:.3})", arw.value);
-    assert!(e_b < RECOVERY_TOL, "B: want {bias_instability_dph} got {} (rel err {e_b:.3})", b.value);
+    assert!(
+        e_arw < RECOVERY_TOL,
+        "ARW: want {arw_deg_rt_h} got {} (rel err {e_arw:.3})",
+        arw.value
+    );
+    assert!(
+        e_b < RECOVERY_TOL,
+        "B: want {bias_instability_dph} got {} (rel err {e_b:.3})",
+        b.value
+    );
     assert_eq!(arw.tau_read_s, 1.0);
     // Short τ of white noise: the lag-1 noise ID must say α = 0 (white FM / ARW).
     assert_eq!(pts[0].alpha, 0, "α at τ0 for white-dominated data");
@@ -121,11 +140,24 @@ fn white_only_curve_has_no_rrw() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let normal = Normal::new(0.0, 1e-3).unwrap();
     let y: Vec<f64> = (0..1 << 16).map(|_| normal.sample(&mut rng)).collect();
-    let pts = deviation(&y, 0.1, DevKind::Oadev, &TauSet::Octave, NoiseModel::Identify).unwrap();
+    let pts = deviation(
+        &y,
+        0.1,
+        DevKind::Oadev,
+        &TauSet::Octave,
+        NoiseModel::Identify,
+    )
+    .unwrap();
     let t = noise_terms(&pts, 3600.0);
-    assert!(t.rrw_deg_h_rt_h.is_none() && t.rate_ramp_deg_h2.is_none(), "{t:?}");
+    assert!(
+        t.rrw_deg_h_rt_h.is_none() && t.rate_ramp_deg_h2.is_none(),
+        "{t:?}"
+    );
     // σ(τ) = σ_w·√(τ0/τ): N_s = σ_w·√τ0 °/√s → N = 60·N_s °/√h.
     let want = 60.0 * 1e-3 * 0.1f64.sqrt();
     let got = t.arw_deg_rt_h.unwrap().value;
-    assert!((got - want).abs() / want < 0.05, "ARW want {want} got {got}");
+    assert!(
+        (got - want).abs() / want < 0.05,
+        "ARW want {want} got {got}"
+    );
 }

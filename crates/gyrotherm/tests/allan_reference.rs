@@ -6,8 +6,7 @@
 use std::path::PathBuf;
 
 use gyrotherm::allan::{
-    self, confidence, deviation, deviation_from_phase, phase_from_rate, DevKind, NoiseModel,
-    TauSet,
+    self, confidence, deviation, deviation_from_phase, phase_from_rate, DevKind, NoiseModel, TauSet,
 };
 use gyrotherm::metrics::tau_means_std;
 
@@ -108,12 +107,20 @@ fn check_alltau(kind: DevKind, file: &str) {
         let (got, n) = deviation_from_phase(&x, kind, m).expect("τ in range");
         assert_eq!(n, n_want, "{file} m={m}: term count want {n_want} got {n}");
         let e = rel(got, want);
-        assert!(e < ALLTAU_TOL, "{file} m={m}: want {want:e} got {got:e} rel err {e:e}");
+        assert!(
+            e < ALLTAU_TOL,
+            "{file} m={m}: want {want:e} got {got:e} rel err {e:e}"
+        );
         if e > worst.0 {
             worst = (e, m);
         }
     }
-    eprintln!("{file}: {} τ, max rel err {:.2e} at m={}", rows.len(), worst.0, worst.1);
+    eprintln!(
+        "{file}: {} τ, max rel err {:.2e} at m={}",
+        rows.len(),
+        worst.0,
+        worst.1
+    );
 }
 
 #[test]
@@ -156,12 +163,19 @@ fn check_octave(kind: DevKind, file: &str) {
         let (m, n_want, alpha, lo_want, dev_want, hi_want) = (r.0, r.2, r.3, r.4, r.5, r.6);
         assert_eq!(p.n, n_want, "{file} m={m}: term count");
         let (_edf, lo, hi) = confidence(kind, p.dev, alpha, m, y.len());
-        for (i, (name, got, want)) in [("σ", p.dev, dev_want), ("lo", lo, lo_want), ("hi", hi, hi_want)]
-            .into_iter()
-            .enumerate()
+        for (i, (name, got, want)) in [
+            ("σ", p.dev, dev_want),
+            ("lo", lo, lo_want),
+            ("hi", hi, hi_want),
+        ]
+        .into_iter()
+        .enumerate()
         {
             let e = rel(got, want);
-            assert!(e < OCTAVE_TOL, "{file} m={m} α={alpha} {name}: want {want:e} got {got:e} rel err {e:e}");
+            assert!(
+                e < OCTAVE_TOL,
+                "{file} m={m} α={alpha} {name}: want {want:e} got {got:e} rel err {e:e}"
+            );
             worst[i] = worst[i].max(e);
         }
     }
@@ -188,12 +202,26 @@ fn ocxo_oadev_tau1_checked_value() {
         return;
     };
     let y = ocxo_fractional_frequency(&data);
-    let p = deviation(&y, 1.0, DevKind::Oadev, &TauSet::Seconds(vec![1.0]), NoiseModel::Identify)
-        .unwrap();
+    let p = deviation(
+        &y,
+        1.0,
+        DevKind::Oadev,
+        &TauSet::Seconds(vec![1.0]),
+        NoiseModel::Identify,
+    )
+    .unwrap();
     assert_eq!(p[0].n, 19_981);
     let e = rel(p[0].dev, 7.6106e-11);
-    assert!(e < ALLTAU_TOL, "want 7.6106e-11 got {:e} rel err {e:e}", p[0].dev);
-    assert!(p[0].lo < p[0].dev && p[0].dev < p[0].hi, "bounds bracket σ: {:?}", p[0]);
+    assert!(
+        e < ALLTAU_TOL,
+        "want 7.6106e-11 got {:e} rel err {e:e}",
+        p[0].dev
+    );
+    assert!(
+        p[0].lo < p[0].dev && p[0].dev < p[0].hi,
+        "bounds bracket σ: {:?}",
+        p[0]
+    );
 }
 
 /// NBS 1000-point set: n0 = 1234567890, n_{i+1} = 16807·n_i mod 2147483647,
@@ -211,8 +239,15 @@ fn nbs_data() -> Vec<f64> {
 #[test]
 fn nbs_generator_check_values() {
     let y = nbs_data();
-    let n: Vec<u64> = y[1..4].iter().map(|v| (v * 2_147_483_647.0).round() as u64).collect();
-    assert_eq!(n, vec![395_529_916, 1_209_410_747, 633_705_974], "METHOD.md n1..n3");
+    let n: Vec<u64> = y[1..4]
+        .iter()
+        .map(|v| (v * 2_147_483_647.0).round() as u64)
+        .collect();
+    assert_eq!(
+        n,
+        vec![395_529_916, 1_209_410_747, 633_705_974],
+        "METHOD.md n1..n3"
+    );
 }
 
 /// NIST SP 1065 pp. 107-108 values (METHOD.md table) are printed to 7 digits: 1e-6 relative.
@@ -225,23 +260,51 @@ fn nbs_1000_point_set() {
     // Term counts: N = 1000 frequency points; ADEV ⌊N/m⌋−1, OADEV N+1−2m, MDEV N+2−3m,
     // HDEV ⌊N/m⌋−2 (the estimator definitions; Stable32 prints the same counts for the OCXO).
     let cases: [(DevKind, [f64; 3], [usize; 3]); 4] = [
-        (DevKind::Adev, [2.922319e-01, 9.965736e-02, 3.897804e-02], [999, 99, 9]),
-        (DevKind::Oadev, [2.922319e-01, 9.159953e-02, 3.241343e-02], [999, 981, 801]),
-        (DevKind::Mdev, [2.922319e-01, 6.172376e-02, 2.170921e-02], [999, 972, 702]),
-        (DevKind::Hdev, [2.943883e-01, 1.052754e-01, 3.910860e-02], [998, 98, 8]),
+        (
+            DevKind::Adev,
+            [2.922319e-01, 9.965736e-02, 3.897804e-02],
+            [999, 99, 9],
+        ),
+        (
+            DevKind::Oadev,
+            [2.922319e-01, 9.159953e-02, 3.241343e-02],
+            [999, 981, 801],
+        ),
+        (
+            DevKind::Mdev,
+            [2.922319e-01, 6.172376e-02, 2.170921e-02],
+            [999, 972, 702],
+        ),
+        (
+            DevKind::Hdev,
+            [2.943883e-01, 1.052754e-01, 3.910860e-02],
+            [998, 98, 8],
+        ),
     ];
     for (kind, want, n_want) in cases {
         for (i, m) in [1usize, 10, 100].into_iter().enumerate() {
             let (got, n) = deviation_from_phase(&x, kind, m).unwrap();
             let e = rel(got, want[i]);
-            assert!(e < NBS_TOL, "{} τ={m}: want {:e} got {got:e} rel err {e:e}", kind.name(), want[i]);
+            assert!(
+                e < NBS_TOL,
+                "{} τ={m}: want {:e} got {got:e} rel err {e:e}",
+                kind.name(),
+                want[i]
+            );
             assert_eq!(n, n_want[i], "{} τ={m}: term count", kind.name());
         }
     }
-    for (m, want, n_want) in [(1, 2.884664e-01, 1000), (10, 9.296352e-02, 100), (100, 3.206656e-02, 10)] {
+    for (m, want, n_want) in [
+        (1, 2.884664e-01, 1000),
+        (10, 9.296352e-02, 100),
+        (100, 3.206656e-02, 10),
+    ] {
         let (got, n) = tau_means_std(&y, m).unwrap();
         let e = rel(got, want);
-        assert!(e < NBS_TOL, "std of τ-means τ={m}: want {want:e} got {got:e} rel err {e:e}");
+        assert!(
+            e < NBS_TOL,
+            "std of τ-means τ={m}: want {want:e} got {got:e} rel err {e:e}"
+        );
         assert_eq!(n, n_want);
     }
 }
@@ -258,9 +321,15 @@ fn oadev_set_equals_definition() {
     for p in pts {
         let m = p.m;
         let n = x.len() - 2 * m;
-        let s: f64 = (0..n).map(|k| (x[k + 2 * m] - 2.0 * x[k + m] + x[k]).powi(2)).sum();
+        let s: f64 = (0..n)
+            .map(|k| (x[k + 2 * m] - 2.0 * x[k + m] + x[k]).powi(2))
+            .sum();
         let want = (s / (2.0 * p.tau_s * p.tau_s * n as f64)).sqrt();
-        assert!(rel(p.dev, want) < 1e-9, "m={m}: want {want:e} got {:e}", p.dev);
+        assert!(
+            rel(p.dev, want) < 1e-9,
+            "m={m}: want {want:e} got {:e}",
+            p.dev
+        );
         assert_eq!(p.n, n);
         assert!((p.tau_s - 0.5 * m as f64).abs() < 1e-12);
     }
@@ -279,9 +348,17 @@ fn tau_list_errors_are_clear() {
     assert!(e.to_string().contains("`x`"), "{e}");
     let mut bad = y.clone();
     bad[7] = f64::NAN;
-    let e = deviation(&bad, 1.0, DevKind::Adev, &TauSet::Octave, NoiseModel::Identify).unwrap_err();
+    let e = deviation(
+        &bad,
+        1.0,
+        DevKind::Adev,
+        &TauSet::Octave,
+        NoiseModel::Identify,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("sample 7"), "{e}");
     // 0.1 s · 30 = 3 s is a multiple despite binary rounding of 0.1.
-    let ms = allan::averaging_factors(&TauSet::Seconds(vec![3.0]), DevKind::Adev, 1000, 0.1).unwrap();
+    let ms =
+        allan::averaging_factors(&TauSet::Seconds(vec![3.0]), DevKind::Adev, 1000, 0.1).unwrap();
     assert_eq!(ms, vec![30]);
 }

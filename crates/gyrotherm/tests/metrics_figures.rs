@@ -34,7 +34,11 @@ fn bias_stability_matches_nbs_tau_means() {
     // Treat y as °/s sampled every 0.5 s: τ = 5 s is m = 10; result ×3600 in °/h.
     let bs = bias_stability_dph(&y, 0.5, 5.0).unwrap();
     let want = 9.296352e-02 * 3600.0;
-    assert!(rel(bs.bias_stability_dph, want) < 1e-6, "want {want} got {}", bs.bias_stability_dph);
+    assert!(
+        rel(bs.bias_stability_dph, want) < 1e-6,
+        "want {want} got {}",
+        bs.bias_stability_dph
+    );
     assert_eq!((bs.samples_per_mean, bs.means), (10, 100));
     let e = bias_stability_dph(&y, 0.5, 5.2).unwrap_err();
     assert!(e.to_string().contains("integer multiple"), "{e}");
@@ -79,14 +83,20 @@ fn scale_factor_asymmetry_and_nonlinearity() {
     // F = B + K±·Ω: K+ and K− exact by construction.
     let (kp, kn, b) = (1.0002, 0.9998, 0.01);
     let rates = [0.0, 20.0, 0.0, -20.0, 0.0, 50.0, 0.0, -50.0, 0.0];
-    let (t, g, tab) = table_run(&rates, 100, |_, w, _| b + if w > 0.0 { kp * w } else { kn * w });
+    let (t, g, tab) = table_run(&rates, 100, |_, w, _| {
+        b + if w > 0.0 { kp * w } else { kn * w }
+    });
     let r = scale_factor(&t, &g, &tab, &ScaleFactorOptions::default()).unwrap();
     assert_eq!(r.segments.len(), 9);
     assert_eq!(r.rate_points.len(), 5);
     assert!(rel(r.scale_positive.unwrap(), kp) < 1e-12);
     assert!(rel(r.scale_negative.unwrap(), kn) < 1e-12);
     let want_asym = (kp - kn) / ((kp + kn) / 2.0) * 1e6; // 400 ppm
-    assert!(rel(r.asymmetry_ppm.unwrap(), want_asym) < 1e-9, "asym {:?}", r.asymmetry_ppm);
+    assert!(
+        rel(r.asymmetry_ppm.unwrap(), want_asym) < 1e-9,
+        "asym {:?}",
+        r.asymmetry_ppm
+    );
     // Least squares on the 5 rate points, solved here by the normal equations directly.
     let pts: Vec<(f64, f64)> = [-50.0, -20.0, 0.0, 20.0, 50.0]
         .iter()
@@ -94,13 +104,28 @@ fn scale_factor_asymmetry_and_nonlinearity() {
         .collect();
     let n = pts.len() as f64;
     let (sx, sy) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
-    let (sxx, sxy) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 * p.0, a.1 + p.0 * p.1));
+    let (sxx, sxy) = pts
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0 * p.0, a.1 + p.0 * p.1));
     let k = (n * sxy - sx * sy) / (n * sxx - sx * sx);
     let f0 = (sy - k * sx) / n;
-    assert!(rel(r.scale_factor, k) < 1e-12, "K want {k} got {}", r.scale_factor);
+    assert!(
+        rel(r.scale_factor, k) < 1e-12,
+        "K want {k} got {}",
+        r.scale_factor
+    );
     let fmax = pts.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
-    let nl = pts.iter().map(|p| (p.1 - k * p.0 - f0).abs()).fold(0.0, f64::max) / fmax * 1e6;
-    assert!(rel(r.nonlinearity_ppm, nl) < 1e-6, "NL want {nl} got {}", r.nonlinearity_ppm);
+    let nl = pts
+        .iter()
+        .map(|p| (p.1 - k * p.0 - f0).abs())
+        .fold(0.0, f64::max)
+        / fmax
+        * 1e6;
+    assert!(
+        rel(r.nonlinearity_ppm, nl) < 1e-6,
+        "NL want {nl} got {}",
+        r.nonlinearity_ppm
+    );
 }
 
 #[test]
@@ -116,10 +141,18 @@ fn scale_factor_over_time_with_drifting_bias() {
     assert_eq!(r.scale_over_time.len(), 4);
     for (i, s) in r.scale_over_time.iter().enumerate() {
         let want = k0 * (1.0 + 100e-6 * i as f64);
-        assert!(rel(s.scale, want) < 1e-10, "segment {i}: want K {want} got {}", s.scale);
+        assert!(
+            rel(s.scale, want) < 1e-10,
+            "segment {i}: want K {want} got {}",
+            s.scale
+        );
     }
     // Largest deviation: segment 3 vs segment 0 = 300 ppm.
-    assert!((r.sf_thermal_error_ppm - 300.0).abs() < 1e-4, "{}", r.sf_thermal_error_ppm);
+    assert!(
+        (r.sf_thermal_error_ppm - 300.0).abs() < 1e-4,
+        "{}",
+        r.sf_thermal_error_ppm
+    );
     // Without the settle time the 3 °/s spikes would bias every segment mean by 0.15 °/s.
     let no_settle = ScaleFactorOptions {
         settle_s: 0.0,
@@ -131,8 +164,13 @@ fn scale_factor_over_time_with_drifting_bias() {
 
 #[test]
 fn scale_factor_bad_input() {
-    let e = scale_factor(&[0.0, 1.0], &[0.0, 1.0], &[0.0, 0.0], &ScaleFactorOptions::default())
-        .unwrap_err();
+    let e = scale_factor(
+        &[0.0, 1.0],
+        &[0.0, 1.0],
+        &[0.0, 0.0],
+        &ScaleFactorOptions::default(),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("need two distinct rates"), "{e}");
     let e = scale_factor(&[0.0], &[0.0, 1.0], &[0.0], &ScaleFactorOptions::default()).unwrap_err();
     assert!(e.to_string().contains("differ in length"), "{e}");

@@ -123,10 +123,15 @@ fn noise_json(t: &NoiseTerms) -> Value {
             "rate_ramp_deg_h2" => "rate_ramp",
             _ => key,
         };
-        obj.insert(format!("{key}_tau_s"), term.map_or(Value::Null, |x| num(x.tau_read_s)));
+        obj.insert(
+            format!("{key}_tau_s"),
+            term.map_or(Value::Null, |x| num(x.tau_read_s)),
+        );
         obj.insert(
             format!("{key}_fit_tau_s"),
-            term.map_or(Value::Null, |x| json!([num(x.fit_tau_min_s), num(x.fit_tau_max_s)])),
+            term.map_or(Value::Null, |x| {
+                json!([num(x.fit_tau_min_s), num(x.fit_tau_max_s)])
+            }),
         );
     }
     Value::Object(obj)
@@ -211,7 +216,10 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
                     "{label:<22} {:>13.6e} {unit:<10} (read at τ = {:.4} s; fit {:.4}..{:.4} s)",
                     x.value, x.tau_read_s, x.fit_tau_min_s, x.fit_tau_max_s
                 ),
-                None => println!("{label:<22} {:>13} {unit:<10} (no such region on the curve)", "-"),
+                None => println!(
+                    "{label:<22} {:>13} {unit:<10} (no such region on the curve)",
+                    "-"
+                ),
             };
             println!("noise terms (from {}):", noise_from.unwrap_or("oadev"));
             line("angle random walk", "°/√h", t.arw_deg_rt_h);

@@ -74,9 +74,18 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         o.insert("scale_factor".into(), num(r.scale_factor));
         o.insert("intercept_dps".into(), num(r.intercept_dps));
         o.insert("nonlinearity_ppm".into(), num(r.nonlinearity_ppm));
-        o.insert("asymmetry_ppm".into(), r.asymmetry_ppm.map_or(Value::Null, num));
-        o.insert("scale_positive".into(), r.scale_positive.map_or(Value::Null, num));
-        o.insert("scale_negative".into(), r.scale_negative.map_or(Value::Null, num));
+        o.insert(
+            "asymmetry_ppm".into(),
+            r.asymmetry_ppm.map_or(Value::Null, num),
+        );
+        o.insert(
+            "scale_positive".into(),
+            r.scale_positive.map_or(Value::Null, num),
+        );
+        o.insert(
+            "scale_negative".into(),
+            r.scale_negative.map_or(Value::Null, num),
+        );
         o.insert("sf_thermal_error_ppm".into(), num(r.sf_thermal_error_ppm));
         o.insert("reference_scale".into(), num(r.reference_scale));
         o.insert("settle_s".into(), num(args.settle));
@@ -103,7 +112,12 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(ExitCode::SUCCESS);
     }
-    println!("{} ({} samples, τ0 = {} s)", args.column, rate_dps.len(), tau0_s);
+    println!(
+        "{} ({} samples, τ0 = {} s)",
+        args.column,
+        rate_dps.len(),
+        tau0_s
+    );
     println!("bias                 {:>14.6} °/h", bias);
     println!(
         "bias stability       {:>14.6} °/h (1σ of {} means of {} s)",

@@ -251,7 +251,7 @@ fn ln_gamma(x: f64) -> f64 {
 
 /// Regularized lower incomplete gamma P(a, x) = γ(a, x)/Γ(a), a > 0, x ≥ 0.
 pub fn regularized_gamma_p(a: f64, x: f64) -> f64 {
-    if !(a > 0.0) || x.is_nan() {
+    if a.is_nan() || a <= 0.0 || x.is_nan() {
         return f64::NAN;
     }
     if x <= 0.0 {
@@ -348,7 +348,7 @@ mod tests {
     fn chi2_quantiles_match_tables() {
         let cases = [
             (0.95, 1.0, 3.841_459),
-            (0.05, 1.0, 0.003_932_1),
+            (0.05, 1.0, 0.003_932_14),
             (0.95, 10.0, 18.307_038),
             (0.05, 10.0, 3.940_299),
             (0.99, 100.0, 135.806_723),

@@ -34,7 +34,10 @@ pub enum MetricsError {
     /// τ not a positive integer multiple of the sample period.
     TauNotMultiple { tau_s: f64, sample_period_s: f64 },
     /// Fewer than two τ-means fit in the log.
-    TooShort { samples: usize, samples_per_mean: usize },
+    TooShort {
+        samples: usize,
+        samples_per_mean: usize,
+    },
 }
 
 impl fmt::Display for MetricsError {

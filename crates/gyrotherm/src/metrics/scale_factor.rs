@@ -99,7 +99,11 @@ pub struct ScaleFactorReport {
 #[non_exhaustive]
 pub enum ScaleFactorError {
     /// Slices of different lengths.
-    LengthMismatch { time: usize, output: usize, table: usize },
+    LengthMismatch {
+        time: usize,
+        output: usize,
+        table: usize,
+    },
     /// NaN or infinite value.
     NonFinite { column: &'static str, index: usize },
     /// Fewer than two distinct rates (one non-zero) with samples left after settling.
@@ -200,7 +204,11 @@ pub fn scale_factor(
             table: table_dps.len(),
         });
     }
-    for (column, v) in [("time_s", time_s), ("gyro", output_dps), ("table_dps", table_dps)] {
+    for (column, v) in [
+        ("time_s", time_s),
+        ("gyro", output_dps),
+        ("table_dps", table_dps),
+    ] {
         if let Some(index) = v.iter().position(|x| !x.is_finite()) {
             return Err(ScaleFactorError::NonFinite { column, index });
         }
@@ -263,7 +271,9 @@ pub fn scale_factor(
         with_zero.extend(rate_points.iter().copied().filter(|p| p.0.abs() <= tol));
         match fit_line(&with_zero) {
             Some((k, _)) => Some(k),
-            None => Some(signed.iter().map(|p| (p.1 - f0) / p.0).sum::<f64>() / signed.len() as f64),
+            None => {
+                Some(signed.iter().map(|p| (p.1 - f0) / p.0).sum::<f64>() / signed.len() as f64)
+            }
         }
     };
     let scale_positive = side(true);
