@@ -11,5 +11,11 @@ if [ ! -x "$VENV/bin/python" ]; then
     "$VENV/bin/pip" install --quiet allantools numpy
 fi
 echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
-GYROTHERM_ALLAN_N="$N" cargo bench --quiet -p gyrotherm --bench allan 2>/dev/null | grep gyrotherm_oadev
-"$VENV/bin/python" bench/allan_vs_allantools.py "$N"
+RUST_OUT=$(GYROTHERM_ALLAN_N="$N" cargo bench --quiet -p gyrotherm --bench allan 2>/dev/null | grep gyrotherm_oadev)
+echo "$RUST_OUT"
+PY_OUT=$("$VENV/bin/python" bench/allan_vs_allantools.py "$N")
+echo "$PY_OUT"
+# Speed-up of the full gyrotherm run (noise ID + Greenhall bounds) over allantools' oadev.
+RS=$(echo "$RUST_OUT" | sed -n 's/^gyrotherm_oadev_octave_s=\([0-9.]*\).*/\1/p')
+PS=$(echo "$PY_OUT" | sed -n 's/^allantools_oadev_octave_s=\([0-9.]*\).*/\1/p')
+awk -v r="$RS" -v p="$PS" 'BEGIN { printf "speedup=%.1fx\n", p / r }'

@@ -362,3 +362,21 @@ fn tau_list_errors_are_clear() {
         allan::averaging_factors(&TauSet::Seconds(vec![3.0]), DevKind::Adev, 1000, 0.1).unwrap();
     assert_eq!(ms, vec![30]);
 }
+
+/// `max_m` is the last m with a term, by the term-count formulas.
+#[test]
+fn max_m_is_last_with_terms() {
+    for kind in [
+        DevKind::Adev,
+        DevKind::Oadev,
+        DevKind::Mdev,
+        DevKind::Hdev,
+        DevKind::Ohdev,
+    ] {
+        for n in [1usize, 2, 3, 4, 5, 6, 7, 10, 11, 1000, 1001] {
+            let m = kind.max_m(n);
+            let want = (1..=n).rev().find(|&m| kind.terms(n, m) > 0).unwrap_or(0);
+            assert_eq!(m, want, "{} n={n}", kind.name());
+        }
+    }
+}

@@ -1,6 +1,7 @@
 //! `gyrotherm allan`: Allan-family deviation of a rate column, with 68.3 % bounds and noise
 //! terms. JSON: `{"kind", "points": [{"tau_s", "dev", "n", "lo", "hi", …}], "noise": {…}}`.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -43,13 +44,14 @@ fn parse_taus(s: &str) -> Result<TauSet, String> {
     s.parse().map_err(|e: allan::AllanError| e.to_string())
 }
 
-/// Reads the log and picks a numeric column; returns (values, sample period s).
+/// Reads the log and picks a numeric column; returns (log, values, sample period s). The
+/// chosen column is moved out of the log (left empty there) to keep one copy in memory.
 pub(crate) fn read_column(input: &Path, column: &str) -> anyhow::Result<(TestLog, Vec<f64>, f64)> {
-    let (log, _report) = csvlog::read_log(input, &ReadOptions::default())
+    let (mut log, _report) = csvlog::read_log(input, &ReadOptions::default())
         .with_context(|| format!("reading {}", input.display()))?;
     let values = match column {
-        "gyro_dps" => log.gyro_dps.clone(),
-        "temp_c" => log.temp_c.clone(),
+        "gyro_dps" => std::mem::take(&mut log.gyro_dps),
+        "temp_c" => std::mem::take(&mut log.temp_c),
         "time_s" => log.time_s.clone(),
         "table_dps" => match &log.table_dps {
             Some(t) => t.clone(),
@@ -138,6 +140,7 @@ fn noise_json(t: &NoiseTerms) -> Value {
 }
 
 pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
+    let mut w = std::io::stdout().lock();
     if args.plot.is_some() {
         bail!("--plot is not available yet; use --json and plot the points");
     }
@@ -186,47 +189,57 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
             "noise": noise.as_ref().map_or(Value::Null, noise_json),
             "noise_from": noise_from,
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        writeln!(w, "{}", serde_json::to_string_pretty(&out)?)?;
         return Ok(ExitCode::SUCCESS);
     }
-    println!(
+    writeln!(
+        w,
         "{} of {} ({} samples, τ0 = {} s; 68.3 % bounds from Greenhall EDF)",
         args.kind.name().to_uppercase(),
         args.column,
         values.len(),
         tau0_s
-    );
-    println!(
+    )?;
+    writeln!(
+        w,
         "{:>12} {:>10} {:>10} {:>5} {:>13} {:>13} {:>13}",
         "tau_s", "m", "n", "alpha", "lo", "dev", "hi"
-    );
+    )?;
     for p in &points {
-        println!(
+        writeln!(
+            w,
             "{:>12.6} {:>10} {:>10} {:>5} {:>13.6e} {:>13.6e} {:>13.6e}",
             p.tau_s, p.m, p.n, p.alpha, p.lo, p.dev, p.hi
-        );
+        )?;
     }
     match noise {
-        None => println!(
+        None => writeln!(
+            w,
             "noise terms: column unit unknown (name it *_dps, *_dph or *_rad_s for noise terms)"
-        ),
+        )?,
         Some(t) => {
-            let line = |label: &str, unit: &str, term: Option<allan::NoiseTerm>| match term {
-                Some(x) => println!(
-                    "{label:<22} {:>13.6e} {unit:<10} (read at τ = {:.4} s; fit {:.4}..{:.4} s)",
-                    x.value, x.tau_read_s, x.fit_tau_min_s, x.fit_tau_max_s
-                ),
-                None => println!(
-                    "{label:<22} {:>13} {unit:<10} (no such region on the curve)",
-                    "-"
-                ),
-            };
-            println!("noise terms (from {}):", noise_from.unwrap_or("oadev"));
-            line("angle random walk", "°/√h", t.arw_deg_rt_h);
-            line("bias instability", "°/h", t.bias_instability_dph);
-            line("rate random walk", "°/h/√h", t.rrw_deg_h_rt_h);
-            line("quantization", "arcsec", t.quantization_arcsec);
-            line("rate ramp", "°/h²", t.rate_ramp_deg_h2);
+            writeln!(w, "noise terms (from {}):", noise_from.unwrap_or("oadev"))?;
+            let rows = [
+                ("angle random walk", "°/√h", t.arw_deg_rt_h),
+                ("bias instability", "°/h", t.bias_instability_dph),
+                ("rate random walk", "°/h/√h", t.rrw_deg_h_rt_h),
+                ("quantization", "arcsec", t.quantization_arcsec),
+                ("rate ramp", "°/h²", t.rate_ramp_deg_h2),
+            ];
+            for (label, unit, term) in rows {
+                match term {
+                    Some(x) => writeln!(
+                        w,
+                        "{label:<22} {:>13.6e} {unit:<10} (read at τ = {:.4} s; fit {:.4}..{:.4} s)",
+                        x.value, x.tau_read_s, x.fit_tau_min_s, x.fit_tau_max_s
+                    )?,
+                    None => writeln!(
+                        w,
+                        "{label:<22} {:>13} {unit:<10} (no such region on the curve)",
+                        "-"
+                    )?,
+                }
+            }
         }
     }
     Ok(ExitCode::SUCCESS)

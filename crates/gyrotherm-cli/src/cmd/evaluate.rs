@@ -1,6 +1,7 @@
 //! `gyrotherm evaluate`: bias, bias stability and, for rate-table logs, the scale-factor
 //! figures (IEEE Std 952 / GJB 2426A definitions).
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -41,6 +42,7 @@ fn num(v: f64) -> Value {
 }
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
+    let mut w = std::io::stdout().lock();
     let (log, values, tau0_s) = read_column(&args.input, &args.column)?;
     let Some(to_dph) = to_dph_factor(&args.column) else {
         bail!(
@@ -109,31 +111,33 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         sf_report = Some(r);
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        writeln!(w, "{}", serde_json::to_string_pretty(&out)?)?;
         return Ok(ExitCode::SUCCESS);
     }
-    println!(
+    writeln!(
+        w,
         "{} ({} samples, τ0 = {} s)",
         args.column,
         rate_dps.len(),
         tau0_s
-    );
-    println!("bias                 {:>14.6} °/h", bias);
-    println!(
+    )?;
+    writeln!(w, "bias                 {:>14.6} °/h", bias)?;
+    writeln!(
+        w,
         "bias stability       {:>14.6} °/h (1σ of {} means of {} s)",
         stab.bias_stability_dph, stab.means, stab.tau_s
-    );
+    )?;
     if let Some(r) = sf_report {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.3}"));
-        println!("scale factor         {:>14.9}", r.scale_factor);
-        println!("nonlinearity         {:>14.3} ppm", r.nonlinearity_ppm);
-        println!("asymmetry            {:>14} ppm", opt(r.asymmetry_ppm));
-        println!(
+        writeln!(w, "scale factor         {:>14.9}", r.scale_factor)?;
+        writeln!(w, "nonlinearity         {:>14.3} ppm", r.nonlinearity_ppm)?;
+        writeln!(w, "asymmetry            {:>14} ppm", opt(r.asymmetry_ppm))?;
+        writeln!(w,
             "SF thermal error     {:>14.3} ppm (max |K(t) − K_ref|, K_ref = {:.9}, {} rate segments)",
             r.sf_thermal_error_ppm,
             r.reference_scale,
             r.scale_over_time.len()
-        );
+        )?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -75,6 +75,16 @@ impl DevKind {
         }
     }
 
+    /// Largest m that leaves at least one term (0 if none).
+    pub fn max_m(self, n_samples: usize) -> usize {
+        let n = n_samples;
+        match self {
+            DevKind::Adev | DevKind::Oadev => n / 2,
+            DevKind::Mdev => (n + 1) / 3,
+            DevKind::Hdev | DevKind::Ohdev => n / 3,
+        }
+    }
+
     /// Largest m used by the automatic τ sets (`octave`, `decade`, `all`): ⌊N/5⌋ for the
     /// non-overlapping estimators, ⌊N/4⌋ otherwise — the limits Stable32 uses (they reproduce
     /// the τ lists of the reference files in METHOD.md).
@@ -266,10 +276,7 @@ pub fn averaging_factors(
         TauSet::All => (1..=max_auto).collect(),
         TauSet::Seconds(taus) => {
             let mut v = Vec::with_capacity(taus.len());
-            let max_m = (1..=n_samples)
-                .rev()
-                .find(|&m| kind.terms(n_samples, m) > 0)
-                .unwrap_or(0);
+            let max_m = kind.max_m(n_samples);
             let max_tau_s = max_m as f64 * tau0_s;
             for &tau_s in taus {
                 if !(tau_s.is_finite() && tau_s > 0.0) {
