@@ -380,3 +380,32 @@ fn max_m_is_last_with_terms() {
         }
     }
 }
+
+/// Lag-1 autocorrelation noise ID (Riley & Greenhall 2004) gives Stable32's α at every octave
+/// τ with at least 30 averages (the method's range; Stable32 uses it there too).
+#[test]
+fn stable32_noise_id_alpha() {
+    for (kind, file) in [
+        (DevKind::Adev, "adev_octave.txt"),
+        (DevKind::Oadev, "oadev_octave.txt"),
+    ] {
+        let (Some(data), Some(table)) = (reference("ocxo_frequency.txt"), reference(file)) else {
+            return;
+        };
+        let y = ocxo_fractional_frequency(&data);
+        let pts = deviation(&y, 1.0, kind, &TauSet::Octave, NoiseModel::Identify).unwrap();
+        let rows = stable32_rows(&table);
+        let mut checked = 0;
+        for (p, r) in pts.iter().zip(&rows) {
+            if y.len() / p.m >= allan::noise_id::MIN_AVERAGES {
+                assert_eq!(
+                    p.alpha, r.3,
+                    "{file} m={}: Stable32 α {} ours {}",
+                    p.m, r.3, p.alpha
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 10, "{file}: octave τ with ≥ 30 averages");
+    }
+}

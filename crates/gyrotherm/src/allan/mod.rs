@@ -22,12 +22,12 @@
 //! over a stream of chunks (a log larger than memory) in O(m_max) memory.
 
 mod edf;
-mod noise_id;
+pub mod noise_id;
 mod streaming;
 mod terms;
 
 pub use edf::{chi2_inv, edf_greenhall, edf_simple, regularized_gamma_p, ONE_SIGMA_CI};
-pub use noise_id::{lag1_noise_id, lag1_noise_id_from_phase, NoiseId};
+pub use noise_id::{b1_noise_id_from_phase, lag1_noise_id, lag1_noise_id_from_phase, NoiseId};
 pub use streaming::StreamingOadev;
 pub use terms::{noise_terms, NoiseTerm, NoiseTerms};
 
@@ -483,7 +483,8 @@ pub fn deviation_from_phase(x: &[f64], kind: DevKind, m: usize) -> Option<(f64, 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum NoiseModel {
     /// Identify α at every τ by the lag-1 autocorrelation method (Riley & Greenhall 2004);
-    /// for τ with fewer than 30 averages the α of the previous τ is kept.
+    /// for τ with fewer than 30 averages by the B1 ratio and R(n) (as Stable32 does), and
+    /// with fewer than 4 the α of the previous τ is kept.
     #[default]
     Identify,
     /// Use this α at every τ.
@@ -525,6 +526,8 @@ pub fn deviation(
             NoiseModel::Identify => {
                 if let Some(id) = lag1_noise_id_from_phase(&x, m, kind.diff_order()) {
                     last_alpha = id.alpha;
+                } else if let Some(a) = b1_noise_id_from_phase(&x, m) {
+                    last_alpha = a;
                 }
                 last_alpha
             }

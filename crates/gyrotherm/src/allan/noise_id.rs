@@ -112,3 +112,68 @@ fn identify(mut x: Vec<f64>, dmax: u32) -> Option<NoiseId> {
         d += 1;
     }
 }
+
+/// Expected B1 ratio (standard variance of N averages / Allan variance) for the power-law
+/// exponent μ of σ²(τ) ∝ τ^μ (Barnes' bias function; Riley, Handbook of Frequency Stability
+/// Analysis, NIST SP 1065 §5.5.3).
+fn b1_theory(n: f64, mu: i32) -> f64 {
+    match mu {
+        1 => n / 2.0,
+        0 => n * n.ln() / (2.0 * (n - 1.0) * std::f64::consts::LN_2),
+        -1 => 1.0,
+        _ => (n * n - 1.0) / (1.5 * n * (n - 1.0)),
+    }
+}
+
+/// Fewest averages for the B1 method.
+pub const B1_MIN_AVERAGES: usize = 4;
+
+/// Noise identification for τ with too few averages for the lag-1 method (Stable32's
+/// fallback): the B1 ratio picks α ∈ {−2, −1, 0, ≥1} by the geometric-mean boundaries of
+/// [`b1_theory`]; for α ≥ 1 the ratio R(n) = MVAR/AVAR separates flicker PM (α = 1) from
+/// white PM (α = 2) (R(n) = 1/m for white PM; IEEE Std 1139 table for flicker PM with
+/// f_h = 1/(2τ0)). `phase` as made by [`super::phase_from_rate`].
+pub fn b1_noise_id_from_phase(phase: &[f64], m: usize) -> Option<i32> {
+    if m == 0 || phase.is_empty() {
+        return None;
+    }
+    let groups = (phase.len() - 1) / m;
+    if groups < B1_MIN_AVERAGES {
+        return None;
+    }
+    let y: Vec<f64> = (0..groups)
+        .map(|j| (phase[(j + 1) * m] - phase[j * m]) / m as f64)
+        .collect();
+    let n = groups as f64;
+    let mean = y.iter().sum::<f64>() / n;
+    let var = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let avar = y.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / (2.0 * (n - 1.0));
+    if !(avar > 0.0 && var.is_finite()) {
+        return None;
+    }
+    let b1 = var / avar;
+    let bound = |mu_hi: i32, mu_lo: i32| (b1_theory(n, mu_hi) * b1_theory(n, mu_lo)).sqrt();
+    let alpha = if b1 < bound(-2, -1) {
+        // α = 1 or 2: R(n) = MVAR/AVAR.
+        let mdev = super::deviation_from_phase(phase, super::DevKind::Mdev, m)?.0;
+        let adev = super::deviation_from_phase(phase, super::DevKind::Oadev, m)?.0;
+        let rn = (mdev / adev).powi(2);
+        let pi2 = std::f64::consts::PI.powi(2);
+        let rn_white_pm = 1.0 / m as f64;
+        let avar_fpm = (1.038 + 3.0 * (std::f64::consts::PI * m as f64).ln()) / (4.0 * pi2);
+        let mvar_fpm = 3.0 * (256.0f64 / 27.0).ln() / (8.0 * pi2);
+        let rn_flicker_pm = mvar_fpm / avar_fpm;
+        if rn < (rn_white_pm * rn_flicker_pm).sqrt() {
+            2
+        } else {
+            1
+        }
+    } else if b1 < bound(-1, 0) {
+        0
+    } else if b1 < bound(0, 1) {
+        -1
+    } else {
+        -2
+    };
+    Some(alpha)
+}
