@@ -1,0 +1,578 @@
+//! Allan-family deviations of rate (or fractional-frequency) data, with confidence intervals
+//! and noise-term identification (IEEE Std 952-1997 Annex C; NIST SP 1065 §5.2).
+//!
+//! Rate data Ω (any unit) sampled every τ0 is integrated to the "phase"
+//! θ_k = Σ_{i<k} Ω_i·τ0 (leading 0, N+1 points). With τ = m·τ0 (m the averaging factor):
+//!
+//! - ADEV (non-overlapping): σ² = Σ_{k=0,m,2m,…} (θ_{k+2m} − 2θ_{k+m} + θ_k)² / (2τ²·n),
+//!   n = ⌊N/m⌋ − 1 terms.
+//! - OADEV (overlapping): the same sum over every k, n = N + 1 − 2m terms (METHOD.md).
+//! - MDEV: σ² = Σ_j (Σ_{i=j}^{j+m−1} θ_{i+2m} − 2θ_{i+m} + θ_i)² / (2m²τ²·n), n = N + 2 − 3m.
+//! - HDEV: non-overlapping Hadamard, σ² = Σ_{k=0,m,…} (θ_{k+3m} − 3θ_{k+2m} + 3θ_{k+m} − θ_k)²
+//!   / (6τ²·n), n = ⌊N/m⌋ − 2. This is what Stable32 calls "Hadamard" and what NIST SP 1065's
+//!   table lists as HDEV (both reference sets in METHOD.md are this estimator).
+//! - OHDEV: the overlapping Hadamard deviation, n = N + 1 − 3m.
+//!
+//! Frequency data y is the same math as rate data Ω (τ0 cancels: θ is kept in units of
+//! Ω·τ0 internally). The mean is removed before integrating, which leaves every deviation
+//! unchanged in exact arithmetic and keeps θ small for precision on long logs.
+//!
+//! Memory: one extra f64 array (θ) of N + 1 values. OADEV for a set of τ runs in one blocked
+//! pass over θ (O(N) per τ, cache-friendly for octave sets). [`StreamingOadev`] computes OADEV
+//! over a stream of chunks (a log larger than memory) in O(m_max) memory.
+
+mod edf;
+pub mod noise_id;
+mod streaming;
+mod terms;
+
+pub use edf::{chi2_inv, edf_greenhall, edf_simple, regularized_gamma_p, ONE_SIGMA_CI};
+pub use noise_id::{b1_noise_id_from_phase, lag1_noise_id, lag1_noise_id_from_phase, NoiseId};
+pub use streaming::StreamingOadev;
+pub use terms::{noise_terms, NoiseTerm, NoiseTerms};
+
+use std::fmt;
+
+/// Which deviation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DevKind {
+    /// Non-overlapping Allan deviation.
+    Adev,
+    /// Overlapping Allan deviation.
+    Oadev,
+    /// Modified Allan deviation.
+    Mdev,
+    /// Non-overlapping Hadamard deviation (Stable32 "Hadamard").
+    Hdev,
+    /// Overlapping Hadamard deviation.
+    Ohdev,
+}
+
+impl DevKind {
+    /// Lower-case name as used on the command line and in JSON (`"oadev"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DevKind::Adev => "adev",
+            DevKind::Oadev => "oadev",
+            DevKind::Mdev => "mdev",
+            DevKind::Hdev => "hdev",
+            DevKind::Ohdev => "ohdev",
+        }
+    }
+
+    /// Number of terms in the sum for N rate samples and averaging factor m (0 if none).
+    pub fn terms(self, n_samples: usize, m: usize) -> usize {
+        if m == 0 {
+            return 0;
+        }
+        let n = n_samples;
+        match self {
+            DevKind::Adev => (n / m).saturating_sub(1),
+            DevKind::Oadev => (n + 1).saturating_sub(2 * m),
+            DevKind::Mdev => (n + 2).saturating_sub(3 * m),
+            DevKind::Hdev => (n / m).saturating_sub(2),
+            DevKind::Ohdev => (n + 1).saturating_sub(3 * m),
+        }
+    }
+
+    /// Largest m that leaves at least one term (0 if none).
+    pub fn max_m(self, n_samples: usize) -> usize {
+        let n = n_samples;
+        match self {
+            DevKind::Adev | DevKind::Oadev => n / 2,
+            DevKind::Mdev => (n + 1) / 3,
+            DevKind::Hdev | DevKind::Ohdev => n / 3,
+        }
+    }
+
+    /// Largest m used by the automatic τ sets (`octave`, `decade`, `all`): ⌊N/5⌋ for the
+    /// non-overlapping estimators, ⌊N/4⌋ otherwise — the limits Stable32 uses (they reproduce
+    /// the τ lists of the reference files in METHOD.md).
+    pub fn auto_max_m(self, n_samples: usize) -> usize {
+        match self {
+            DevKind::Adev | DevKind::Hdev => n_samples / 5,
+            _ => n_samples / 4,
+        }
+    }
+
+    /// Order of the difference (2: Allan, 3: Hadamard) for EDF and noise identification.
+    fn diff_order(self) -> u32 {
+        match self {
+            DevKind::Hdev | DevKind::Ohdev => 3,
+            _ => 2,
+        }
+    }
+}
+
+impl std::str::FromStr for DevKind {
+    type Err = AllanError;
+    fn from_str(s: &str) -> Result<Self, AllanError> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "adev" => Ok(DevKind::Adev),
+            "oadev" => Ok(DevKind::Oadev),
+            "mdev" => Ok(DevKind::Mdev),
+            "hdev" => Ok(DevKind::Hdev),
+            "ohdev" => Ok(DevKind::Ohdev),
+            other => Err(AllanError::BadKind(other.to_string())),
+        }
+    }
+}
+
+/// Which τ values to evaluate.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TauSet {
+    /// m = 1, 2, 4, 8, … up to [`DevKind::auto_max_m`].
+    Octave,
+    /// m = 1, 2, 5, 10, 20, 50, … up to [`DevKind::auto_max_m`].
+    Decade,
+    /// Every m from 1 to [`DevKind::auto_max_m`] (O(N) work per τ: for short logs).
+    All,
+    /// Explicit τ values in seconds; each must be an integer multiple of τ0.
+    Seconds(Vec<f64>),
+}
+
+impl std::str::FromStr for TauSet {
+    type Err = AllanError;
+    /// `octave`, `decade`, `all`, or a comma-separated list of seconds (`1,10,100`).
+    fn from_str(s: &str) -> Result<Self, AllanError> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "octave" => Ok(TauSet::Octave),
+            "decade" => Ok(TauSet::Decade),
+            "all" => Ok(TauSet::All),
+            list => {
+                let taus = list
+                    .split(',')
+                    .map(|t| {
+                        t.trim().parse::<f64>().map_err(|_| {
+                            AllanError::BadTauList(format!(
+                                "`{t}` is not a number; give octave, decade, all or seconds like 1,10,100"
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<f64>, _>>()?;
+                Ok(TauSet::Seconds(taus))
+            }
+        }
+    }
+}
+
+/// Why a deviation could not be computed.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum AllanError {
+    /// Unknown kind name.
+    BadKind(String),
+    /// A τ list that does not parse.
+    BadTauList(String),
+    /// τ0 not finite and positive.
+    BadSamplePeriod(f64),
+    /// A sample is NaN or infinite.
+    NonFinite { index: usize },
+    /// τ is not an integer multiple of τ0.
+    TauNotMultiple { tau_s: f64, tau0_s: f64 },
+    /// τ leaves no term in the sum (too long for the log, or not positive).
+    TauOutOfRange { tau_s: f64, max_tau_s: f64 },
+    /// Too few samples for any τ.
+    TooShort { samples: usize, need: usize },
+}
+
+impl fmt::Display for AllanError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AllanError::BadKind(k) => {
+                write!(f, "unknown deviation kind `{k}`; use adev, oadev, mdev, hdev or ohdev")
+            }
+            AllanError::BadTauList(m) => write!(f, "bad τ list: {m}"),
+            AllanError::BadSamplePeriod(t) => {
+                write!(f, "sample period {t} s is not a positive finite number; check the time column")
+            }
+            AllanError::NonFinite { index } => {
+                write!(f, "sample {index} is NaN or infinite; clean or fill the log first")
+            }
+            AllanError::TauNotMultiple { tau_s, tau0_s } => write!(
+                f,
+                "τ = {tau_s} s is not an integer multiple of the sample period {tau0_s} s; pick a multiple"
+            ),
+            AllanError::TauOutOfRange { tau_s, max_tau_s } => write!(
+                f,
+                "τ = {tau_s} s is out of range for this log (allowed: τ0 ≤ τ ≤ {max_tau_s} s)"
+            ),
+            AllanError::TooShort { samples, need } => write!(
+                f,
+                "{samples} samples is too short for this deviation (need at least {need})"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for AllanError {}
+
+/// One point of a deviation curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AllanPoint {
+    /// Averaging factor m (τ = m·τ0).
+    pub m: usize,
+    /// τ, s.
+    pub tau_s: f64,
+    /// The deviation, in the unit of the input samples.
+    pub dev: f64,
+    /// Number of terms in the sum.
+    pub n: usize,
+    /// Noise exponent α (S(f) ∝ f^α) used for the EDF.
+    pub alpha: i32,
+    /// Equivalent degrees of freedom (Greenhall & Riley 2003), NaN when not defined.
+    pub edf: f64,
+    /// Lower 68.3 % bound: σ·√(edf/χ²(0.8413, edf)).
+    pub lo: f64,
+    /// Upper 68.3 % bound: σ·√(edf/χ²(0.1587, edf)).
+    pub hi: f64,
+}
+
+/// Checks τ0 and the samples (finite).
+fn check_input(samples: &[f64], tau0_s: f64) -> Result<(), AllanError> {
+    if !(tau0_s.is_finite() && tau0_s > 0.0) {
+        return Err(AllanError::BadSamplePeriod(tau0_s));
+    }
+    if let Some(index) = samples.iter().position(|v| !v.is_finite()) {
+        return Err(AllanError::NonFinite { index });
+    }
+    Ok(())
+}
+
+/// Averaging factors for a τ set, ascending and unique. Explicit τ must be positive integer
+/// multiples of τ0 (to 1e-9 relative) that leave at least one term.
+pub fn averaging_factors(
+    set: &TauSet,
+    kind: DevKind,
+    n_samples: usize,
+    tau0_s: f64,
+) -> Result<Vec<usize>, AllanError> {
+    if !(tau0_s.is_finite() && tau0_s > 0.0) {
+        return Err(AllanError::BadSamplePeriod(tau0_s));
+    }
+    let max_auto = kind.auto_max_m(n_samples).max(1);
+    let mut ms: Vec<usize> = match set {
+        TauSet::Octave => std::iter::successors(Some(1usize), |m| m.checked_mul(2))
+            .take_while(|&m| m <= max_auto)
+            .collect(),
+        TauSet::Decade => {
+            let mut v = Vec::new();
+            let mut dec = 1usize;
+            'outer: loop {
+                for k in [1, 2, 5] {
+                    let m = dec.saturating_mul(k);
+                    if m > max_auto {
+                        break 'outer;
+                    }
+                    v.push(m);
+                }
+                dec = match dec.checked_mul(10) {
+                    Some(d) => d,
+                    None => break,
+                };
+            }
+            v
+        }
+        TauSet::All => (1..=max_auto).collect(),
+        TauSet::Seconds(taus) => {
+            let mut v = Vec::with_capacity(taus.len());
+            let max_m = kind.max_m(n_samples);
+            let max_tau_s = max_m as f64 * tau0_s;
+            for &tau_s in taus {
+                if !(tau_s.is_finite() && tau_s > 0.0) {
+                    return Err(AllanError::TauOutOfRange { tau_s, max_tau_s });
+                }
+                let ratio = tau_s / tau0_s;
+                let m = ratio.round();
+                if (ratio - m).abs() > 1e-9 * ratio.max(1.0) {
+                    return Err(AllanError::TauNotMultiple { tau_s, tau0_s });
+                }
+                if m < 1.0 || m > max_m as f64 {
+                    return Err(AllanError::TauOutOfRange { tau_s, max_tau_s });
+                }
+                v.push(m as usize);
+            }
+            v
+        }
+    };
+    ms.retain(|&m| kind.terms(n_samples, m) > 0);
+    ms.sort_unstable();
+    ms.dedup();
+    if ms.is_empty() {
+        return Err(AllanError::TooShort {
+            samples: n_samples,
+            need: match kind.diff_order() {
+                3 => 3,
+                _ => 2,
+            },
+        });
+    }
+    Ok(ms)
+}
+
+/// θ: cumulative sum of (Ω − mean Ω) with a leading 0, in units of Ω·τ0 (N + 1 values).
+/// Compensated (Neumaier) summation keeps θ accurate on 1e8-sample logs.
+pub fn phase_from_rate(samples: &[f64]) -> Vec<f64> {
+    let mean = if samples.is_empty() {
+        0.0
+    } else {
+        samples.iter().sum::<f64>() / samples.len() as f64
+    };
+    let mut x = Vec::with_capacity(samples.len() + 1);
+    x.push(0.0);
+    let (mut s, mut c) = (0.0f64, 0.0f64);
+    for &v in samples {
+        let v = v - mean;
+        let t = s + v;
+        if s.abs() >= v.abs() {
+            c += (s - t) + v;
+        } else {
+            c += (v - t) + s;
+        }
+        s = t;
+        x.push(s + c);
+    }
+    x
+}
+
+/// Σ_k (θ_{k+2m} − 2θ_{k+m} + θ_k)² for each m of a set. The k range is split across up to
+/// `available_parallelism` threads (at least 1e6 k per thread); each thread makes one blocked
+/// pass (each block of θ is read once for all m, and octave offsets share cache lines).
+fn overlapping_second_diff_sums(x: &[f64], ms: &[usize]) -> Vec<f64> {
+    const MIN_PER_THREAD: usize = 1_000_000;
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(8)
+        .min(x.len() / MIN_PER_THREAD)
+        .max(1);
+    if threads == 1 {
+        return second_diff_sums_range(x, ms, 0, x.len());
+    }
+    let step = x.len().div_ceil(threads);
+    let parts: Vec<Vec<f64>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                let (k0, k1) = (t * step, ((t + 1) * step).min(x.len()));
+                s.spawn(move || second_diff_sums_range(x, ms, k0, k1))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    let mut sums = vec![0.0; ms.len()];
+    for p in parts {
+        for (s, v) in sums.iter_mut().zip(p) {
+            *s += v;
+        }
+    }
+    sums
+}
+
+/// The sums of [`overlapping_second_diff_sums`] over k in [k_start, k_end).
+fn second_diff_sums_range(x: &[f64], ms: &[usize], k_start: usize, k_end: usize) -> Vec<f64> {
+    const BLOCK: usize = 2048;
+    let len = x.len();
+    let mut sums = vec![0.0f64; ms.len()];
+    let mut k0 = k_start;
+    while k0 < k_end {
+        let k1 = (k0 + BLOCK).min(k_end);
+        let mut any = false;
+        for (sum, &m) in sums.iter_mut().zip(ms) {
+            let kmax = len.saturating_sub(2 * m); // k < len − 2m
+            if k0 >= kmax {
+                continue;
+            }
+            any = true;
+            let end = k1.min(kmax);
+            let a = &x[k0..end];
+            let b = &x[k0 + m..end + m];
+            let c = &x[k0 + 2 * m..end + 2 * m];
+            let mut acc = [0.0f64; 4];
+            let (ac, bc, cc) = (a.chunks_exact(4), b.chunks_exact(4), c.chunks_exact(4));
+            let (ar, br, cr) = (ac.remainder(), bc.remainder(), cc.remainder());
+            for ((a4, b4), c4) in ac.zip(bc).zip(cc) {
+                for l in 0..4 {
+                    let d = c4[l] - 2.0 * b4[l] + a4[l];
+                    acc[l] += d * d;
+                }
+            }
+            for ((a1, b1), c1) in ar.iter().zip(br).zip(cr) {
+                let d = c1 - 2.0 * b1 + a1;
+                acc[0] += d * d;
+            }
+            *sum += (acc[0] + acc[1]) + (acc[2] + acc[3]);
+        }
+        if !any {
+            break;
+        }
+        k0 = k1;
+    }
+    sums
+}
+
+/// Deviation from θ (as made by [`phase_from_rate`]) for one m; returns (σ, terms) in the
+/// unit of the samples, or None when no term fits.
+pub fn deviation_from_phase(x: &[f64], kind: DevKind, m: usize) -> Option<(f64, usize)> {
+    if x.is_empty() || m == 0 {
+        return None;
+    }
+    let n_samples = x.len() - 1;
+    let n = kind.terms(n_samples, m);
+    if n == 0 {
+        return None;
+    }
+    let mf = m as f64;
+    let var = match kind {
+        DevKind::Oadev => overlapping_second_diff_sums(x, &[m])[0] / (2.0 * mf * mf * n as f64),
+        DevKind::Adev => {
+            let s: f64 = (0..n)
+                .map(|j| {
+                    let k = j * m;
+                    let d = x[k + 2 * m] - 2.0 * x[k + m] + x[k];
+                    d * d
+                })
+                .sum();
+            s / (2.0 * mf * mf * n as f64)
+        }
+        DevKind::Hdev | DevKind::Ohdev => {
+            let stride = if kind == DevKind::Hdev { m } else { 1 };
+            let s: f64 = (0..n)
+                .map(|j| {
+                    let k = j * stride;
+                    let d = x[k + 3 * m] - 3.0 * x[k + 2 * m] + 3.0 * x[k + m] - x[k];
+                    d * d
+                })
+                .sum();
+            s / (6.0 * mf * mf * n as f64)
+        }
+        DevKind::Mdev => {
+            // s_j = Σ_{i=j}^{j+m−1} d_i with d_i the second difference at lag m; s_{j+1} =
+            // s_j + d_{j+m} − d_j, the running sum kept with Neumaier compensation.
+            let d = |i: usize| x[i + 2 * m] - 2.0 * x[i + m] + x[i];
+            let (mut s, mut c) = (0.0f64, 0.0f64);
+            let add = |s: &mut f64, c: &mut f64, v: f64| {
+                let t = *s + v;
+                if s.abs() >= v.abs() {
+                    *c += (*s - t) + v;
+                } else {
+                    *c += (v - t) + *s;
+                }
+                *s = t;
+            };
+            for i in 0..m {
+                add(&mut s, &mut c, d(i));
+            }
+            let mut total = 0.0f64;
+            for j in 0..n {
+                let v = s + c;
+                total += v * v;
+                if j + 1 < n {
+                    add(&mut s, &mut c, d(j + m));
+                    add(&mut s, &mut c, -d(j));
+                }
+            }
+            total / (2.0 * mf.powi(4) * n as f64)
+        }
+    };
+    Some((var.max(0.0).sqrt(), n))
+}
+
+/// How to compute the confidence intervals.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum NoiseModel {
+    /// Identify α at every τ by the lag-1 autocorrelation method (Riley & Greenhall 2004);
+    /// for τ with fewer than 30 averages by the B1 ratio and R(n) (as Stable32 does), and
+    /// with fewer than 4 the α of the previous τ is kept.
+    #[default]
+    Identify,
+    /// Use this α at every τ.
+    Alpha(i32),
+}
+
+/// Deviation curve of rate (or fractional-frequency) samples taken every `tau0_s` seconds,
+/// with terms, α, Greenhall EDF and 68.3 % bounds at every τ of the set.
+pub fn deviation(
+    samples: &[f64],
+    tau0_s: f64,
+    kind: DevKind,
+    taus: &TauSet,
+    noise: NoiseModel,
+) -> Result<Vec<AllanPoint>, AllanError> {
+    check_input(samples, tau0_s)?;
+    let ms = averaging_factors(taus, kind, samples.len(), tau0_s)?;
+    let x = phase_from_rate(samples);
+    let devs: Vec<(f64, usize)> = if kind == DevKind::Oadev {
+        let sums = overlapping_second_diff_sums(&x, &ms);
+        ms.iter()
+            .zip(sums)
+            .map(|(&m, s)| {
+                let n = kind.terms(samples.len(), m);
+                let mf = m as f64;
+                ((s / (2.0 * mf * mf * n as f64)).max(0.0).sqrt(), n)
+            })
+            .collect()
+    } else {
+        ms.iter()
+            .map(|&m| deviation_from_phase(&x, kind, m).unwrap_or((f64::NAN, 0)))
+            .collect()
+    };
+    let mut last_alpha = 0i32;
+    let mut points = Vec::with_capacity(ms.len());
+    for (&m, (dev, n)) in ms.iter().zip(devs) {
+        let alpha = match noise {
+            NoiseModel::Alpha(a) => a,
+            NoiseModel::Identify => {
+                if let Some(id) = lag1_noise_id_from_phase(&x, m, kind.diff_order()) {
+                    last_alpha = id.alpha;
+                } else if let Some(a) = b1_noise_id_from_phase(&x, m) {
+                    last_alpha = a;
+                }
+                last_alpha
+            }
+        };
+        let (edf, lo, hi) = confidence(kind, dev, alpha, m, samples.len());
+        points.push(AllanPoint {
+            m,
+            tau_s: m as f64 * tau0_s,
+            dev,
+            n,
+            alpha,
+            edf,
+            lo,
+            hi,
+        });
+    }
+    Ok(points)
+}
+
+/// EDF and 68.3 % bounds of one deviation: Greenhall's EDF for α clamped to the range the
+/// estimator converges for (α + 2d > 1, α ≤ 2); NaN bounds when no EDF is defined.
+pub fn confidence(
+    kind: DevKind,
+    dev: f64,
+    alpha: i32,
+    m: usize,
+    n_samples: usize,
+) -> (f64, f64, f64) {
+    let d = kind.diff_order();
+    let alpha = alpha.clamp(2 - 2 * d as i32, 2);
+    let (overlapping, modified) = match kind {
+        DevKind::Adev | DevKind::Hdev => (false, false),
+        DevKind::Oadev | DevKind::Ohdev => (true, false),
+        DevKind::Mdev => (true, true),
+    };
+    // Greenhall counts phase points: N + 1 for N rate samples.
+    let edf = edf_greenhall(alpha, d, m, n_samples + 1, overlapping, modified);
+    match edf {
+        Some(edf) if edf.is_finite() && edf > 0.0 => {
+            let lo_q = (1.0 - ONE_SIGMA_CI) / 2.0;
+            let hi_q = 1.0 - lo_q;
+            let lo = dev * (edf / chi2_inv(hi_q, edf)).sqrt();
+            let hi = dev * (edf / chi2_inv(lo_q, edf)).sqrt();
+            (edf, lo, hi)
+        }
+        _ => (f64::NAN, f64::NAN, f64::NAN),
+    }
+}
