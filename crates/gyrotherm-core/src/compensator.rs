@@ -268,6 +268,11 @@ impl Compensator {
         })
     }
 
+    /// The feature vector of the latest step (None before the first sample).
+    pub fn features(&self) -> Option<&Features> {
+        self.pipeline.current()
+    }
+
     /// Start over: clear the feature history, the LSTM states and the held values.
     pub fn reset(&mut self) {
         self.pipeline.reset();

@@ -115,3 +115,152 @@ pub fn compensate_log(model: &ModelFile, log: &TestLog) -> Result<Compensated, S
     }
     Ok(out)
 }
+
+/// Warnings, with the numbers, when `log` leaves the model's training temperature or
+/// temperature-rate range (the model then extrapolates).
+pub fn extrapolation_warnings(model: &ModelFile, log: &TestLog) -> Vec<String> {
+    let Ok(spec) = model.feature_spec() else {
+        return Vec::new();
+    };
+    let Ok(table) = crate::features::extract(log, &spec) else {
+        return Vec::new();
+    };
+    match (table.range(0), table.range(1)) {
+        (Some(t), Some(r)) => range_warnings(model, t, r),
+        _ => Vec::new(),
+    }
+}
+
+/// Warnings for a seen temperature range (°C) and temperature-rate range (°C/s) outside the
+/// model's training ranges. A margin of 2 % of the training span absorbs sensor noise.
+pub fn range_warnings(
+    model: &ModelFile,
+    temp_c: (f64, f64),
+    rate_c_per_s: (f64, f64),
+) -> Vec<String> {
+    let t = &model.training;
+    let checks = [
+        ("temperature", "°C", temp_c, t.temp_range_c, 1.0),
+        (
+            "temperature rate",
+            "°C/min",
+            rate_c_per_s,
+            t.rate_range_c_per_s,
+            60.0,
+        ),
+    ];
+    let mut out = Vec::new();
+    for (what, unit, (lo, hi), range, scale) in checks {
+        let margin = 0.02 * (range.max - range.min);
+        if lo < range.min - margin || hi > range.max + margin {
+            out.push(format!(
+                "{what} {:.3} to {:.3} {unit} leaves the training range {:.3} to {:.3} {unit}; the model extrapolates there",
+                lo * scale,
+                hi * scale,
+                range.min * scale,
+                range.max * scale
+            ));
+        }
+    }
+    out
+}
+
+/// Columns appended by [`compensate_stream`].
+pub const OUTPUT_COLUMNS: [&str; 3] = ["bias_dps", "scale", "gyro_comp_dps"];
+
+/// What a streaming compensation saw.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StreamSummary {
+    /// Rows written.
+    pub rows: u64,
+    /// Rows made by gap filling.
+    pub filled_rows: u64,
+    /// Extrapolation warnings (temperature or its rate outside the training range).
+    pub warnings: Vec<String>,
+}
+
+/// Compensate a CSV log from `input` to `output`, one output row per input row: every input
+/// column as it was, then `bias_dps`, `scale` and `gyro_comp_dps` (°/s). Runs the flight
+/// [`Compensator`] sample by sample, so batch files and `--stream` give identical numbers.
+/// With `flush_each_row` every row is flushed as soon as it is written.
+pub fn compensate_stream<R: std::io::Read, W: std::io::Write>(
+    model: &ModelFile,
+    input: R,
+    source: &std::path::Path,
+    opts: &crate::csvlog::ReadOptions,
+    output: W,
+    flush_each_row: bool,
+) -> Result<StreamSummary, String> {
+    use crate::csvlog::{LogReader, LogWriter};
+    let mut comp = compensator(model)?;
+    let mut reader = LogReader::new(input, source, opts).map_err(|e| e.to_string())?;
+    let headers: Vec<String> = reader.headers().to_vec();
+    let mut writer = LogWriter::new(
+        output,
+        headers.iter().map(String::as_str).chain(OUTPUT_COLUMNS),
+    )
+    .map_err(|e| format!("writing the header: {e}"))?;
+    writer.set_flush_each_row(flush_each_row);
+    let col = |name: &str| headers.iter().position(|h| h.trim() == name);
+    let (ti, gi, ci, tabi) = (
+        col(&opts.time_col),
+        col(&opts.gyro_col),
+        col(&opts.temp_col),
+        col(&opts.table_col),
+    );
+    let mut summary = StreamSummary::default();
+    let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
+    while let Some(s) = reader.next_sample().map_err(|e| e.to_string())? {
+        let c = comp
+            .step(s.time_s, s.gyro_dps, s.temp_c)
+            .map_err(|e| format!("{}:{}: {e}", source.display(), reader.line()))?;
+        if let Some(f) = comp.features() {
+            let f = f.as_slice();
+            if let [t, r, ..] = f {
+                temp_seen = (temp_seen.0.min(*t), temp_seen.1.max(*t));
+                rate_seen = (rate_seen.0.min(*r), rate_seen.1.max(*r));
+            }
+        }
+        match reader.record() {
+            Some(rec) if !reader.is_filled() => {
+                for field in rec.iter() {
+                    writer.push_raw(field);
+                }
+            }
+            _ => {
+                summary.filled_rows += 1;
+                for k in 0..headers.len() {
+                    let v = if Some(k) == ti {
+                        Some(s.time_s)
+                    } else if Some(k) == gi {
+                        // The filled value in the file's own unit is not kept; write °/s.
+                        Some(s.gyro_dps)
+                    } else if Some(k) == ci {
+                        Some(s.temp_c)
+                    } else if Some(k) == tabi {
+                        s.table_dps
+                    } else {
+                        None
+                    };
+                    match v {
+                        Some(v) => writer.push_f64(v),
+                        None => writer.push_raw(b""),
+                    }
+                }
+            }
+        }
+        writer.push_f64(c.bias_dps);
+        writer.push_f64(c.scale);
+        writer.push_f64(c.rate_dps);
+        writer
+            .end_row()
+            .map_err(|e| format!("writing output: {e}"))?;
+        summary.rows += 1;
+    }
+    writer.flush().map_err(|e| format!("writing output: {e}"))?;
+    if temp_seen.0 <= temp_seen.1 {
+        summary.warnings = range_warnings(model, temp_seen, rate_seen);
+    }
+    Ok(summary)
+}

@@ -11,6 +11,7 @@
 pub mod allan;
 pub mod atomic_file;
 pub mod baseline;
+pub mod compare;
 pub mod compensate;
 pub mod csvlog;
 pub mod features;

@@ -7,7 +7,9 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
-use gyrotherm::csvlog::{self, ReadOptions, TestLog};
+use gyrotherm::csvlog::TestLog;
+
+use super::common::{read_log_reporting, LogArgs};
 use serde_json::{json, Value};
 
 #[derive(Debug, clap::Args)]
@@ -15,6 +17,8 @@ pub struct AllanArgs {
     /// Test log (CSV).
     #[arg(long)]
     pub input: PathBuf,
+    #[command(flatten)]
+    pub log: LogArgs,
     /// Column to analyse: gyro_dps (default), temp_c, table_dps or any numeric extra column.
     #[arg(long, default_value = "gyro_dps")]
     pub column: String,
@@ -46,9 +50,12 @@ fn parse_taus(s: &str) -> Result<TauSet, String> {
 
 /// Reads the log and picks a numeric column; returns (log, values, sample period s). The
 /// chosen column is moved out of the log (left empty there) to keep one copy in memory.
-pub(crate) fn read_column(input: &Path, column: &str) -> anyhow::Result<(TestLog, Vec<f64>, f64)> {
-    let (mut log, _report) = csvlog::read_log(input, &ReadOptions::default())
-        .with_context(|| format!("reading {}", input.display()))?;
+pub(crate) fn read_column(
+    input: &Path,
+    column: &str,
+    log_args: &LogArgs,
+) -> anyhow::Result<(TestLog, Vec<f64>, f64)> {
+    let mut log = read_log_reporting(input, log_args)?;
     let values = match column {
         "gyro_dps" => std::mem::take(&mut log.gyro_dps),
         "temp_c" => std::mem::take(&mut log.temp_c),
@@ -144,7 +151,7 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
     if args.plot.is_some() {
         bail!("--plot is not available yet; use --json and plot the points");
     }
-    let (_log, values, tau0_s) = read_column(&args.input, &args.column)?;
+    let (_log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
     let noise_model = args.alpha.map_or(NoiseModel::Identify, NoiseModel::Alpha);
     let points = allan::deviation(&values, tau0_s, args.kind, &args.taus, noise_model)
         .with_context(|| format!("{} of column {}", args.kind.name(), args.column))?;

@@ -57,7 +57,6 @@ impl From<GyroUnitArg> for GyroUnit {
     }
 }
 
-#[allow(dead_code)]
 impl LogArgs {
     /// The library's read options for these arguments.
     pub fn read_options(&self) -> ReadOptions {
@@ -74,7 +73,6 @@ impl LogArgs {
 }
 
 /// Read a log with these options; say on stderr how many samples gap filling made.
-#[allow(dead_code)]
 pub fn read_log_reporting(path: &Path, args: &LogArgs) -> anyhow::Result<TestLog> {
     let (log, report) = csvlog::read_log(path, &args.read_options())
         .with_context(|| format!("cannot use log {}", path.display()))?;

@@ -1,10 +1,118 @@
-//! `gyrotherm demo`.
+//! `gyrotherm demo`: the main job on built-in defaults. Simulates a training pair (static and
+//! rate-table runs of the default unit on one chamber profile) and a held-out pair on another
+//! profile, fits linear, polynomial and LSTM models, and prints the held-out results table.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct DemoArgs {}
+use anyhow::Context as _;
+use gyrotherm::compare::CompareConfig;
+use gyrotherm::csvlog::{write_log, TestLog};
+use gyrotherm::fit::NamedLog;
+use gyrotherm::model::Method;
+use gyrotherm::sim::{simulate, SimConfig};
 
-pub fn run(_args: DemoArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`gyrotherm demo` is not implemented yet")
+use super::compare::{print_table, run_comparison};
+use super::train::FitArgs;
+
+#[derive(Debug, clap::Args)]
+pub struct DemoArgs {
+    /// Folder for the simulated logs and the fitted models (created if missing).
+    #[arg(long, default_value = "gyrotherm-demo")]
+    pub dir: PathBuf,
+    /// Chamber profile of the training runs.
+    #[arg(long, default_value = "seed-shock")]
+    pub train_profile: String,
+    /// Chamber profile of the held-out runs (a different one: the test is held out).
+    #[arg(long, default_value = "slow-ramp")]
+    pub test_profile: String,
+    /// Rate-table rate of the rate-table runs, °/s.
+    #[arg(long, default_value_t = 20.0)]
+    pub table_rate: f64,
+    #[command(flatten)]
+    pub fit: FitArgs,
+}
+
+fn sim_run(profile: &str, seed: u64, table: Option<f64>, truth: bool) -> anyhow::Result<TestLog> {
+    let mut cfg = SimConfig::builtin(profile).map_err(|e| anyhow::anyhow!("{e}"))?;
+    cfg.seed = seed;
+    cfg.table_rate_dps = table;
+    cfg.truth = truth;
+    simulate(&cfg).map_err(|e| anyhow::anyhow!("simulating {profile}: {e}"))
+}
+
+pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
+    let started = std::time::Instant::now();
+    std::fs::create_dir_all(&args.dir)
+        .with_context(|| format!("cannot create {}", args.dir.display()))?;
+    let seed = args.fit.seed;
+    let runs = [
+        (
+            "train_static.csv",
+            args.train_profile.as_str(),
+            1,
+            None,
+            false,
+        ),
+        (
+            "train_table.csv",
+            args.train_profile.as_str(),
+            2,
+            Some(args.table_rate),
+            false,
+        ),
+        ("test_static.csv", args.test_profile.as_str(), 3, None, true),
+        (
+            "test_table.csv",
+            args.test_profile.as_str(),
+            4,
+            Some(args.table_rate),
+            true,
+        ),
+    ];
+    let mut logs = Vec::new();
+    for (file, profile, k, table, truth) in runs {
+        let log = sim_run(profile, seed.wrapping_mul(10).wrapping_add(k), table, truth)?;
+        let path = args.dir.join(file);
+        write_log(&path, &log).with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!(
+            "gyrotherm: simulated {} ({profile}{}, {} samples)",
+            path.display(),
+            table
+                .map(|r| format!(", table ±{r} °/s"))
+                .unwrap_or_default(),
+            log.len()
+        );
+        logs.push((path.display().to_string(), log));
+    }
+    let named: Vec<NamedLog> = logs
+        .iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect();
+    let cfg = CompareConfig {
+        fit: args.fit.fit_config(Method::Lstm)?,
+        settle_s: args.fit.settle,
+        ..CompareConfig::default()
+    };
+    eprintln!("gyrotherm: fitting linear, poly and lstm models on the training runs ...");
+    let cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
+    for fit in &cmp.fits {
+        let path = args
+            .dir
+            .join(format!("model_{}.json", fit.model.method.as_str()));
+        fit.model.save(&path).map_err(anyhow::Error::msg)?;
+    }
+    let mut out = std::io::stdout().lock();
+    print_table(&mut out, &cmp, &cfg)?;
+    for t in &cmp.tests {
+        for w in &t.warnings {
+            eprintln!("gyrotherm: warning: {w}");
+        }
+    }
+    eprintln!(
+        "gyrotherm: demo done in {:.1} s; logs and models are in {}",
+        started.elapsed().as_secs_f64(),
+        args.dir.display()
+    );
+    Ok(ExitCode::SUCCESS)
 }

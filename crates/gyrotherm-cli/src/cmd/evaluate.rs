@@ -16,6 +16,8 @@ pub struct EvaluateArgs {
     /// Test log (CSV).
     #[arg(long)]
     pub input: PathBuf,
+    #[command(flatten)]
+    pub log: super::common::LogArgs,
     /// Rate column to judge: gyro_dps (default) or a numeric extra column (*_dps, *_dph, *_rad_s).
     #[arg(long, default_value = "gyro_dps")]
     pub column: String,
@@ -43,7 +45,7 @@ fn num(v: f64) -> Value {
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     let mut w = std::io::stdout().lock();
-    let (log, values, tau0_s) = read_column(&args.input, &args.column)?;
+    let (log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
     let Some(to_dph) = to_dph_factor(&args.column) else {
         bail!(
             "column `{}` has no rate unit in its name; name it *_dps, *_dph or *_rad_s",

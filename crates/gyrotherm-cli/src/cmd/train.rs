@@ -1,10 +1,191 @@
-//! `gyrotherm train`.
+//! `gyrotherm train`: fit a compensation model to test logs and write it as JSON.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct TrainArgs {}
+use anyhow::Context as _;
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, Target};
+use gyrotherm::model::Method;
 
-pub fn run(_args: TrainArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`gyrotherm train` is not implemented yet")
+use super::common::{read_log_reporting, LogArgs};
+use super::progress::TrainingBars;
+
+/// Fitting options shared by `train` and `compare`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct FitArgs {
+    /// LSTM recipe: `default` (the project's, chosen by held-out figures) or `published`
+    /// (He et al. 2024 exactly: whole run, T and dT inputs, 1000 Adam steps at lr 0.01).
+    #[arg(long, default_value = "default", value_parser = ["default", "published"])]
+    pub recipe: String,
+    /// LSTM training epochs (default: the recipe's).
+    #[arg(long)]
+    pub epochs: Option<usize>,
+    /// Random seed of the LSTM initialisation and window order.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Bias target smoothing window, s (centred moving average; 100 s as published).
+    #[arg(long, default_value_t = gyrotherm::targets::BIAS_WINDOW_S)]
+    pub bias_window: f64,
+    /// Time dropped at the start of each rate-table segment, s.
+    #[arg(long, default_value_t = gyrotherm::targets::SETTLE_S)]
+    pub settle: f64,
+    /// Highest power of T in the `poly` bias model.
+    #[arg(long, default_value_t = 3)]
+    pub poly_temp_degree: u8,
+    /// Highest power of dT in the `poly` bias model.
+    #[arg(long, default_value_t = 1)]
+    pub poly_rate_degree: u8,
+    /// Leave the T·dT cross term out of the `poly` bias model.
+    #[arg(long)]
+    pub no_cross: bool,
+}
+
+impl FitArgs {
+    /// The library's fit configuration for `method`.
+    pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
+        let mut cfg = FitConfig::new(method);
+        if self.recipe == "published" {
+            cfg.recipe = gyrotherm::fit::LstmRecipe::published();
+        }
+        if let Some(e) = self.epochs {
+            anyhow::ensure!(e > 0, "--epochs must be at least 1");
+            cfg.recipe.epochs = e;
+        }
+        anyhow::ensure!(
+            self.bias_window.is_finite() && self.bias_window > 0.0,
+            "--bias-window must be a positive number of seconds"
+        );
+        anyhow::ensure!(
+            self.settle.is_finite() && self.settle >= 0.0,
+            "--settle must be zero or a positive number of seconds"
+        );
+        cfg.seed = self.seed;
+        cfg.bias_window_s = self.bias_window;
+        cfg.settle_s = self.settle;
+        cfg.poly.temp = self.poly_temp_degree;
+        cfg.poly.rate = self.poly_rate_degree;
+        cfg.poly.cross = !self.no_cross;
+        Ok(cfg)
+    }
+}
+
+/// `--method` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// LSTM networks (He et al. 2024), bias and scale factor.
+    Lstm,
+    /// bias = c0 + c1·T + c2·dT (the paper's comparison).
+    Linear,
+    /// Polynomial in T and dT (industry standard).
+    Poly,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Method {
+        match m {
+            MethodArg::Lstm => Method::Lstm,
+            MethodArg::Linear => Method::Linear,
+            MethodArg::Poly => Method::Poly,
+        }
+    }
+}
+
+#[derive(Debug, clap::Args)]
+pub struct TrainArgs {
+    /// Training log (CSV); repeat for several. Static logs train the bias model, logs with
+    /// table_dps the scale-factor model.
+    #[arg(long, required = true)]
+    pub input: Vec<PathBuf>,
+    /// Fitting method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Lstm)]
+    pub method: MethodArg,
+    #[command(flatten)]
+    pub fit: FitArgs,
+    /// Model file to write (JSON).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub log: LogArgs,
+}
+
+/// Read every input log, reporting each failure, then stop if any failed.
+pub fn read_logs(
+    paths: &[PathBuf],
+    log: &LogArgs,
+) -> anyhow::Result<Vec<(String, gyrotherm::csvlog::TestLog)>> {
+    let mut out = Vec::new();
+    let mut failed = 0;
+    for p in paths {
+        match read_log_reporting(p, log) {
+            Ok(l) => out.push((p.display().to_string(), l)),
+            Err(e) => {
+                eprintln!("gyrotherm: {e:#}");
+                failed += 1;
+            }
+        }
+    }
+    anyhow::ensure!(
+        failed == 0,
+        "{failed} of {} input logs could not be read (see above)",
+        paths.len()
+    );
+    Ok(out)
+}
+
+pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
+    let logs = read_logs(&args.input, &args.log)?;
+    let named: Vec<NamedLog> = logs
+        .iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect();
+    let method: Method = args.method.into();
+    let cfg = args.fit.fit_config(method)?;
+    let started = std::time::Instant::now();
+    let bars = TrainingBars::new(method == Method::Lstm, cfg.recipe.epochs, &[""]);
+    let outcome = fit_model(&named, &cfg, &|t: Target, e, l| bars.update("", t, e, l));
+    bars.finish();
+    let outcome = outcome
+        .map_err(anyhow::Error::msg)
+        .context("training failed")?;
+    outcome
+        .model
+        .save(&args.out)
+        .map_err(anyhow::Error::msg)
+        .context("cannot write the model")?;
+    let m = &outcome.model;
+    eprintln!(
+        "gyrotherm: wrote {} ({} model; bias: {}, scale factor: {}) in {:.1} s",
+        args.out.display(),
+        m.method.as_str(),
+        if m.bias.is_some() {
+            "fitted"
+        } else {
+            "none (no static log)"
+        },
+        if m.scale.is_some() {
+            "fitted"
+        } else {
+            "none (no rate-table log)"
+        },
+        started.elapsed().as_secs_f64()
+    );
+    eprintln!(
+        "  training range: temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min",
+        m.training.temp_range_c.min,
+        m.training.temp_range_c.max,
+        m.training.rate_range_c_per_s.min * 60.0,
+        m.training.rate_range_c_per_s.max * 60.0
+    );
+    for (name, t) in [
+        ("bias", &outcome.bias_training),
+        ("scale", &outcome.scale_training),
+    ] {
+        if let Some(t) = t {
+            eprintln!(
+                "  {name} network: {} epochs, final loss {:.4e} (normalised MSE)",
+                t.epochs, t.final_loss
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }
