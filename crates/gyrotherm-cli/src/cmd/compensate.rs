@@ -2,9 +2,11 @@
 //! stdin/stdout). Both run the flight compensator of `gyrotherm-core`, so their numbers are
 //! identical.
 
-use std::io::{BufWriter, Write};
+use std::cell::RefCell;
+use std::io::{BufWriter, Read, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::rc::Rc;
 
 use anyhow::Context as _;
 use gyrotherm::compensate::compensate_stream;
@@ -36,10 +38,28 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
     let model = ModelFile::load(&args.model).map_err(anyhow::Error::msg)?;
     let opts = args.log.read_options();
     let summary = if args.stream {
-        let stdin = std::io::stdin().lock();
-        let stdout = std::io::stdout().lock();
-        compensate_stream(&model, stdin, "<stdin>".as_ref(), &opts, stdout, true)
-            .map_err(anyhow::Error::msg)?
+        // Rows are handed on as they are made and stdout is flushed whenever the input has
+        // to be read again: a live feed gets each line at once, a file is not written one
+        // system call per line.
+        let out = Rc::new(RefCell::new(BufWriter::with_capacity(
+            64 * 1024,
+            std::io::stdout().lock(),
+        )));
+        let input = FlushBeforeRead {
+            inner: std::io::stdin().lock(),
+            out: Rc::clone(&out),
+        };
+        let summary = compensate_stream(
+            &model,
+            input,
+            "<stdin>".as_ref(),
+            &opts,
+            DeferredFlush(Rc::clone(&out)),
+            true,
+        )
+        .map_err(anyhow::Error::msg)?;
+        out.borrow_mut().flush()?;
+        summary
     } else {
         let (Some(input), Some(out)) = (&args.input, &args.out) else {
             anyhow::bail!("give --input FILE and --out FILE, or --stream");
@@ -77,4 +97,32 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
         eprintln!("gyrotherm: warning: {w}");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+type SharedOut<'a> = Rc<RefCell<BufWriter<std::io::StdoutLock<'a>>>>;
+
+/// Stdin that flushes stdout before every read, so no output line waits on more input.
+struct FlushBeforeRead<'a, R> {
+    inner: R,
+    out: SharedOut<'a>,
+}
+
+impl<R: Read> Read for FlushBeforeRead<'_, R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        self.out.borrow_mut().flush()?;
+        self.inner.read(buf)
+    }
+}
+
+/// Stdout whose `flush` waits for [`FlushBeforeRead`] (the real flush happens before the next
+/// read and at the end).
+struct DeferredFlush<'a>(SharedOut<'a>);
+
+impl Write for DeferredFlush<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
