@@ -1,13 +1,18 @@
 //! gyrotherm-core: what flies.
 //!
-//! `#![no_std]`, no allocation, no panics on any input. f32 maths through `libm`.
+//! `#![no_std]`, no allocation, no panics on any input. Flight code holds one
+//! [`Compensator`] and calls [`Compensator::step`] once per gyro sample.
 //!
-//! Layers (a flight loop holds one [`compensator`] value):
-//! - [`lstm`]: LSTM cell + linear read-out inference, hidden size a const generic (8 by default,
-//!   as in He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004, §2).
-//! - [`features`]: the streaming feature pipeline (temperature, its 20 s rate, moving averages).
-//! - [`baseline`]: evaluation of fitted linear/polynomial baseline models.
-//! - [`compensator`]: bias and scale factor to corrected rate, G = (Ĝ - B) / K (eq. 4 of the paper).
+//! Layers:
+//! - [`lstm`]: LSTM cell + linear read-out inference in f32, hidden size a const generic (8 by
+//!   default, as in He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004, §2).
+//! - [`features`]: the streaming feature pipeline (temperature, its 20 s rate, moving average,
+//!   first-order thermal lags), in f64: a 30,000 s run needs f64 time stamps, and it runs once
+//!   per step (1 s), so the cost does not matter.
+//! - [`baseline`]: evaluation of fitted linear/polynomial baseline models (f64).
+//! - [`compensator`]: bias and scale factor to corrected rate, G = (Ĝ − B)/K (eq. 4 of the
+//!   paper).
+//! - [`error`]: what the core refuses instead of panicking.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code)]
 
@@ -16,3 +21,7 @@ pub mod compensator;
 pub mod error;
 pub mod features;
 pub mod lstm;
+
+pub use compensator::{Compensator, Corrected, TargetModel};
+pub use error::{Channel, InputError};
+pub use features::FeatureSpec;
