@@ -126,7 +126,11 @@ fn check_svg(files: &FigureFiles, texts: &[&str]) {
     assert!(svg.contains(&format!("height=\"{}\"", files.height_px)));
     for t in texts {
         // These labels contain no XML markup characters, so they appear verbatim.
-        assert!(svg.contains(t), "{}: text {t:?} missing", files.svg.display());
+        assert!(
+            svg.contains(t),
+            "{}: text {t:?} missing",
+            files.svg.display()
+        );
     }
     assert!(
         svg.trim_end().ends_with("</svg>"),
@@ -422,7 +426,10 @@ fn report_over_two_synthetic_runs() {
     );
     for r in &refs {
         let p: PathBuf = out.join(r);
-        assert!(p.is_file(), "index.html references {r}, which does not exist");
+        assert!(
+            p.is_file(),
+            "index.html references {r}, which does not exist"
+        );
     }
     // A short row is padded to the header width.
     assert!(html.contains("<td>LSTM</td><td>0.071</td><td></td>"));
@@ -466,7 +473,10 @@ fn report_creates_missing_dir_and_rejects_missing_figure() {
         ..Default::default()
     };
     let err = write_report(&out, &content).unwrap_err().to_string();
-    assert!(err.contains("nope.png"), "error should name the file: {err}");
+    assert!(
+        err.contains("nope.png"),
+        "error should name the file: {err}"
+    );
     let content = ReportContent {
         figures: vec![ReportFigure {
             png: "../escape.png".into(),
@@ -534,8 +544,7 @@ fn font_registration_is_thread_safe() {
         for k in 0..4 {
             let path = dir.path().join(format!("t{k}"));
             s.spawn(move || {
-                let files =
-                    allan_figure(&path, &[synthetic_allan("x", 0.1)], &[], "°/h").unwrap();
+                let files = allan_figure(&path, &[synthetic_allan("x", 0.1)], &[], "°/h").unwrap();
                 check_png(&files);
             });
         }

@@ -6,9 +6,11 @@
 /// at `columns` pixel columns: the first and last points, and for each column (equal slices
 /// of `x[0]..=x[last]`) its minimum and maximum `y`, in the order they occur.
 ///
-/// `x` is expected in increasing order (time); points whose `x` or `y` is not finite are
-/// dropped (a gap, not a value). Series short enough already (`<= 2 * columns + 2` finite
-/// points) are returned whole. Extra elements of the longer slice are ignored.
+/// When `x` is not in non-decreasing order (output against temperature, which cycles), the
+/// columns are instead equal runs of consecutive samples, so the drawn path still follows
+/// the data and keeps each run's extremes. Points whose `x` or `y` is not finite are dropped
+/// (a gap, not a value). Series short enough already (`<= 2 * columns + 2` finite points)
+/// are returned whole. Extra elements of the longer slice are ignored.
 pub fn decimate_min_max(x: &[f64], y: &[f64], columns: usize) -> Vec<(f64, f64)> {
     let points: Vec<(f64, f64)> = x
         .iter()
@@ -20,9 +22,12 @@ pub fn decimate_min_max(x: &[f64], y: &[f64], columns: usize) -> Vec<(f64, f64)>
     if points.len() <= 2 * columns + 2 {
         return points;
     }
+    if points.windows(2).any(|w| w[1].0 < w[0].0) {
+        return by_runs(&points, columns);
+    }
     let (x0, x1) = (points[0].0, points[points.len() - 1].0);
     let span = x1 - x0;
-    if !(span > 0.0) {
+    if span <= 0.0 {
         // All at one x: the extremes are all there is to draw.
         return min_max_in_order(&points, 0, points.len());
     }
@@ -46,6 +51,23 @@ pub fn decimate_min_max(x: &[f64], y: &[f64], columns: usize) -> Vec<(f64, f64)>
         }
         out.extend(min_max_in_order(&points, start, end));
         start = end;
+    }
+    out.push(points[last]);
+    out
+}
+
+/// Decimation over runs of consecutive samples (for non-monotonic `x`).
+fn by_runs(points: &[(f64, f64)], columns: usize) -> Vec<(f64, f64)> {
+    let last = points.len() - 1;
+    let inner = last - 1; // points[1..last]
+    let mut out = Vec::with_capacity(2 * columns + 2);
+    out.push(points[0]);
+    for c in 0..columns {
+        let start = 1 + c * inner / columns;
+        let end = 1 + (c + 1) * inner / columns;
+        if start < end {
+            out.extend(min_max_in_order(points, start, end));
+        }
     }
     out.push(points[last]);
     out
@@ -105,9 +127,7 @@ mod tests {
         // Per column: the decimated points of a column hold that column's min and max.
         let n = 10_000;
         let x: Vec<f64> = (0..n).map(|i| i as f64).collect();
-        let y: Vec<f64> = (0..n)
-            .map(|i| ((i * 7919) % 1000) as f64 - 500.0)
-            .collect();
+        let y: Vec<f64> = (0..n).map(|i| ((i * 7919) % 1000) as f64 - 500.0).collect();
         let columns = 50;
         let d = decimate_min_max(&x, &y, columns);
         let width = (x[n - 1] - x[0]) / columns as f64;
@@ -122,6 +142,23 @@ mod tests {
             assert!(dec.contains(&fmax), "column {c}: max {fmax} lost");
             assert!(dec.contains(&fmin), "column {c}: min {fmin} lost");
         }
+    }
+
+    #[test]
+    fn non_monotonic_x_keeps_path_and_extremes() {
+        // Output against a cycling temperature: x goes up and down.
+        let n = 20_000;
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 / 1000.0).sin() * 40.0).collect();
+        let mut y: Vec<f64> = (0..n).map(|i| ((i * 31) % 17) as f64).collect();
+        y[5_000] = 99.0;
+        y[15_000] = -99.0;
+        let d = decimate_min_max(&x, &y, 300);
+        assert!(d.len() <= 602, "got {}", d.len());
+        assert!(d.contains(&(x[5_000], 99.0)) && d.contains(&(x[15_000], -99.0)));
+        // Every kept point is a point of the series, in sample order (x range covered).
+        let xmin = d.iter().map(|p| p.0).fold(f64::MAX, f64::min);
+        let xmax = d.iter().map(|p| p.0).fold(f64::MIN, f64::max);
+        assert!(xmin < -39.0 && xmax > 39.0, "x range lost: {xmin}..{xmax}");
     }
 
     #[test]

@@ -10,7 +10,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::decimate::decimate_min_max;
-use super::font::{ensure_font, FONT_FAMILY};
+use super::font::{ensure_font, GlyphFix, FONT_FAMILY};
 use super::ReportError;
 use crate::atomic_file::write_bytes_atomically;
 
@@ -141,7 +141,7 @@ pub fn write_figure(path: &Path, fig: &Figure) -> Result<FigureFiles, ReportErro
 
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
-        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        let root = GlyphFix::new(BitMapBackend::with_buffer(&mut rgb, (w, h))).into_drawing_area();
         draw_figure(&root, fig).map_err(|message| ReportError::Draw {
             path: png_path.clone(),
             message,
@@ -281,6 +281,30 @@ fn padded_range(values: impl Iterator<Item = f64>, log: bool, pad: bool) -> (f64
 
 type DrawResult = Result<(), String>;
 
+/// Tick text: plain decimals without trailing zeros (`2000`, `0.5`), scientific outside
+/// 1e-3..1e5 (`1.5e5`); values within 1e-12 of zero (tick arithmetic) print as `0`.
+pub(crate) fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if a < 1e-12 {
+        return "0".to_owned();
+    }
+    if !(1e-3..1e5).contains(&a) {
+        let s = format!("{v:.3e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = trim_zeros(mantissa);
+        return format!("{mantissa}e{exponent}");
+    }
+    trim_zeros(&format!("{v:.6}")).to_owned()
+}
+
+fn trim_zeros(s: &str) -> &str {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
+    }
+}
+
 fn draw_figure<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> DrawResult
 where
     DB::ErrorType: 'static,
@@ -290,13 +314,18 @@ where
         .titled(&fig.title, (FONT_FAMILY, TITLE_FONT_PX).into_font())
         .map_err(|e| e.to_string())?;
     let areas = body.split_evenly((fig.panels.len(), 1));
-    // The x range is shared by all panels; time axes are not padded.
+    // The x range is shared by all panels; lines run edge to edge, markers get a margin.
+    let has_markers = fig
+        .panels
+        .iter()
+        .flat_map(|p| &p.series)
+        .any(|s| matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints));
     let xs = fig
         .panels
         .iter()
         .flat_map(|p| &p.series)
         .flat_map(|s| s.x.iter().copied());
-    let (x0, x1) = padded_range(xs, fig.log_x, fig.log_x);
+    let (x0, x1) = padded_range(xs, fig.log_x, fig.log_x || has_markers);
     for (area, panel) in areas.iter().zip(&fig.panels) {
         let ys = panel.series.iter().flat_map(|s| {
             let bars = s
@@ -374,6 +403,8 @@ where
         .bold_line_style(RGBColor(215, 215, 215))
         .x_labels(10)
         .y_labels(8)
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
         .draw()
         .map_err(err)?;
 
@@ -388,15 +419,29 @@ where
                 p.retain(ok);
                 p
             }
-            SeriesStyle::Points | SeriesStyle::LinePoints => s
-                .x
-                .iter()
-                .copied()
-                .zip(s.y.iter().copied())
-                .filter(ok)
-                .collect(),
+            SeriesStyle::Points | SeriesStyle::LinePoints => {
+                s.x.iter()
+                    .copied()
+                    .zip(s.y.iter().copied())
+                    .filter(ok)
+                    .collect()
+            }
         };
-        let line_style = color.stroke_width(2);
+        // plotters draws lines wider than 1 px as polygons with mitred joins, which spike far
+        // outside the plot on the sharp, short zig-zags of a dense noisy series: a line with
+        // more than one point per 4 px that reverses direction at more than a quarter of its
+        // points is drawn 1 px wide.
+        let reversals = points
+            .windows(3)
+            .filter(|w| (w[1].1 - w[0].1) * (w[2].1 - w[1].1) < 0.0)
+            .count();
+        let dense = points.len() > columns / 4;
+        let width = if dense && reversals * 4 > points.len() {
+            1
+        } else {
+            2
+        };
+        let line_style = color.stroke_width(width);
         let anno = match s.style {
             SeriesStyle::Line => chart
                 .draw_series(LineSeries::new(points.iter().copied(), line_style))
@@ -410,22 +455,14 @@ where
                 ))
                 .map_err(err)?,
             SeriesStyle::Points => chart
-                .draw_series(
-                    points
-                        .iter()
-                        .map(|&p| Circle::new(p, 3, color.filled())),
-                )
+                .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 .map_err(err)?,
             SeriesStyle::LinePoints => {
                 chart
                     .draw_series(LineSeries::new(points.iter().copied(), line_style))
                     .map_err(err)?;
                 chart
-                    .draw_series(
-                        points
-                            .iter()
-                            .map(|&p| Circle::new(p, 3, color.filled())),
-                    )
+                    .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
                     .map_err(err)?
             }
         };
@@ -446,8 +483,7 @@ where
             // Vertical bar from lo to hi with 8 px caps.
             let bar_style = color.stroke_width(1);
             for ((&x, &y), (&l, &h)) in s.x.iter().zip(&s.y).zip(lo.iter().zip(hi)) {
-                if !(usable(x, log_x) && usable(y, log_y) && usable(l, log_y) && usable(h, log_y))
-                {
+                if !(usable(x, log_x) && usable(y, log_y) && usable(l, log_y) && usable(h, log_y)) {
                     continue;
                 }
                 let (l, h) = (l.min(y), h.max(y));
@@ -473,4 +509,41 @@ where
             .map_err(err)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        for (v, want) in [
+            (2000.0, "2000"),
+            (0.5, "0.5"),
+            (-10.0, "-10"),
+            (0.1 + 0.2, "0.3"),
+            (-1.1e-16, "0"),
+            (150_000.0, "1.5e5"),
+            (2e-5, "2e-5"),
+            (0.001, "0.001"),
+        ] {
+            assert_eq!(tick_label(v), want, "tick_label({v})");
+        }
+    }
+
+    #[test]
+    fn paths_from_stem_or_extension() {
+        let (p, s) = figure_paths(Path::new("out/fig1"));
+        assert_eq!(
+            (p.as_path(), s.as_path()),
+            (Path::new("out/fig1.png"), Path::new("out/fig1.svg"))
+        );
+        let (p, s) = figure_paths(Path::new("adev.PNG"));
+        assert_eq!(
+            (p.as_path(), s.as_path()),
+            (Path::new("adev.png"), Path::new("adev.svg"))
+        );
+        let (p, _) = figure_paths(Path::new("run.2024"));
+        assert_eq!(p, Path::new("run.2024.png"));
+    }
 }

@@ -71,8 +71,9 @@ pub fn temperature_figure(path: &Path, d: &TemperatureData) -> Result<FigureFile
         temps.push(Series::line("chamber", d.time_s, chamber).with_color(ORANGE));
     }
     temps.push(Series::line("gyro", d.time_s, d.gyro_temp_c).with_color(BLUE));
-    let rate = vec![Series::line("gyro temperature rate", d.time_s, d.temp_rate_c_per_min)
-        .with_color(GREEN)];
+    let rate = vec![
+        Series::line("gyro temperature rate", d.time_s, d.temp_rate_c_per_min).with_color(GREEN),
+    ];
     write_figure(
         path,
         &two_panels(
@@ -311,14 +312,15 @@ pub struct CompensationData<'a> {
 
 /// Figure 7: held-out output (°/h) before and after compensation, each series as means over
 /// consecutive `window_s` windows (drawn at the window centres). 1000 × 600 px.
-pub fn compensation_figure(
-    path: &Path,
-    d: &CompensationData,
-) -> Result<FigureFiles, ReportError> {
+pub fn compensation_figure(path: &Path, d: &CompensationData) -> Result<FigureFiles, ReportError> {
     check_window(d.window_s, "compensation figure")?;
     let mut series = Vec::with_capacity(d.series.len());
     for s in d.series {
-        check_len(&format!("compensation: {}", s.label), d.time_s, s.values_dph)?;
+        check_len(
+            &format!("compensation: {}", s.label),
+            d.time_s,
+            s.values_dph,
+        )?;
         let (t, m) = window_means(d.time_s, s.values_dph, d.window_s);
         series.push(Series::line(s.label, &t, &m));
     }
@@ -382,7 +384,7 @@ impl NoiseTerm {
 }
 
 /// √(2 ln 2 / π), IEEE Std 952-1997 eq. C.19: the flat floor of σ(τ) is 0.6643·B.
-pub const BIAS_INSTABILITY_FACTOR: f64 = 0.664_282_57;
+pub const BIAS_INSTABILITY_FACTOR: f64 = 0.664_282_470_267_960_1;
 
 /// A noise term drawn as a dashed slope line across the τ range of the curves.
 #[derive(Debug, Clone, PartialEq)]
@@ -475,7 +477,11 @@ pub fn moving_average(time_s: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
             }
             lo += 1;
         }
-        out.push(if count > 0 { sum / count as f64 } else { f64::NAN });
+        out.push(if count > 0 {
+            sum / count as f64
+        } else {
+            f64::NAN
+        });
     }
     out
 }
@@ -562,7 +568,11 @@ mod tests {
                 .collect();
             let want = sel.iter().sum::<f64>() / sel.len() as f64;
             // Running sums lose a few ulps per update; 1e-12 is far above that here.
-            assert!((got[i] - want).abs() < 1e-12, "i={i} want {want} got {}", got[i]);
+            assert!(
+                (got[i] - want).abs() < 1e-12,
+                "i={i} want {want} got {}",
+                got[i]
+            );
         }
     }
 
@@ -574,7 +584,11 @@ mod tests {
         assert_eq!(c.len(), 10);
         for k in 0..10 {
             let want = 100.0 * k as f64 + 49.5;
-            assert!((m[k] - want).abs() < 1e-9, "window {k}: want {want} got {}", m[k]);
+            assert!(
+                (m[k] - want).abs() < 1e-9,
+                "window {k}: want {want} got {}",
+                m[k]
+            );
             assert_eq!(c[k], 100.0 * k as f64 + 50.0);
         }
     }
@@ -588,6 +602,9 @@ mod tests {
         let k = NoiseTerm::RateRandomWalk { k: 0.02 };
         assert!((k.sigma(3.0) - 0.02).abs() < 1e-15);
         let want = (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt();
-        assert!((BIAS_INSTABILITY_FACTOR - want).abs() < 1e-8);
+        assert!(
+            (BIAS_INSTABILITY_FACTOR - want).abs() < 1e-15,
+            "want {want}"
+        );
     }
 }

@@ -97,11 +97,12 @@ pub fn write_report(dir: &Path, content: &ReportContent) -> Result<PathBuf, Repo
         }
     }
     let path = dir.join("index.html");
-    write_bytes_atomically(&path, render_html(content).as_bytes())
-        .map_err(|source| ReportError::Io {
+    write_bytes_atomically(&path, render_html(content).as_bytes()).map_err(|source| {
+        ReportError::Io {
             path: path.clone(),
             source,
-        })?;
+        }
+    })?;
     Ok(path)
 }
 
