@@ -550,3 +550,65 @@ fn font_registration_is_thread_safe() {
         }
     });
 }
+
+#[test]
+fn degenerate_data_draws_without_panic() {
+    // Empty, constant, non-finite and extreme data: each figure is still written (empty
+    // axes or a flat line), never a panic.
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, Vec<f64>, Vec<f64>); 6] = [
+        ("empty", vec![], vec![]),
+        ("one", vec![1.0], vec![2.0]),
+        ("constant", vec![0.0, 1.0, 2.0], vec![5.0; 3]),
+        ("nan", vec![0.0, 1.0, 2.0], vec![f64::NAN; 3]),
+        (
+            "mixed",
+            vec![0.0, f64::INFINITY, 2.0, 3.0],
+            vec![1.0, 2.0, f64::NEG_INFINITY, -4.0],
+        ),
+        ("huge", vec![0.0, 1.0, 2.0], vec![-1e300, 0.0, 1e300]),
+    ];
+    for (name, t, y) in &cases {
+        let files = raw_output_figure(
+            &dir.path().join(format!("raw_{name}")),
+            &RawOutputData {
+                time_s: t,
+                gyro_dph: y,
+                window_s: 100.0,
+            },
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let img = decode(&files.png);
+        assert_eq!((img.width(), img.height()), (1000, 600), "{name}");
+        let loss = loss_figure(
+            &dir.path().join(format!("loss_{name}")),
+            &[LossCurve {
+                label: "loss",
+                loss: y,
+            }],
+        );
+        assert!(loss.is_ok(), "{name}: {loss:?}");
+        let allan = allan_figure(
+            &dir.path().join(format!("allan_{name}")),
+            &[AllanCurve {
+                label: name.to_string(),
+                points: t
+                    .iter()
+                    .zip(y)
+                    .map(|(&tau_s, &dev)| AllanPointPlot {
+                        tau_s,
+                        dev,
+                        lo: dev,
+                        hi: dev,
+                    })
+                    .collect(),
+            }],
+            &[NoiseLine {
+                label: "ARW".into(),
+                term: NoiseTerm::AngleRandomWalk { n: 1.0 },
+            }],
+            "°/h",
+        );
+        assert!(allan.is_ok(), "{name}: {allan:?}");
+    }
+}

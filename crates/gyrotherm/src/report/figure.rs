@@ -246,9 +246,13 @@ fn color_of(s: &Series, index: usize) -> RGBColor {
     RGBColor(r, g, b)
 }
 
-/// Finite, and positive on a log axis.
+/// Largest magnitude drawn: plotters 0.3.7's tick arithmetic never ends on an axis spanning
+/// ±1e300 (found by test), and no gyro quantity comes near 1e200 in any unit.
+const MAX_DRAWN_MAGNITUDE: f64 = 1e200;
+
+/// Finite, within ±[`MAX_DRAWN_MAGNITUDE`], and on a log axis at least its inverse.
 fn usable(v: f64, log: bool) -> bool {
-    v.is_finite() && (!log || v > 0.0)
+    v.is_finite() && v.abs() <= MAX_DRAWN_MAGNITUDE && (!log || v >= 1.0 / MAX_DRAWN_MAGNITUDE)
 }
 
 /// Range of the usable values, padded: 4 % of the span on a linear axis, a factor on a log
