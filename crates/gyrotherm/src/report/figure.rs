@@ -477,9 +477,17 @@ where
             let none = ShapeStyle::from(&TRANSPARENT);
             let stroke = if line { color.stroke_width(2) } else { none };
             let dot = if marker { color.filled() } else { none };
+            // Dashed lines show a gap in the middle of their legend stroke.
+            let gap = if matches!(style, SeriesStyle::Dashed) {
+                none
+            } else {
+                stroke
+            };
             anno.label(s.label.as_str()).legend(move |(x, y)| {
                 EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (22, 0)], stroke)
+                    + PathElement::new(vec![(0, 0), (8, 0)], stroke)
+                    + PathElement::new(vec![(8, 0), (14, 0)], gap)
+                    + PathElement::new(vec![(14, 0), (22, 0)], stroke)
                     + Circle::new((11, 0), 3, dot)
             });
         }
