@@ -1,1 +1,68 @@
-//! TODO: filled in by its issue.
+//! Figures and the HTML report: the pictures a gyro engineer looks at.
+//!
+//! Everything here works over plain data (slices of `f64` and small structs), so the report
+//! does not depend on how the numbers were made.
+//! - [`figure`]: the generic figure writer (time series, x-y, log-log; one or more stacked
+//!   panels), written as PNG and SVG of a stated size, atomically.
+//! - [`figures`]: the eight named figures of the report and the Allan figure that
+//!   `gyrotherm allan --plot` reuses.
+//! - [`html`]: `DIR/index.html`, self-contained (inline CSS, no script, no network).
+//! - [`decimate`]: min/max per pixel column, so long runs draw fast without losing extremes.
+//! - [`font`]: the embedded DejaVu Sans font; no system font or graphics library is used.
+
+pub mod decimate;
+pub mod figure;
+pub mod figures;
+pub mod font;
+pub mod html;
+
+use std::fmt;
+use std::path::PathBuf;
+
+pub use decimate::decimate_min_max;
+pub use figure::{write_figure, Figure, FigureFiles, Panel, Series, SeriesStyle};
+pub use figures::{
+    allan_figure, bias_figure, compensation_figure, loss_figure, rate_table_figure,
+    raw_output_figure, scale_factor_figure, temperature_figure, AllanCurve, AllanPointPlot,
+    BiasData, CompensationData, LossCurve, NamedSeries, NoiseLine, NoiseTerm, RateAxis,
+    RateSegment, RateTableData, RawOutputData, ScaleFactorData, TemperatureData,
+};
+pub use html::{write_report, ReportContent, ReportFigure, Table};
+
+/// Why a figure or report could not be written.
+#[derive(Debug)]
+pub enum ReportError {
+    /// Reading or writing `path` failed.
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The plotting library failed while drawing `path`.
+    Draw { path: PathBuf, message: String },
+    /// The data handed in cannot be drawn (for example x and y of different lengths).
+    Data { what: String },
+    /// The embedded font could not be registered.
+    Font(String),
+}
+
+impl fmt::Display for ReportError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ReportError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            ReportError::Draw { path, message } => {
+                write!(f, "{}: drawing failed: {message}", path.display())
+            }
+            ReportError::Data { what } => write!(f, "cannot draw: {what}"),
+            ReportError::Font(msg) => write!(f, "embedded font: {msg}"),
+        }
+    }
+}
+
+impl std::error::Error for ReportError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ReportError::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}

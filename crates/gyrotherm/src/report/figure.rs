@@ -1,0 +1,561 @@
+//! The generic figure writer: one or more stacked panels sharing an x axis, linear or log
+//! axes, lines / dashed lines / points with optional error bars, a legend per panel. Every
+//! figure is written twice, as PNG and as SVG of the same size, each atomically
+//! ([`crate::atomic_file`]).
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::ranged1d::{Ranged, ValueFormatter};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::decimate::decimate_min_max;
+use super::font::{ensure_font, GlyphFix, FONT_FAMILY};
+use super::ReportError;
+use crate::atomic_file::write_bytes_atomically;
+
+/// Default figure width, pixels (PNG) and user units (SVG).
+pub const FIGURE_WIDTH_PX: u32 = 1000;
+/// Default height of a one-panel figure.
+pub const FIGURE_HEIGHT_PX: u32 = 600;
+/// Default height of a two-panel figure.
+pub const FIGURE_HEIGHT_2_PANELS_PX: u32 = 800;
+
+const LEGEND_FONT_PX: u32 = 15;
+const TICK_FONT_PX: u32 = 15;
+const AXIS_FONT_PX: u32 = 17;
+const TITLE_FONT_PX: u32 = 22;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeriesStyle {
+    /// A solid line.
+    Line,
+    /// A dashed line (model lines, fits).
+    Dashed,
+    /// Markers only.
+    Points,
+    /// A solid line with markers.
+    LinePoints,
+}
+
+/// One named curve.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend text.
+    pub label: String,
+    /// Abscissa, same unit as the figure's x label.
+    pub x: Vec<f64>,
+    /// Ordinate, same unit as the panel's y label.
+    pub y: Vec<f64>,
+    pub style: SeriesStyle,
+    /// Colour as RGB; `None` takes the next colour of the palette.
+    pub color: Option<(u8, u8, u8)>,
+    /// Optional error bars: lower and upper ends per point (same length as `x`).
+    pub bars: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+impl Series {
+    /// A solid line with a palette colour and no error bars.
+    pub fn line(label: impl Into<String>, x: &[f64], y: &[f64]) -> Self {
+        Series {
+            label: label.into(),
+            x: x.to_vec(),
+            y: y.to_vec(),
+            style: SeriesStyle::Line,
+            color: None,
+            bars: None,
+        }
+    }
+
+    /// The same series drawn in another style.
+    pub fn with_style(mut self, style: SeriesStyle) -> Self {
+        self.style = style;
+        self
+    }
+
+    /// The same series in a fixed colour.
+    pub fn with_color(mut self, rgb: (u8, u8, u8)) -> Self {
+        self.color = Some(rgb);
+        self
+    }
+}
+
+/// One plot area: its y axis and the series drawn in it.
+#[derive(Debug, Clone)]
+pub struct Panel {
+    /// Quantity and unit, e.g. `"temperature (°C)"`.
+    pub y_label: String,
+    pub log_y: bool,
+    pub series: Vec<Series>,
+}
+
+/// A figure: a title, a shared x axis and one or more panels stacked top to bottom.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    pub title: String,
+    /// Quantity and unit, e.g. `"time (s)"`.
+    pub x_label: String,
+    pub log_x: bool,
+    pub width_px: u32,
+    pub height_px: u32,
+    pub panels: Vec<Panel>,
+}
+
+/// The two files written for one figure, and their size in pixels.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FigureFiles {
+    pub png: PathBuf,
+    pub svg: PathBuf,
+    pub width_px: u32,
+    pub height_px: u32,
+}
+
+/// The PNG and SVG paths for `path`: a trailing `.png` or `.svg` is replaced, any other name
+/// gets the extensions appended (`out/fig1` and `out/fig1.png` both give `out/fig1.png` and
+/// `out/fig1.svg`).
+pub fn figure_paths(path: &Path) -> (PathBuf, PathBuf) {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let stem = match ext.as_deref() {
+        Some("png") | Some("svg") => path.with_extension(""),
+        _ => path.to_path_buf(),
+    };
+    let mut png = stem.clone().into_os_string();
+    png.push(".png");
+    let mut svg = stem.into_os_string();
+    svg.push(".svg");
+    (PathBuf::from(png), PathBuf::from(svg))
+}
+
+/// Draw `fig` and write it as PNG and SVG beside each other (see [`figure_paths`]); the
+/// folder must exist. Lines longer than twice the plot width are decimated to min/max per
+/// pixel column first. Errors: series with x, y (or bars) of different lengths, a figure
+/// without panels or with a zero size, and any I/O failure, each naming the file or series.
+pub fn write_figure(path: &Path, fig: &Figure) -> Result<FigureFiles, ReportError> {
+    validate(fig)?;
+    ensure_font()?;
+    let (png_path, svg_path) = figure_paths(path);
+    let (w, h) = (fig.width_px, fig.height_px);
+
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = GlyphFix::new(BitMapBackend::with_buffer(&mut rgb, (w, h))).into_drawing_area();
+        draw_figure(&root, fig).map_err(|message| ReportError::Draw {
+            path: png_path.clone(),
+            message,
+        })?;
+        root.present().map_err(|e| ReportError::Draw {
+            path: png_path.clone(),
+            message: e.to_string(),
+        })?;
+    }
+    let mut png = Vec::new();
+    {
+        use image::ImageEncoder;
+        image::codecs::png::PngEncoder::new(&mut png)
+            .write_image(&rgb, w, h, image::ColorType::Rgb8)
+            .map_err(|e| ReportError::Draw {
+                path: png_path.clone(),
+                message: format!("PNG encoding: {e}"),
+            })?;
+    }
+    write_bytes_atomically(&png_path, &png).map_err(|source| ReportError::Io {
+        path: png_path.clone(),
+        source,
+    })?;
+
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        draw_figure(&root, fig).map_err(|message| ReportError::Draw {
+            path: svg_path.clone(),
+            message,
+        })?;
+        root.present().map_err(|e| ReportError::Draw {
+            path: svg_path.clone(),
+            message: e.to_string(),
+        })?;
+    }
+    write_bytes_atomically(&svg_path, svg.as_bytes()).map_err(|source| ReportError::Io {
+        path: svg_path.clone(),
+        source,
+    })?;
+    Ok(FigureFiles {
+        png: png_path,
+        svg: svg_path,
+        width_px: w,
+        height_px: h,
+    })
+}
+
+fn validate(fig: &Figure) -> Result<(), ReportError> {
+    let data_err = |what: String| ReportError::Data {
+        what: format!("figure \"{}\": {what}", fig.title),
+    };
+    if fig.panels.is_empty() {
+        return Err(data_err("no panels to draw".into()));
+    }
+    if fig.width_px < 200 || fig.height_px < 150 * fig.panels.len() as u32 {
+        return Err(data_err(format!(
+            "size {}x{} px is too small for {} panel(s); use at least 200 x 150 per panel",
+            fig.width_px,
+            fig.height_px,
+            fig.panels.len()
+        )));
+    }
+    for s in fig.panels.iter().flat_map(|p| &p.series) {
+        if s.x.len() != s.y.len() {
+            return Err(data_err(format!(
+                "series \"{}\" has {} x values but {} y values",
+                s.label,
+                s.x.len(),
+                s.y.len()
+            )));
+        }
+        if let Some((lo, hi)) = &s.bars {
+            if lo.len() != s.x.len() || hi.len() != s.x.len() {
+                return Err(data_err(format!(
+                    "series \"{}\" has {} points but {} / {} error-bar ends",
+                    s.label,
+                    s.x.len(),
+                    lo.len(),
+                    hi.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Colour-blind-safe palette (Okabe & Ito 2008), darkened a little for thin lines.
+const PALETTE: [(u8, u8, u8); 8] = [
+    (0, 90, 170),   // blue
+    (213, 94, 0),   // vermillion
+    (0, 140, 100),  // bluish green
+    (150, 80, 150), // reddish purple
+    (200, 150, 0),  // dark yellow
+    (60, 60, 60),   // grey
+    (86, 160, 220), // sky blue
+    (180, 40, 40),  // red
+];
+
+fn color_of(s: &Series, index: usize) -> RGBColor {
+    let (r, g, b) = s.color.unwrap_or(PALETTE[index % PALETTE.len()]);
+    RGBColor(r, g, b)
+}
+
+/// Largest magnitude drawn: plotters 0.3.7's tick arithmetic never ends on an axis spanning
+/// ±1e300 (found by test), and no gyro quantity comes near 1e200 in any unit.
+const MAX_DRAWN_MAGNITUDE: f64 = 1e200;
+
+/// Finite, within ±[`MAX_DRAWN_MAGNITUDE`], and on a log axis at least its inverse.
+fn usable(v: f64, log: bool) -> bool {
+    v.is_finite() && v.abs() <= MAX_DRAWN_MAGNITUDE && (!log || v >= 1.0 / MAX_DRAWN_MAGNITUDE)
+}
+
+/// Range of the usable values, padded: 4 % of the span on a linear axis, a factor on a log
+/// axis; a single value gets a span of its own.
+fn padded_range(values: impl Iterator<Item = f64>, log: bool, pad: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|&v| usable(v, log)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > hi {
+        return if log { (0.1, 10.0) } else { (0.0, 1.0) };
+    }
+    if log {
+        if hi / lo < 1.0001 {
+            return (lo / 2.0, hi * 2.0);
+        }
+        let f = if pad { (hi / lo).powf(0.04) } else { 1.0 };
+        (lo / f, hi * f)
+    } else {
+        let span = hi - lo;
+        if span <= 1e-12 * lo.abs().max(hi.abs()).max(1e-300) {
+            let d = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
+            return (lo - d, hi + d);
+        }
+        let p = if pad { 0.04 * span } else { 0.0 };
+        (lo - p, hi + p)
+    }
+}
+
+type DrawResult = Result<(), String>;
+
+/// Tick text: plain decimals without trailing zeros (`2000`, `0.5`), scientific outside
+/// 1e-3..1e5 (`1.5e5`); values within 1e-12 of zero (tick arithmetic) print as `0`.
+pub(crate) fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if a < 1e-12 {
+        return "0".to_owned();
+    }
+    if !(1e-3..1e5).contains(&a) {
+        let s = format!("{v:.3e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = trim_zeros(mantissa);
+        return format!("{mantissa}e{exponent}");
+    }
+    trim_zeros(&format!("{v:.6}")).to_owned()
+}
+
+fn trim_zeros(s: &str) -> &str {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
+    }
+}
+
+fn draw_figure<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let body = root
+        .titled(&fig.title, (FONT_FAMILY, TITLE_FONT_PX).into_font())
+        .map_err(|e| e.to_string())?;
+    let areas = body.split_evenly((fig.panels.len(), 1));
+    // The x range is shared by all panels; lines run edge to edge, markers get a margin.
+    let has_markers = fig
+        .panels
+        .iter()
+        .flat_map(|p| &p.series)
+        .any(|s| matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints));
+    let xs = fig
+        .panels
+        .iter()
+        .flat_map(|p| &p.series)
+        .flat_map(|s| s.x.iter().copied());
+    let (x0, x1) = padded_range(xs, fig.log_x, fig.log_x || has_markers);
+    for (area, panel) in areas.iter().zip(&fig.panels) {
+        let ys = panel.series.iter().flat_map(|s| {
+            let bars = s
+                .bars
+                .iter()
+                .flat_map(|(lo, hi)| lo.iter().chain(hi.iter()).copied());
+            s.y.iter().copied().chain(bars)
+        });
+        let (y0, y1) = padded_range(ys, panel.log_y, true);
+        let mut builder = ChartBuilder::on(area);
+        builder
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(90);
+        let columns = area.dim_in_pixel().0.saturating_sub(110).max(50) as usize;
+        let r = match (fig.log_x, panel.log_y) {
+            (false, false) => draw_panel(
+                builder
+                    .build_cartesian_2d(x0..x1, y0..y1)
+                    .map_err(|e| e.to_string())?,
+                fig,
+                panel,
+                columns,
+            ),
+            (false, true) => draw_panel(
+                builder
+                    .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                    .map_err(|e| e.to_string())?,
+                fig,
+                panel,
+                columns,
+            ),
+            (true, false) => draw_panel(
+                builder
+                    .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+                    .map_err(|e| e.to_string())?,
+                fig,
+                panel,
+                columns,
+            ),
+            (true, true) => draw_panel(
+                builder
+                    .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                    .map_err(|e| e.to_string())?,
+                fig,
+                panel,
+                columns,
+            ),
+        };
+        r?;
+    }
+    Ok(())
+}
+
+fn draw_panel<'a, DB, X, Y>(
+    mut chart: ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    fig: &Figure,
+    panel: &Panel,
+    columns: usize,
+) -> DrawResult
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    chart
+        .configure_mesh()
+        .x_desc(fig.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .label_style((FONT_FAMILY, TICK_FONT_PX))
+        .axis_desc_style((FONT_FAMILY, AXIS_FONT_PX))
+        .light_line_style(RGBColor(238, 238, 238))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .x_labels(10)
+        .y_labels(8)
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
+        .draw()
+        .map_err(err)?;
+
+    for (i, s) in panel.series.iter().enumerate() {
+        let color = color_of(s, i);
+        let log_x = fig.log_x;
+        let log_y = panel.log_y;
+        let ok = |&(x, y): &(f64, f64)| usable(x, log_x) && usable(y, log_y);
+        let points: Vec<(f64, f64)> = match s.style {
+            SeriesStyle::Line | SeriesStyle::Dashed => {
+                let mut p = decimate_min_max(&s.x, &s.y, columns);
+                p.retain(ok);
+                p
+            }
+            SeriesStyle::Points | SeriesStyle::LinePoints => {
+                s.x.iter()
+                    .copied()
+                    .zip(s.y.iter().copied())
+                    .filter(ok)
+                    .collect()
+            }
+        };
+        // plotters draws lines wider than 1 px as polygons with mitred joins, which spike far
+        // outside the plot on the sharp, short zig-zags of a dense noisy series: a line with
+        // more than one point per 4 px that reverses direction at more than a quarter of its
+        // points is drawn 1 px wide.
+        let reversals = points
+            .windows(3)
+            .filter(|w| (w[1].1 - w[0].1) * (w[2].1 - w[1].1) < 0.0)
+            .count();
+        let dense = points.len() > columns / 4;
+        let width = if dense && reversals * 4 > points.len() {
+            1
+        } else {
+            2
+        };
+        let line_style = color.stroke_width(width);
+        let anno = match s.style {
+            SeriesStyle::Line => chart
+                .draw_series(LineSeries::new(points.iter().copied(), line_style))
+                .map_err(err)?,
+            SeriesStyle::Dashed => chart
+                .draw_series(DashedLineSeries::new(
+                    points.iter().copied(),
+                    10,
+                    6,
+                    line_style,
+                ))
+                .map_err(err)?,
+            SeriesStyle::Points => chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .map_err(err)?,
+            SeriesStyle::LinePoints => {
+                chart
+                    .draw_series(LineSeries::new(points.iter().copied(), line_style))
+                    .map_err(err)?;
+                chart
+                    .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                    .map_err(err)?
+            }
+        };
+        if !s.label.is_empty() {
+            let style = s.style;
+            let marker = matches!(style, SeriesStyle::Points | SeriesStyle::LinePoints);
+            let line = !matches!(style, SeriesStyle::Points);
+            let none = ShapeStyle::from(&TRANSPARENT);
+            let stroke = if line { color.stroke_width(2) } else { none };
+            let dot = if marker { color.filled() } else { none };
+            // Dashed lines show a gap in the middle of their legend stroke.
+            let gap = if matches!(style, SeriesStyle::Dashed) {
+                none
+            } else {
+                stroke
+            };
+            anno.label(s.label.as_str()).legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (8, 0)], stroke)
+                    + PathElement::new(vec![(8, 0), (14, 0)], gap)
+                    + PathElement::new(vec![(14, 0), (22, 0)], stroke)
+                    + Circle::new((11, 0), 3, dot)
+            });
+        }
+        if let Some((lo, hi)) = &s.bars {
+            // Vertical bar from lo to hi with 8 px caps.
+            let bar_style = color.stroke_width(1);
+            for ((&x, &y), (&l, &h)) in s.x.iter().zip(&s.y).zip(lo.iter().zip(hi)) {
+                if !(usable(x, log_x) && usable(y, log_y) && usable(l, log_y) && usable(h, log_y)) {
+                    continue;
+                }
+                let (l, h) = (l.min(y), h.max(y));
+                let cap = |v: f64| {
+                    EmptyElement::at((x, v)) + PathElement::new(vec![(-4, 0), (4, 0)], bar_style)
+                };
+                chart
+                    .draw_series([PathElement::new(vec![(x, l), (x, h)], bar_style)])
+                    .map_err(err)?;
+                chart.draw_series([cap(l), cap(h)]).map_err(err)?;
+            }
+        }
+    }
+
+    if panel.series.iter().any(|s| !s.label.is_empty()) {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(120, 120, 120))
+            .label_font((FONT_FAMILY, LEGEND_FONT_PX))
+            .draw()
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        for (v, want) in [
+            (2000.0, "2000"),
+            (0.5, "0.5"),
+            (-10.0, "-10"),
+            (0.1 + 0.2, "0.3"),
+            (-1.1e-16, "0"),
+            (150_000.0, "1.5e5"),
+            (2e-5, "2e-5"),
+            (0.001, "0.001"),
+        ] {
+            assert_eq!(tick_label(v), want, "tick_label({v})");
+        }
+    }
+
+    #[test]
+    fn paths_from_stem_or_extension() {
+        let (p, s) = figure_paths(Path::new("out/fig1"));
+        assert_eq!(
+            (p.as_path(), s.as_path()),
+            (Path::new("out/fig1.png"), Path::new("out/fig1.svg"))
+        );
+        let (p, s) = figure_paths(Path::new("adev.PNG"));
+        assert_eq!(
+            (p.as_path(), s.as_path()),
+            (Path::new("adev.png"), Path::new("adev.svg"))
+        );
+        let (p, _) = figure_paths(Path::new("run.2024"));
+        assert_eq!(p, Path::new("run.2024.png"));
+    }
+}
