@@ -132,33 +132,11 @@ pub fn exp_f64(x: f64) -> f64 {
     p * f64::from_bits(bits)
 }
 
-/// eˣ for f32, branch-free as [`exp_f64`]: x clamped to [-87, 88], Taylor polynomial to
-/// degree 7 on |r| ≤ ln2/2 (truncation < 1e-8 relative). Relative error a few ulps.
+/// eˣ for f32: the flight crate's [`gyrotherm_core::lstm::exp`] (same polynomial, so training
+/// and flight agree to the bit on the activations).
 #[inline(always)]
 pub fn exp_f32(x: f32) -> f32 {
-    const LOG2E: f32 = core::f32::consts::LOG2_E;
-    const LN2_HI: f32 = 0.693_145_75;
-    const LN2_LO: f32 = 1.428_606_8e-6;
-    // 1.5·2^23.
-    const SHIFT: f32 = 12_582_912.0;
-    let x = x.clamp(-87.0, 88.0);
-    let t = x * LOG2E + SHIFT;
-    let n = t - SHIFT;
-    let r = (x - n * LN2_HI) - n * LN2_LO;
-    let mut p = 1.0 / 5_040.0;
-    for c in [
-        1.0 / 720.0,
-        1.0 / 120.0,
-        1.0 / 24.0,
-        1.0 / 6.0,
-        0.5,
-        1.0,
-        1.0,
-    ] {
-        p = p * r + c;
-    }
-    let bits = t.to_bits().wrapping_sub(SHIFT.to_bits()).wrapping_add(127) << 23;
-    p * f32::from_bits(bits)
+    gyrotherm_core::lstm::exp(x)
 }
 
 #[inline(always)]
