@@ -163,9 +163,21 @@ fn main() {
     };
     row("raw", &raw, 0.0, 0.0);
     let mut linear_bias = f64::NAN;
-    for method in [Method::Linear, Method::Poly, Method::Lstm] {
+    for (label, method) in [
+        ("linear", Method::Linear),
+        ("poly", Method::Poly),
+        ("phys", Method::Lstm),
+        ("lstm", Method::Lstm),
+    ] {
         let mut cfg = FitConfig::new(method);
         cfg.recipe = recipe.clone();
+        if label == "phys" {
+            // The residual recipe's physical fit alone (no LSTM), for comparison.
+            if recipe.kind != RecipeKind::Residual {
+                continue;
+            }
+            cfg.recipe.epochs = 0;
+        }
         cfg.seed = 1;
         let (t0, c0) = (Instant::now(), cpu_s());
         let out = fit_model(&named, &cfg, &|_, _, _| {}).expect("fit");
@@ -173,21 +185,22 @@ fn main() {
         let s = compensate_log(&out.model, &test_static).expect("compensate static");
         let t = compensate_log(&out.model, &test_table).expect("compensate table");
         let f = figures(&s.gyro_comp_dps, &test_table, &t.gyro_comp_dps);
-        row(method.as_str(), &f, wall, cpu);
+        row(label, &f, wall, cpu);
         if method == Method::Linear {
             linear_bias = f.bias_dph;
         }
-        if method == Method::Lstm {
+        if label == "lstm" {
             for (n, tr) in [("bias", &out.bias_training), ("scale", &out.scale_training)] {
                 if let Some(tr) = tr {
                     println!(
-                        "  {n}: epochs {} best {:?} final loss {:.4} val {:?} baseline rms {:?} gain {:?}",
+                        "  {n}: epochs {} best {:?} final loss {:.4} val {:?} baseline rms {:?} gain {:?} val impr {:?}",
                         tr.epochs,
                         tr.best_epoch,
                         tr.final_loss,
                         tr.best_epoch.and_then(|b| tr.val_loss_history.get(b)),
                         tr.baseline_rms,
-                        tr.lstm_gain
+                        tr.lstm_gain,
+                        tr.val_improvement
                     );
                 }
             }

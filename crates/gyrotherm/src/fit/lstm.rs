@@ -17,11 +17,12 @@
 //!   baseline only ([`scale_terms`]; K depends on the coil temperature alone), or a residual
 //!   LSTM too with [`LstmRecipe::scale_lstm`].
 
-use crate::baseline::{self, Terms};
+use crate::baseline::Terms;
 use crate::features::FeatureSpec;
 use crate::model::SubModel;
 use crate::targets::TargetSet;
 use crate::train::{predict, train_normalised, Bptt, Sequence, TrainConfig, WindowStart};
+use nalgebra::{DMatrix, DVector};
 
 /// Which recipe.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,6 +88,9 @@ pub struct LstmRecipe {
     pub patience: Option<usize>,
     /// `Residual`: also fit a residual LSTM to the scale factor (default: baseline only).
     pub scale_lstm: bool,
+    /// `Residual`: the least relative validation-loss reduction for which the residual LSTM is
+    /// kept; below it the sub-model is the physical fit alone.
+    pub min_val_improvement: f64,
 }
 
 impl LstmRecipe {
@@ -113,6 +117,7 @@ impl LstmRecipe {
             validation_every: 4,
             patience: Some(20),
             scale_lstm: false,
+            min_val_improvement: 0.05,
         }
     }
 
@@ -151,6 +156,9 @@ pub struct TrainSummary {
     /// Gain the residual LSTM's output was scaled by, chosen on the validation blocks
     /// (`Residual` with an LSTM only; 0: the LSTM did not help there and contributes nothing).
     pub lstm_gain: Option<f64>,
+    /// Relative reduction of the validation loss by the residual LSTM against no correction,
+    /// `1 - best / epoch-0` (`Residual` with validation only).
+    pub val_improvement: Option<f64>,
 }
 
 /// The feature specification a recipe's models read.
@@ -273,6 +281,140 @@ fn fit_published(
     ))
 }
 
+/// A least-squares baseline with one offset per training run.
+struct FixedEffectsFit {
+    terms: Terms,
+    /// Coefficients; the constant term holds the mean offset over the runs (by labelled steps).
+    coefficients: Vec<f64>,
+    /// Offset of each run relative to the constant term, target units.
+    run_offset: Vec<f64>,
+    /// RMS residual over the labelled steps, target units.
+    rms: f64,
+}
+
+impl FixedEffectsFit {
+    fn predict_row(&self, x: &[f64]) -> f64 {
+        self.terms
+            .design_row(x)
+            .iter()
+            .zip(&self.coefficients)
+            .map(|(a, c)| a * c)
+            .sum()
+    }
+
+    fn sub_model(&self) -> SubModel {
+        SubModel::Baseline {
+            terms: self.terms.clone(),
+            coefficients: self.coefficients.clone(),
+        }
+    }
+}
+
+/// Least squares `y = a_run + Σ_j c_j·m_j(x)` over the labelled steps of all runs (`terms`
+/// must start with the constant term, which becomes the per-run offsets `a_run`): the
+/// "within" estimator — monomials and targets centred per run, solved by SVD on RMS-scaled
+/// columns, refused below [`crate::baseline::RANK_TOL`]. With one run this is ordinary least
+/// squares.
+fn fit_fixed_effects(train: &[TargetSet], terms: &Terms) -> Result<FixedEffectsFit, String> {
+    debug_assert!(terms.powers[0].iter().all(|p| *p == 0));
+    let nt = terms.len();
+    let mut design: Vec<f64> = Vec::new();
+    let mut y: Vec<f64> = Vec::new();
+    let mut run_means: Vec<(Vec<f64>, f64, usize)> = Vec::new();
+    for s in train {
+        let (start_row, start_y) = (design.len(), y.len());
+        for r in 0..s.table.n_rows() {
+            if s.mask[r] {
+                design.extend_from_slice(&terms.design_row(s.table.row(r))[1..]);
+                y.push(s.target[r]);
+            }
+        }
+        let n = y.len() - start_y;
+        let mut mean = vec![0.0; nt - 1];
+        let mut ymean = 0.0;
+        if n > 0 {
+            for (k, row) in design[start_row..].chunks_exact(nt - 1).enumerate() {
+                for (m, v) in mean.iter_mut().zip(row) {
+                    *m += v;
+                }
+                ymean += y[start_y + k];
+            }
+            mean.iter_mut().for_each(|m| *m /= n as f64);
+            ymean /= n as f64;
+            for (k, row) in design[start_row..].chunks_exact_mut(nt - 1).enumerate() {
+                for (v, m) in row.iter_mut().zip(&mean) {
+                    *v -= m;
+                }
+                y[start_y + k] -= ymean;
+            }
+        }
+        run_means.push((mean, ymean, n));
+    }
+    let n = y.len();
+    if n < nt + train.len() {
+        return Err(format!(
+            "{n} labelled steps for {} terms and {} run offsets: too few to fit",
+            nt - 1,
+            train.len()
+        ));
+    }
+    let mut scale = vec![0.0; nt - 1];
+    for row in design.chunks_exact(nt - 1) {
+        for (s, v) in scale.iter_mut().zip(row) {
+            *s += v * v;
+        }
+    }
+    for (j, s) in scale.iter_mut().enumerate() {
+        *s = (*s / n as f64).sqrt();
+        if !(*s > 0.0) {
+            return Err(format!(
+                "term {j} does not vary within the training runs: cannot fit it",
+                j = j + 1
+            ));
+        }
+    }
+    let x = DMatrix::from_fn(n, nt - 1, |r, c| design[r * (nt - 1) + c] / scale[c]);
+    let svd = x.clone().svd(true, true);
+    let (smax, smin) = svd
+        .singular_values
+        .iter()
+        .fold((0.0f64, f64::INFINITY), |(a, b), &v| (a.max(v), b.min(v)));
+    if !(smin / smax >= crate::baseline::RANK_TOL) {
+        return Err(format!(
+            "the baseline terms are (nearly) dependent on the training data (singular value ratio {:.1e}); use more varied training runs",
+            smin / smax
+        ));
+    }
+    let yv = DVector::from_vec(y);
+    let c = svd.solve(&yv, 0.0).map_err(|e| e.to_string())?;
+    let resid = &yv - &x * &c;
+    let rms = (resid.norm_squared() / n as f64).sqrt();
+    let slopes: Vec<f64> = c.iter().zip(&scale).map(|(v, s)| v / s).collect();
+    let offsets: Vec<f64> = run_means
+        .iter()
+        .map(|(m, ym, _)| ym - m.iter().zip(&slopes).map(|(a, b)| a * b).sum::<f64>())
+        .collect();
+    let total: usize = run_means.iter().map(|r| r.2).sum();
+    let c0 = offsets
+        .iter()
+        .zip(&run_means)
+        .map(|(o, r)| o * r.2 as f64)
+        .sum::<f64>()
+        / total as f64;
+    let mut coefficients = vec![c0];
+    coefficients.extend_from_slice(&slopes);
+    Ok(FixedEffectsFit {
+        terms: terms.clone(),
+        coefficients,
+        run_offset: offsets
+            .iter()
+            .zip(&run_means)
+            .map(|(o, r)| if r.2 > 0 { o - c0 } else { 0.0 })
+            .collect(),
+        rms,
+    })
+}
+
 /// One block of a run for the residual LSTM: rows, residual target and loss mask.
 struct Block {
     rows: Vec<f64>,
@@ -305,42 +447,27 @@ fn fit_residual(
             terms.n_features
         ));
     }
-    // 1. The physical baseline on every labelled step of every run.
-    let first = &train[0].table;
-    let (mut rows, mut y, mut mask) = (Vec::new(), Vec::new(), Vec::new());
-    for s in train {
-        rows.extend_from_slice(&s.table.rows);
-        y.extend_from_slice(&s.target);
-        mask.extend_from_slice(&s.mask);
-    }
-    let base = baseline::fit_rows(
-        &rows,
-        n_in,
-        &first.names,
-        &first.units,
-        &y,
-        Some(&mask),
-        &terms,
-    )
-    .map_err(|e| e.to_string())?;
+    // 1. The physical baseline on every labelled step of every run, each run with its own
+    //    offset (turn-on bias / scale-factor repeatability); the model keeps their mean.
+    let base = fit_fixed_effects(train, &terms)?;
     let want_lstm = match target {
         RecipeTarget::Bias => true,
         RecipeTarget::Scale => recipe.scale_lstm,
     };
     if !want_lstm || recipe.epochs == 0 {
         let summary = TrainSummary {
-            final_loss: base.rms_residual,
-            baseline_rms: Some(base.rms_residual),
+            final_loss: base.rms,
+            baseline_rms: Some(base.rms),
             ..TrainSummary::default()
         };
-        return Ok((SubModel::from_fit(&base), summary));
+        return Ok((base.sub_model(), summary));
     }
     // 2. Residual per run, cut into blocks; every `validation_every`-th block validates.
     let block = recipe.block_steps.max(recipe.burn_in + 1);
     let mut train_blocks = Vec::new();
     let mut val_blocks = Vec::new();
     let mut k = 0usize;
-    for s in train {
+    for (run, s) in train.iter().enumerate() {
         let nr = s.table.n_rows();
         let mut start = 0;
         while start < nr {
@@ -354,7 +481,7 @@ fn fit_residual(
                 target: (start..end)
                     .map(|r| {
                         if s.mask[r] {
-                            s.target[r] - base.predict_row(s.table.row(r))
+                            s.target[r] - base.predict_row(s.table.row(r)) - base.run_offset[run]
                         } else {
                             f64::NAN
                         }
@@ -398,14 +525,22 @@ fn fit_residual(
         },
         clip_grad_norm: Some(1.0),
         patience: if va.is_empty() { None } else { recipe.patience },
+        zero_output_init: true,
         ..TrainConfig::default()
     };
     let fit = train_normalised(&tr, &va, n_in, &cfg, progress).map_err(|e| e.to_string())?;
-    // 3. Shrink the LSTM's contribution to what the validation blocks support.
-    let gain = if val_blocks.is_empty() {
-        1.0
-    } else {
-        validation_gain(&fit, &val_blocks, n_in)?
+    // 3. Keep the LSTM only if it beat "no correction" (epoch 0, zero output layer) on the
+    //    validation blocks by `min_val_improvement`, and shrink its contribution to what the
+    //    validation blocks support.
+    let out = &fit.output;
+    let val_improvement = match (out.best_epoch, out.val_loss_history.first()) {
+        (Some(b), Some(&v0)) if v0 > 0.0 => Some(1.0 - out.val_loss_history[b] / v0),
+        _ => None,
+    };
+    let gain = match val_improvement {
+        None => 1.0,
+        Some(g) if g < recipe.min_val_improvement => 0.0,
+        Some(_) => validation_gain(&fit, &val_blocks, n_in)?,
     };
     let mut target_norm = fit.target_z.clone();
     target_norm.mean[0] *= gain;
@@ -416,12 +551,13 @@ fn fit_residual(
         loss_history: fit.output.loss_history,
         val_loss_history: fit.output.val_loss_history,
         best_epoch: fit.output.best_epoch,
-        baseline_rms: Some(base.rms_residual),
+        baseline_rms: Some(base.rms),
         lstm_gain: Some(gain),
+        val_improvement,
     };
     if gain < MIN_GAIN {
         // The LSTM predicted none of the held-out residual: the physical fit alone.
-        return Ok((SubModel::from_fit(&base), summary));
+        return Ok((base.sub_model(), summary));
     }
     Ok((
         SubModel::Residual {
