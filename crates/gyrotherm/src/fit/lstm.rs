@@ -108,14 +108,14 @@ impl LstmRecipe {
     pub fn residual() -> Self {
         LstmRecipe {
             kind: RecipeKind::Residual,
-            epochs: 200,
-            lr: 0.005,
+            epochs: 300,
+            lr: 0.003,
             window: 1000,
             burn_in: 200,
-            batch: 8,
-            block_steps: 3000,
+            batch: 4,
+            block_steps: 1000,
             validation_every: 4,
-            patience: Some(20),
+            patience: Some(30),
             scale_lstm: false,
             min_val_improvement: 0.05,
         }
@@ -215,6 +215,8 @@ pub fn scale_terms() -> Terms {
         term(n, &[(2, 1)]),
         term(n, &[(0, 1), (2, 1)]),
         term(n, &[(2, 2)]),
+        term(n, &[(3, 1)]),
+        term(n, &[(0, 1), (3, 1)]),
     ];
     Terms {
         n_features: n,
@@ -366,7 +368,7 @@ fn fit_fixed_effects(train: &[TargetSet], terms: &Terms) -> Result<FixedEffectsF
     }
     for (j, s) in scale.iter_mut().enumerate() {
         *s = (*s / n as f64).sqrt();
-        if !(*s > 0.0) {
+        if *s <= 0.0 || !s.is_finite() {
             return Err(format!(
                 "term {j} does not vary within the training runs: cannot fit it",
                 j = j + 1
@@ -379,7 +381,8 @@ fn fit_fixed_effects(train: &[TargetSet], terms: &Terms) -> Result<FixedEffectsF
         .singular_values
         .iter()
         .fold((0.0f64, f64::INFINITY), |(a, b), &v| (a.max(v), b.min(v)));
-    if !(smin / smax >= crate::baseline::RANK_TOL) {
+    let ratio = smin / smax;
+    if ratio.is_nan() || ratio < crate::baseline::RANK_TOL {
         return Err(format!(
             "the baseline terms are (nearly) dependent on the training data (singular value ratio {:.1e}); use more varied training runs",
             smin / smax
