@@ -13,7 +13,7 @@ use crate::features::{FeatureSpec, FeatureTable};
 use crate::model::{self, FeatureDef, Method, ModelFile, SubModel, TrainingInfo};
 use crate::targets::{self, TargetSet};
 
-pub use lstm::{LstmRecipe, RecipeKind, TrainSummary};
+pub use lstm::{LstmRecipe, RecipeKind, RecipeTarget, TrainSummary};
 
 /// A training log and the name it is reported under (its file name).
 #[derive(Debug, Clone, Copy)]
@@ -146,7 +146,11 @@ fn fit_one(
                 Target::Bias => 0,
                 Target::Scale => 1,
             });
-            let (sub, summary) = lstm::fit_target(sets, &cfg.recipe, seed, progress)?;
+            let t = match target {
+                Target::Bias => RecipeTarget::Bias,
+                Target::Scale => RecipeTarget::Scale,
+            };
+            let (sub, summary) = lstm::fit_target(sets, &cfg.recipe, t, seed, progress)?;
             Ok((sub, Some(summary)))
         }
     }

@@ -131,6 +131,10 @@ pub struct TrainConfig {
     /// With validation runs: stop after this many epochs without a new best validation loss.
     /// Default None (run all epochs, still return the best parameters).
     pub patience: Option<usize>,
+    /// Start the output layer (`w_out`, `b_out`) at zero, so the untrained network predicts
+    /// the target mean: for a residual network, epoch 0 is then "no correction", and early
+    /// stopping on validation can choose it. Default false (PyTorch init throughout).
+    pub zero_output_init: bool,
 }
 
 impl Default for TrainConfig {
@@ -148,6 +152,7 @@ impl Default for TrainConfig {
             bptt: Bptt::Full,
             precision: Precision::F32,
             patience: None,
+            zero_output_init: false,
         }
     }
 }
@@ -722,7 +727,11 @@ impl<'r, 'a, T: Real> Trainer<'r, 'a, T> {
             i: input_size,
             h: cfg.hidden_size,
         };
-        let init = init_params(input_size, cfg.hidden_size, cfg.seed);
+        let mut init = init_params(input_size, cfg.hidden_size, cfg.seed);
+        if cfg.zero_output_init {
+            init.w_out.fill(0.0);
+            init.b_out = 0.0;
+        }
         // The window-shuffling rng continues the init stream's seed on another stream.
         let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
         rng.set_stream(1);

@@ -1,0 +1,318 @@
+//! LSTM recipes (issue 5): the residual recipe on a held-out simulated run, its physical fit,
+//! its gate on the residual LSTM, determinism, and the published recipe kept as an option.
+
+use gyrotherm::baseline::Terms;
+use gyrotherm::compensate::compensate_log;
+use gyrotherm::csvlog::TestLog;
+use gyrotherm::features::FeatureSpec;
+use gyrotherm::fit::lstm::{self, bias_terms, LstmRecipe, RecipeKind, RecipeTarget};
+use gyrotherm::fit::{fit_model, FitConfig, FitOutcome, NamedLog};
+use gyrotherm::metrics::bias_stability_dph;
+use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
+use gyrotherm::model::{Method, SubModel};
+use gyrotherm::sim::{simulate, SimConfig};
+use gyrotherm::targets::TargetSet;
+
+const TABLE_RATE_DPS: f64 = 20.0;
+
+fn sim(profile: &str, seed: u64, table: bool, truth: bool) -> TestLog {
+    let mut c = SimConfig::builtin(profile).unwrap();
+    c.seed = seed;
+    c.truth = truth;
+    c.table_rate_dps = table.then_some(TABLE_RATE_DPS);
+    simulate(&c).unwrap()
+}
+
+fn column(log: &TestLog, name: &str) -> Vec<f64> {
+    let c = log
+        .extra
+        .iter()
+        .find(|c| c.name == name)
+        .unwrap_or_else(|| panic!("the simulator wrote no {name} column"));
+    c.values.iter().map(|v| v.parse().unwrap()).collect()
+}
+
+fn fit(logs: &[(&str, &TestLog)], cfg: &FitConfig) -> FitOutcome {
+    let named: Vec<NamedLog> = logs
+        .iter()
+        .map(|(name, log)| NamedLog { name, log })
+        .collect();
+    fit_model(&named, cfg, &|_, _, _| {}).unwrap()
+}
+
+fn bias_stability(x: &[f64]) -> f64 {
+    bias_stability_dph(x, 1.0, 100.0)
+        .unwrap()
+        .bias_stability_dph
+}
+
+/// The issue's "done when" on one held-out pair, judged through the flight compensator:
+/// train on `seed-shock` (static + rate table), test on `slow-ramp` with other seeds.
+#[test]
+fn residual_recipe_meets_the_issue_targets_on_a_held_out_profile() {
+    let train_static = sim("seed-shock", 7, false, false);
+    let train_table = sim("seed-shock", 107, true, false);
+    let test_static = sim("slow-ramp", 11, false, true);
+    let test_table = sim("slow-ramp", 111, true, false);
+    let logs = [("static", &train_static), ("table", &train_table)];
+
+    let linear = fit(&logs, &FitConfig::new(Method::Linear)).model;
+    let mut cfg = FitConfig::new(Method::Lstm);
+    // Few epochs keep the test cheap; the recipe's gate decides whether the LSTM stays.
+    cfg.recipe.epochs = 10;
+    let lstm = fit(&logs, &cfg).model;
+
+    // Noise-only floor: the simulator's truth column of the output noise (independent of
+    // any fit).
+    let floor = bias_stability(&column(&test_static, "noise_dps"));
+    let lin = bias_stability(&compensate_log(&linear, &test_static).unwrap().gyro_comp_dps);
+    let got = bias_stability(&compensate_log(&lstm, &test_static).unwrap().gyro_comp_dps);
+    // Issue 5: ≤ 1.5 × the noise floor, and ≥ 30 % below the linear fit.
+    assert!(
+        got <= 1.5 * floor,
+        "bias stability: want ≤ 1.5 × floor = {:.5} °/h, got {got:.5} (ratio {:.2})",
+        1.5 * floor,
+        got / floor
+    );
+    assert!(
+        got <= 0.7 * lin,
+        "bias stability: want ≤ 0.7 × linear = {:.5} °/h, got {got:.5} ({:+.1} %)",
+        0.7 * lin,
+        (got / lin - 1.0) * 100.0
+    );
+
+    let comp = compensate_log(&lstm, &test_table).unwrap();
+    let table = test_table.table_dps.as_ref().unwrap();
+    let rep = scale_factor(
+        &test_table.time_s,
+        &comp.gyro_comp_dps,
+        table,
+        &ScaleFactorOptions::default(),
+    )
+    .unwrap();
+    // Issue 5: scale-factor thermal error < 10 ppm across the cycle.
+    assert!(
+        rep.sf_thermal_error_ppm < 10.0,
+        "SF thermal error: want < 10 ppm, got {:.2}",
+        rep.sf_thermal_error_ppm
+    );
+    // Issue 5: compensated output at +20 °/s within 20 ± 0.0005 °/s in every segment.
+    let mut n20 = 0;
+    for s in rep
+        .segments
+        .iter()
+        .filter(|s| s.table_dps == TABLE_RATE_DPS)
+    {
+        n20 += 1;
+        let err = s.mean_output_dps - TABLE_RATE_DPS;
+        assert!(
+            err.abs() <= 0.0005,
+            "segment at {:.0} s: want 20 ± 0.0005 °/s, got {:.6} (error {err:+.6})",
+            s.start_time_s,
+            s.mean_output_dps
+        );
+    }
+    assert!(n20 > 10, "only {n20} +20 °/s segments were evaluated");
+}
+
+/// Static logs whose bias is a known function of the logged temperature: the physical
+/// terms' part (coefficients `c` over [`bias_terms`]), a per-run offset, and `extra(x)`.
+fn synthetic_log(
+    profile: &str,
+    seed: u64,
+    offset_dps: f64,
+    c: &[f64],
+    extra: &dyn Fn(&[f64]) -> f64,
+) -> TestLog {
+    let mut log = sim(profile, seed, false, false);
+    let table = gyrotherm::features::extract(&log, &FeatureSpec::THERMAL_STATE).unwrap();
+    let terms = bias_terms();
+    let rows = table.row_of_sample(log.len());
+    log.gyro_dps = rows
+        .iter()
+        .map(|&r| {
+            let x = table.row(r);
+            let phys: f64 = terms.design_row(x).iter().zip(c).map(|(m, k)| m * k).sum();
+            offset_dps + phys + extra(x)
+        })
+        .collect();
+    log
+}
+
+/// Arbitrary but physically sized coefficients over [`bias_terms`] (°/s per monomial unit).
+const C: [f64; 8] = [1e-4, 8e-7, 2e-9, 1e-6, 4e-9, 1e-9, 3e-7, -2e-7];
+
+/// Target sets whose target at every step is exactly `offset + Σ c_j·m_j(x)`.
+fn exact_set(profile: &str, seed: u64, offset_dps: f64) -> TargetSet {
+    let log = sim(profile, seed, false, false);
+    let table = gyrotherm::features::extract(&log, &FeatureSpec::THERMAL_STATE).unwrap();
+    let terms = bias_terms();
+    let target = (0..table.n_rows())
+        .map(|r| {
+            let m = terms.design_row(table.row(r));
+            offset_dps + m.iter().zip(&C).map(|(a, b)| a * b).sum::<f64>()
+        })
+        .collect();
+    let mask = vec![true; table.n_rows()];
+    TargetSet {
+        table,
+        target,
+        mask,
+    }
+}
+
+/// With exact data from the physical terms plus a different offset per run, the fit
+/// recovers the thermal part and the constant as the mean offset weighted by labelled steps
+/// (independent: the construction).
+#[test]
+fn physical_fit_recovers_known_coefficients_across_run_offsets() {
+    let (oa, ob) = (2e-4, -3e-4);
+    let sets = vec![
+        exact_set("seed-shock", 1, oa),
+        exact_set("fast-cycle", 2, ob),
+    ];
+    let recipe = LstmRecipe {
+        epochs: 0,
+        ..LstmRecipe::residual()
+    };
+    let (sub, summary) =
+        lstm::fit_target(&sets, &recipe, RecipeTarget::Bias, 0, &mut |_, _| {}).unwrap();
+    let SubModel::Baseline {
+        terms,
+        coefficients,
+    } = sub
+    else {
+        panic!("epochs 0: want the physical fit alone, got {sub:?}");
+    };
+    assert_eq!(terms, bias_terms());
+    // Round-off of an SVD least-squares solve on exact data (the design's columns span
+    // 1 to ~10^4 before scaling): 1e-10 °/s = 3.6e-7 °/h, far below any figure judged.
+    const ROUND_OFF_DPS: f64 = 1e-10;
+    let (na, nb) = (sets[0].labelled() as f64, sets[1].labelled() as f64);
+    let want_c0 = C[0] + (oa * na + ob * nb) / (na + nb);
+    let c0_err = (coefficients[0] - want_c0).abs();
+    assert!(
+        c0_err < ROUND_OFF_DPS,
+        "constant: want {want_c0:e}, got {:e} (error {c0_err:e})",
+        coefficients[0]
+    );
+    for set in &sets {
+        let mut worst = 0.0f64;
+        for r in 0..set.table.n_rows() {
+            let m = terms.design_row(set.table.row(r));
+            let got: f64 = m
+                .iter()
+                .zip(&coefficients)
+                .skip(1)
+                .map(|(a, b)| a * b)
+                .sum();
+            let want: f64 = m.iter().zip(&C).skip(1).map(|(a, b)| a * b).sum();
+            worst = worst.max((got - want).abs());
+        }
+        assert!(
+            worst < ROUND_OFF_DPS,
+            "thermal part: want the true one within {ROUND_OFF_DPS:e} °/s, worst error {worst:e}"
+        );
+    }
+    let rms = summary.baseline_rms.unwrap();
+    assert!(rms < ROUND_OFF_DPS, "baseline rms residual {rms:e} °/s");
+}
+
+/// A bias part the physical terms cannot express (a smooth step in T): the residual LSTM
+/// must be kept by the validation gate and must reduce the error on a held-out run of another
+/// profile below that of the physical fit alone (both measured, same data).
+#[test]
+fn residual_lstm_is_kept_when_it_learns_what_the_physical_terms_cannot() {
+    // An unmodelled coupling of temperature and slow thermal state, 0.05 °/h at T = 30 °C,
+    // T - lag1000 = 10 °C: far above the noiseless data's smoothing error.
+    let coupling = |x: &[f64]| 0.05 / 3600.0 * (x[0] / 30.0) * (x[3] / 10.0);
+    let train_a = synthetic_log("seed-shock", 3, 0.0, &C, &coupling);
+    let train_b = synthetic_log("fast-cycle", 4, 0.0, &C, &coupling);
+    let test = synthetic_log("slow-ramp", 5, 0.0, &C, &coupling);
+    let logs = [("a", &train_a), ("b", &train_b)];
+    let mut cfg = FitConfig::new(Method::Lstm);
+    cfg.recipe.epochs = 60;
+    let out = fit(&logs, &cfg);
+    let summary = out.bias_training.clone().unwrap();
+    let gain = summary.lstm_gain.unwrap();
+    assert!(
+        matches!(out.model.bias, Some(SubModel::Residual { .. })),
+        "want the residual LSTM kept; validation improvement {:?}, gain {gain}",
+        summary.val_improvement
+    );
+    cfg.recipe.epochs = 0;
+    let phys = fit(&logs, &cfg).model;
+    // The true bias is known exactly here: compare the bias prediction error.
+    let truth = &test.gyro_dps;
+    let rms = |model| {
+        let b = compensate_log(model, &test).unwrap().bias_dps;
+        let skip = 3000; // thermal-state lags start from the first reading
+        let e: f64 = b[skip..]
+            .iter()
+            .zip(&truth[skip..])
+            .map(|(p, t)| (p - t) * (p - t))
+            .sum();
+        (e / (b.len() - skip) as f64).sqrt()
+    };
+    let (with, without) = (rms(&out.model), rms(&phys));
+    eprintln!("held-out bias error: {with:e} °/s with the LSTM (gain {gain}), {without:e} without");
+    assert!(
+        with < 0.8 * without,
+        "held-out bias error: want the LSTM to remove > 20 %, got {with:e} °/s with vs {without:e} without"
+    );
+}
+
+/// Same data and seed, same file; another seed, another network.
+#[test]
+fn residual_recipe_is_deterministic() {
+    let log = sim("fast-cycle", 5, false, false);
+    let logs = [("static", &log)];
+    let mut cfg = FitConfig::new(Method::Lstm);
+    cfg.recipe.epochs = 3;
+    // No validation blocks: the LSTM is kept as trained, so the test covers its training.
+    cfg.recipe.validation_every = 0;
+    cfg.seed = 9;
+    let a = fit(&logs, &cfg).model;
+    assert!(matches!(a.bias, Some(SubModel::Residual { .. })));
+    let b = fit(&logs, &cfg).model;
+    assert_eq!(a.to_json().unwrap(), b.to_json().unwrap());
+    cfg.seed = 10;
+    let c = fit(&logs, &cfg).model;
+    assert_ne!(a.to_json().unwrap(), c.to_json().unwrap());
+}
+
+/// `--recipe published` is the paper's recipe: T and dT in, a plain LSTM, full BPTT.
+#[test]
+fn published_recipe_is_kept() {
+    let r = LstmRecipe::of_kind(RecipeKind::parse("published").unwrap());
+    assert_eq!(r, LstmRecipe::published());
+    assert_eq!((r.epochs, r.lr), (1000, 0.01));
+    assert_eq!(lstm::feature_spec(&r), FeatureSpec::PUBLISHED);
+    assert_eq!(LstmRecipe::default().kind, RecipeKind::Residual);
+    assert!(RecipeKind::parse("fancy")
+        .unwrap_err()
+        .contains("published"));
+
+    let log = sim("seed-shock", 6, false, false);
+    let mut cfg = FitConfig::new(Method::Lstm);
+    cfg.recipe = LstmRecipe {
+        epochs: 3,
+        ..LstmRecipe::published()
+    };
+    let out = fit(&[("static", &log)], &cfg);
+    assert!(matches!(out.model.bias, Some(SubModel::Lstm { .. })));
+    assert_eq!(out.model.features.lag_tau_s, Vec::<f64>::new());
+    assert_eq!(out.bias_training.unwrap().epochs, 3);
+}
+
+/// The physical terms fit the flight crate's capacity and use the thermal-state features.
+#[test]
+fn physical_terms_are_valid_for_flight() {
+    let n = FeatureSpec::THERMAL_STATE.n_features();
+    for t in [bias_terms(), lstm::scale_terms()] {
+        assert_eq!(t.n_features, n);
+        t.validate().unwrap();
+        assert_eq!(t.powers[0], vec![0; n], "the constant term comes first");
+    }
+    let _: Terms = bias_terms();
+}
