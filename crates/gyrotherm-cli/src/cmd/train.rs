@@ -13,9 +13,11 @@ use super::progress::TrainingBars;
 /// Fitting options shared by `train` and `compare`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
-    /// LSTM recipe: `default` (the project's, chosen by held-out figures) or `published`
-    /// (He et al. 2024 exactly: whole run, T and dT inputs, 1000 Adam steps at lr 0.01).
-    #[arg(long, default_value = "default", value_parser = ["default", "published"])]
+    /// LSTM recipe: `residual` (default, chosen by held-out figures: least squares on
+    /// thermal-state inputs plus an LSTM on its residual, kept only where it helps on
+    /// validation blocks) or `published` (He et al. 2024 exactly: whole run, T and dT
+    /// inputs, 1000 Adam steps at lr 0.01).
+    #[arg(long, default_value = "residual", value_parser = ["residual", "published"])]
     pub recipe: String,
     /// LSTM training epochs (default: the recipe's).
     #[arg(long)]
@@ -44,9 +46,9 @@ impl FitArgs {
     /// The library's fit configuration for `method`.
     pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
         let mut cfg = FitConfig::new(method);
-        if self.recipe == "published" {
-            cfg.recipe = gyrotherm::fit::LstmRecipe::published();
-        }
+        let kind =
+            gyrotherm::fit::lstm::RecipeKind::parse(&self.recipe).map_err(anyhow::Error::msg)?;
+        cfg.recipe = gyrotherm::fit::LstmRecipe::of_kind(kind);
         if let Some(e) = self.epochs {
             anyhow::ensure!(e > 0, "--epochs must be at least 1");
             cfg.recipe.epochs = e;
