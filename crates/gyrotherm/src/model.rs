@@ -152,6 +152,16 @@ pub enum SubModel {
 }
 
 impl SubModel {
+    /// What the sub-model is made of: `"lstm"`, `"least squares"` or
+    /// `"least squares + lstm"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SubModel::Lstm { .. } => "lstm",
+            SubModel::Baseline { .. } => "least squares",
+            SubModel::Residual { .. } => "least squares + lstm",
+        }
+    }
+
     /// A baseline sub-model from a fit.
     pub fn from_fit(fit: &baseline::BaselineFit) -> SubModel {
         SubModel::Baseline {

@@ -135,6 +135,8 @@ pub fn comparison_json(cmp: &Comparison, cfg: &CompareConfig) -> Value {
         }).collect::<Vec<_>>(),
         "models": cmp.fits.iter().map(|f| json!({
             "method": f.model.method.as_str(),
+            "bias_model": f.model.bias.as_ref().map(|b| b.kind()),
+            "scale_model": f.model.scale.as_ref().map(|b| b.kind()),
             "bias_epochs": f.bias_training.as_ref().map(|t| t.epochs),
             "bias_final_loss": f.bias_training.as_ref().map(|t| t.final_loss),
             "scale_epochs": f.scale_training.as_ref().map(|t| t.epochs),
@@ -156,6 +158,25 @@ pub fn print_table(
     cmp: &Comparison,
     cfg: &CompareConfig,
 ) -> std::io::Result<()> {
+    use gyrotherm::model::SubModel;
+    for f in &cmp.fits {
+        let part = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
+        write!(
+            w,
+            "{:>6}: bias model {}, scale-factor model {}",
+            f.model.method.as_str(),
+            part(&f.model.bias),
+            part(&f.model.scale)
+        )?;
+        let lstm_kept = [&f.model.bias, &f.model.scale]
+            .iter()
+            .any(|s| matches!(s, Some(SubModel::Lstm { .. } | SubModel::Residual { .. })));
+        if f.model.method == Method::Lstm && !lstm_kept {
+            write!(w, " (no residual LSTM beat its least-squares base on the validation blocks, so none was kept)")?;
+        }
+        writeln!(w)?;
+    }
+    writeln!(w)?;
     for t in &cmp.tests {
         let mut cols = vec!["raw".to_string()];
         cols.extend(t.methods.iter().map(|m| m.method.as_str().to_string()));
