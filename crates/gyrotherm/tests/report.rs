@@ -403,6 +403,7 @@ fn report_over_two_synthetic_runs() {
             .iter()
             .map(|(f, _)| ReportFigure::from_files(f, "caption for <figure>"))
             .collect(),
+        notes: vec!["figure 9 not drawn: <no data>".into()],
     };
     let index = write_report(&out, &content).unwrap();
     let html = std::fs::read_to_string(&index).unwrap();
@@ -413,6 +414,7 @@ fn report_over_two_synthetic_runs() {
     );
     assert!(!html.contains("<test>"), "raw markup leaked into the page");
     assert!(html.contains("&lt;-40, 60&gt;"), "warning not escaped");
+    assert!(html.contains("&lt;no data&gt;"), "note not shown escaped");
     assert!(!html.contains("<script"), "page must hold no script");
     assert!(
         !html.contains("http://") && !html.contains("https://"),
