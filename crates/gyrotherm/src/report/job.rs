@@ -494,7 +494,9 @@ fn rate_table_figures(
         return Ok(());
     }
     let segs = crate::targets::segments(table);
-    let mut data: Vec<(f64, Vec<f64>, Vec<f64>, Vec<f64>)> = Vec::new();
+    // (table rate °/s, time s, error before °/h, error after °/h)
+    type RateErrors = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
+    let mut data: Vec<RateErrors> = Vec::new();
     for &w in &chosen {
         let (mut x, mut before, mut after) = (Vec::new(), Vec::new(), Vec::new());
         for s in segs.iter().filter(|s| s.rate_dps == w) {
