@@ -500,6 +500,12 @@ fn rate_table_figures(
     for &w in &chosen {
         let (mut x, mut before, mut after) = (Vec::new(), Vec::new(), Vec::new());
         for s in segs.iter().filter(|s| s.rate_dps == w) {
+            if !x.is_empty() {
+                // A gap between segments: the figure breaks its lines at non-finite values.
+                x.push(f64::NAN);
+                before.push(f64::NAN);
+                after.push(f64::NAN);
+            }
             let t0 = log.time_s[s.start];
             for i in s.start..s.end {
                 if log.time_s[i] - t0 < cfg.settle_s {
@@ -510,7 +516,7 @@ fn rate_table_figures(
                 after.push((m.compensated.gyro_comp_dps[i] - w) * DPS_TO_DPH);
             }
         }
-        if !x.is_empty() {
+        if x.iter().any(|t| t.is_finite()) {
             data.push((w, x, before, after));
         }
     }
