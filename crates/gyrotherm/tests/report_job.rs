@@ -273,3 +273,31 @@ fn mismatched_logs_are_refused() {
         "{err}"
     );
 }
+
+#[test]
+fn measured_scale_factor_follows_simulator_truth() {
+    // Independent check of figure 5's data: with the simulator's true K as the "prediction",
+    // the scale factor measured from the raw output (segment mean minus the local bias of
+    // the neighbouring stops, over the table rate) must agree with the true K averaged over
+    // the same samples. Output = bias + K·Ω + noise (sim), so the difference is the noise
+    // mean (~0.003 °/h over 290 s) and the bias change the stop average does not cancel
+    // (≲ 0.1 °/h), over 20 °/s = 72 000 °/h: ≲ 1.5 ppm.
+    const TOL_PPM: f64 = 3.0;
+    let log = sim(8, true);
+    let truth = log
+        .extra_f64(gyrotherm::csvlog::TRUE_SCALE_COL)
+        .expect("simulated with truth");
+    let p = gyrotherm::report::job::scale_factor_points(&log, &truth, 10.0).unwrap();
+    // 3900 s in 300 s segments, +Ω / stop / −Ω / stop: 7 rate segments.
+    assert_eq!(p.time_s.len(), 7, "rate segments: {:?}", p.time_s);
+    for ((t, m), k) in p.time_s.iter().zip(&p.measured_ppm).zip(&p.predicted_ppm) {
+        assert!(
+            (m - k).abs() < TOL_PPM,
+            "segment at {t} s: want {k:.2} ppm (truth) got {m:.2} ppm, error {:.2}",
+            m - k
+        );
+    }
+    // Wrong length and a static log are errors, not panics.
+    assert!(gyrotherm::report::job::scale_factor_points(&log, &truth[1..], 10.0).is_err());
+    assert!(gyrotherm::report::job::scale_factor_points(&sim(9, false), &truth, 10.0).is_err());
+}

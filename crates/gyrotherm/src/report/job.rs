@@ -417,6 +417,61 @@ pub fn temperature_rate_c_per_min(time_s: &[f64], temp_c: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Figure 5's data: one point per usable rate segment.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ScalePoints {
+    /// Middle of each rate segment, s.
+    pub time_s: Vec<f64>,
+    /// Measured K − 1, ppm: K = (segment mean − local bias) / table rate of the raw output
+    /// ([`metrics::scale_factor`], `scale_over_time`).
+    pub measured_ppm: Vec<f64>,
+    /// Predicted K − 1, ppm: mean of `scale` over the samples the measurement used (the
+    /// segment after its settle time).
+    pub predicted_ppm: Vec<f64>,
+}
+
+/// Measured against predicted scale factor of a rate-table log: `scale` is the predicted K
+/// per sample (e.g. `Compensated::scale`), `settle_s` the time dropped at each segment start.
+/// Errors: no table column, `scale` of another length, or a log the scale-factor metric
+/// refuses (its message).
+pub fn scale_factor_points(
+    log: &TestLog,
+    scale: &[f64],
+    settle_s: f64,
+) -> Result<ScalePoints, String> {
+    let Some(table) = log.table_dps.as_deref() else {
+        return Err("the log has no table_dps column".to_owned());
+    };
+    if scale.len() != log.len() {
+        return Err(format!(
+            "{} predicted scale factors for {} samples",
+            scale.len(),
+            log.len()
+        ));
+    }
+    let opts = ScaleFactorOptions {
+        settle_s,
+        ..Default::default()
+    };
+    let r = metrics::scale_factor(&log.time_s, &log.gyro_dps, table, &opts)
+        .map_err(|e| e.to_string())?;
+    // `scale_over_time` has one entry per usable non-stop segment, in order; the used
+    // samples are the tail of the segment (the settle time is dropped at its start).
+    let rate_segs = r
+        .segments
+        .iter()
+        .filter(|s| s.used_samples > 0 && s.table_dps.abs() > opts.rate_tol_dps);
+    let mut out = ScalePoints::default();
+    for (seg, k) in rate_segs.zip(&r.scale_over_time) {
+        let used = &scale[seg.end - seg.used_samples..seg.end];
+        let mean = used.iter().sum::<f64>() / used.len() as f64;
+        out.time_s.push(k.time_s);
+        out.measured_ppm.push((k.scale - 1.0) * 1e6);
+        out.predicted_ppm.push((mean - 1.0) * 1e6);
+    }
+    Ok(out)
+}
+
 /// Figures 5 and 6 on a rate-table log, `m` the compensation shown.
 fn rate_table_figures(
     b: &mut Builder,
@@ -430,28 +485,14 @@ fn rate_table_figures(
         b.note(6, "the rate-table log has no table_dps column");
         return Ok(());
     };
-    let opts = ScaleFactorOptions {
-        settle_s: cfg.settle_s,
-        ..Default::default()
-    };
     let label = method_label(m.method);
-    match metrics::scale_factor(&log.time_s, &log.gyro_dps, table, &opts) {
+    match scale_factor_points(log, &m.compensated.scale, cfg.settle_s) {
         Err(e) => b.note(5, &format!("{}: {e}", l.name)),
-        Ok(r) => {
-            // `scale_over_time` has one entry per usable non-stop segment, in order.
-            let tol = opts.rate_tol_dps;
-            let rate_segs = r
-                .segments
-                .iter()
-                .filter(|s| s.used_samples > 0 && s.table_dps.abs() > tol);
-            let (mut t, mut measured, mut predicted) = (Vec::new(), Vec::new(), Vec::new());
-            for (seg, k) in rate_segs.zip(&r.scale_over_time) {
-                let used = &m.compensated.scale[seg.end - seg.used_samples..seg.end];
-                let mean = used.iter().sum::<f64>() / used.len() as f64;
-                t.push(k.time_s);
-                measured.push((k.scale - 1.0) * 1e6);
-                predicted.push((mean - 1.0) * 1e6);
-            }
+        Ok(ScalePoints {
+            time_s: t,
+            measured_ppm: measured,
+            predicted_ppm: predicted,
+        }) => {
             if t.is_empty() {
                 b.note(5, &format!("{} has no usable rate segment", l.name));
             } else {
