@@ -91,9 +91,14 @@ fn allan_human_table_and_errors() {
     let (code, _, err) = gyrotherm(&["allan", "--input", p, "--column", "missing_dps"]);
     assert_eq!(code, 2);
     assert!(err.contains("no column `missing_dps`"), "{err}");
-    let (code, _, err) = gyrotherm(&["allan", "--input", p, "--plot", "x.png"]);
+    // --plot into a folder that does not exist: an error naming the file, no panic.
+    let bad = dir.path().join("no_such_dir/x.png");
+    let (code, _, err) = gyrotherm(&["allan", "--input", p, "--plot", bad.to_str().unwrap()]);
     assert_eq!(code, 2);
-    assert!(err.contains("not available yet"), "{err}");
+    assert!(
+        err.contains("cannot write the plot") && err.contains("x.png"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -403,6 +403,7 @@ fn report_over_two_synthetic_runs() {
             .iter()
             .map(|(f, _)| ReportFigure::from_files(f, "caption for <figure>"))
             .collect(),
+        notes: vec!["figure 9 not drawn: <no data>".into()],
     };
     let index = write_report(&out, &content).unwrap();
     let html = std::fs::read_to_string(&index).unwrap();
@@ -413,6 +414,7 @@ fn report_over_two_synthetic_runs() {
     );
     assert!(!html.contains("<test>"), "raw markup leaked into the page");
     assert!(html.contains("&lt;-40, 60&gt;"), "warning not escaped");
+    assert!(html.contains("&lt;no data&gt;"), "note not shown escaped");
     assert!(!html.contains("<script"), "page must hold no script");
     assert!(
         !html.contains("http://") && !html.contains("https://"),
@@ -611,4 +613,49 @@ fn degenerate_data_draws_without_panic() {
         );
         assert!(allan.is_ok(), "{name}: {allan:?}");
     }
+}
+
+#[test]
+fn non_finite_values_break_lines() {
+    // y = 0 on x in [0, 10], a NaN, then y = 1 on x in [20, 30]: joined, the line would run
+    // through (15, 0.5), the middle of the plot; broken, no pixel of the line's colour lies in
+    // the columns around x = 15.
+    let mut x: Vec<f64> = (0..=10).map(f64::from).collect();
+    let mut y = vec![0.0; x.len()];
+    x.push(f64::NAN);
+    y.push(f64::NAN);
+    x.extend((20..=30).map(f64::from));
+    y.extend([1.0; 11]);
+    const RED: (u8, u8, u8) = (255, 0, 0);
+    let fig = Figure {
+        title: "gap".into(),
+        x_label: "x (s)".into(),
+        log_x: false,
+        width_px: 1000,
+        height_px: 600,
+        panels: vec![Panel {
+            y_label: "y (°/h)".into(),
+            log_y: false,
+            // No label: no legend box in the plot.
+            series: vec![Series::line("", &x, &y).with_color(RED)],
+        }],
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let files = write_figure(&dir.path().join("gap"), &fig).unwrap();
+    let img = decode(&files.png);
+    let red_columns: Vec<u32> = (0..img.width())
+        .filter(|&c| (0..img.height()).any(|r| img.get_pixel(c, r).0 == [255, 0, 0]))
+        .collect();
+    assert!(!red_columns.is_empty(), "the two runs are drawn");
+    // x in [0, 30] spans the plot area (≈ columns 80..990): x = 13.5..16.5 lies well inside
+    // columns 480..600 only if the gap is drawn; the runs end at x = 10 and start at x = 20.
+    let in_gap: Vec<u32> = red_columns
+        .iter()
+        .copied()
+        .filter(|c| (500..580).contains(c))
+        .collect();
+    assert!(
+        in_gap.is_empty(),
+        "line drawn across the gap at columns {in_gap:?}"
+    );
 }

@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context};
 use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
 use gyrotherm::csvlog::TestLog;
+use gyrotherm::report;
 
 use super::common::{read_log_reporting, LogArgs};
 use serde_json::{json, Value};
@@ -35,8 +36,9 @@ pub struct AllanArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
-    /// Plot the curve to a PNG (not available yet).
-    #[arg(long)]
+    /// Also draw the curve with its 68.3 % bars and the noise-term slope lines (ADEV/OADEV)
+    /// as FILE.png, with FILE.svg beside it.
+    #[arg(long, value_name = "FILE.png")]
     pub plot: Option<PathBuf>,
 }
 
@@ -146,11 +148,49 @@ fn noise_json(t: &NoiseTerms) -> Value {
     Value::Object(obj)
 }
 
+/// Unit of a column for the plot's σ axis when it is not a rate (rates are drawn in °/h).
+fn plain_unit(column: &str) -> String {
+    if column.ends_with("_c") {
+        "°C".to_owned()
+    } else if column == "time_s" {
+        "s".to_owned()
+    } else {
+        format!("unit of {column}")
+    }
+}
+
+/// `--plot`: the curve in °/h for rate columns (else the column's unit), the noise terms as
+/// slope lines when they were read from this curve (ADEV/OADEV); PNG and SVG, atomically.
+fn plot(
+    path: &Path,
+    args: &AllanArgs,
+    points: &[AllanPoint],
+    noise: Option<&NoiseTerms>,
+) -> anyhow::Result<()> {
+    let (factor, unit) = match to_dph_factor(&args.column) {
+        Some(f) => (f, "°/h".to_owned()),
+        None => (1.0, plain_unit(&args.column)),
+    };
+    let label = format!("{} of {}", args.kind.name().to_uppercase(), args.column);
+    let curve = report::allan_curve(&label, points, factor);
+    let lines = match (args.kind, noise) {
+        (DevKind::Adev | DevKind::Oadev, Some(t)) => report::noise_lines(t, ""),
+        _ => Vec::new(),
+    };
+    let files = report::allan_figure(path, &[curve], &lines, &unit)
+        .with_context(|| format!("cannot write the plot {}", path.display()))?;
+    eprintln!(
+        "gyrotherm: wrote {} and {} ({}x{} px)",
+        files.png.display(),
+        files.svg.display(),
+        files.width_px,
+        files.height_px
+    );
+    Ok(())
+}
+
 pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
     let mut w = std::io::stdout().lock();
-    if args.plot.is_some() {
-        bail!("--plot is not available yet; use --json and plot the points");
-    }
     let (_log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
     let noise_model = args.alpha.map_or(NoiseModel::Identify, NoiseModel::Alpha);
     let points = allan::deviation(&values, tau0_s, args.kind, &args.taus, noise_model)
@@ -176,6 +216,9 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
             (Some(allan::noise_terms(&curve, f)), Some(from))
         }
     };
+    if let Some(path) = &args.plot {
+        plot(path, &args, &points, noise.as_ref())?;
+    }
     if args.json {
         let pts: Vec<Value> = points
             .iter()

@@ -1,10 +1,120 @@
-//! `gyrotherm report`.
+//! `gyrotherm report`: run the held-out comparison of `gyrotherm compare` and write it as an
+//! HTML report with the figures a gyro engineer looks at (`DIR/index.html`, one PNG and SVG
+//! per figure; see `gyrotherm::report::job`).
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct ReportArgs {}
+use std::io::Write as _;
 
-pub fn run(_args: ReportArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`gyrotherm report` is not implemented yet")
+use anyhow::Context as _;
+use gyrotherm::compare::CompareConfig;
+use gyrotherm::csvlog::{self, TestLog};
+use gyrotherm::fit::NamedLog;
+use gyrotherm::model::Method;
+use gyrotherm::report::write_full_report_with;
+
+use super::common::LogArgs;
+use super::compare::{print_table, run_comparison};
+use super::train::FitArgs;
+
+#[derive(Debug, clap::Args)]
+pub struct ReportArgs {
+    /// Training log (CSV); repeat for several (static → bias, rate-table → scale factor).
+    #[arg(long, required = true)]
+    pub train: Vec<PathBuf>,
+    /// Held-out log to judge on (CSV); repeat for several.
+    #[arg(long, required = true)]
+    pub test: Vec<PathBuf>,
+    /// Report folder (created if missing): index.html and a PNG and SVG per figure.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Bias-stability smoothing time, s.
+    #[arg(long, default_value_t = 100.0)]
+    pub tau: f64,
+    #[command(flatten)]
+    pub fit: FitArgs,
+    #[command(flatten)]
+    pub log: LogArgs,
+}
+
+/// Read every log like `read_logs` (each failure reported, then stop), and collect a
+/// warning for each log in which `--fill-gaps` interpolated samples, for the page.
+fn read_logs_noting_gaps(
+    paths: &[PathBuf],
+    log: &LogArgs,
+    warnings: &mut Vec<String>,
+) -> anyhow::Result<Vec<(String, TestLog)>> {
+    let mut out = Vec::new();
+    let mut failed = 0;
+    for p in paths {
+        match csvlog::read_log(p, &log.read_options()) {
+            Ok((l, r)) => {
+                if r.filled_gaps > 0 {
+                    let w = format!(
+                        "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps)",
+                        p.display(),
+                        r.filled_gaps,
+                        r.filled_samples
+                    );
+                    eprintln!("gyrotherm: {w}");
+                    warnings.push(w);
+                }
+                out.push((p.display().to_string(), l));
+            }
+            Err(e) => {
+                eprintln!("gyrotherm: cannot use log {}: {e}", p.display());
+                failed += 1;
+            }
+        }
+    }
+    anyhow::ensure!(
+        failed == 0,
+        "{failed} of {} input logs could not be read (see above)",
+        paths.len()
+    );
+    Ok(out)
+}
+
+pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        args.tau.is_finite() && args.tau > 0.0,
+        "--tau must be a positive number of seconds"
+    );
+    let mut gap_warnings = Vec::new();
+    let train = read_logs_noting_gaps(&args.train, &args.log, &mut gap_warnings)?;
+    let test = read_logs_noting_gaps(&args.test, &args.log, &mut gap_warnings)?;
+    let train_named: Vec<NamedLog> = train
+        .iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect();
+    let test_named: Vec<NamedLog> = test
+        .iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect();
+    let cfg = CompareConfig {
+        fit: args.fit.fit_config(Method::Lstm)?,
+        tau_s: args.tau,
+        settle_s: args.fit.settle,
+        ..CompareConfig::default()
+    };
+    let cmp = run_comparison(&train_named, &test_named, &cfg)?;
+    let index = write_full_report_with(
+        &args.out,
+        &train_named,
+        &test_named,
+        &cmp,
+        &cfg,
+        &gap_warnings,
+    )
+    .with_context(|| format!("cannot write the report in {}", args.out.display()))?;
+    let mut out = std::io::stdout().lock();
+    print_table(&mut out, &cmp, &cfg)?;
+    writeln!(out, "report: {}", index.display())?;
+    for t in &cmp.tests {
+        for w in &t.warnings {
+            eprintln!("gyrotherm: warning: {w}");
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }

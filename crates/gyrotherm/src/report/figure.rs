@@ -283,6 +283,28 @@ fn padded_range(values: impl Iterator<Item = f64>, log: bool, pad: bool) -> (f64
     }
 }
 
+/// Index ranges of the maximal runs of points with finite x and y.
+fn finite_runs(x: &[f64], y: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let n = x.len().min(y.len());
+    let mut runs = Vec::new();
+    let mut start = None;
+    for i in 0..n {
+        let finite = x[i].is_finite() && y[i].is_finite();
+        match (finite, start) {
+            (true, None) => start = Some(i),
+            (false, Some(s0)) => {
+                runs.push(s0..i);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(s0) = start {
+        runs.push(s0..n);
+    }
+    runs
+}
+
 type DrawResult = Result<(), String>;
 
 /// Tick text: plain decimals without trailing zeros (`2000`, `0.5`), scientific outside
@@ -417,20 +439,27 @@ where
         let log_x = fig.log_x;
         let log_y = panel.log_y;
         let ok = |&(x, y): &(f64, f64)| usable(x, log_x) && usable(y, log_y);
-        let points: Vec<(f64, f64)> = match s.style {
-            SeriesStyle::Line | SeriesStyle::Dashed => {
-                let mut p = decimate_min_max(&s.x, &s.y, columns);
-                p.retain(ok);
-                p
-            }
-            SeriesStyle::Points | SeriesStyle::LinePoints => {
-                s.x.iter()
-                    .copied()
-                    .zip(s.y.iter().copied())
-                    .filter(ok)
-                    .collect()
-            }
+        // Lines are drawn as runs: a non-finite x or y is a gap that breaks the line (e.g.
+        // between rate-table segments), each run decimated on its own.
+        let runs: Vec<Vec<(f64, f64)>> = match s.style {
+            SeriesStyle::Line | SeriesStyle::Dashed => finite_runs(&s.x, &s.y)
+                .into_iter()
+                .map(|r| {
+                    let mut p = decimate_min_max(&s.x[r.clone()], &s.y[r], columns);
+                    p.retain(ok);
+                    p
+                })
+                .filter(|p| !p.is_empty())
+                .collect(),
+            SeriesStyle::Points | SeriesStyle::LinePoints => vec![s
+                .x
+                .iter()
+                .copied()
+                .zip(s.y.iter().copied())
+                .filter(ok)
+                .collect()],
         };
+        let points: Vec<(f64, f64)> = runs.iter().flatten().copied().collect();
         // plotters draws lines wider than 1 px as polygons with mitred joins, which spike far
         // outside the plot on the sharp, short zig-zags of a dense noisy series: a line with
         // more than one point per 4 px that reverses direction at more than a quarter of its
@@ -446,13 +475,36 @@ where
             2
         };
         let line_style = color.stroke_width(width);
+        // Every run but the last is drawn here; the last one below carries the legend entry.
+        let last_run = runs.len().saturating_sub(1);
+        for run in &runs[..last_run] {
+            match s.style {
+                SeriesStyle::Line => {
+                    chart
+                        .draw_series(LineSeries::new(run.iter().copied(), line_style))
+                        .map_err(err)?;
+                }
+                SeriesStyle::Dashed => {
+                    chart
+                        .draw_series(DashedLineSeries::new(
+                            run.iter().copied(),
+                            10,
+                            6,
+                            line_style,
+                        ))
+                        .map_err(err)?;
+                }
+                SeriesStyle::Points | SeriesStyle::LinePoints => {}
+            }
+        }
+        let last: &[(f64, f64)] = runs.get(last_run).map(Vec::as_slice).unwrap_or(&[]);
         let anno = match s.style {
             SeriesStyle::Line => chart
-                .draw_series(LineSeries::new(points.iter().copied(), line_style))
+                .draw_series(LineSeries::new(last.iter().copied(), line_style))
                 .map_err(err)?,
             SeriesStyle::Dashed => chart
                 .draw_series(DashedLineSeries::new(
-                    points.iter().copied(),
+                    last.iter().copied(),
                     10,
                     6,
                     line_style,

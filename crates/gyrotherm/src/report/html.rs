@@ -55,6 +55,8 @@ pub struct ReportContent {
     /// Warnings (extrapolation, gaps filled, ...).
     pub warnings: Vec<String>,
     pub figures: Vec<ReportFigure>,
+    /// Notes on figures that were not drawn (e.g. "no rate-table log"), shown after them.
+    pub notes: Vec<String>,
 }
 
 const CSS: &str = "body{font-family:'DejaVu Sans',Helvetica,Arial,sans-serif;margin:2em auto;\
@@ -165,6 +167,13 @@ pub fn render_html(c: &ReportContent) -> String {
             let _ = write!(h, " (<a href=\"{}\">SVG</a>)", escape(svg));
         }
         h.push_str("</figcaption>\n</figure>\n");
+    }
+    if !c.notes.is_empty() {
+        h.push_str("<h2>Figures not drawn</h2>\n<ul class=\"notes\">\n");
+        for n in &c.notes {
+            let _ = writeln!(h, "<li>{}</li>", escape(n));
+        }
+        h.push_str("</ul>\n");
     }
     h.push_str("</body>\n</html>\n");
     h

@@ -7,6 +7,8 @@
 //! - [`figures`]: the eight named figures of the report and the Allan figure that
 //!   `gyrotherm allan --plot` reuses.
 //! - [`html`]: `DIR/index.html`, self-contained (inline CSS, no script, no network).
+//! - [`job`]: the full report of a held-out comparison (`gyrotherm report`), from the logs
+//!   and a [`crate::compare::Comparison`].
 //! - [`decimate`]: min/max per pixel column, so long runs draw fast without losing extremes.
 //! - [`font`]: the embedded DejaVu Sans font; no system font or graphics library is used.
 
@@ -15,6 +17,7 @@ pub mod figure;
 pub mod figures;
 pub mod font;
 pub mod html;
+pub mod job;
 
 use std::fmt;
 use std::path::PathBuf;
@@ -28,6 +31,7 @@ pub use figures::{
     RateSegment, RateTableData, RawOutputData, ScaleFactorData, TemperatureData,
 };
 pub use html::{write_report, ReportContent, ReportFigure, Table};
+pub use job::{allan_curve, noise_lines, write_full_report, write_full_report_with};
 
 /// Why a figure or report could not be written.
 #[derive(Debug)]
