@@ -10,7 +10,13 @@ mod cmd;
 
 /// Remove temperature-induced errors from fiber optic gyroscope (FOG) test logs.
 #[derive(Debug, Parser)]
-#[command(name = "gyrotherm", version, about, long_about = None)]
+#[command(
+    name = "gyrotherm",
+    version,
+    about,
+    long_about = None,
+    after_help = "Exit status: 0 success, 2 error (the message names the file, line and column).\nStart with `gyrotherm demo`; every command has --help."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
