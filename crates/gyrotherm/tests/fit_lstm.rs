@@ -5,7 +5,9 @@ use gyrotherm::baseline::Terms;
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::features::FeatureSpec;
-use gyrotherm::fit::lstm::{self, bias_terms, LstmRecipe, RecipeKind, RecipeTarget};
+use gyrotherm::fit::lstm::{
+    self, bias_terms, generic_linear_terms, BaseTerms, LstmRecipe, RecipeKind, RecipeTarget,
+};
 use gyrotherm::fit::{fit_model, FitConfig, FitOutcome, NamedLog};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
@@ -292,6 +294,18 @@ fn published_recipe_is_kept() {
     assert!(RecipeKind::parse("fancy")
         .unwrap_err()
         .contains("published"));
+    for kind in [
+        RecipeKind::Published,
+        RecipeKind::Residual,
+        RecipeKind::Generic,
+        RecipeKind::Direct,
+    ] {
+        assert_eq!(RecipeKind::parse(kind.as_str()), Ok(kind));
+        assert_eq!(LstmRecipe::of_kind(kind).kind, kind);
+    }
+    assert_eq!(LstmRecipe::generic().base, BaseTerms::LinearT2);
+    assert_eq!(LstmRecipe::direct().base, BaseTerms::Constant);
+    assert_eq!(LstmRecipe::default().base, BaseTerms::Tailored);
 
     let log = sim("seed-shock", 6, false, false);
     let mut cfg = FitConfig::new(Method::Lstm);
@@ -309,10 +323,73 @@ fn published_recipe_is_kept() {
 #[test]
 fn physical_terms_are_valid_for_flight() {
     let n = FeatureSpec::THERMAL_STATE.n_features();
-    for t in [bias_terms(), lstm::scale_terms()] {
+    for t in [
+        bias_terms(),
+        lstm::scale_terms(),
+        generic_linear_terms(false),
+        generic_linear_terms(true),
+        BaseTerms::Constant.bias_terms(),
+    ] {
         assert_eq!(t.n_features, n);
         t.validate().unwrap();
         assert_eq!(t.powers[0], vec![0; n], "the constant term comes first");
     }
     let _: Terms = bias_terms();
+}
+
+/// The generic base is linear in every thermal-state input (plus `T²`): no product of
+/// inputs, and it is what `BaseTerms::LinearT2` fits (construction of the terms).
+#[test]
+fn generic_terms_are_linear_in_the_thermal_state() {
+    let n = FeatureSpec::THERMAL_STATE.n_features();
+    let t = generic_linear_terms(true);
+    assert_eq!(t, BaseTerms::LinearT2.bias_terms());
+    assert_eq!(generic_linear_terms(false), BaseTerms::Linear.bias_terms());
+    assert_eq!(t.len(), 1 + n + 1, "1, the {n} inputs and T²");
+    for p in &t.powers {
+        let degree: u8 = p.iter().sum();
+        let inputs = p.iter().filter(|q| **q > 0).count();
+        assert!(inputs <= 1, "no cross terms, got powers {p:?}");
+        assert!(
+            degree <= 1 || p[0] == 2,
+            "only T is squared, got powers {p:?}"
+        );
+    }
+}
+
+/// The direct recipe's base is a constant: with the LSTM off (epochs 0) the model is the mean
+/// of the per-run target means weighted by labelled steps (independent: the arithmetic mean
+/// of each run's targets, computed here).
+#[test]
+fn direct_recipe_base_is_the_mean_over_runs() {
+    let sets = vec![
+        exact_set("seed-shock", 1, 2e-4),
+        exact_set("fast-cycle", 2, -3e-4),
+    ];
+    let recipe = LstmRecipe {
+        epochs: 0,
+        ..LstmRecipe::direct()
+    };
+    let (sub, summary) =
+        lstm::fit_target(&sets, &recipe, RecipeTarget::Bias, 0, &mut |_, _| {}).unwrap();
+    let SubModel::Baseline {
+        terms,
+        coefficients,
+    } = sub
+    else {
+        panic!("epochs 0: want the constant base alone, got {sub:?}");
+    };
+    assert_eq!(terms, BaseTerms::Constant.bias_terms());
+    let (sum, n) = sets.iter().fold((0.0, 0usize), |(s, n), set| {
+        (s + set.target.iter().sum::<f64>(), n + set.target.len())
+    });
+    let want = sum / n as f64;
+    // Summation round-off on ~10^5 terms of ~1e-4 °/s.
+    const ROUND_OFF_DPS: f64 = 1e-12;
+    assert!(
+        (coefficients[0] - want).abs() < ROUND_OFF_DPS,
+        "constant: want {want:e}, got {:e}",
+        coefficients[0]
+    );
+    assert!(summary.baseline_rms.unwrap() > 0.0);
 }
