@@ -13,11 +13,13 @@ use super::progress::TrainingBars;
 /// Fitting options shared by `train` and `compare`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
-    /// LSTM recipe: `residual` (default, chosen by held-out figures: least squares on
-    /// thermal-state inputs plus an LSTM on its residual, kept only where it helps on
-    /// validation blocks) or `published` (He et al. 2024 exactly: whole run, T and dT
-    /// inputs, 1000 Adam steps at lr 0.01).
-    #[arg(long, default_value = "residual", value_parser = ["residual", "published"])]
+    /// LSTM recipe. `residual` (default): least squares on thermal-state inputs (T, dT,
+    /// T − first-order lags of 300/1000/3000 s) plus an LSTM on its residual, kept only where
+    /// it beats the least-squares base on validation blocks. `generic`: the same on a
+    /// generic linear + T² base. `direct`: an LSTM alone on the thermal-state inputs.
+    /// `published`: He et al. 2024 exactly (whole run, T and dT inputs, 1000 Adam steps at
+    /// lr 0.01).
+    #[arg(long, default_value = "residual", value_parser = ["residual", "generic", "direct", "published"])]
     pub recipe: String,
     /// LSTM training epochs (default: the recipe's).
     #[arg(long)]
