@@ -10,39 +10,11 @@ use gyrotherm::allan::{
 };
 use gyrotherm::metrics::tau_means_std;
 
-/// The shared reference directory: $GYROTHERM_SHARED, else a `shared/` next to an ancestor of
-/// this crate, else /work/shared.
-fn shared_dir() -> Option<PathBuf> {
-    if let Ok(p) = std::env::var("GYROTHERM_SHARED") {
-        return Some(PathBuf::from(p));
-    }
-    let mut dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    loop {
-        let cand = dir.join("shared");
-        if cand.join("reference").is_dir() {
-            return Some(cand);
-        }
-        if !dir.pop() {
-            break;
-        }
-    }
-    let fallback = PathBuf::from("/work/shared");
-    fallback.join("reference").is_dir().then_some(fallback)
-}
+mod common;
 
 /// The reference file, or None (test skipped) — but a failure when CI=true.
 fn reference(name: &str) -> Option<PathBuf> {
-    let path = shared_dir().map(|d| d.join("reference/allan").join(name));
-    match path {
-        Some(p) if p.is_file() => Some(p),
-        _ => {
-            if std::env::var("CI").as_deref() == Ok("true") {
-                panic!("reference file allan/{name} missing (set GYROTHERM_SHARED)");
-            }
-            eprintln!("skipped: reference file allan/{name} not found");
-            None
-        }
-    }
+    common::reference_file(&format!("allan/{name}"))
 }
 
 /// Fractional frequency of the OCXO record: f/1e7 − 1, computed from the decimal text so that

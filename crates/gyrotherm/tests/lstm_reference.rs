@@ -3,8 +3,6 @@
 //! outputs and final states, MSE loss and every parameter's gradient for case 1, and the params
 //! after three `torch.optim.Adam(lr=0.01)` steps).
 
-use std::path::PathBuf;
-
 use gyrotherm::train::adam::Adam;
 use gyrotherm::train::{flatten, loss_and_grad, predict_with_state, LstmParams, Sequence};
 use serde_json::Value;
@@ -16,35 +14,12 @@ const GRAD_REL_TOL: f64 = 1e-5;
 /// Relative error denominators are floored here: values this small are compared absolutely.
 const REL_FLOOR: f64 = 1e-12;
 
-/// `<dir>/shared` walking up from this crate, else `$GYROTHERM_SHARED`, else `/work/shared`.
-fn shared_dir() -> PathBuf {
-    if let Ok(p) = std::env::var("GYROTHERM_SHARED") {
-        return PathBuf::from(p);
-    }
-    let mut dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    loop {
-        let cand = dir.join("shared");
-        if cand.is_dir() {
-            return cand;
-        }
-        if !dir.pop() {
-            return PathBuf::from("/work/shared");
-        }
-    }
-}
+mod common;
 
 fn load() -> Option<Value> {
-    let path = shared_dir().join("reference/lstm/pytorch_lstm_2x8.json");
-    match std::fs::read_to_string(&path) {
-        Ok(s) => Some(serde_json::from_str(&s).expect("reference JSON parses")),
-        Err(e) => {
-            if std::env::var("CI").as_deref() == Ok("true") {
-                panic!("reference {} missing on CI: {e}", path.display());
-            }
-            println!("skipped: reference {} not readable: {e}", path.display());
-            None
-        }
-    }
+    let path = common::reference_file("lstm/pytorch_lstm_2x8.json")?;
+    let text = std::fs::read_to_string(&path).expect("reference file readable");
+    Some(serde_json::from_str(&text).expect("reference JSON parses"))
 }
 
 fn flat(v: &Value) -> Vec<f64> {
