@@ -122,6 +122,9 @@ fn main() {
     if let Some(v) = get("--base") {
         recipe.base = BaseTerms::parse(&v).unwrap();
     }
+    if let Some(v) = get("--scale-base") {
+        recipe.scale_base = BaseTerms::parse(&v).unwrap();
+    }
     if let Some(v) = get("--window") {
         recipe.window = v.parse().unwrap();
     }
@@ -184,20 +187,38 @@ fn main() {
     row("raw", &raw, 0.0, 0.0);
     let mut linear_bias = f64::NAN;
     let mut summary = vec![raw.bias_dph / floor];
-    for (label, method) in [
-        ("linear", Method::Linear),
-        ("poly", Method::Poly),
-        ("base", Method::Lstm),
-        ("lstm", Method::Lstm),
-    ] {
+    // `--bases a,b`: the residual recipe's least-squares base alone (no LSTM) for each named
+    // base (bias and scale factor alike), for comparison; default: the recipe's own base.
+    let bases: Vec<Option<BaseTerms>> = match get("--bases") {
+        Some(v) => v
+            .split(',')
+            .map(|b| Some(BaseTerms::parse(b).unwrap()))
+            .collect(),
+        None => vec![None],
+    };
+    let mut runs: Vec<(String, Method, Option<Option<BaseTerms>>)> = vec![
+        ("linear".into(), Method::Linear, None),
+        ("poly".into(), Method::Poly, None),
+    ];
+    if recipe.kind != RecipeKind::Published {
+        for b in &bases {
+            let label = b.map_or("base".to_string(), |b| format!("b:{}", b.name()));
+            runs.push((label, Method::Lstm, Some(*b)));
+        }
+    }
+    if !args.iter().any(|a| a == "--no-lstm") {
+        runs.push(("lstm".into(), Method::Lstm, None));
+    }
+    for (label, method, base) in runs {
+        let label = label.as_str();
         let mut cfg = FitConfig::new(method);
         cfg.recipe = recipe.clone();
-        if label == "base" {
-            // The residual recipe's least-squares base alone (no LSTM), for comparison.
-            if recipe.kind == RecipeKind::Published {
-                continue;
-            }
+        if let Some(b) = base {
             cfg.recipe.epochs = 0;
+            if let Some(b) = b {
+                cfg.recipe.base = b;
+                cfg.recipe.scale_base = b;
+            }
         }
         cfg.seed = fit_seed;
         let (t0, c0) = (Instant::now(), cpu_s());
@@ -211,7 +232,7 @@ fn main() {
         if method == Method::Linear {
             linear_bias = f.bias_dph;
         }
-        if label == "lstm" {
+        if method == Method::Lstm {
             for (n, tr) in [("bias", &out.bias_training), ("scale", &out.scale_training)] {
                 if let Some(tr) = tr {
                     println!(
@@ -224,8 +245,13 @@ fn main() {
                         tr.lstm_gain,
                         tr.val_improvement
                     );
+                    if let Some(sel) = &tr.selection {
+                        println!("  {n} terms: {}", sel.describe());
+                    }
                 }
             }
+        }
+        if label == "lstm" {
             println!(
                 "lstm vs linear: {:+.1} %   lstm / floor: {:.2}",
                 (f.bias_dph / linear_bias - 1.0) * 100.0,

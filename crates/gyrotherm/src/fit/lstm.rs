@@ -38,6 +38,7 @@
 //! default stays `Residual` on the tailored base; the LSTM parts are kept for data that carry
 //! what the base cannot express (`tests/fit_lstm.rs` shows one).
 
+use super::select::{self, TermSelection};
 use crate::baseline::Terms;
 use crate::features::FeatureSpec;
 use crate::model::SubModel;
@@ -87,11 +88,15 @@ impl RecipeKind {
     }
 }
 
-/// The least-squares base of the residual recipe (bias target; the scale factor always uses
-/// [`scale_terms`]).
+/// The least-squares base of the residual recipe ([`LstmRecipe::base`] for the bias,
+/// [`LstmRecipe::scale_base`] for the scale factor).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BaseTerms {
-    /// [`bias_terms`]: terms chosen to span the simulator's FOG bias equation.
+    /// Chosen from the training data among [`select::candidates`] by blocked
+    /// cross-validation in time ([`select::select_terms`]).
+    Selected,
+    /// [`bias_terms`] (bias) or [`scale_terms`] (scale factor): terms chosen to span the
+    /// simulator's FOG bias and scale-factor equations.
     Tailored,
     /// [`generic_linear_terms`]: `1, T, dT, D300, D1000, D3000` (linear in the inputs).
     Linear,
@@ -99,33 +104,71 @@ pub enum BaseTerms {
     LinearT2,
     /// A constant (per-run offset) only: the LSTM models the whole bias (a direct LSTM).
     Constant,
+    /// Term set `i` of [`select::ladder`], fixed (to measure what selection chooses
+    /// among; name `family:<candidate name>`).
+    Family(u8),
 }
 
 impl BaseTerms {
     /// The experiment name (`examples/heldout.rs --base`).
     pub fn parse(name: &str) -> Result<BaseTerms, String> {
         match name {
+            "selected" => Ok(BaseTerms::Selected),
             "tailored" => Ok(BaseTerms::Tailored),
             "linear" => Ok(BaseTerms::Linear),
             "linear-t2" => Ok(BaseTerms::LinearT2),
             "constant" => Ok(BaseTerms::Constant),
-            _ => Err(format!(
-                "unknown base {name:?}: use tailored, linear, linear-t2 or constant"
-            )),
+            _ => {
+                if let Some(c) = name.strip_prefix("family:") {
+                    if let Some(i) = select::ladder().iter().position(|k| k.name == c) {
+                        return Ok(BaseTerms::Family(i as u8));
+                    }
+                }
+                Err(format!(
+                    "unknown base {name:?}: use selected, tailored, linear, linear-t2, constant \
+                     or family:<name> (names: {})",
+                    select::ladder()
+                        .iter()
+                        .map(|c| c.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            }
         }
     }
 
-    /// The bias terms over [`FeatureSpec::THERMAL_STATE`] features.
-    pub fn bias_terms(&self) -> Terms {
+    /// The experiment name ([`BaseTerms::parse`] reads it back).
+    pub fn name(&self) -> String {
         match self {
-            BaseTerms::Tailored => bias_terms(),
-            BaseTerms::Linear => generic_linear_terms(false),
-            BaseTerms::LinearT2 => generic_linear_terms(true),
-            BaseTerms::Constant => Terms {
+            BaseTerms::Selected => "selected".into(),
+            BaseTerms::Tailored => "tailored".into(),
+            BaseTerms::Linear => "linear".into(),
+            BaseTerms::LinearT2 => "linear-t2".into(),
+            BaseTerms::Constant => "constant".into(),
+            BaseTerms::Family(i) => format!(
+                "family:{}",
+                select::ladder()
+                    .get(*i as usize)
+                    .map_or("?", |c| c.name.as_str())
+            ),
+        }
+    }
+
+    /// The fixed terms over [`FeatureSpec::THERMAL_STATE`] features for a target (`None` for
+    /// [`BaseTerms::Selected`]: chosen from the data).
+    pub fn fixed_terms(&self, target: RecipeTarget) -> Option<Terms> {
+        Some(match (self, target) {
+            (BaseTerms::Selected, _) => return None,
+            (BaseTerms::Tailored, RecipeTarget::Bias) => bias_terms(),
+            (BaseTerms::Tailored, RecipeTarget::Scale) => scale_terms(),
+            (BaseTerms::Linear, _) => generic_linear_terms(false),
+            (BaseTerms::LinearT2, _) => generic_linear_terms(true),
+            (BaseTerms::Constant, _) => Terms {
                 n_features: 5,
                 powers: vec![vec![0; 5]],
             },
-        }
+            (BaseTerms::Family(i), _) => select::ladder().get(*i as usize)?.terms.clone(),
+        })
     }
 }
 
@@ -167,6 +210,8 @@ pub struct LstmRecipe {
     pub min_val_improvement: f64,
     /// `Residual`: least-squares base of the bias model.
     pub base: BaseTerms,
+    /// `Residual`: least-squares base of the scale-factor model.
+    pub scale_base: BaseTerms,
     /// `Residual`: centred moving average (steps) applied to the base's residual before the
     /// LSTM is trained on it (1: none), to take the sensor noise out of its target.
     pub residual_smooth_steps: usize,
@@ -197,7 +242,8 @@ impl LstmRecipe {
             patience: Some(30),
             scale_lstm: false,
             min_val_improvement: 0.05,
-            base: BaseTerms::Tailored,
+            base: BaseTerms::Selected,
+            scale_base: BaseTerms::Selected,
             residual_smooth_steps: 1,
         }
     }
@@ -207,6 +253,7 @@ impl LstmRecipe {
         LstmRecipe {
             kind: RecipeKind::Generic,
             base: BaseTerms::LinearT2,
+            scale_base: BaseTerms::Tailored,
             ..Self::residual()
         }
     }
@@ -216,6 +263,7 @@ impl LstmRecipe {
         LstmRecipe {
             kind: RecipeKind::Direct,
             base: BaseTerms::Constant,
+            scale_base: BaseTerms::Tailored,
             ..Self::residual()
         }
     }
@@ -260,6 +308,9 @@ pub struct TrainSummary {
     /// Relative reduction of the validation loss by the residual LSTM against no correction,
     /// `1 - best / epoch-0` (`Residual` with validation only).
     pub val_improvement: Option<f64>,
+    /// How the least-squares terms were chosen (base [`BaseTerms::Selected`] only): every
+    /// candidate's cross-validated RMS residual, so the choice can be checked.
+    pub selection: Option<TermSelection>,
 }
 
 /// The feature specification a recipe's models read.
@@ -406,18 +457,18 @@ fn fit_published(
 }
 
 /// A least-squares baseline with one offset per training run.
-struct FixedEffectsFit {
-    terms: Terms,
+pub(crate) struct FixedEffectsFit {
+    pub(crate) terms: Terms,
     /// Coefficients; the constant term holds the mean offset over the runs (by labelled steps).
-    coefficients: Vec<f64>,
+    pub(crate) coefficients: Vec<f64>,
     /// Offset of each run relative to the constant term, target units.
-    run_offset: Vec<f64>,
+    pub(crate) run_offset: Vec<f64>,
     /// RMS residual over the labelled steps, target units.
-    rms: f64,
+    pub(crate) rms: f64,
 }
 
 impl FixedEffectsFit {
-    fn predict_row(&self, x: &[f64]) -> f64 {
+    pub(crate) fn predict_row(&self, x: &[f64]) -> f64 {
         self.terms
             .design_row(x)
             .iter()
@@ -439,7 +490,10 @@ impl FixedEffectsFit {
 /// "within" estimator — monomials and targets centred per run, solved by SVD on RMS-scaled
 /// columns, refused below [`crate::baseline::RANK_TOL`]. With one run this is ordinary least
 /// squares.
-fn fit_fixed_effects(train: &[TargetSet], terms: &Terms) -> Result<FixedEffectsFit, String> {
+pub(crate) fn fit_fixed_effects(
+    train: &[TargetSet],
+    terms: &Terms,
+) -> Result<FixedEffectsFit, String> {
     debug_assert!(terms.powers[0].iter().all(|p| *p == 0));
     let nt = terms.len();
     let mut design: Vec<f64> = Vec::new();
@@ -577,20 +631,43 @@ fn fit_residual(
     seed: u64,
     progress: &mut dyn FnMut(usize, f64),
 ) -> Result<(SubModel, TrainSummary), String> {
-    let terms = match target {
-        RecipeTarget::Bias => recipe.base.bias_terms(),
-        RecipeTarget::Scale => scale_terms(),
+    let base_kind = match target {
+        RecipeTarget::Bias => recipe.base,
+        RecipeTarget::Scale => recipe.scale_base,
     };
-    if terms.n_features != n_in {
+    if n_in != FeatureSpec::THERMAL_STATE.n_features() {
         return Err(format!(
             "the residual recipe reads {} features (T, dT and three thermal-state lags), the \
              training data has {n_in}",
-            terms.n_features
+            FeatureSpec::THERMAL_STATE.n_features()
         ));
     }
     // 1. The physical baseline on every labelled step of every run, each run with its own
     //    offset (turn-on bias / scale-factor repeatability); the model keeps their mean.
-    let base = fit_fixed_effects(train, &terms)?;
+    if let BaseTerms::Family(i) = base_kind {
+        if i as usize >= select::ladder().len() {
+            return Err(format!(
+                "base family:{i}: the ladder has {} term sets",
+                select::ladder().len()
+            ));
+        }
+    }
+    let (base, selection) = match base_kind.fixed_terms(target) {
+        Some(terms) => (fit_fixed_effects(train, &terms)?, None),
+        None => {
+            let cands = select::candidates(target);
+            let sel = select::select_terms(train, &cands, select::FOLDS, select::GAP_STEPS)?;
+            let fit = fit_fixed_effects(train, &cands[sel.chosen].terms)?;
+            (fit, Some(sel))
+        }
+    };
+    if base.terms.n_features != n_in {
+        return Err(format!(
+            "the residual recipe reads {} features (T, dT and three thermal-state lags), the \
+             training data has {n_in}",
+            base.terms.n_features
+        ));
+    }
     let want_lstm = match target {
         RecipeTarget::Bias => true,
         RecipeTarget::Scale => recipe.scale_lstm,
@@ -599,6 +676,7 @@ fn fit_residual(
         let summary = TrainSummary {
             final_loss: base.rms,
             baseline_rms: Some(base.rms),
+            selection,
             ..TrainSummary::default()
         };
         return Ok((base.sub_model(), summary));
@@ -697,6 +775,7 @@ fn fit_residual(
         baseline_rms: Some(base.rms),
         lstm_gain: Some(gain),
         val_improvement,
+        selection,
     };
     if gain < MIN_GAIN {
         // The LSTM predicted none of the held-out residual: the physical fit alone.
