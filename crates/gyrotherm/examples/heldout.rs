@@ -6,7 +6,15 @@
 //!
 //! `cargo run -p gyrotherm --release --example heldout -- [--train seed-shock[,slow-ramp]]
 //!  [--test slow-ramp] [--train-seed 7] [--test-seed 11] [--recipe residual|published]
-//!  [--epochs N] [--scale-lstm] [--patience N] [--lr X] [--validation-every K]`
+//!  [--epochs N] [--scale-lstm] [--patience N] [--lr X] [--validation-every K]
+//!  [--base B] [--scale-base B] [--bases B1,B2,...] [--no-lstm]`
+//!
+//! Bases `B`: `selected` (default), `tailored`, `linear`, `linear-t2`, `constant`,
+//! `family:<set>` (one set of `fit::select::ladder`, e.g. `family:T3+fast`). `--bases` adds a
+//! row per base with its least-squares fit alone (bias and scale factor on that base);
+//! `--no-lstm` leaves out the full recipe's row. Env `HELDOUT_UNIT=<unit json>` swaps the
+//! simulated unit (`examples/heldout_units/`); `examples/heldout_sweep.sh` runs the sweep of
+//! the `fit::lstm` module doc.
 
 use std::time::Instant;
 
