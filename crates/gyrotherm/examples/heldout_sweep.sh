@@ -6,7 +6,7 @@ set -u
 bin=$1; out=$2; shift 2
 dir=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$out"
-fam=$(for d in 1 2 3; do for s in "" "+fast" "+fast+mid"; do printf "family:T%s%s," "$d" "$s"; done; done; [ -n "${SEL_DT:-}" ] && printf "family:P3,family:P3+lags,family:T3+1lag,family:T3+2lag,")
+fam=$(for d in 1 2 3; do for s in "" "+fast" "+fast+mid"; do printf "family:T%s%s," "$d" "$s"; done; done)
 bases="selected,tailored,linear,linear-t2,${fam%,}"
 for unit in default variant_b variant_c; do
   for test in slow-ramp fast-cycle; do
