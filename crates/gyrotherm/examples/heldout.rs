@@ -6,7 +6,15 @@
 //!
 //! `cargo run -p gyrotherm --release --example heldout -- [--train seed-shock[,slow-ramp]]
 //!  [--test slow-ramp] [--train-seed 7] [--test-seed 11] [--recipe residual|published]
-//!  [--epochs N] [--scale-lstm] [--patience N] [--lr X] [--validation-every K]`
+//!  [--epochs N] [--scale-lstm] [--patience N] [--lr X] [--validation-every K]
+//!  [--base B] [--scale-base B] [--bases B1,B2,...] [--no-lstm]`
+//!
+//! Bases `B`: `selected` (default), `tailored`, `linear`, `linear-t2`, `constant`,
+//! `family:<set>` (one set of `fit::select::ladder`, e.g. `family:T3+fast`). `--bases` adds a
+//! row per base with its least-squares fit alone (bias and scale factor on that base);
+//! `--no-lstm` leaves out the full recipe's row. Env `HELDOUT_UNIT=<unit json>` swaps the
+//! simulated unit (`examples/heldout_units/`); `examples/heldout_sweep.sh` runs the sweep of
+//! the `fit::lstm` module doc.
 
 use std::time::Instant;
 
@@ -122,6 +130,9 @@ fn main() {
     if let Some(v) = get("--base") {
         recipe.base = BaseTerms::parse(&v).unwrap();
     }
+    if let Some(v) = get("--scale-base") {
+        recipe.scale_base = BaseTerms::parse(&v).unwrap();
+    }
     if let Some(v) = get("--window") {
         recipe.window = v.parse().unwrap();
     }
@@ -184,20 +195,38 @@ fn main() {
     row("raw", &raw, 0.0, 0.0);
     let mut linear_bias = f64::NAN;
     let mut summary = vec![raw.bias_dph / floor];
-    for (label, method) in [
-        ("linear", Method::Linear),
-        ("poly", Method::Poly),
-        ("base", Method::Lstm),
-        ("lstm", Method::Lstm),
-    ] {
+    // `--bases a,b`: the residual recipe's least-squares base alone (no LSTM) for each named
+    // base (bias and scale factor alike), for comparison; default: the recipe's own base.
+    let bases: Vec<Option<BaseTerms>> = match get("--bases") {
+        Some(v) => v
+            .split(',')
+            .map(|b| Some(BaseTerms::parse(b).unwrap()))
+            .collect(),
+        None => vec![None],
+    };
+    let mut runs: Vec<(String, Method, Option<Option<BaseTerms>>)> = vec![
+        ("linear".into(), Method::Linear, None),
+        ("poly".into(), Method::Poly, None),
+    ];
+    if recipe.kind != RecipeKind::Published {
+        for b in &bases {
+            let label = b.map_or("base".to_string(), |b| format!("b:{}", b.name()));
+            runs.push((label, Method::Lstm, Some(*b)));
+        }
+    }
+    if !args.iter().any(|a| a == "--no-lstm") {
+        runs.push(("lstm".into(), Method::Lstm, None));
+    }
+    for (label, method, base) in runs {
+        let label = label.as_str();
         let mut cfg = FitConfig::new(method);
         cfg.recipe = recipe.clone();
-        if label == "base" {
-            // The residual recipe's least-squares base alone (no LSTM), for comparison.
-            if recipe.kind == RecipeKind::Published {
-                continue;
-            }
+        if let Some(b) = base {
             cfg.recipe.epochs = 0;
+            if let Some(b) = b {
+                cfg.recipe.base = b;
+                cfg.recipe.scale_base = b;
+            }
         }
         cfg.seed = fit_seed;
         let (t0, c0) = (Instant::now(), cpu_s());
@@ -211,7 +240,7 @@ fn main() {
         if method == Method::Linear {
             linear_bias = f.bias_dph;
         }
-        if label == "lstm" {
+        if method == Method::Lstm {
             for (n, tr) in [("bias", &out.bias_training), ("scale", &out.scale_training)] {
                 if let Some(tr) = tr {
                     println!(
@@ -224,8 +253,13 @@ fn main() {
                         tr.lstm_gain,
                         tr.val_improvement
                     );
+                    if let Some(sel) = &tr.selection {
+                        println!("  {n} terms: {}", sel.describe());
+                    }
                 }
             }
+        }
+        if label == "lstm" {
             println!(
                 "lstm vs linear: {:+.1} %   lstm / floor: {:.2}",
                 (f.bias_dph / linear_bias - 1.0) * 100.0,

@@ -8,17 +8,23 @@ use gyrotherm::features::FeatureSpec;
 use gyrotherm::fit::lstm::{
     self, bias_terms, generic_linear_terms, BaseTerms, LstmRecipe, RecipeKind, RecipeTarget,
 };
+use gyrotherm::fit::select;
 use gyrotherm::fit::{fit_model, FitConfig, FitOutcome, NamedLog};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::{Method, SubModel};
-use gyrotherm::sim::{simulate, SimConfig};
+use gyrotherm::sim::{simulate, FogUnit, SimConfig};
 use gyrotherm::targets::TargetSet;
 
 const TABLE_RATE_DPS: f64 = 20.0;
 
 fn sim(profile: &str, seed: u64, table: bool, truth: bool) -> TestLog {
+    sim_unit(profile, seed, table, truth, FogUnit::default())
+}
+
+fn sim_unit(profile: &str, seed: u64, table: bool, truth: bool, unit: FogUnit) -> TestLog {
     let mut c = SimConfig::builtin(profile).unwrap();
+    c.unit = unit;
     c.seed = seed;
     c.truth = truth;
     c.table_rate_dps = table.then_some(TABLE_RATE_DPS);
@@ -175,6 +181,7 @@ fn physical_fit_recovers_known_coefficients_across_run_offsets() {
     ];
     let recipe = LstmRecipe {
         epochs: 0,
+        base: BaseTerms::Tailored,
         ..LstmRecipe::residual()
     };
     let (sub, summary) =
@@ -234,6 +241,8 @@ fn residual_lstm_is_kept_when_it_learns_what_the_physical_terms_cannot() {
     let logs = [("a", &train_a), ("b", &train_b)];
     let mut cfg = FitConfig::new(Method::Lstm);
     cfg.recipe.epochs = 60;
+    // The base the data were made from: this test is about the LSTM, not the term choice.
+    cfg.recipe.base = BaseTerms::Tailored;
     let out = fit(&logs, &cfg);
     let summary = out.bias_training.clone().unwrap();
     let gain = summary.lstm_gain.unwrap();
@@ -305,7 +314,21 @@ fn published_recipe_is_kept() {
     }
     assert_eq!(LstmRecipe::generic().base, BaseTerms::LinearT2);
     assert_eq!(LstmRecipe::direct().base, BaseTerms::Constant);
-    assert_eq!(LstmRecipe::default().base, BaseTerms::Tailored);
+    assert_eq!(LstmRecipe::default().base, BaseTerms::Selected);
+    assert_eq!(LstmRecipe::default().scale_base, BaseTerms::Selected);
+    for b in [
+        BaseTerms::Selected,
+        BaseTerms::Tailored,
+        BaseTerms::Linear,
+        BaseTerms::LinearT2,
+        BaseTerms::Constant,
+        BaseTerms::Family(4),
+    ] {
+        assert_eq!(BaseTerms::parse(&b.name()), Ok(b));
+    }
+    assert!(BaseTerms::parse("family:T9")
+        .unwrap_err()
+        .contains("T3+fast"));
 
     let log = sim("seed-shock", 6, false, false);
     let mut cfg = FitConfig::new(Method::Lstm);
@@ -323,13 +346,15 @@ fn published_recipe_is_kept() {
 #[test]
 fn physical_terms_are_valid_for_flight() {
     let n = FeatureSpec::THERMAL_STATE.n_features();
-    for t in [
+    let mut sets = vec![
         bias_terms(),
         lstm::scale_terms(),
         generic_linear_terms(false),
         generic_linear_terms(true),
-        BaseTerms::Constant.bias_terms(),
-    ] {
+        BaseTerms::Constant.fixed_terms(RecipeTarget::Bias).unwrap(),
+    ];
+    sets.extend(select::ladder().into_iter().map(|c| c.terms));
+    for t in sets {
         assert_eq!(t.n_features, n);
         t.validate().unwrap();
         assert_eq!(t.powers[0], vec![0; n], "the constant term comes first");
@@ -343,8 +368,14 @@ fn physical_terms_are_valid_for_flight() {
 fn generic_terms_are_linear_in_the_thermal_state() {
     let n = FeatureSpec::THERMAL_STATE.n_features();
     let t = generic_linear_terms(true);
-    assert_eq!(t, BaseTerms::LinearT2.bias_terms());
-    assert_eq!(generic_linear_terms(false), BaseTerms::Linear.bias_terms());
+    assert_eq!(
+        Some(t.clone()),
+        BaseTerms::LinearT2.fixed_terms(RecipeTarget::Bias)
+    );
+    assert_eq!(
+        Some(generic_linear_terms(false)),
+        BaseTerms::Linear.fixed_terms(RecipeTarget::Bias)
+    );
     assert_eq!(t.len(), 1 + n + 1, "1, the {n} inputs and T²");
     for p in &t.powers {
         let degree: u8 = p.iter().sum();
@@ -379,7 +410,10 @@ fn direct_recipe_base_is_the_mean_over_runs() {
     else {
         panic!("epochs 0: want the constant base alone, got {sub:?}");
     };
-    assert_eq!(terms, BaseTerms::Constant.bias_terms());
+    assert_eq!(
+        Some(terms),
+        BaseTerms::Constant.fixed_terms(RecipeTarget::Bias)
+    );
     let (sum, n) = sets.iter().fold((0.0, 0usize), |(s, n), set| {
         (s + set.target.iter().sum::<f64>(), n + set.target.len())
     });
@@ -392,4 +426,112 @@ fn direct_recipe_base_is_the_mean_over_runs() {
         coefficients[0]
     );
     assert!(summary.baseline_rms.unwrap() > 0.0);
+}
+
+/// Issue 5, robustness: on a unit whose bias does not follow the simulator's default equation
+/// (420 s coil, Shupe temperature coefficient 0.03, cubic bias, 4000 s stress relaxation;
+/// `examples/heldout_units/variant_b.json`), the terms chosen by cross-validation beat the
+/// terms tailored to the default equation on a held-out run of another profile (both
+/// measured here on the same data; the claim is a reduction by at least 40 %: the sweep in
+/// the module doc of `fit::lstm` measured 49–71 % over 8 held-out cases), and keep the scale
+/// factor below the issue's 10 ppm.
+#[test]
+fn selected_terms_beat_the_tailored_terms_on_a_variant_unit() {
+    let unit = FogUnit {
+        coil_tau_s: 420.0,
+        stress_tau_s: 4000.0,
+        shupe_tc_per_c: 0.03,
+        bias_c2_dph_per_c2: 2e-5,
+        bias_c3_dph_per_c3: 2e-6,
+        ..FogUnit::default()
+    };
+    let train_static = sim_unit("seed-shock", 7, false, false, unit.clone());
+    let train_table = sim_unit("seed-shock", 107, true, false, unit.clone());
+    let test_static = sim_unit("slow-ramp", 11, false, false, unit.clone());
+    let test_table = sim_unit("slow-ramp", 111, true, false, unit);
+    let logs = [("static", &train_static), ("table", &train_table)];
+    let mut cfg = FitConfig::new(Method::Lstm);
+    cfg.recipe.epochs = 0; // the least-squares base alone: this test is about its terms
+    let selected = fit(&logs, &cfg);
+    cfg.recipe.base = BaseTerms::Tailored;
+    cfg.recipe.scale_base = BaseTerms::Tailored;
+    let tailored = fit(&logs, &cfg).model;
+    let sel = selected.bias_training.unwrap().selection.unwrap();
+    let bs = |m| bias_stability(&compensate_log(m, &test_static).unwrap().gyro_comp_dps);
+    let (got, tail) = (bs(&selected.model), bs(&tailored));
+    assert!(
+        got <= 0.6 * tail,
+        "held-out bias stability: want ≤ 0.6 × tailored = {:.5} °/h, got {got:.5} (chose {}: {})",
+        0.6 * tail,
+        sel.chosen_name(),
+        sel.describe()
+    );
+    let comp = compensate_log(&selected.model, &test_table).unwrap();
+    let rep = scale_factor(
+        &test_table.time_s,
+        &comp.gyro_comp_dps,
+        test_table.table_dps.as_ref().unwrap(),
+        &ScaleFactorOptions::default(),
+    )
+    .unwrap();
+    assert!(
+        rep.sf_thermal_error_ppm < 10.0,
+        "SF thermal error: want < 10 ppm, got {:.2}",
+        rep.sf_thermal_error_ppm
+    );
+}
+
+/// On exact data made from one set of the ladder (`T3`: cubic in T, lag differences linear)
+/// plus a different offset per run, blocked cross-validation chooses a set that spans it
+/// (its cross-validated residual is round-off) and ranks a set that cannot (`T2`, no T³)
+/// far worse (independent: the construction).
+#[test]
+fn cross_validation_chooses_a_set_that_spans_exact_data() {
+    let ladder = select::ladder();
+    let t3 = ladder
+        .iter()
+        .find(|c| c.name == "T3")
+        .unwrap()
+        .terms
+        .clone();
+    // Physically sized: °/s per monomial unit of 1, T, T², T³, D300, D1000, D3000.
+    let c = [1e-4, 8e-7, 2e-8, 5e-10, 1e-6, 3e-7, -2e-7];
+    let set = |profile: &str, seed: u64, offset: f64| {
+        let log = sim(profile, seed, false, false);
+        let table = gyrotherm::features::extract(&log, &FeatureSpec::THERMAL_STATE).unwrap();
+        let target = (0..table.n_rows())
+            .map(|r| {
+                let m = t3.design_row(table.row(r));
+                offset + m.iter().zip(&c).map(|(a, b)| a * b).sum::<f64>()
+            })
+            .collect();
+        let mask = vec![true; table.n_rows()];
+        TargetSet {
+            table,
+            target,
+            mask,
+        }
+    };
+    let sets = vec![set("seed-shock", 1, 2e-4), set("fast-cycle", 2, -3e-4)];
+    let cands = select::candidates(RecipeTarget::Bias);
+    let sel = select::select_terms(&sets, &cands, select::FOLDS, select::GAP_STEPS).unwrap();
+    let chosen = &cands[sel.chosen].terms;
+    for p in &t3.powers {
+        assert!(
+            chosen.powers.contains(p),
+            "chose {} ({}), which lacks the term {p:?}",
+            sel.chosen_name(),
+            sel.describe()
+        );
+    }
+    // Round-off of SVD least squares on exact data, as in the physical-fit test above.
+    const ROUND_OFF_DPS: f64 = 1e-10;
+    let best = sel.cv_rms[sel.chosen];
+    assert!(best < ROUND_OFF_DPS, "chosen set's CV RMS {best:e} °/s");
+    let t2 = sel.names.iter().position(|n| n == "T2").unwrap();
+    assert!(
+        sel.cv_rms[t2] > 1e3 * ROUND_OFF_DPS,
+        "T2 cannot express T³, want its CV RMS far above round-off: {}",
+        sel.describe()
+    );
 }

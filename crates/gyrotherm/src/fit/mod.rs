@@ -6,6 +6,7 @@
 //! `poly` (degree n in T, m in dT, optional T·dT), `lstm` (see [`lstm`]).
 
 pub mod lstm;
+pub mod select;
 
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
