@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use gyrotherm::fit::{fit_model, FitConfig, NamedLog, Target};
-use gyrotherm::model::Method;
+use gyrotherm::model::{Method, SubModel};
 
 use super::common::{read_log_reporting, LogArgs};
 use super::progress::TrainingBars;
@@ -180,14 +180,30 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         m.training.rate_range_c_per_s.min * 60.0,
         m.training.rate_range_c_per_s.max * 60.0
     );
-    for (name, t) in [
-        ("bias", &outcome.bias_training),
-        ("scale", &outcome.scale_training),
+    for (name, sub, t) in [
+        ("bias", &m.bias, &outcome.bias_training),
+        ("scale factor", &m.scale, &outcome.scale_training),
     ] {
-        if let Some(t) = t {
+        let Some(sub) = sub else { continue };
+        eprintln!("  {name} model: {}", sub.kind());
+        let Some(t) = t else { continue };
+        if let Some(sel) = &t.selection {
             eprintln!(
-                "  {name} network: {} epochs, final loss {:.4e} (normalised MSE)",
-                t.epochs, t.final_loss
+                "    least-squares terms by time-segment cross-validation (RMS, * chosen): {}",
+                sel.describe()
+            );
+        }
+        if t.epochs > 0 {
+            let kept = matches!(sub, SubModel::Lstm { .. } | SubModel::Residual { .. });
+            eprintln!(
+                "    LSTM: {} epochs, final loss {:.4e} (normalised MSE); {}",
+                t.epochs,
+                t.final_loss,
+                if kept {
+                    "kept"
+                } else {
+                    "left out: it did not beat the least-squares base on the validation blocks"
+                }
             );
         }
     }
