@@ -2,11 +2,12 @@
 //!
 //! Flatten into a command's arguments with `#[command(flatten)] log: LogArgs`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use clap::{Args, ValueEnum};
 use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
+use gyrotherm::fit::NamedLog;
 
 /// How to read test logs: which columns hold what, the gyro unit, the gap policy.
 #[derive(Debug, Clone, Args)]
@@ -74,17 +75,64 @@ impl LogArgs {
 
 /// Read a log with these options; say on stderr how many samples gap filling made.
 pub fn read_log_reporting(path: &Path, args: &LogArgs) -> anyhow::Result<TestLog> {
+    read_log_noting_gaps(path, args).map(|(log, _)| log)
+}
+
+/// Read a log; when `--fill-gaps` made samples, say so on stderr and return that warning.
+pub fn read_log_noting_gaps(
+    path: &Path,
+    args: &LogArgs,
+) -> anyhow::Result<(TestLog, Option<String>)> {
     let (log, report) = csvlog::read_log(path, &args.read_options())
         .with_context(|| format!("cannot use log {}", path.display()))?;
-    if report.filled_gaps > 0 {
-        eprintln!(
-            "gyrotherm: {}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps)",
+    let warning = (report.filled_gaps > 0).then(|| {
+        format!(
+            "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps)",
             path.display(),
             report.filled_gaps,
             report.filled_samples
-        );
+        )
+    });
+    if let Some(w) = &warning {
+        eprintln!("gyrotherm: {w}");
     }
-    Ok(log)
+    Ok((log, warning))
+}
+
+/// Read every log, reporting each failure, then stop if any failed. Gap-filling warnings are
+/// added to `warnings`.
+pub fn read_logs(
+    paths: &[PathBuf],
+    args: &LogArgs,
+    warnings: &mut Vec<String>,
+) -> anyhow::Result<Vec<(String, TestLog)>> {
+    let mut out = Vec::new();
+    let mut failed = 0;
+    for p in paths {
+        match read_log_noting_gaps(p, args) {
+            Ok((log, warning)) => {
+                warnings.extend(warning);
+                out.push((p.display().to_string(), log));
+            }
+            Err(e) => {
+                eprintln!("gyrotherm: {e:#}");
+                failed += 1;
+            }
+        }
+    }
+    anyhow::ensure!(
+        failed == 0,
+        "{failed} of {} input logs could not be read (see above)",
+        paths.len()
+    );
+    Ok(out)
+}
+
+/// The library's view of read logs: name and data.
+pub fn named(logs: &[(String, TestLog)]) -> Vec<NamedLog<'_>> {
+    logs.iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect()
 }
 
 fn positive_seconds(s: &str) -> Result<f64, String> {

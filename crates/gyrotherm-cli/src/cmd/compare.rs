@@ -12,8 +12,9 @@ use gyrotherm::model::Method;
 use serde_json::{json, Value};
 
 use super::common::LogArgs;
+use super::common::{named, read_logs};
 use super::progress::TrainingBars;
-use super::train::{read_logs, FitArgs};
+use super::train::FitArgs;
 
 #[derive(Debug, clap::Args)]
 pub struct CompareArgs {
@@ -62,16 +63,11 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         args.tau.is_finite() && args.tau > 0.0,
         "--tau must be a positive number of seconds"
     );
-    let train = read_logs(&args.train, &args.log)?;
-    let test = read_logs(&args.test, &args.log)?;
-    let train_named: Vec<NamedLog> = train
-        .iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect();
-    let test_named: Vec<NamedLog> = test
-        .iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect();
+    let mut warnings = Vec::new();
+    let train = read_logs(&args.train, &args.log, &mut warnings)?;
+    let test = read_logs(&args.test, &args.log, &mut warnings)?;
+    let train_named = named(&train);
+    let test_named = named(&test);
     let cfg = CompareConfig {
         fit: args.fit.fit_config(Method::Lstm)?,
         tau_s: args.tau,

@@ -8,10 +8,10 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 use gyrotherm::compare::CompareConfig;
 use gyrotherm::csvlog::{write_log, TestLog};
-use gyrotherm::fit::NamedLog;
 use gyrotherm::model::Method;
 use gyrotherm::sim::{simulate, SimConfig};
 
+use super::common::named;
 use super::compare::{print_table, run_comparison};
 use super::train::FitArgs;
 
@@ -85,10 +85,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         );
         logs.push((path.display().to_string(), log));
     }
-    let named: Vec<NamedLog> = logs
-        .iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect();
+    let named = named(&logs);
     let cfg = CompareConfig {
         fit: args.fit.fit_config(Method::Lstm)?,
         settle_s: args.fit.settle,

@@ -9,12 +9,10 @@ use std::io::Write as _;
 
 use anyhow::Context as _;
 use gyrotherm::compare::CompareConfig;
-use gyrotherm::csvlog::{self, TestLog};
-use gyrotherm::fit::NamedLog;
 use gyrotherm::model::Method;
 use gyrotherm::report::write_full_report_with;
 
-use super::common::LogArgs;
+use super::common::{named, read_logs, LogArgs};
 use super::compare::{print_table, run_comparison};
 use super::train::FitArgs;
 
@@ -38,60 +36,16 @@ pub struct ReportArgs {
     pub log: LogArgs,
 }
 
-/// Read every log like `read_logs` (each failure reported, then stop), and collect a
-/// warning for each log in which `--fill-gaps` interpolated samples, for the page.
-fn read_logs_noting_gaps(
-    paths: &[PathBuf],
-    log: &LogArgs,
-    warnings: &mut Vec<String>,
-) -> anyhow::Result<Vec<(String, TestLog)>> {
-    let mut out = Vec::new();
-    let mut failed = 0;
-    for p in paths {
-        match csvlog::read_log(p, &log.read_options()) {
-            Ok((l, r)) => {
-                if r.filled_gaps > 0 {
-                    let w = format!(
-                        "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps)",
-                        p.display(),
-                        r.filled_gaps,
-                        r.filled_samples
-                    );
-                    eprintln!("gyrotherm: {w}");
-                    warnings.push(w);
-                }
-                out.push((p.display().to_string(), l));
-            }
-            Err(e) => {
-                eprintln!("gyrotherm: cannot use log {}: {e}", p.display());
-                failed += 1;
-            }
-        }
-    }
-    anyhow::ensure!(
-        failed == 0,
-        "{failed} of {} input logs could not be read (see above)",
-        paths.len()
-    );
-    Ok(out)
-}
-
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(
         args.tau.is_finite() && args.tau > 0.0,
         "--tau must be a positive number of seconds"
     );
     let mut gap_warnings = Vec::new();
-    let train = read_logs_noting_gaps(&args.train, &args.log, &mut gap_warnings)?;
-    let test = read_logs_noting_gaps(&args.test, &args.log, &mut gap_warnings)?;
-    let train_named: Vec<NamedLog> = train
-        .iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect();
-    let test_named: Vec<NamedLog> = test
-        .iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect();
+    let train = read_logs(&args.train, &args.log, &mut gap_warnings)?;
+    let test = read_logs(&args.test, &args.log, &mut gap_warnings)?;
+    let train_named = named(&train);
+    let test_named = named(&test);
     let cfg = CompareConfig {
         fit: args.fit.fit_config(Method::Lstm)?,
         tau_s: args.tau,

@@ -4,10 +4,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, Target};
+use gyrotherm::fit::{fit_model, FitConfig, Target};
 use gyrotherm::model::{Method, SubModel};
 
-use super::common::{read_log_reporting, LogArgs};
+use super::common::{named, read_logs, LogArgs};
 use super::progress::TrainingBars;
 
 /// Fitting options shared by `train` and `compare`.
@@ -112,36 +112,9 @@ pub struct TrainArgs {
     pub log: LogArgs,
 }
 
-/// Read every input log, reporting each failure, then stop if any failed.
-pub fn read_logs(
-    paths: &[PathBuf],
-    log: &LogArgs,
-) -> anyhow::Result<Vec<(String, gyrotherm::csvlog::TestLog)>> {
-    let mut out = Vec::new();
-    let mut failed = 0;
-    for p in paths {
-        match read_log_reporting(p, log) {
-            Ok(l) => out.push((p.display().to_string(), l)),
-            Err(e) => {
-                eprintln!("gyrotherm: {e:#}");
-                failed += 1;
-            }
-        }
-    }
-    anyhow::ensure!(
-        failed == 0,
-        "{failed} of {} input logs could not be read (see above)",
-        paths.len()
-    );
-    Ok(out)
-}
-
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
-    let logs = read_logs(&args.input, &args.log)?;
-    let named: Vec<NamedLog> = logs
-        .iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect();
+    let logs = read_logs(&args.input, &args.log, &mut Vec::new())?;
+    let named = named(&logs);
     let method: Method = args.method.into();
     let cfg = args.fit.fit_config(method)?;
     let started = std::time::Instant::now();
