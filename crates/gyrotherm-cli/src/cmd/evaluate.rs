@@ -53,9 +53,18 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         );
     };
     let rate_dps: Vec<f64> = values.iter().map(|v| v * to_dph / 3600.0).collect();
-    let bias = metrics::bias_dph(&rate_dps).with_context(|| format!("column {}", args.column))?;
-    let stab = metrics::bias_stability_dph(&rate_dps, tau0_s, args.tau)
-        .with_context(|| format!("bias stability of column {}", args.column))?;
+    // A rate-table log's bias comes from its stop segments only.
+    let (bias, stab) = match &log.table_dps {
+        Some(table) if table.iter().any(|w| *w != 0.0) => {
+            metrics::stop_segment_bias_dph(&log.time_s, &rate_dps, table, args.settle, args.tau)
+                .with_context(|| format!("bias of column {} over the stop segments", args.column))?
+        }
+        _ => (
+            metrics::bias_dph(&rate_dps).with_context(|| format!("column {}", args.column))?,
+            metrics::bias_stability_dph(&rate_dps, tau0_s, args.tau)
+                .with_context(|| format!("bias stability of column {}", args.column))?,
+        ),
+    };
     let mut out = json!({
         "column": args.column,
         "samples": rate_dps.len(),
@@ -126,8 +135,15 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     writeln!(w, "bias                 {:>14.6} °/h", bias)?;
     writeln!(
         w,
-        "bias stability       {:>14.6} °/h (1σ of {} means of {} s)",
-        stab.bias_stability_dph, stab.means, stab.tau_s
+        "bias stability       {:>14.6} °/h (1σ of {} means of {} s{})",
+        stab.bias_stability_dph,
+        stab.means,
+        stab.tau_s,
+        if sf_report.is_some() {
+            ", stop segments only"
+        } else {
+            ""
+        }
     )?;
     if let Some(r) = sf_report {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.3}"));

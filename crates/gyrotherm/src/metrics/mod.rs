@@ -122,13 +122,8 @@ pub struct BiasStability {
     pub means: usize,
 }
 
-/// Bias stability (GJB 2426A / IEEE 952): sample std (n − 1) of consecutive non-overlapping
-/// τ-means of `rate_dps`, in °/h. τ must be an integer multiple of `sample_period_s`.
-pub fn bias_stability_dph(
-    rate_dps: &[f64],
-    sample_period_s: f64,
-    tau_s: f64,
-) -> Result<BiasStability, MetricsError> {
+/// Samples per τ-mean: τ / sample period, which must be a positive integer.
+fn samples_per_mean(sample_period_s: f64, tau_s: f64) -> Result<usize, MetricsError> {
     if !(sample_period_s.is_finite() && sample_period_s > 0.0) {
         return Err(MetricsError::BadSamplePeriod(sample_period_s));
     }
@@ -140,7 +135,17 @@ pub fn bias_stability_dph(
             sample_period_s,
         });
     }
-    let m = m as usize;
+    Ok(m as usize)
+}
+
+/// Bias stability (GJB 2426A / IEEE 952): sample std (n − 1) of consecutive non-overlapping
+/// τ-means of `rate_dps`, in °/h. τ must be an integer multiple of `sample_period_s`.
+pub fn bias_stability_dph(
+    rate_dps: &[f64],
+    sample_period_s: f64,
+    tau_s: f64,
+) -> Result<BiasStability, MetricsError> {
+    let m = samples_per_mean(sample_period_s, tau_s)?;
     let (std, means) = tau_means_std(rate_dps, m)?;
     Ok(BiasStability {
         bias_stability_dph: std * DPS_TO_DPH,
@@ -148,6 +153,61 @@ pub fn bias_stability_dph(
         samples_per_mean: m,
         means,
     })
+}
+
+/// Bias and bias stability of a rate-table log, from its stop segments only (table rate 0):
+/// τ-means are taken inside each stop segment after `settle_s` (a mean never spans a table
+/// rate; a segment's remainder shorter than τ is dropped), and the bias stability is their
+/// sample std (n − 1), °/h. The bias is the mean of the used stop samples, °/h.
+pub fn stop_segment_bias_dph(
+    time_s: &[f64],
+    rate_dps: &[f64],
+    table_dps: &[f64],
+    settle_s: f64,
+    tau_s: f64,
+) -> Result<(f64, BiasStability), MetricsError> {
+    check_finite(rate_dps)?;
+    let period = median_step(time_s).ok_or(MetricsError::Empty)?;
+    let m = samples_per_mean(period, tau_s)?;
+    let mut means = Vec::new();
+    let mut used = Vec::new();
+    for seg in scale_factor::detect_segments(time_s, rate_dps, table_dps, settle_s, 1e-9) {
+        if seg.table_dps != 0.0 {
+            continue;
+        }
+        let t0 = time_s[seg.start] + settle_s;
+        let samples: Vec<f64> = (seg.start..seg.end)
+            .filter(|&i| time_s[i] >= t0)
+            .map(|i| rate_dps[i])
+            .collect();
+        means.extend(samples.chunks_exact(m).map(mean));
+        used.extend(samples);
+    }
+    if means.len() < 2 {
+        return Err(MetricsError::TooShort {
+            samples: used.len(),
+            samples_per_mean: m,
+        });
+    }
+    Ok((
+        mean(&used) * DPS_TO_DPH,
+        BiasStability {
+            bias_stability_dph: sample_std(&means).unwrap_or(f64::NAN) * DPS_TO_DPH,
+            tau_s,
+            samples_per_mean: m,
+            means: means.len(),
+        },
+    ))
+}
+
+/// Median time step, s (None for fewer than two samples).
+fn median_step(time_s: &[f64]) -> Option<f64> {
+    let mut d: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    if d.is_empty() {
+        return None;
+    }
+    d.sort_by(f64::total_cmp);
+    Some(d[d.len() / 2])
 }
 
 /// Repeatability over runs: sample std (n − 1) of one figure (bias in °/h, K, …) measured
@@ -167,4 +227,54 @@ pub fn bias_repeatability_dph(runs_dps: &[&[f64]]) -> Result<Option<f64>, Metric
         .map(|r| bias_dph(r))
         .collect::<Result<Vec<f64>, _>>()?;
     Ok(repeatability(&biases))
+}
+
+#[cfg(test)]
+mod stop_segment_tests {
+    use super::*;
+
+    #[test]
+    fn stop_segment_bias_ignores_rate_segments_and_settle_time() {
+        // 1 Hz; segments of 300 s: stop, +20, stop, -20, stop. Stop output alternates
+        // between 1e-3 and 3e-3 °/s in 100 s blocks after a 10 s settle spike; rate segments
+        // carry 20 °/s. Independent: the 100 s means of the stops are 1e-3, 3e-3, 1e-3, …
+        // (after dropping the settle time each stop keeps 290 s = two whole 100 s means).
+        let n = 1500;
+        let time_s: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let table: Vec<f64> = (0..n)
+            .map(|i| match i / 300 {
+                1 => 20.0,
+                3 => -20.0,
+                _ => 0.0,
+            })
+            .collect();
+        let rate: Vec<f64> = (0..n)
+            .map(|i| {
+                let in_seg = i % 300;
+                if table[i] != 0.0 {
+                    table[i]
+                } else if in_seg < 10 {
+                    5.0
+                } else if ((in_seg - 10) / 100) % 2 == 0 {
+                    1e-3
+                } else {
+                    3e-3
+                }
+            })
+            .collect();
+        let (bias, st) = stop_segment_bias_dph(&time_s, &rate, &table, 10.0, 100.0).unwrap();
+        assert_eq!(st.means, 6);
+        let means = [1e-3, 3e-3, 1e-3, 3e-3, 1e-3, 3e-3];
+        let want = sample_std(&means).unwrap() * DPS_TO_DPH;
+        assert!(
+            (st.bias_stability_dph - want).abs() < 1e-9 * want,
+            "{st:?} vs {want}"
+        );
+        // Used stop samples: 3 × 290 = 870; per stop 100 at 1e-3, 100 at 3e-3, 90 at 1e-3.
+        let want_bias = (3.0 * (190.0 * 1e-3 + 100.0 * 3e-3) / 870.0) * DPS_TO_DPH;
+        assert!(
+            (bias - want_bias).abs() < 1e-9 * want_bias,
+            "{bias} vs {want_bias}"
+        );
+    }
 }
