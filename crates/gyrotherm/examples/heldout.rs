@@ -14,7 +14,8 @@
 //! row per base with its least-squares fit alone (bias and scale factor on that base);
 //! `--no-lstm` leaves out the full recipe's row. Env `HELDOUT_UNIT=<unit json>` swaps the
 //! simulated unit (`examples/heldout_units/`); `examples/heldout_sweep.sh` runs the sweep of
-//! the `fit::lstm` module doc.
+//! the `fit::lstm` module doc; `examples/heldout_lstm_sweep.sh` the sweep of the residual LSTM's
+//! settings recorded there.
 
 use std::time::Instant;
 
