@@ -59,21 +59,12 @@ pub fn run_comparison(
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
-    anyhow::ensure!(
-        args.tau.is_finite() && args.tau > 0.0,
-        "--tau must be a positive number of seconds"
-    );
     let mut warnings = Vec::new();
     let train = read_logs(&args.train, &args.log, &mut warnings)?;
     let test = read_logs(&args.test, &args.log, &mut warnings)?;
     let train_named = named(&train);
     let test_named = named(&test);
-    let cfg = CompareConfig {
-        fit: args.fit.fit_config(Method::Lstm)?,
-        tau_s: args.tau,
-        settle_s: args.fit.settle,
-        ..CompareConfig::default()
-    };
+    let cfg = args.fit.compare_config(args.tau)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let mut out = std::io::stdout().lock();
     if args.json {

@@ -6,9 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::compare::CompareConfig;
 use gyrotherm::csvlog::{write_log, TestLog};
-use gyrotherm::model::Method;
 use gyrotherm::sim::{simulate, SimConfig};
 
 use super::common::named;
@@ -86,11 +84,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         logs.push((path.display().to_string(), log));
     }
     let named = named(&logs);
-    let cfg = CompareConfig {
-        fit: args.fit.fit_config(Method::Lstm)?,
-        settle_s: args.fit.settle,
-        ..CompareConfig::default()
-    };
+    let cfg = args.fit.compare_config(gyrotherm::targets::BIAS_WINDOW_S)?;
     eprintln!("gyrotherm: fitting linear, poly and lstm models on the training runs ...");
     let cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
     for fit in &cmp.fits {

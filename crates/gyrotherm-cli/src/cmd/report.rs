@@ -8,8 +8,6 @@ use std::process::ExitCode;
 use std::io::Write as _;
 
 use anyhow::Context as _;
-use gyrotherm::compare::CompareConfig;
-use gyrotherm::model::Method;
 use gyrotherm::report::write_full_report_with;
 
 use super::common::{named, read_logs, LogArgs};
@@ -37,21 +35,12 @@ pub struct ReportArgs {
 }
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
-    anyhow::ensure!(
-        args.tau.is_finite() && args.tau > 0.0,
-        "--tau must be a positive number of seconds"
-    );
     let mut gap_warnings = Vec::new();
     let train = read_logs(&args.train, &args.log, &mut gap_warnings)?;
     let test = read_logs(&args.test, &args.log, &mut gap_warnings)?;
     let train_named = named(&train);
     let test_named = named(&test);
-    let cfg = CompareConfig {
-        fit: args.fit.fit_config(Method::Lstm)?,
-        tau_s: args.tau,
-        settle_s: args.fit.settle,
-        ..CompareConfig::default()
-    };
+    let cfg = args.fit.compare_config(args.tau)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let index = write_full_report_with(
         &args.out,

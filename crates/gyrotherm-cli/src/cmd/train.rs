@@ -45,6 +45,20 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
+    /// The comparison settings (all methods) with bias stability over `tau_s`.
+    pub fn compare_config(&self, tau_s: f64) -> anyhow::Result<gyrotherm::compare::CompareConfig> {
+        anyhow::ensure!(
+            tau_s.is_finite() && tau_s > 0.0,
+            "--tau must be a positive number of seconds"
+        );
+        Ok(gyrotherm::compare::CompareConfig {
+            fit: self.fit_config(Method::Lstm)?,
+            tau_s,
+            settle_s: self.settle,
+            ..Default::default()
+        })
+    }
+
     /// The library's fit configuration for `method`.
     pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
         let mut cfg = FitConfig::new(method);
