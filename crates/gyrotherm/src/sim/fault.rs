@@ -91,19 +91,7 @@ pub(crate) fn apply(s: &mut SimSeries, f: &FaultParams, dt_s: f64, seed: u64) {
         let mut k = keep.iter();
         v.retain(|_| *k.next().unwrap_or(&true));
     };
-    for v in [
-        &mut s.time_s,
-        &mut s.gyro_dps,
-        &mut s.temp_c,
-        &mut s.true_bias_dps,
-        &mut s.true_scale,
-        &mut s.noise_dps,
-        &mut s.setpoint_c,
-        &mut s.chamber_c,
-        &mut s.case_c,
-        &mut s.coil_c,
-        &mut s.stress_c,
-    ] {
+    for v in s.sample_columns_mut() {
         filter(v);
     }
     if let Some(t) = &mut s.table_dps {

@@ -239,6 +239,26 @@ pub struct SimSeries {
     pub stress_c: Vec<f64>,
 }
 
+impl SimSeries {
+    /// Every per-sample column except the optional table rate, for operations that must treat
+    /// them alike (reserving, dropping samples).
+    pub(crate) fn sample_columns_mut(&mut self) -> [&mut Vec<f64>; 11] {
+        [
+            &mut self.time_s,
+            &mut self.gyro_dps,
+            &mut self.temp_c,
+            &mut self.true_bias_dps,
+            &mut self.true_scale,
+            &mut self.noise_dps,
+            &mut self.setpoint_c,
+            &mut self.chamber_c,
+            &mut self.case_c,
+            &mut self.coil_c,
+            &mut self.stress_c,
+        ]
+    }
+}
+
 /// Simulate a run and return every series as numbers (truth included, whatever
 /// `cfg.truth` says).
 pub fn simulate_series(cfg: &SimConfig) -> Result<SimSeries, SimError> {
@@ -271,19 +291,7 @@ pub fn simulate_series(cfg: &SimConfig) -> Result<SimSeries, SimError> {
         table_dps: cfg.table_rate_dps.map(|_| Vec::with_capacity(n)),
         ..SimSeries::default()
     };
-    for v in [
-        &mut s.time_s,
-        &mut s.gyro_dps,
-        &mut s.temp_c,
-        &mut s.true_bias_dps,
-        &mut s.true_scale,
-        &mut s.noise_dps,
-        &mut s.setpoint_c,
-        &mut s.chamber_c,
-        &mut s.case_c,
-        &mut s.coil_c,
-        &mut s.stress_c,
-    ] {
+    for v in s.sample_columns_mut() {
         v.reserve_exact(n);
     }
 
