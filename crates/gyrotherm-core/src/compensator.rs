@@ -122,7 +122,9 @@ impl NormalisedLstm {
 }
 
 /// One target's model: value = offset + baseline(features) + lstm(features), each part
-/// optional (a residual LSTM on top of a physical fit has both).
+/// optional (a residual LSTM on top of a physical fit has both). With
+/// [`lstm_reads_base`](Self::lstm_reads_base) the LSTM reads
+/// `(features..., baseline(features))` instead: the base prediction as one more input.
 #[derive(Debug, Clone)]
 pub struct TargetModel {
     /// Constant part (e.g. K = 1 when no scale-factor model was fitted).
@@ -131,6 +133,9 @@ pub struct TargetModel {
     pub baseline: Option<BaselineModel>,
     /// LSTM (normalised), added to the rest.
     pub lstm: Option<NormalisedLstm>,
+    /// When both a baseline and an LSTM are present: the LSTM's inputs are the features
+    /// followed by the baseline's value (`n_features + 1` inputs). Ignored otherwise.
+    pub lstm_reads_base: bool,
 }
 
 impl TargetModel {
@@ -140,7 +145,13 @@ impl TargetModel {
             offset: value,
             baseline: None,
             lstm: None,
+            lstm_reads_base: false,
         }
+    }
+
+    /// Whether the LSTM reads the baseline's value as its last input.
+    fn base_input(&self) -> bool {
+        self.lstm_reads_base && self.baseline.is_some() && self.lstm.is_some()
     }
 
     fn check(&self, n_features: usize) -> Result<(), ModelError> {
@@ -153,9 +164,10 @@ impl TargetModel {
             }
         }
         if let Some(l) = &self.lstm {
-            if l.n_inputs() != n_features {
+            let expected = n_features + usize::from(self.base_input());
+            if l.n_inputs() != expected {
                 return Err(ModelError::FeatureCount {
-                    expected: n_features,
+                    expected,
                     got: l.n_inputs(),
                 });
             }
@@ -166,14 +178,27 @@ impl TargetModel {
     /// Evaluate on one feature step. The baseline is evaluated before the LSTM steps, so an
     /// error leaves the LSTM state untouched.
     pub fn eval(&mut self, f: &Features) -> Result<f64, InputError> {
+        let base_input = self.base_input();
         let mut y = self.offset;
+        let mut base = 0.0;
         if let Some(b) = &self.baseline {
-            y += b
+            base = b
                 .eval_features(f)
                 .map_err(|_| InputError::NonFinite(Channel::Temperature))?;
+            y += base;
         }
         if let Some(l) = &mut self.lstm {
-            y += l.step(f.as_slice())?;
+            let feats = f.as_slice();
+            y += if base_input {
+                // Features, then the base value (checked: n_features + 1 ≤ MAX_FEATURES).
+                let mut x = [0.0f64; MAX_FEATURES];
+                let n = feats.len().min(MAX_FEATURES - 1);
+                x[..n].copy_from_slice(&feats[..n]);
+                x[n] = base;
+                l.step(&x[..n + 1])?
+            } else {
+                l.step(feats)?
+            };
         }
         if y.is_finite() {
             Ok(y)

@@ -7,7 +7,10 @@
 //! `cargo run -p gyrotherm --release --example heldout -- [--train seed-shock[,slow-ramp]]
 //!  [--test slow-ramp] [--train-seed 7] [--test-seed 11] [--recipe residual|published]
 //!  [--epochs N] [--scale-lstm] [--patience N] [--lr X] [--validation-every K]
-//!  [--base B] [--scale-base B] [--bases B1,B2,...] [--no-lstm]`
+//!  [--base B] [--scale-base B] [--bases B1,B2,...] [--no-lstm] [--base-input]`
+//!
+//! `--base-input`: the residual LSTM reads the base prediction as one more input
+//! (`LstmRecipe::base_input`).
 //!
 //! Bases `B`: `selected` (default), `tailored`, `linear`, `linear-t2`, `constant`,
 //! `family:<set>` (one set of `fit::select::ladder`, e.g. `family:T3+fast`). `--bases` adds a
@@ -151,6 +154,9 @@ fn main() {
     }
     let fit_seed: u64 = get("--fit-seed").map_or(1, |v| v.parse().unwrap());
     recipe.scale_lstm = args.iter().any(|a| a == "--scale-lstm");
+    if args.iter().any(|a| a == "--base-input") {
+        recipe.base_input = true;
+    }
 
     let mut train_logs = Vec::new();
     let mut names = Vec::new();

@@ -81,10 +81,18 @@ pub fn target_model(sub: Option<&SubModel>, absent: f64) -> Result<TargetModel, 
         } => Some(core_lstm(params, input_norm, target_norm)?),
         SubModel::Baseline { .. } => None,
     };
+    let lstm_reads_base = matches!(
+        sub,
+        SubModel::Residual {
+            lstm_reads_base: true,
+            ..
+        }
+    );
     Ok(TargetModel {
         offset: 0.0,
         baseline,
         lstm,
+        lstm_reads_base,
     })
 }
 

@@ -141,13 +141,18 @@ pub enum SubModel {
         coefficients: Vec<f64>,
     },
     /// A baseline plus an LSTM fitted to its residual: y = baseline(x) + lstm(x) (a residual
-    /// LSTM on top of a physical fit, issue 5).
+    /// LSTM on top of a physical fit, issue 5); with `lstm_reads_base`,
+    /// y = baseline(x) + lstm(x, baseline(x)): the LSTM reads the features followed by the
+    /// baseline's value (`n_features + 1` inputs).
     Residual {
         terms: Terms,
         coefficients: Vec<f64>,
         params: LstmParams,
         input_norm: ZScore,
         target_norm: ZScore,
+        /// The LSTM's last input is the baseline's value (absent in older files: false).
+        #[serde(default)]
+        lstm_reads_base: bool,
     },
 }
 
@@ -195,18 +200,34 @@ impl SubModel {
                 params,
                 input_norm,
                 target_norm,
+                lstm_reads_base,
             } => {
                 SubModel::Baseline {
                     terms: terms.clone(),
                     coefficients: coefficients.clone(),
                 }
                 .validate(n_features)?;
+                let lstm_inputs = n_features + usize::from(*lstm_reads_base);
+                if lstm_inputs > gyrotherm_core::features::MAX_FEATURES {
+                    return Err(format!(
+                        "lstm_reads_base: {n_features} features plus the base value exceed the \
+                         flight LSTM's {} inputs",
+                        gyrotherm_core::features::MAX_FEATURES
+                    ));
+                }
                 SubModel::Lstm {
                     params: params.clone(),
                     input_norm: input_norm.clone(),
                     target_norm: target_norm.clone(),
                 }
-                .validate(n_features)
+                .validate(lstm_inputs)
+                .map_err(|e| {
+                    if *lstm_reads_base {
+                        format!("{e} (lstm_reads_base: the features plus the base value)")
+                    } else {
+                        e
+                    }
+                })
             }
             SubModel::Lstm {
                 params,

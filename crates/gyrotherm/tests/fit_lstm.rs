@@ -292,6 +292,47 @@ fn residual_recipe_is_deterministic() {
     assert_ne!(a.to_json().unwrap(), c.to_json().unwrap());
 }
 
+/// `base_input`: the residual LSTM is trained on the features followed by the base prediction,
+/// and the model file says so (`lstm_reads_base`, one LSTM input more than the features), so
+/// that the flight compensator feeds it the same vector; the LSTM contributes there.
+#[test]
+fn residual_lstm_can_read_the_base_prediction() {
+    let log = sim("fast-cycle", 5, false, false);
+    let logs = [("static", &log)];
+    let mut cfg = FitConfig::new(Method::Lstm);
+    cfg.recipe.epochs = 3;
+    cfg.recipe.validation_every = 0;
+    cfg.recipe.base_input = true;
+    cfg.seed = 9;
+    let out = fit(&logs, &cfg).model;
+    let n = FeatureSpec::THERMAL_STATE.n_features();
+    match &out.bias {
+        Some(SubModel::Residual {
+            params,
+            input_norm,
+            lstm_reads_base,
+            ..
+        }) => {
+            assert!(*lstm_reads_base, "want lstm_reads_base set");
+            assert_eq!(params.input_size, n + 1, "LSTM inputs: features + base");
+            assert_eq!(input_norm.mean.len(), n + 1);
+        }
+        other => panic!("want a residual sub-model, got {other:?}"),
+    }
+    let back = gyrotherm::model::ModelFile::from_json(&out.to_json().unwrap()).unwrap();
+    assert_eq!(back, out);
+    cfg.recipe.epochs = 0;
+    let base = fit(&logs, &cfg).model;
+    let with = compensate_log(&out, &log).unwrap().bias_dps;
+    let without = compensate_log(&base, &log).unwrap().bias_dps;
+    let diff = with
+        .iter()
+        .zip(&without)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f64, f64::max);
+    assert!(diff > 0.0, "the LSTM reading the base changed nothing");
+}
+
 /// `--recipe published` is the paper's recipe: T and dT in, a plain LSTM, full BPTT.
 #[test]
 fn published_recipe_is_kept() {

@@ -376,3 +376,78 @@ fn fitted_baseline_saves_and_flies() {
         );
     }
 }
+
+/// A residual sub-model whose LSTM reads the base prediction: `n_features + 1` LSTM inputs.
+fn residual_model(reads_base: bool, lstm_inputs: usize) -> ModelFile {
+    let spec = FeatureSpec::THERMAL_STATE;
+    let terms = Terms::linear(spec.n_features());
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let coefficients = random_vec(&mut rng, terms.len());
+    let SubModel::Lstm {
+        params,
+        input_norm,
+        target_norm,
+    } = lstm_sub(&mut rng, lstm_inputs, 8)
+    else {
+        unreachable!()
+    };
+    ModelFile {
+        format_version: 1,
+        method: Method::Lstm,
+        features: FeatureDef::from_spec(&spec),
+        bias: Some(SubModel::Residual {
+            terms,
+            coefficients,
+            params,
+            input_norm,
+            target_norm,
+            lstm_reads_base: reads_base,
+        }),
+        scale: None,
+        training: training(),
+    }
+}
+
+/// `lstm_reads_base` round-trips bit-exactly, flies, is checked against the LSTM's input count
+/// (features + 1), and a file without the field (written before it existed) reads as `false`.
+#[test]
+fn residual_reading_the_base_round_trips_and_is_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = residual_model(true, 6);
+    let path = dir.path().join("residual.json");
+    m.save(&path).unwrap();
+    let back = ModelFile::load(&path).unwrap();
+    assert_bit_exact(&m, &back);
+    assert!(matches!(
+        back.bias,
+        Some(SubModel::Residual {
+            lstm_reads_base: true,
+            ..
+        })
+    ));
+    gyrotherm::compensate::compensator(&back).unwrap();
+
+    // Wrong input counts, either way round, are refused with the count named.
+    let e = residual_model(true, 5).validate().unwrap_err();
+    assert!(e.contains("input_size is 5") && e.contains("6"), "{e}");
+    let e = residual_model(false, 6).validate().unwrap_err();
+    assert!(e.contains("input_size is 6"), "{e}");
+
+    // An older file (no `lstm_reads_base` key) loads as features-only.
+    let mut v = serde_json::to_value(residual_model(false, 5)).unwrap();
+    let removed = v["bias"]["residual"]
+        .as_object_mut()
+        .unwrap()
+        .remove("lstm_reads_base");
+    assert_eq!(removed, Some(serde_json::Value::Bool(false)));
+    let p = save_text(dir.path(), "old.json", &v.to_string());
+    let old = ModelFile::load(&p).unwrap();
+    assert_eq!(old, residual_model(false, 5));
+    // The same old file with a 6-input LSTM is refused (it would need the flag).
+    let mut v = serde_json::to_value(residual_model(true, 6)).unwrap();
+    v["bias"]["residual"]
+        .as_object_mut()
+        .unwrap()
+        .remove("lstm_reads_base");
+    expect_load_error(&v, &["input_size is 6"]);
+}

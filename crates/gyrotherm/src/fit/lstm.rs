@@ -106,10 +106,37 @@
 //! forcing the LSTM on costs the default unit and unit C up to 0.3–0.4 × floor, where the
 //! default gate drops it (±0.00). Training on two profiles lowers unit B's
 //! `slow-ramp` base (2.16–2.94 against 2.39–3.85) but the LSTM on top stays inconsistent
-//! (+1.04 in pair 41→43). The defaults are therefore unchanged. Not tried: the base prediction
-//! as an LSTM input (the flight model's residual sub-model reads the features only). CPU for
+//! (+1.04 in pair 41→43). The defaults are therefore unchanged. CPU for
 //! both networks ≤ 2.4 s with the defaults, ≤ 5.7 s in any setting above (`heldout` prints it
 //! per method).
+//!
+//! The base prediction as an LSTM input ([`LstmRecipe::base_input`], `heldout --base-input`;
+//! the model file's `lstm_reads_base`, the flight LSTM then reads the features followed by the
+//! baseline value), so that the correction can depend on the predicted bias level
+//! (`examples/heldout_base_input_sweep.sh target/release/examples/heldout <dir> 2
+//! [--fit-seed S]`: the same units, profiles and 4 seed pairs as above; base alone → base +
+//! LSTM, change × floor, range over the pairs and the count better / worse by more than 0.02;
+//! network seeds 1 (the default) and 2):
+//!
+//! | setting, fit seed   | B slow-ramp       | B fast-cycle      | C, both profiles  | default, both     |
+//! |---------------------|-------------------|-------------------|-------------------|-------------------|
+//! | gated, 1            | −0.04…+0.17 (1/2) | −0.58…−0.37 (4/0) | dropped: ±0       | dropped: ±0       |
+//! | gated + base, 1     | +0.24…+0.72 (0/4) | −0.83…−0.48 (4/0) | −0.08…+0.10 (2/2) | dropped: ±0       |
+//! | forced, 1           | −0.16…+0.06 (3/1) | −0.93…+0.02 (3/1) | −0.32…+0.16 (2/6) | −0.05…+0.29 (1/5) |
+//! | forced + base, 1    | +0.06…+0.93 (0/4) | −1.23…−0.40 (4/0) | −0.27…+0.20 (4/3) | −0.09…+0.22 (1/5) |
+//! | gated, 2            | +0.03…+0.20 (0/4) | −0.84…−0.35 (4/0) | 0…+0.02 (0/1)     | −0.04…+0.01 (1/0) |
+//! | gated + base, 2     | +0.10…+0.56 (0/4) | −1.30…−1.03 (4/0) | −0.01…+0.04 (0/1) | −0.04…0 (1/0)     |
+//! | forced, 2           | +0.31…+0.71 (0/4) | −0.70…−0.30 (4/0) | −0.18…+0.29 (3/4) | −0.01…+0.14 (0/5) |
+//! | forced + base, 2    | −1.03…+1.59 (1/3) | −1.29…−0.39 (4/0) | −0.29…+0.23 (2/5) | −0.07…+0.15 (2/6) |
+//!
+//! (Forced: `--validation-every 0 --epochs 150`. The "base alone" figures are those of the
+//! table above.) Reading the base doubles what the gated LSTM takes off unit B's `fast-cycle`
+//! (−0.48 to −1.30 × floor in 8 of 8, against −0.35 to −0.84) but costs `slow-ramp` in 8 of 8
+//! (+0.10 to +0.72, against −0.04 to +0.20): on the slow profile the base predicts bias levels
+//! the network never saw in `seed-shock`, and a correction that depends on that level
+//! extrapolates badly there. The default unit is unchanged when gated (the gate still drops
+//! the LSTM) and worse when forced, as without the base input. Not a consistent held-out
+//! improvement, so `base_input` stays `false` by default.
 
 use super::select::{self, TermSelection};
 use crate::baseline::Terms;
@@ -288,6 +315,10 @@ pub struct LstmRecipe {
     /// `Residual`: centred moving average (steps) applied to the base's residual before the
     /// LSTM is trained on it (1: none), to take the sensor noise out of its target.
     pub residual_smooth_steps: usize,
+    /// `Residual`: the LSTM reads the base (least-squares) prediction as one more input after
+    /// the features, so that its correction can depend on the predicted level
+    /// ([`SubModel::Residual::lstm_reads_base`](crate::model::SubModel::Residual)).
+    pub base_input: bool,
 }
 
 impl LstmRecipe {
@@ -318,6 +349,7 @@ impl LstmRecipe {
             base: BaseTerms::Selected,
             scale_base: BaseTerms::Selected,
             residual_smooth_steps: 1,
+            base_input: false,
         }
     }
 
@@ -756,6 +788,7 @@ fn fit_residual(
     }
     // 2. Residual per run, cut into blocks; every `validation_every`-th block validates.
     let block = recipe.block_steps.max(recipe.burn_in + 1);
+    let n_lstm = n_in + usize::from(recipe.base_input);
     let mut train_blocks = Vec::new();
     let mut val_blocks = Vec::new();
     let mut k = 0usize;
@@ -771,6 +804,18 @@ fn fit_residual(
             })
             .collect();
         let resid = smooth_masked(&resid, &s.mask, recipe.residual_smooth_steps);
+        // The LSTM's input rows: the features, then (with `base_input`) the base prediction
+        // as flight code computes it (coefficients with the mean offset, no run offset).
+        let rows: Vec<f64> = if recipe.base_input {
+            (0..nr)
+                .flat_map(|r| {
+                    let x = s.table.row(r);
+                    x.iter().copied().chain([base.predict_row(x)])
+                })
+                .collect()
+        } else {
+            s.table.rows.clone()
+        };
         let mut start = 0;
         while start < nr {
             let end = (start + block).min(nr);
@@ -779,7 +824,7 @@ fn fit_residual(
                 break;
             }
             let b = Block {
-                rows: s.table.rows[start * n_in..end * n_in].to_vec(),
+                rows: rows[start * n_lstm..end * n_lstm].to_vec(),
                 target: resid[start..end].to_vec(),
                 // Each block starts from zero state: its first `burn_in` steps settle it.
                 mask: (start..end)
@@ -822,7 +867,7 @@ fn fit_residual(
         zero_output_init: true,
         ..TrainConfig::default()
     };
-    let fit = train_normalised(&tr, &va, n_in, &cfg, progress).map_err(|e| e.to_string())?;
+    let fit = train_normalised(&tr, &va, n_lstm, &cfg, progress).map_err(|e| e.to_string())?;
     // 3. Keep the LSTM only if it beat "no correction" (epoch 0, zero output layer) on the
     //    validation blocks by `min_val_improvement`, and shrink its contribution to what the
     //    validation blocks support.
@@ -834,7 +879,7 @@ fn fit_residual(
     let gain = match val_improvement {
         None => 1.0,
         Some(g) if g < recipe.min_val_improvement => 0.0,
-        Some(_) => validation_gain(&fit, &val_blocks, n_in)?,
+        Some(_) => validation_gain(&fit, &val_blocks, n_lstm)?,
     };
     let mut target_norm = fit.target_z.clone();
     target_norm.mean[0] *= gain;
@@ -861,6 +906,7 @@ fn fit_residual(
             params: fit.output.params,
             input_norm: fit.input_z,
             target_norm,
+            lstm_reads_base: recipe.base_input,
         },
         summary,
     ))
