@@ -2,6 +2,9 @@
 //! stated size, is not blank, has text drawn (the embedded font works), and the HTML page
 //! references only files that exist.
 
+mod html_refs;
+use html_refs::references;
+
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
@@ -137,21 +140,6 @@ fn check_svg(files: &FigureFiles, texts: &[&str]) {
         "{}: not closed",
         files.svg.display()
     );
-}
-
-/// Every `src="..."` and `href="..."` value in `html`.
-fn references(html: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    for attr in ["src=\"", "href=\""] {
-        let mut rest = html;
-        while let Some(i) = rest.find(attr) {
-            rest = &rest[i + attr.len()..];
-            let end = rest.find('"').expect("unterminated attribute");
-            out.push(rest[..end].to_owned());
-            rest = &rest[end..];
-        }
-    }
-    out
 }
 
 /// A synthetic Allan curve: white rate noise σ/√τ plus a rate-random-walk rise, ±10 % bars.

@@ -2,6 +2,9 @@
 //! written, decodes as a PNG of its stated size and is not blank; the page references only
 //! files that exist, carries the comparison numbers, and notes the figures that cannot apply.
 
+mod html_refs;
+use html_refs::references;
+
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -92,21 +95,6 @@ fn check_png(path: &Path, want: (u32, u32)) {
         path.display(),
         colours.len()
     );
-}
-
-/// Every `src="…"` and `href="…"` of the page.
-fn references(html: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    for attr in ["src=\"", "href=\""] {
-        let mut rest = html;
-        while let Some(i) = rest.find(attr) {
-            rest = &rest[i + attr.len()..];
-            let end = rest.find('"').expect("unterminated attribute");
-            out.push(rest[..end].to_owned());
-            rest = &rest[end..];
-        }
-    }
-    out
 }
 
 fn named<'a>(logs: &'a [(String, TestLog)]) -> Vec<NamedLog<'a>> {
