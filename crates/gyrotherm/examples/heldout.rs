@@ -7,10 +7,12 @@
 //! `cargo run -p gyrotherm --release --example heldout -- [--train seed-shock[,slow-ramp]]
 //!  [--test slow-ramp] [--train-seed 7] [--test-seed 11] [--recipe residual|published]
 //!  [--epochs N] [--scale-lstm] [--patience N] [--lr X] [--validation-every K]
-//!  [--base B] [--scale-base B] [--bases B1,B2,...] [--no-lstm] [--base-input]`
+//!  [--base B] [--scale-base B] [--bases B1,B2,...] [--no-lstm] [--base-input]
+//!  [--run-gate]`
 //!
 //! `--base-input`: the residual LSTM reads the base prediction as one more input
-//! (`LstmRecipe::base_input`).
+//! (`LstmRecipe::base_input`). `--run-gate`: the leave-one-run-out check of the residual
+//! LSTM (`LstmRecipe::validate_on_runs`).
 //!
 //! Bases `B`: `selected` (default), `tailored`, `linear`, `linear-t2`, `constant`,
 //! `family:<set>` (one set of `fit::select::ladder`, e.g. `family:T3+fast`). `--bases` adds a
@@ -157,6 +159,9 @@ fn main() {
     if args.iter().any(|a| a == "--base-input") {
         recipe.base_input = true;
     }
+    if args.iter().any(|a| a == "--run-gate") {
+        recipe.validate_on_runs = true;
+    }
 
     let mut train_logs = Vec::new();
     let mut names = Vec::new();
@@ -251,14 +256,15 @@ fn main() {
             for (n, tr) in [("bias", &out.bias_training), ("scale", &out.scale_training)] {
                 if let Some(tr) = tr {
                     println!(
-                        "  {n}: epochs {} best {:?} final loss {:.4} val {:?} baseline rms {:?} gain {:?} val impr {:?}",
+                        "  {n}: epochs {} best {:?} final loss {:.4} val {:?} baseline rms {:?} gain {:?} val impr {:?} run gate {:?}",
                         tr.epochs,
                         tr.best_epoch,
                         tr.final_loss,
                         tr.best_epoch.and_then(|b| tr.val_loss_history.get(b)),
                         tr.baseline_rms,
                         tr.lstm_gain,
-                        tr.val_improvement
+                        tr.val_improvement,
+                        tr.run_gate
                     );
                     if let Some(sel) = &tr.selection {
                         println!("  {n} terms: {}", sel.describe());

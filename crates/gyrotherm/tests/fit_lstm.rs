@@ -251,6 +251,17 @@ fn residual_lstm_is_kept_when_it_learns_what_the_physical_terms_cannot() {
         "want the residual LSTM kept; validation improvement {:?}, gain {gain}",
         summary.val_improvement
     );
+    // The same structure in both runs carries from one to the other: the leave-one-run-out
+    // gate keeps it too.
+    cfg.recipe.validate_on_runs = true;
+    let run_gated = fit(&logs, &cfg);
+    let gate = run_gated.bias_training.unwrap().run_gate.unwrap();
+    eprintln!("run gate, structure in both runs: {gate:?}");
+    assert!(
+        matches!(run_gated.model.bias, Some(SubModel::Residual { .. })),
+        "want the LSTM kept by the run gate too, got per-run improvements {gate:?}"
+    );
+    cfg.recipe.validate_on_runs = false;
     cfg.recipe.epochs = 0;
     let phys = fit(&logs, &cfg).model;
     // The true bias is known exactly here: compare the bias prediction error.
@@ -270,6 +281,47 @@ fn residual_lstm_is_kept_when_it_learns_what_the_physical_terms_cannot() {
     assert!(
         with < 0.8 * without,
         "held-out bias error: want the LSTM to remove > 20 %, got {with:e} °/s with vs {without:e} without"
+    );
+}
+
+/// The leave-one-run-out gate (`LstmRecipe::validate_on_runs`, issue 5's "early stopping on
+/// a validation run"): when the part the base cannot express does not carry from one run to
+/// the other (here only one of the two runs has it, so what the LSTM learns from that run
+/// makes the other worse, and the other run teaches it nothing), the LSTM is left out, with
+/// each run's figure reported; without that gate (and without validation blocks, so that the
+/// run gate alone decides) it is kept. Independent: the construction of the two runs.
+#[test]
+fn run_gate_drops_an_lstm_that_does_not_carry_to_another_run() {
+    let coupling = |x: &[f64]| 0.05 / 3600.0 * (x[0] / 30.0) * (x[3] / 10.0);
+    let none = |_: &[f64]| 0.0;
+    let train_a = synthetic_log("seed-shock", 3, 0.0, &C, &coupling);
+    let train_b = synthetic_log("fast-cycle", 4, 0.0, &C, &none);
+    let logs = [("a", &train_a), ("b", &train_b)];
+    let mut cfg = FitConfig::new(Method::Lstm);
+    cfg.recipe.epochs = 60;
+    cfg.recipe.base = BaseTerms::Tailored;
+    cfg.recipe.validation_every = 0;
+    cfg.recipe.validate_on_runs = true;
+    let gated = fit(&logs, &cfg);
+    let summary = gated.bias_training.clone().unwrap();
+    let gate = summary.run_gate.clone().expect("two runs: a run gate");
+    eprintln!("run gate, structure in one run: {gate:?}");
+    assert_eq!(gate.len(), 2, "one figure per training run");
+    assert!(
+        gate.iter().any(|g| *g < cfg.recipe.min_val_improvement),
+        "want a left-out run the LSTM does not help, got {gate:?}"
+    );
+    assert!(
+        matches!(gated.model.bias, Some(SubModel::Baseline { .. })),
+        "want the LSTM left out by the run gate ({gate:?})"
+    );
+    cfg.recipe.validate_on_runs = false;
+    let ungated = fit(&logs, &cfg);
+    let summary = ungated.bias_training.unwrap();
+    assert!(summary.run_gate.is_none());
+    assert!(
+        matches!(ungated.model.bias, Some(SubModel::Residual { .. })),
+        "without the run gate the LSTM is kept as trained: else this test shows nothing"
     );
 }
 

@@ -159,7 +159,7 @@ pub fn print_table(
             .iter()
             .any(|s| matches!(s, Some(SubModel::Lstm { .. } | SubModel::Residual { .. })));
         if f.model.method == Method::Lstm && !lstm_kept {
-            write!(w, " (no residual LSTM beat its least-squares base on the validation blocks, so none was kept)")?;
+            write!(w, " (no residual LSTM beat its least-squares base on the validation data, so none was kept)")?;
         }
         writeln!(w)?;
     }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, FitConfig, Target};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, Target};
 use gyrotherm::model::{Method, SubModel};
 
 use super::common::{named, read_logs, LogArgs};
@@ -42,6 +42,11 @@ pub struct FitArgs {
     /// Leave the T·dT cross term out of the `poly` bias model.
     #[arg(long)]
     pub no_cross: bool,
+    /// With two or more static (or rate-table) training logs: keep the residual LSTM only if,
+    /// trained without each log in turn, it also improves that log (slower: one more training
+    /// per log; reports each log's figure).
+    #[arg(long)]
+    pub validate_on_runs: bool,
 }
 
 impl FitArgs {
@@ -83,6 +88,7 @@ impl FitArgs {
         cfg.poly.temp = self.poly_temp_degree;
         cfg.poly.rate = self.poly_rate_degree;
         cfg.poly.cross = !self.no_cross;
+        cfg.recipe.validate_on_runs = self.validate_on_runs;
         Ok(cfg)
     }
 }
@@ -167,9 +173,12 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         m.training.rate_range_c_per_s.min * 60.0,
         m.training.rate_range_c_per_s.max * 60.0
     );
-    for (name, sub, t) in [
-        ("bias", &m.bias, &outcome.bias_training),
-        ("scale factor", &m.scale, &outcome.scale_training),
+    // The training runs of each target, in the order the fit saw them.
+    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) =
+        named.iter().partition(|l| gyrotherm::targets::is_static(l.log));
+    for (name, sub, t, runs) in [
+        ("bias", &m.bias, &outcome.bias_training, &static_names),
+        ("scale factor", &m.scale, &outcome.scale_training, &table_names),
     ] {
         let Some(sub) = sub else { continue };
         eprintln!("  {name} model: {}", sub.kind());
@@ -188,10 +197,25 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 t.final_loss,
                 if kept {
                     "kept"
+                } else if t.run_gate.is_some() {
+                    "left out: it did not beat the least-squares base on the validation blocks \
+                     and on every left-out run"
                 } else {
                     "left out: it did not beat the least-squares base on the validation blocks"
                 }
             );
+            if let Some(gate) = &t.run_gate {
+                let each: Vec<String> = gate
+                    .iter()
+                    .zip(runs.iter())
+                    .map(|(g, l)| format!("{} {:.1} %", l.name, 100.0 * g))
+                    .collect();
+                eprintln!(
+                    "    LSTM trained without each run, loss reduction on that run (needs {:.0} %): {}",
+                    100.0 * cfg.recipe.min_val_improvement,
+                    each.join(", ")
+                );
+            }
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -319,6 +319,11 @@ pub struct LstmRecipe {
     /// the features, so that its correction can depend on the predicted level
     /// ([`SubModel::Residual::lstm_reads_base`](crate::model::SubModel::Residual)).
     pub base_input: bool,
+    /// `Residual`: with two or more training runs, the LSTM is also kept only if, trained
+    /// without each run in turn, it lowers that run's residual by `min_val_improvement`
+    /// (the held-out-run question; see [`TrainSummary::run_gate`]). Off by default: on the
+    /// held-out sweep of the module doc it changed no outcome for the better on balance.
+    pub validate_on_runs: bool,
 }
 
 impl LstmRecipe {
@@ -350,6 +355,7 @@ impl LstmRecipe {
             scale_base: BaseTerms::Selected,
             residual_smooth_steps: 1,
             base_input: false,
+            validate_on_runs: false,
         }
     }
 
@@ -416,6 +422,11 @@ pub struct TrainSummary {
     /// How the least-squares terms were chosen (base [`BaseTerms::Selected`] only): every
     /// candidate's cross-validated RMS residual, so the choice can be checked.
     pub selection: Option<TermSelection>,
+    /// Leave-one-run-out check of the residual LSTM (two or more training runs and
+    /// [`LstmRecipe::validate_on_runs`]): per training run, the relative loss reduction on
+    /// that run by an LSTM trained on the other runs' residuals (0: no help). The LSTM is kept
+    /// only if every entry reaches [`LstmRecipe::min_val_improvement`].
+    pub run_gate: Option<Vec<f64>>,
 }
 
 /// The feature specification a recipe's models read.
@@ -722,6 +733,124 @@ struct Block {
     mask: Vec<bool>,
 }
 
+/// The base's residual on run `s` (`offset`: the run's own offset against the base's mean
+/// one), cut into `block_steps` blocks for the residual LSTM: each block starts from zero
+/// state, so its first `burn_in` steps are left out of the loss; a tail no longer than the
+/// burn-in and blocks with no labelled step are dropped. With `base_input` the rows carry the
+/// base prediction after the features, as flight code computes it (mean offset, no run
+/// offset).
+fn run_blocks(
+    s: &TargetSet,
+    base: &FixedEffectsFit,
+    offset: f64,
+    recipe: &LstmRecipe,
+) -> Vec<Block> {
+    let nr = s.table.n_rows();
+    let n_lstm = s.table.n_features + usize::from(recipe.base_input);
+    let block = recipe.block_steps.max(recipe.burn_in + 1);
+    let resid: Vec<f64> = (0..nr)
+        .map(|r| {
+            if s.mask[r] {
+                s.target[r] - base.predict_row(s.table.row(r)) - offset
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    let resid = smooth_masked(&resid, &s.mask, recipe.residual_smooth_steps);
+    let rows: Vec<f64> = if recipe.base_input {
+        (0..nr)
+            .flat_map(|r| {
+                let x = s.table.row(r);
+                x.iter().copied().chain([base.predict_row(x)])
+            })
+            .collect()
+    } else {
+        s.table.rows.clone()
+    };
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < nr {
+        let end = (start + block).min(nr);
+        if end - start <= recipe.burn_in {
+            break;
+        }
+        let b = Block {
+            rows: rows[start * n_lstm..end * n_lstm].to_vec(),
+            target: resid[start..end].to_vec(),
+            mask: (start..end)
+                .map(|r| s.mask[r] && r - start >= recipe.burn_in)
+                .collect(),
+        };
+        if b.mask.iter().any(|m| *m) {
+            out.push(b);
+        }
+        start = end;
+    }
+    out
+}
+
+/// The held-out-run question for the residual LSTM, asked of each training run `k` in turn:
+/// the base (the same terms) is refitted on the other runs, an LSTM is trained on their
+/// residuals and stopped early on run `k`, whose residual is out of sample for the base (its
+/// offset is its mean residual: bias stability ignores a constant). Returns, per run, the
+/// relative reduction of run `k`'s loss by the LSTM against no correction,
+/// `1 - best / epoch-0` (0 where it never helped). Needs two or more runs.
+fn leave_one_run_out(
+    train: &[TargetSet],
+    terms: &Terms,
+    recipe: &LstmRecipe,
+    cfg: &TrainConfig,
+) -> Result<Vec<f64>, String> {
+    let n_lstm = train[0].table.n_features + usize::from(recipe.base_input);
+    // Early stopping on the left-out run, whatever the main training's validation.
+    let cfg = &TrainConfig {
+        patience: recipe.patience,
+        ..cfg.clone()
+    };
+    let mut out = Vec::with_capacity(train.len());
+    for k in 0..train.len() {
+        let others: Vec<TargetSet> = train
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != k)
+            .map(|(_, s)| s.clone())
+            .collect();
+        let base_k = fit_fixed_effects(&others, terms)?;
+        let tr_blocks: Vec<Block> = others
+            .iter()
+            .enumerate()
+            .flat_map(|(j, s)| run_blocks(s, &base_k, base_k.run_offset[j], recipe))
+            .collect();
+        let held = &train[k];
+        let (mut sum, mut n) = (0.0, 0usize);
+        for r in (0..held.table.n_rows()).filter(|r| held.mask[*r]) {
+            sum += held.target[r] - base_k.predict_row(held.table.row(r));
+            n += 1;
+        }
+        let offset = if n > 0 { sum / n as f64 } else { 0.0 };
+        let va_blocks = run_blocks(held, &base_k, offset, recipe);
+        if tr_blocks.is_empty() || va_blocks.is_empty() {
+            out.push(0.0);
+            continue;
+        }
+        let fit = train_normalised(
+            &seqs(&tr_blocks),
+            &seqs(&va_blocks),
+            n_lstm,
+            cfg,
+            &mut |_, _| {},
+        )
+        .map_err(|e| e.to_string())?;
+        let o = &fit.output;
+        out.push(match (o.best_epoch, o.val_loss_history.first()) {
+            (Some(b), Some(&v0)) if v0 > 0.0 => (1.0 - o.val_loss_history[b] / v0).max(0.0),
+            _ => 0.0,
+        });
+    }
+    Ok(out)
+}
+
 fn seqs(bs: &[Block]) -> Vec<Sequence<'_>> {
     bs.iter()
         .map(|b| Sequence::new(&b.rows, &b.target).with_mask(&b.mask))
@@ -787,63 +916,23 @@ fn fit_residual(
         return Ok((base.sub_model(), summary));
     }
     // 2. Residual per run, cut into blocks; every `validation_every`-th block validates.
-    let block = recipe.block_steps.max(recipe.burn_in + 1);
     let n_lstm = n_in + usize::from(recipe.base_input);
     let mut train_blocks = Vec::new();
     let mut val_blocks = Vec::new();
     let mut k = 0usize;
     for (run, s) in train.iter().enumerate() {
-        let nr = s.table.n_rows();
-        let resid: Vec<f64> = (0..nr)
-            .map(|r| {
-                if s.mask[r] {
-                    s.target[r] - base.predict_row(s.table.row(r)) - base.run_offset[run]
-                } else {
-                    f64::NAN
-                }
-            })
-            .collect();
-        let resid = smooth_masked(&resid, &s.mask, recipe.residual_smooth_steps);
-        // The LSTM's input rows: the features, then (with `base_input`) the base prediction
-        // as flight code computes it (coefficients with the mean offset, no run offset).
-        let rows: Vec<f64> = if recipe.base_input {
-            (0..nr)
-                .flat_map(|r| {
-                    let x = s.table.row(r);
-                    x.iter().copied().chain([base.predict_row(x)])
-                })
-                .collect()
-        } else {
-            s.table.rows.clone()
-        };
-        let mut start = 0;
-        while start < nr {
-            let end = (start + block).min(nr);
-            // A short tail joins the previous block's role only if it is long enough.
-            if end - start <= recipe.burn_in {
-                break;
+        for b in run_blocks(s, &base, base.run_offset[run], recipe) {
+            if recipe.validation_every > 0
+                && k % recipe.validation_every == recipe.validation_every - 1
+            {
+                val_blocks.push(b);
+            } else {
+                train_blocks.push(b);
             }
-            let b = Block {
-                rows: rows[start * n_lstm..end * n_lstm].to_vec(),
-                target: resid[start..end].to_vec(),
-                // Each block starts from zero state: its first `burn_in` steps settle it.
-                mask: (start..end)
-                    .map(|r| s.mask[r] && r - start >= recipe.burn_in)
-                    .collect(),
-            };
-            if b.mask.iter().any(|m| *m) {
-                if recipe.validation_every > 0
-                    && k % recipe.validation_every == recipe.validation_every - 1
-                {
-                    val_blocks.push(b);
-                } else {
-                    train_blocks.push(b);
-                }
-                k += 1;
-            }
-            start = end;
+            k += 1;
         }
     }
+    let block = recipe.block_steps.max(recipe.burn_in + 1);
     if train_blocks.is_empty() {
         return Err(format!(
             "no {}-step block with labelled steps past the {}-step burn-in: the training runs \
@@ -867,6 +956,14 @@ fn fit_residual(
         zero_output_init: true,
         ..TrainConfig::default()
     };
+    let run_gate = if recipe.validate_on_runs && train.len() >= 2 {
+        Some(leave_one_run_out(train, &base.terms, recipe, &cfg)?)
+    } else {
+        None
+    };
+    let runs_agree = run_gate
+        .as_ref()
+        .is_none_or(|g| g.iter().all(|v| *v >= recipe.min_val_improvement));
     let fit = train_normalised(&tr, &va, n_lstm, &cfg, progress).map_err(|e| e.to_string())?;
     // 3. Keep the LSTM only if it beat "no correction" (epoch 0, zero output layer) on the
     //    validation blocks by `min_val_improvement`, and shrink its contribution to what the
@@ -877,6 +974,7 @@ fn fit_residual(
         _ => None,
     };
     let gain = match val_improvement {
+        _ if !runs_agree => 0.0,
         None => 1.0,
         Some(g) if g < recipe.min_val_improvement => 0.0,
         Some(_) => validation_gain(&fit, &val_blocks, n_lstm)?,
@@ -894,6 +992,7 @@ fn fit_residual(
         lstm_gain: Some(gain),
         val_improvement,
         selection,
+        run_gate,
     };
     if gain < MIN_GAIN {
         // The LSTM predicted none of the held-out residual: the physical fit alone.
