@@ -170,6 +170,42 @@ fn lstm_training_from_the_cli_writes_a_loadable_model() {
     assert!(comp.exists());
 }
 
+/// `--validate-on-runs` with two static logs: the output names each log with its figure for
+/// the LSTM trained without it (the leave-one-run-out gate of `fit::lstm`).
+#[test]
+fn validate_on_runs_reports_each_left_out_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = simulate(dir.path(), "a_static.csv", "fast-cycle", 5, false);
+    let b = simulate(dir.path(), "b_static.csv", "slow-ramp", 6, false);
+    let model = dir.path().join("m.json");
+    let out = run_ok(
+        gyrotherm()
+            .args([
+                "train",
+                "--method",
+                "lstm",
+                "--epochs",
+                "3",
+                "--validate-on-runs",
+            ])
+            .arg("--input")
+            .arg(&a)
+            .arg("--input")
+            .arg(&b)
+            .arg("--out")
+            .arg(&model),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    let line = err
+        .lines()
+        .find(|l| l.contains("trained without each run"))
+        .unwrap_or_else(|| panic!("no per-run line in:\n{err}"));
+    for name in ["a_static.csv", "b_static.csv"] {
+        assert!(line.contains(name), "{name} missing from {line:?}");
+    }
+    assert!(line.contains('%'), "no figure in {line:?}");
+}
+
 #[test]
 fn bad_inputs_say_where_and_exit_2() {
     let dir = tempfile::tempdir().unwrap();

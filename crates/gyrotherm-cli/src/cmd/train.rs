@@ -174,11 +174,17 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         m.training.rate_range_c_per_s.max * 60.0
     );
     // The training runs of each target, in the order the fit saw them.
-    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) =
-        named.iter().partition(|l| gyrotherm::targets::is_static(l.log));
+    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) = named
+        .iter()
+        .partition(|l| gyrotherm::targets::is_static(l.log));
     for (name, sub, t, runs) in [
         ("bias", &m.bias, &outcome.bias_training, &static_names),
-        ("scale factor", &m.scale, &outcome.scale_training, &table_names),
+        (
+            "scale factor",
+            &m.scale,
+            &outcome.scale_training,
+            &table_names,
+        ),
     ] {
         let Some(sub) = sub else { continue };
         eprintln!("  {name} model: {}", sub.kind());
@@ -191,17 +197,31 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         }
         if t.epochs > 0 {
             let kept = matches!(sub, SubModel::Lstm { .. } | SubModel::Residual { .. });
+            let min = cfg.recipe.min_val_improvement;
+            let blocks_ok = t.val_improvement.is_none_or(|v| v >= min);
+            let runs_ok = t
+                .run_gate
+                .as_ref()
+                .is_none_or(|g| g.iter().all(|v| *v >= min));
             eprintln!(
                 "    LSTM: {} epochs, final loss {:.4e} (normalised MSE); {}",
                 t.epochs,
                 t.final_loss,
-                if kept {
-                    "kept"
-                } else if t.run_gate.is_some() {
-                    "left out: it did not beat the least-squares base on the validation blocks \
-                     and on every left-out run"
-                } else {
-                    "left out: it did not beat the least-squares base on the validation blocks"
+                match (kept, blocks_ok, runs_ok) {
+                    (true, _, _) => "kept",
+                    (false, false, false) => {
+                        "left out: it beat the least-squares base neither on the validation \
+                         blocks nor on every left-out run"
+                    }
+                    (false, false, true) => {
+                        "left out: it did not beat the least-squares base on the validation blocks"
+                    }
+                    (false, true, false) => {
+                        "left out: it did not beat the least-squares base on every left-out run"
+                    }
+                    (false, true, true) => {
+                        "left out: its correction fitted none of the validation residual"
+                    }
                 }
             );
             if let Some(gate) = &t.run_gate {
