@@ -70,19 +70,10 @@ fn check_png(path: &Path, want: (u32, u32)) {
     );
 }
 
-fn references(html: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    for attr in ["src=\"", "href=\""] {
-        let mut rest = html;
-        while let Some(i) = rest.find(attr) {
-            rest = &rest[i + attr.len()..];
-            let end = rest.find('"').expect("unterminated attribute");
-            out.push(rest[..end].to_owned());
-            rest = &rest[end..];
-        }
-    }
-    out
-}
+/// The one HTML link parser of the report tests (the library's `tests/html_refs`).
+#[path = "../../gyrotherm/tests/html_refs/mod.rs"]
+mod html_refs;
+use html_refs::references;
 
 #[test]
 fn report_writes_the_page_and_every_figure() {
