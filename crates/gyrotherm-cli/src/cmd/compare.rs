@@ -128,6 +128,15 @@ pub fn comparison_json(cmp: &Comparison, cfg: &CompareConfig) -> Value {
             "bias_final_loss": f.bias_training.as_ref().map(|t| t.final_loss),
             "scale_epochs": f.scale_training.as_ref().map(|t| t.epochs),
             "scale_final_loss": f.scale_training.as_ref().map(|t| t.final_loss),
+            // Why a residual LSTM was kept or left out: the relative validation-loss
+            // reduction on the validation blocks and, with --validate-on-runs, on each
+            // left-out training run (fractions; null where not measured).
+            "bias_lstm_validation_improvement":
+                f.bias_training.as_ref().and_then(|t| t.val_improvement),
+            "bias_lstm_run_gate": f.bias_training.as_ref().and_then(|t| t.run_gate.clone()),
+            "scale_lstm_validation_improvement":
+                f.scale_training.as_ref().and_then(|t| t.val_improvement),
+            "scale_lstm_run_gate": f.scale_training.as_ref().and_then(|t| t.run_gate.clone()),
         })).collect::<Vec<_>>(),
     })
 }
