@@ -315,6 +315,14 @@ fn run_gate_drops_an_lstm_that_does_not_carry_to_another_run() {
         matches!(gated.model.bias, Some(SubModel::Baseline { .. })),
         "want the LSTM left out by the run gate ({gate:?})"
     );
+    assert_eq!(
+        summary.lstm_verdict,
+        Some(gyrotherm::fit::LstmVerdict::LeftOut {
+            validation_blocks: false,
+            left_out_runs: true
+        }),
+        "no validation blocks here: the run gate alone left it out"
+    );
     cfg.recipe.validate_on_runs = false;
     let ungated = fit(&logs, &cfg);
     let summary = ungated.bias_training.unwrap();

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, Target};
-use gyrotherm::model::{Method, SubModel};
+use gyrotherm::fit::{fit_model, FitConfig, LstmVerdict, NamedLog, Target};
+use gyrotherm::model::Method;
 
 use super::common::{named, read_logs, LogArgs};
 use super::progress::TrainingBars;
@@ -195,33 +195,36 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 sel.describe()
             );
         }
-        if t.epochs > 0 {
-            let kept = matches!(sub, SubModel::Lstm { .. } | SubModel::Residual { .. });
-            let min = cfg.recipe.min_val_improvement;
-            let blocks_ok = t.val_improvement.is_none_or(|v| v >= min);
-            let runs_ok = t
-                .run_gate
-                .as_ref()
-                .is_none_or(|g| g.iter().all(|v| *v >= min));
+        if let Some(verdict) = t.lstm_verdict {
             eprintln!(
                 "    LSTM: {} epochs, final loss {:.4e} (normalised MSE); {}",
                 t.epochs,
                 t.final_loss,
-                match (kept, blocks_ok, runs_ok) {
-                    (true, _, _) => "kept",
-                    (false, false, false) => {
+                match verdict {
+                    LstmVerdict::Kept => "kept",
+                    LstmVerdict::LeftOut {
+                        validation_blocks: true,
+                        left_out_runs: true,
+                    } => {
                         "left out: it beat the least-squares base neither on the validation \
                          blocks nor on every left-out run"
                     }
-                    (false, false, true) => {
+                    LstmVerdict::LeftOut {
+                        validation_blocks: true,
+                        left_out_runs: false,
+                    } => {
                         "left out: it did not beat the least-squares base on the validation blocks"
                     }
-                    (false, true, false) => {
+                    LstmVerdict::LeftOut {
+                        validation_blocks: false,
+                        left_out_runs: true,
+                    } => {
                         "left out: it did not beat the least-squares base on every left-out run"
                     }
-                    (false, true, true) => {
-                        "left out: its correction fitted none of the validation residual"
-                    }
+                    LstmVerdict::LeftOut {
+                        validation_blocks: false,
+                        left_out_runs: false,
+                    } => "left out: its correction fitted none of the validation residual",
                 }
             );
             if let Some(gate) = &t.run_gate {

@@ -461,6 +461,25 @@ pub struct TrainSummary {
     /// that run by an LSTM trained on the other runs' residuals (0: no help). The LSTM is kept
     /// only if every entry reaches [`LstmRecipe::min_val_improvement`].
     pub run_gate: Option<Vec<f64>>,
+    /// Whether the residual LSTM was kept, and if not which check left it out (`Residual`
+    /// with an LSTM trained only).
+    pub lstm_verdict: Option<LstmVerdict>,
+}
+
+/// What became of a trained residual LSTM.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LstmVerdict {
+    /// Kept in the model (scaled by [`TrainSummary::lstm_gain`]).
+    Kept,
+    /// Left out; the flags say which check it failed (neither: its validation gain fell
+    /// below [`MIN_GAIN`]).
+    LeftOut {
+        /// It did not beat the base by [`LstmRecipe::min_val_improvement`] on the validation
+        /// blocks.
+        validation_blocks: bool,
+        /// It did not do so on every left-out run ([`TrainSummary::run_gate`]).
+        left_out_runs: bool,
+    },
 }
 
 /// The feature specification a recipe's models read.
@@ -594,6 +613,7 @@ fn fit_published(
         epochs: fit.output.loss_history.len(),
         final_loss: fit.output.loss_history.last().copied().unwrap_or(f64::NAN),
         loss_history: fit.output.loss_history,
+        lstm_verdict: Some(LstmVerdict::Kept),
         ..TrainSummary::default()
     };
     Ok((
@@ -995,7 +1015,7 @@ fn fit_residual(
     } else {
         None
     };
-    let runs_agree = run_gate
+    let runs_ok = run_gate
         .as_ref()
         .is_none_or(|g| g.iter().all(|v| *v >= recipe.min_val_improvement));
     let fit = train_normalised(&tr, &va, n_lstm, &cfg, progress).map_err(|e| e.to_string())?;
@@ -1007,11 +1027,19 @@ fn fit_residual(
         (Some(b), Some(&v0)) if v0 > 0.0 => Some(1.0 - out.val_loss_history[b] / v0),
         _ => None,
     };
+    let blocks_ok = val_improvement.is_none_or(|g| g >= recipe.min_val_improvement);
     let gain = match val_improvement {
-        _ if !runs_agree => 0.0,
+        _ if !(runs_ok && blocks_ok) => 0.0,
         None => 1.0,
-        Some(g) if g < recipe.min_val_improvement => 0.0,
         Some(_) => validation_gain(&fit, &val_blocks, n_lstm)?,
+    };
+    let verdict = if gain < MIN_GAIN {
+        LstmVerdict::LeftOut {
+            validation_blocks: !blocks_ok,
+            left_out_runs: !runs_ok,
+        }
+    } else {
+        LstmVerdict::Kept
     };
     let mut target_norm = fit.target_z.clone();
     target_norm.mean[0] *= gain;
@@ -1027,8 +1055,9 @@ fn fit_residual(
         val_improvement,
         selection,
         run_gate,
+        lstm_verdict: Some(verdict),
     };
-    if gain < MIN_GAIN {
+    if verdict != LstmVerdict::Kept {
         // The LSTM predicted none of the held-out residual: the physical fit alone.
         return Ok((base.sub_model(), summary));
     }

@@ -14,7 +14,7 @@ use crate::features::{FeatureSpec, FeatureTable};
 use crate::model::{self, FeatureDef, Method, ModelFile, SubModel, TrainingInfo};
 use crate::targets::{self, TargetSet};
 
-pub use lstm::{LstmRecipe, RecipeKind, RecipeTarget, TrainSummary};
+pub use lstm::{LstmRecipe, LstmVerdict, RecipeKind, RecipeTarget, TrainSummary};
 
 /// A training log and the name it is reported under (its file name).
 #[derive(Debug, Clone, Copy)]
