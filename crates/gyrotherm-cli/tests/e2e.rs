@@ -321,3 +321,35 @@ fn bad_inputs_say_where_and_exit_2() {
         "{err}"
     );
 }
+
+/// `simulate --unit random --unit-seed N` writes the drawn unit beside the log, and the same
+/// seed gives the same unit as the library's `random_unit` (independent: the library call).
+#[test]
+fn simulate_random_unit_writes_its_parameters() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.csv");
+    run_ok(
+        gyrotherm()
+            .args([
+                "simulate",
+                "--profile",
+                "room-steady",
+                "--unit",
+                "random",
+                "--unit-seed",
+                "12",
+                "--out",
+            ])
+            .arg(&out),
+    );
+    let text = std::fs::read_to_string(dir.path().join("r.csv.unit.json")).unwrap();
+    let unit = gyrotherm::sim::FogUnit::from_json_str(&text, "sidecar").unwrap();
+    assert_eq!(unit, gyrotherm::sim::random_unit(12));
+    let bad = gyrotherm()
+        .args(["simulate", "--unit", "random", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--unit-seed"));
+}
