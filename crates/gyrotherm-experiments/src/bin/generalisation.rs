@@ -25,6 +25,7 @@ use std::time::Instant;
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
+use gyrotherm::fit::thermal::Basis;
 use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, NamedLog, RecipeKind};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
@@ -56,6 +57,25 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         "generic" => lstm(LstmRecipe::generic()),
         "published" => lstm(LstmRecipe::published()),
         "direct" => lstm(LstmRecipe::of_kind(RecipeKind::Direct)),
+        "thermal" => lstm(LstmRecipe::of_kind(RecipeKind::Thermal)),
+        v if v.starts_with("thermal:") => {
+            // thermal:<lags>:<basis>[:<folds>] for the design-family sweep.
+            let mut c = lstm(LstmRecipe::of_kind(RecipeKind::Thermal));
+            let parts: Vec<&str> = v.split(':').collect();
+            if let Some(n) = parts.get(1) {
+                c.thermal.n_lags = n.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            c.thermal.basis = match parts.get(2).copied() {
+                None | Some("full") => Basis::Full,
+                Some("small") => Basis::Small,
+                Some("minimal") => Basis::Minimal,
+                Some(b) => return Err(format!("{v}: unknown basis {b}")),
+            };
+            if let Some(f) = parts.get(3) {
+                c.thermal.folds = f.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            c
+        }
         other => {
             return Err(format!(
                 "unknown method {other:?}: linear, poly, residual, residual-ls, generic, \
@@ -177,6 +197,16 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                     t.as_ref().and_then(|t| {
                         t.lstm_verdict
                             .map(|v| format!("{n}:{}", if v == gyrotherm::fit::LstmVerdict::Kept { "lstm" } else { "ls" }))
+                            .or_else(|| {
+                                t.thermal.as_ref().map(|r| {
+                                    format!(
+                                        "{n}:lags {:?} ridge {:.0e} {}",
+                                        r.lags_s.iter().map(|v| v.round()).collect::<Vec<_>>(),
+                                        r.ridge,
+                                        r.basis
+                                    )
+                                })
+                            })
                     })
                 })
                 .collect::<Vec<_>>()

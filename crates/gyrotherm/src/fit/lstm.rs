@@ -194,6 +194,9 @@ pub enum RecipeKind {
     /// As `Residual` with a constant base only ([`BaseTerms::Constant`]): the LSTM models the
     /// whole bias from the thermal-state inputs (windowed truncated BPTT, early stopping).
     Direct,
+    /// Thermal time constants identified from the training data and a ridge fit on them, no
+    /// LSTM ([`super::thermal`]).
+    Thermal,
 }
 
 impl RecipeKind {
@@ -204,6 +207,7 @@ impl RecipeKind {
             RecipeKind::Residual => "residual",
             RecipeKind::Generic => "generic",
             RecipeKind::Direct => "direct",
+            RecipeKind::Thermal => "thermal",
         }
     }
 
@@ -214,9 +218,10 @@ impl RecipeKind {
             "residual" => Ok(RecipeKind::Residual),
             "generic" => Ok(RecipeKind::Generic),
             "direct" => Ok(RecipeKind::Direct),
+            "thermal" => Ok(RecipeKind::Thermal),
             _ => Err(format!(
-                "unknown LSTM recipe {name:?}: use `residual` (default), `generic`, `direct` or \
-                 `published`"
+                "unknown LSTM recipe {name:?}: use `residual` (default), `thermal`, `generic`, \
+                 `direct` or `published`"
             )),
         }
     }
@@ -420,6 +425,10 @@ impl LstmRecipe {
             RecipeKind::Residual => Self::residual(),
             RecipeKind::Generic => Self::generic(),
             RecipeKind::Direct => Self::direct(),
+            RecipeKind::Thermal => LstmRecipe {
+                kind: RecipeKind::Thermal,
+                ..Self::residual()
+            },
         }
     }
 }
@@ -464,6 +473,8 @@ pub struct TrainSummary {
     /// Whether the residual LSTM was kept, and if not which check left it out (`Residual`
     /// with an LSTM trained only).
     pub lstm_verdict: Option<LstmVerdict>,
+    /// What the thermal recipe identified and which degradations it took (`Thermal` only).
+    pub thermal: Option<super::thermal::ThermalReport>,
 }
 
 /// What became of a trained residual LSTM.
@@ -486,7 +497,7 @@ pub enum LstmVerdict {
 pub fn feature_spec(recipe: &LstmRecipe) -> FeatureSpec {
     match recipe.kind {
         RecipeKind::Published => FeatureSpec::PUBLISHED,
-        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct => {
+        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct | RecipeKind::Thermal => {
             FeatureSpec::THERMAL_STATE
         }
     }
@@ -587,6 +598,10 @@ pub fn fit_target(
         RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct => {
             fit_residual(train, recipe, target, n_in, seed, progress)
         }
+        RecipeKind::Thermal => Err(
+            "the thermal recipe identifies its features from the logs: fit it through fit_model"
+                .into(),
+        ),
     }
 }
 
@@ -1056,6 +1071,7 @@ fn fit_residual(
         selection,
         run_gate,
         lstm_verdict: Some(verdict),
+        thermal: None,
     };
     if verdict != LstmVerdict::Kept {
         // The LSTM predicted none of the held-out residual: the physical fit alone.

@@ -7,6 +7,7 @@
 
 pub mod lstm;
 pub mod select;
+pub mod thermal;
 
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
@@ -57,6 +58,8 @@ pub struct FitConfig {
     pub scale_window_s: f64,
     /// Random seed (LSTM initialisation and window order).
     pub seed: u64,
+    /// Settings of the thermal recipe ([`thermal`]).
+    pub thermal: thermal::ThermalConfig,
 }
 
 impl FitConfig {
@@ -69,6 +72,7 @@ impl FitConfig {
             settle_s: targets::SETTLE_S,
             scale_window_s: targets::SCALE_WINDOW_S,
             seed: 0,
+            thermal: thermal::ThermalConfig::default(),
         }
     }
 }
@@ -135,8 +139,18 @@ fn fit_one(
     sets: &[TargetSet],
     cfg: &FitConfig,
     target: Target,
+    identified: Option<&thermal::Identified>,
     progress: &mut dyn FnMut(usize, f64),
 ) -> Result<(SubModel, Option<TrainSummary>), String> {
+    if let Some(id) = identified {
+        let (sub, report) =
+            thermal::fit_target(sets, &cfg.thermal, id).map_err(|e| e.to_string())?;
+        let summary = TrainSummary {
+            thermal: Some(report),
+            ..TrainSummary::default()
+        };
+        return Ok((sub, Some(summary)));
+    }
     match cfg.method {
         Method::Linear | Method::Poly => {
             let terms = baseline_terms(cfg, target, sets[0].table.n_features);
@@ -167,7 +181,24 @@ pub fn fit_model(
     if logs.is_empty() {
         return Err("no training logs given".into());
     }
-    let spec = feature_spec(cfg);
+    let identified = if cfg.method == Method::Lstm && cfg.recipe.kind == RecipeKind::Thermal {
+        let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
+        Some(
+            thermal::identify(
+                &named,
+                &cfg.thermal,
+                cfg.bias_window_s,
+                cfg.settle_s,
+                cfg.scale_window_s,
+            )
+            .map_err(|e| e.to_string())?,
+        )
+    } else {
+        None
+    };
+    let spec = identified
+        .as_ref()
+        .map_or_else(|| feature_spec(cfg), |id| id.spec);
     let mut bias_sets = Vec::new();
     let mut scale_sets = Vec::new();
     for l in logs {
@@ -195,7 +226,7 @@ pub fn fit_model(
         let bias = s.spawn(|| {
             (!bias_sets.is_empty())
                 .then(|| {
-                    fit_one(&bias_sets, cfg, Target::Bias, &mut |e, l| {
+                    fit_one(&bias_sets, cfg, Target::Bias, identified.as_ref(), &mut |e, l| {
                         progress(Target::Bias, e, l)
                     })
                 })
@@ -203,7 +234,7 @@ pub fn fit_model(
         });
         let scale = (!scale_sets.is_empty())
             .then(|| {
-                fit_one(&scale_sets, cfg, Target::Scale, &mut |e, l| {
+                fit_one(&scale_sets, cfg, Target::Scale, identified.as_ref(), &mut |e, l| {
                     progress(Target::Scale, e, l)
                 })
             })
