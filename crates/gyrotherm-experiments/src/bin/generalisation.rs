@@ -68,11 +68,17 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
             c.thermal.basis = match parts.get(2).copied() {
                 None | Some("full") => Basis::Full,
                 Some("small") => Basis::Small,
+                Some("linear") => Basis::Linear,
+                Some("lean") => Basis::Lean,
                 Some("minimal") => Basis::Minimal,
                 Some(b) => return Err(format!("{v}: unknown basis {b}")),
             };
+            // thermal:<lags>:<basis>:<min lag ratio>:<ridge tolerance>
             if let Some(f) = parts.get(3) {
-                c.thermal.folds = f.parse().map_err(|e| format!("{v}: {e}"))?;
+                c.thermal.min_lag_ratio = f.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            if let Some(f) = parts.get(4) {
+                c.thermal.ridge_tolerance = f.parse().map_err(|e| format!("{v}: {e}"))?;
             }
             c
         }

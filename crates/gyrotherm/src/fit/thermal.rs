@@ -60,6 +60,12 @@ pub struct ThermalConfig {
     pub fallback_ridge: f64,
     /// Which terms ([`basis`]).
     pub basis: Basis,
+    /// Least ratio between neighbouring time constants (close lags are nearly collinear,
+    /// and their large opposite coefficients extrapolate badly).
+    pub min_lag_ratio: f64,
+    /// The strongest ridge whose cross-validated score is within this relative margin of the
+    /// best is taken (prefer the smoother fit when the data cannot tell them apart).
+    pub ridge_tolerance: f64,
 }
 
 impl Default for ThermalConfig {
@@ -74,6 +80,8 @@ impl Default for ThermalConfig {
             ridge_grid: (0..=9).map(|k| 10f64.powi(-9 + k)).collect(),
             fallback_ridge: 1e-4,
             basis: Basis::Full,
+            min_lag_ratio: 2.0,
+            ridge_tolerance: 0.0,
         }
     }
 }
@@ -85,6 +93,13 @@ pub enum Basis {
     Full,
     /// `1, T, T², T³, Dj, T·D1, D1²` (fewer second-order terms).
     Small,
+    /// `1, T, T², T³, Dj, T·Dj`: a cubic in T, every lag difference linear with a
+    /// temperature-dependent slope; nothing of higher order in the lag differences, so a
+    /// faster temperature change than in training extrapolates linearly.
+    Linear,
+    /// `1, T, T², T³, Dj, T·D1`: as `Linear`, the temperature-dependent slope on the fastest
+    /// lag only (the Shupe term's temperature coefficient).
+    Lean,
     /// `1, T, T², Dj` (short runs).
     Minimal,
 }
@@ -95,6 +110,8 @@ impl Basis {
         match self {
             Basis::Full => "full",
             Basis::Small => "small",
+            Basis::Linear => "linear",
+            Basis::Lean => "lean",
             Basis::Minimal => "minimal",
         }
     }
@@ -128,6 +145,16 @@ pub fn basis(kind: Basis, lags: usize) -> Terms {
     }
     match kind {
         Basis::Minimal => {}
+        Basis::Lean => {
+            if lags >= 1 {
+                p.push(term(n, &[(0, 1), (d(0), 1)]));
+            }
+        }
+        Basis::Linear => {
+            for j in 0..lags {
+                p.push(term(n, &[(0, 1), (d(j), 1)]));
+            }
+        }
         Basis::Small => {
             if lags >= 1 {
                 p.push(term(n, &[(0, 1), (d(0), 1)]));
@@ -471,13 +498,23 @@ fn cv_scores(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -
         .collect()
 }
 
-/// Best (score, λ) for a design.
-fn best_ridge(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -> (f64, f64) {
-    cv_scores(d, nc, folds, gap, lambdas)
+/// Best (score, λ) for a design: the strongest λ within `tol` of the least score.
+fn best_ridge(
+    d: &Design,
+    nc: usize,
+    folds: usize,
+    gap: usize,
+    lambdas: &[f64],
+    tol: f64,
+) -> (f64, f64) {
+    let scores = cv_scores(d, nc, folds, gap, lambdas);
+    let least = scores.iter().copied().fold(f64::INFINITY, f64::min);
+    scores
         .into_iter()
         .zip(lambdas.iter().copied())
+        .filter(|(s, _)| s.is_finite() && *s <= least * (1.0 + tol))
         .fold((f64::INFINITY, f64::NAN), |best, (s, l)| {
-            if s < best.0 {
+            if best.1.is_nan() || l > best.1 {
                 (s, l)
             } else {
                 best
@@ -597,7 +634,7 @@ fn allowance(runs: &[RunData], cfg: &ThermalConfig) -> Result<Allowance, Thermal
     let tau_min_s = cfg.tau_range_s.0.max(3.0 * period);
     // Each lag needs room: a factor 2 between neighbours.
     let mut n_lags = cfg.n_lags.clamp(1, 3);
-    while n_lags > 1 && tau_min_s * 2f64.powi(n_lags as i32 - 1) > tau_max_s {
+    while n_lags > 1 && tau_min_s * cfg.min_lag_ratio.powi(n_lags as i32 - 1) > tau_max_s {
         n_lags -= 1;
     }
     if n_lags < cfg.n_lags {
@@ -611,6 +648,8 @@ fn allowance(runs: &[RunData], cfg: &ThermalConfig) -> Result<Allowance, Thermal
     while basis != Basis::Minimal && labelled < 100 * self::basis(basis, n_lags).len() {
         basis = match basis {
             Basis::Full => Basis::Small,
+            Basis::Small => Basis::Linear,
+            Basis::Linear => Basis::Lean,
             _ => Basis::Minimal,
         };
     }
@@ -669,7 +708,7 @@ pub fn identify(
             // No cross-validation: the in-sample RMS at the fixed ridge strength.
             return Ok((in_sample_rms(&d, nc, cfg.fallback_ridge), cfg.fallback_ridge));
         }
-        Ok(best_ridge(&d, nc, al.folds, al.gap_steps, &lambdas))
+        Ok(best_ridge(&d, nc, al.folds, al.gap_steps, &lambdas, cfg.ridge_tolerance))
     };
     // 1. Grid over increasing lag tuples, neighbours at least one grid step apart.
     let g = cfg.tau_grid.max(al.n_lags + 1);
@@ -683,6 +722,11 @@ pub fn identify(
         for t in &tuples {
             let start = t.last().map_or(0, |v| v + 1);
             for i in start..g {
+                if let Some(&p) = t.last() {
+                    if grid[i] < grid[p] * cfg.min_lag_ratio * 0.999 {
+                        continue;
+                    }
+                }
                 let mut u = t.clone();
                 u.push(i);
                 next.push(u);
@@ -713,7 +757,7 @@ pub fn identify(
                 for f in [step, 1.0 / step] {
                     let mut lags = best.2.clone();
                     lags[j] = (lags[j] * f).clamp(tau_min, al.tau_max_s);
-                    let ok = lags.windows(2).all(|w| w[1] > w[0] * 1.2);
+                    let ok = lags.windows(2).all(|w| w[1] >= w[0] * cfg.min_lag_ratio);
                     if !ok || lags == best.2 {
                         continue;
                     }
@@ -792,6 +836,8 @@ pub fn fit_target(
     while kind != Basis::Minimal && labelled < 100 * basis(kind, lags).len() {
         kind = match kind {
             Basis::Full => Basis::Small,
+            Basis::Small => Basis::Linear,
+            Basis::Linear => Basis::Lean,
             _ => Basis::Minimal,
         };
     }
@@ -843,7 +889,7 @@ pub fn fit_target(
         }
         (None, cfg.fallback_ridge)
     } else {
-        let (s, l) = best_ridge(&d, nc, folds, id.gap_steps, &cfg.ridge_grid);
+        let (s, l) = best_ridge(&d, nc, folds, id.gap_steps, &cfg.ridge_grid, cfg.ridge_tolerance);
         (s.is_finite().then_some(s), if s.is_finite() { l } else { cfg.fallback_ridge })
     };
     let stats: Vec<Stats> = (0..d.x.len())
@@ -910,7 +956,7 @@ mod tests {
     /// Every basis stays within the flight crate's 16 terms, and starts with the constant.
     #[test]
     fn bases_fit_the_flight_crate() {
-        for kind in [Basis::Full, Basis::Small, Basis::Minimal] {
+        for kind in [Basis::Full, Basis::Small, Basis::Linear, Basis::Lean, Basis::Minimal] {
             for lags in 1..=3 {
                 let t = basis(kind, lags);
                 t.validate().unwrap();
