@@ -51,11 +51,37 @@ fn main() {
         };
         if let Ok(k) = RecipeKind::parse(m) {
             cfg.recipe = LstmRecipe::of_kind(k);
+            cfg.thermal.basis = gyrotherm::fit::thermal::Basis::Lean;
+            cfg.thermal.min_lag_ratio = 3.0;
+            cfg.thermal.joint = true;
         }
         let fit = fit_model(&named, &cfg, &|_, _, _| {}).expect("fit");
         if let Some(t) = &fit.bias_training {
             println!("{m}: {:?}", t.thermal);
         }
+        if let Some(t) = &fit.scale_training {
+            println!("{m} scale: {:?}", t.thermal);
+        }
+        let same = profile == "seed-shock";
+        let table = sim(unit_seed, &profile, if same { s0 + 2 } else { s0 + 52 }, true);
+        let ct = compensate_log(&fit.model, &log(&table)).expect("compensate table");
+        let rep = gyrotherm::metrics::scale_factor::scale_factor(
+            &table.time_s,
+            &ct.gyro_comp_dps,
+            table.table_dps.as_deref().unwrap_or_default(),
+            &Default::default(),
+        )
+        .expect("sf");
+        println!(
+            "{m}: SF thermal error {:.1} ppm (in-sample: {same}); K(t) ppm: {}",
+            rep.sf_thermal_error_ppm,
+            rep.scale_over_time
+                .iter()
+                .step_by(4)
+                .map(|k| format!("{:.0}", k.deviation_ppm))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
         let c = compensate_log(&fit.model, &log(&test)).expect("compensate");
         let r: Vec<f64> = c.gyro_comp_dps.iter().zip(&test.noise_dps).map(|(g, n)| (g - n) * 3600.0).collect();
         cols.push((m.to_owned(), r));

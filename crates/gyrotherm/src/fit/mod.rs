@@ -144,7 +144,8 @@ fn fit_one(
 ) -> Result<(SubModel, Option<TrainSummary>), String> {
     if let Some(id) = identified {
         let (sub, report) =
-            thermal::fit_target(sets, &cfg.thermal, id).map_err(|e| e.to_string())?;
+            thermal::fit_target(sets, &cfg.thermal, id, target == Target::Scale)
+                .map_err(|e| e.to_string())?;
         let summary = TrainSummary {
             thermal: Some(report),
             ..TrainSummary::default()

@@ -58,11 +58,17 @@ pub struct ThermalConfig {
     pub ridge_grid: Vec<f64>,
     /// Ridge strength used when the runs are too short to cross-validate.
     pub fallback_ridge: f64,
-    /// Which terms ([`basis`]).
+    /// Which terms the bias model gets, and the lag identification uses ([`basis`]).
     pub basis: Basis,
+    /// Which terms the scale-factor model gets.
+    pub scale_basis: Basis,
     /// Least ratio between neighbouring time constants (close lags are nearly collinear,
     /// and their large opposite coefficients extrapolate badly).
     pub min_lag_ratio: f64,
+    /// Identify the lags on the bias and the scale factor together (the sum of their
+    /// cross-validated scores, each relative to its target's spread) when both kinds of run
+    /// are given; otherwise on the bias alone.
+    pub joint: bool,
     /// The strongest ridge whose cross-validated score is within this relative margin of the
     /// best is taken (prefer the smoother fit when the data cannot tell them apart).
     pub ridge_tolerance: f64,
@@ -79,8 +85,10 @@ impl Default for ThermalConfig {
             gap_s: 200.0,
             ridge_grid: (0..=9).map(|k| 10f64.powi(-9 + k)).collect(),
             fallback_ridge: 1e-4,
-            basis: Basis::Full,
-            min_lag_ratio: 2.0,
+            basis: Basis::Lean,
+            scale_basis: Basis::Full,
+            min_lag_ratio: 3.0,
+            joint: true,
             ridge_tolerance: 0.0,
         }
     }
@@ -237,7 +245,7 @@ impl std::error::Error for ThermalError {}
 pub struct ThermalReport {
     /// Identified time constants, s, fastest first.
     pub lags_s: Vec<f64>,
-    /// Which target identified them (`bias` or `scale`).
+    /// Which target identified them (`bias`, `scale factor`, or both).
     pub identified_on: String,
     /// Cross-validated RMS residual at the identified lags, target units (None without
     /// cross-validation).
@@ -679,16 +687,27 @@ pub fn identify(
     settle_s: f64,
     scale_window_s: f64,
 ) -> Result<Identified, ThermalError> {
-    let mut on = "bias";
-    let mut runs = run_data(logs, true, bias_window_s, settle_s, scale_window_s)?;
-    if runs.is_empty() {
-        on = "scale";
-        runs = run_data(logs, false, bias_window_s, settle_s, scale_window_s)?;
-    }
+    let bias_runs = run_data(logs, true, bias_window_s, settle_s, scale_window_s)?;
+    let scale_runs = run_data(logs, false, bias_window_s, settle_s, scale_window_s)?;
+    let (runs, on) = if bias_runs.is_empty() {
+        (&scale_runs, "scale factor")
+    } else {
+        (&bias_runs, "bias")
+    };
     if runs.is_empty() {
         return Err(ThermalError::NoTargets);
     }
-    let al = allowance(&runs, cfg)?;
+    let al = allowance(runs, cfg)?;
+    // The scale factor joins the identification when it can be cross-validated too.
+    let joint = (cfg.joint && !bias_runs.is_empty() && !scale_runs.is_empty())
+        .then(|| allowance(&scale_runs, cfg).ok())
+        .flatten()
+        .filter(|a| a.folds > 0 && al.folds > 0);
+    let on = if joint.is_some() {
+        "bias and scale factor"
+    } else {
+        on
+    };
     let tau_min = cfg.tau_range_s.0.max(
         3.0 * runs
             .iter()
@@ -697,18 +716,53 @@ pub fn identify(
     );
     let terms = basis(al.basis, al.n_lags);
     let nc = terms.len() - 1;
+    let scale_terms = basis(cfg.scale_basis, al.n_lags);
     let lambdas: Vec<f64> = if al.folds == 0 {
         vec![cfg.fallback_ridge]
     } else {
         cfg.ridge_grid.clone()
     };
+    // Each target's score relative to its own spread, so that the two can be added.
+    let spread = |rs: &[RunData]| {
+        let (mut ss, mut n) = (0.0, 0usize);
+        for r in rs {
+            let v: Vec<f64> = r
+                .target
+                .iter()
+                .zip(&r.mask)
+                .filter(|(t, m)| **m && t.is_finite())
+                .map(|(t, _)| *t)
+                .collect();
+            if v.is_empty() {
+                continue;
+            }
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            ss += v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
+            n += v.len();
+        }
+        (ss / n.max(1) as f64).sqrt().max(f64::MIN_POSITIVE)
+    };
+    let (ref_main, ref_scale) = (spread(runs), spread(&scale_runs));
     let score = |lags: &[f64]| -> Result<(f64, f64), ThermalError> {
-        let d = design(&runs, lags, &terms)?;
+        let d = design(runs, lags, &terms)?;
         if al.folds == 0 {
             // No cross-validation: the in-sample RMS at the fixed ridge strength.
             return Ok((in_sample_rms(&d, nc, cfg.fallback_ridge), cfg.fallback_ridge));
         }
-        Ok(best_ridge(&d, nc, al.folds, al.gap_steps, &lambdas, cfg.ridge_tolerance))
+        let (s, l) = best_ridge(&d, nc, al.folds, al.gap_steps, &lambdas, cfg.ridge_tolerance);
+        let Some(ak) = &joint else {
+            return Ok((s, l));
+        };
+        let dk = design(&scale_runs, lags, &scale_terms)?;
+        let (sk, _) = best_ridge(
+            &dk,
+            scale_terms.len() - 1,
+            ak.folds,
+            ak.gap_steps,
+            &lambdas,
+            cfg.ridge_tolerance,
+        );
+        Ok((s / ref_main + sk / ref_scale, l))
     };
     // 1. Grid over increasing lag tuples, neighbours at least one grid step apart.
     let g = cfg.tau_grid.max(al.n_lags + 1);
@@ -779,7 +833,7 @@ pub fn identify(
         report: ThermalReport {
             lags_s: lags,
             identified_on: on.to_owned(),
-            cv_rms: (al.folds > 0).then_some(best.0),
+            cv_rms: (al.folds > 0 && joint.is_none()).then_some(best.0),
             candidates,
             ridge: best.1,
             folds: al.folds,
@@ -829,9 +883,10 @@ pub fn fit_target(
     sets: &[TargetSet],
     cfg: &ThermalConfig,
     id: &Identified,
+    scale: bool,
 ) -> Result<(SubModel, ThermalReport), ThermalError> {
     let lags = id.report.lags_s.len();
-    let mut kind = id.basis;
+    let mut kind = if scale { cfg.scale_basis } else { id.basis };
     let labelled: usize = sets.iter().map(|s| s.labelled()).sum();
     while kind != Basis::Minimal && labelled < 100 * basis(kind, lags).len() {
         kind = match kind {
