@@ -53,7 +53,7 @@ fn coarse_short_heating_only_log_trains_and_says_how() {
     // Half the 4785 s between the first and the last sample.
     assert!(notes.contains("lags up to 2392 s"), "notes: {notes}");
     assert!(notes.contains("terms `minimal`"), "notes: {notes}");
-    assert!(report.lags_s.iter().all(|t| *t <= 2392.5), "{report:?}");
+    assert!(report.lags_s.iter().all(|t| *t <= 2392.5 + 1e-6), "{report:?}");
     assert!(matches!(out.model.bias, Some(SubModel::Baseline { .. })));
     let comp = compensate_log(&out.model, &log).unwrap();
     assert!(comp.gyro_comp_dps.iter().all(|v| v.is_finite()));
