@@ -21,4 +21,4 @@ pub mod model;
 pub mod report;
 pub mod sim;
 pub mod targets;
-pub mod train;
+pub mod nn;
