@@ -5,9 +5,9 @@
 
 use gyrotherm_core::compensator::{Compensator, NormalisedLstm, TargetModel, HIDDEN, LSTM_INPUTS};
 
+use crate::csvlog::LogError;
 use crate::csvlog::TestLog;
 use crate::model::{ModelFile, SubModel};
-use crate::csvlog::LogError;
 use crate::model::{ModelFileError, Target};
 use crate::nn::params::{LstmParams, ParamsError};
 use crate::nn::zscore::ZScore;
@@ -67,10 +67,7 @@ fn core_lstm(
 }
 
 /// The flight model of one target (`None`: the constant `absent`).
-pub fn target_model(
-    sub: Option<&SubModel>,
-    absent: f64,
-) -> Result<TargetModel, CompensateError> {
+pub fn target_model(sub: Option<&SubModel>, absent: f64) -> Result<TargetModel, CompensateError> {
     let Some(sub) = sub else {
         return Ok(TargetModel::constant(absent));
     };

@@ -18,7 +18,7 @@ pub mod features;
 pub mod fit;
 pub mod metrics;
 pub mod model;
+pub mod nn;
 pub mod report;
 pub mod sim;
 pub mod targets;
-pub mod nn;

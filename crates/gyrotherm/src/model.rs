@@ -18,12 +18,12 @@
 //! version first, then the fields (unknown fields are refused), then shapes and finiteness.
 
 use crate::atomic_file::write_bytes_atomically;
+use crate::baseline::TermsError;
 use crate::baseline::{self, Terms};
 use crate::csvlog::TestLog;
 use crate::features::FeatureTable;
 use crate::nn::params::{LstmParams, ParamsError};
 use crate::nn::zscore::ZScore;
-use crate::baseline::TermsError;
 use gyrotherm_core::baseline::{BaselineError, BaselineModel};
 use gyrotherm_core::features::{FeatureSpec, LagOutputs, MAX_LAGS};
 use serde::{Deserialize, Serialize};
@@ -496,9 +496,7 @@ impl std::fmt::Display for ModelFileError {
             ModelFileError::SubModel { target, source } => {
                 write!(f, "{}: {source}", target.as_str())
             }
-            ModelFileError::Invalid { field, problem } if field.is_empty() => {
-                f.write_str(problem)
-            }
+            ModelFileError::Invalid { field, problem } if field.is_empty() => f.write_str(problem),
             ModelFileError::Invalid { field, problem } => write!(f, "{field}: {problem}"),
         }
     }

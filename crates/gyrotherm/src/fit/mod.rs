@@ -32,10 +32,7 @@ use crate::targets::{self, TargetSet};
 
 pub use crate::model::Target;
 pub use error::FitError;
-pub use recipe::{
-    feature_spec as recipe_feature_spec, LstmRecipe, LstmVerdict, RecipeKind, TrainSummary,
-    UnknownRecipe,
-};
+pub use recipe::{LstmRecipe, LstmVerdict, RecipeKind, TrainSummary, UnknownRecipe};
 pub use select::TermSelection;
 pub use terms::BaseTerms;
 

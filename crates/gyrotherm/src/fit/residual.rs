@@ -24,7 +24,9 @@ use super::terms::{candidates, ladder, BaseTerms};
 use crate::baseline::{fit_fixed_effects, FixedEffectsFit, Terms};
 use crate::features::FeatureSpec;
 use crate::model::{SubModel, Target};
-use crate::nn::{predict, train_normalised, Bptt, NormalisedFit, Sequence, TrainConfig, WindowStart};
+use crate::nn::{
+    predict, train_normalised, Bptt, NormalisedFit, Sequence, TrainConfig, WindowStart,
+};
 use crate::targets::TargetSet;
 
 impl LstmRecipe {
@@ -390,11 +392,7 @@ fn smooth_masked(x: &[f64], mask: &[bool], width: usize) -> Vec<f64> {
 /// Least-squares gain `g = Σ r·p / Σ p²`, clamped to [0, 1], of the LSTM's residual
 /// prediction `p` (raw units, each block from zero state) against the residual `r` over the
 /// counted steps of the validation blocks: shrinkage toward the baseline alone.
-fn validation_gain(
-    fit: &NormalisedFit,
-    val: &[Block],
-    n_in: usize,
-) -> Result<f64, FitError> {
+fn validation_gain(fit: &NormalisedFit, val: &[Block], n_in: usize) -> Result<f64, FitError> {
     let (mut rp, mut pp) = (0.0, 0.0);
     for b in val {
         let x: Vec<f64> = b

@@ -287,7 +287,14 @@ mod tests {
         assert_eq!(
             names,
             [
-                "T1", "T2", "T3", "T1+fast", "T2+fast", "T3+fast", "T1+fast+mid", "T2+fast+mid",
+                "T1",
+                "T2",
+                "T3",
+                "T1+fast",
+                "T2+fast",
+                "T3+fast",
+                "T1+fast+mid",
+                "T2+fast+mid",
                 "T3+fast+mid"
             ]
         );

@@ -4,7 +4,11 @@ use super::config::{Bptt, Sequence, TrainConfig};
 use super::error::TrainError;
 
 /// Check shapes and finiteness of runs (`set`: "training", "validation", "evaluation").
-pub(crate) fn check_runs(set: &'static str, runs: &[Sequence<'_>], input_size: usize) -> Result<(), TrainError> {
+pub(crate) fn check_runs(
+    set: &'static str,
+    runs: &[Sequence<'_>],
+    input_size: usize,
+) -> Result<(), TrainError> {
     for (n, r) in runs.iter().enumerate() {
         let steps = r.steps();
         if steps == 0 {

@@ -82,7 +82,10 @@ impl<'r, 'a, T: Real> Trainer<'r, 'a, T> {
         Ok(())
     }
 
-    pub(crate) fn run(mut self, progress: &mut dyn FnMut(usize, f64)) -> Result<TrainOutput, TrainError> {
+    pub(crate) fn run(
+        mut self,
+        progress: &mut dyn FnMut(usize, f64),
+    ) -> Result<TrainOutput, TrainError> {
         let cfg = self.cfg;
         let mut loss_history = Vec::with_capacity(cfg.epochs);
         let mut val_loss_history = Vec::new();

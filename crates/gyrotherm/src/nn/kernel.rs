@@ -65,7 +65,12 @@ impl<T: Real> Kernel<T> {
 
     /// Full BPTT over all runs: returns the MSE and adds its gradient into `grad` (flat,
     /// PyTorch order; caller zeroes it).
-    pub(crate) fn full_grad(&mut self, theta: &[f64], runs: &[Sequence<'_>], grad: &mut [f64]) -> f64 {
+    pub(crate) fn full_grad(
+        &mut self,
+        theta: &[f64],
+        runs: &[Sequence<'_>],
+        grad: &mut [f64],
+    ) -> f64 {
         self.packed.load(theta);
         let n: usize = runs
             .iter()

@@ -26,9 +26,7 @@ pub mod params;
 mod train;
 pub mod zscore;
 
-pub use config::{
-    Bptt, Precision, Sequence, StopReason, TrainConfig, TrainOutput, WindowStart,
-};
+pub use config::{Bptt, Precision, Sequence, StopReason, TrainConfig, TrainOutput, WindowStart};
 pub use error::TrainError;
 pub use eval::{evaluate_mse, loss_and_grad, predict, predict_with_state, RunOutput};
 pub use params::{init_params, LstmParams, ParamsError};

@@ -52,9 +52,7 @@ pub fn train_pair(
         let hb = s.spawn(move || train_lstm(runs_b, val_b, input_size, cfg, prog_b));
         let (runs_a, val_a, prog_a) = a;
         let ra = train_lstm(runs_a, val_a, input_size, cfg, prog_a);
-        let rb = hb
-            .join()
-            .unwrap_or(Err(TrainError::ThreadPanicked));
+        let rb = hb.join().unwrap_or(Err(TrainError::ThreadPanicked));
         (ra, rb)
     })
 }
