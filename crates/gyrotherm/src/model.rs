@@ -145,7 +145,7 @@ pub enum SubModel {
         coefficients: Vec<f64>,
     },
     /// A baseline plus an LSTM fitted to its residual: y = baseline(x) + lstm(x) (a residual
-    /// LSTM on top of a physical fit, issue 5); with `lstm_reads_base`,
+    /// LSTM on top of a physical fit); with `lstm_reads_base`,
     /// y = baseline(x) + lstm(x, baseline(x)): the LSTM reads the features followed by the
     /// baseline's value (`n_features + 1` inputs).
     Residual {

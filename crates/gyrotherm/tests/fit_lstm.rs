@@ -54,7 +54,8 @@ fn bias_stability(x: &[f64]) -> f64 {
         .bias_stability_dph
 }
 
-/// The issue's "done when" on one held-out pair, judged through the flight compensator:
+/// The project's held-out targets (bias stability near the noise floor, scale factor below
+/// 10 ppm) on one held-out pair, judged through the flight compensator:
 /// train on `seed-shock` (static + rate table), test on `slow-ramp` with other seeds.
 #[test]
 fn residual_recipe_meets_the_issue_targets_on_a_held_out_profile() {
@@ -283,8 +284,8 @@ fn residual_lstm_is_kept_when_it_learns_what_the_physical_terms_cannot() {
     );
 }
 
-/// The leave-one-run-out gate (`LstmRecipe::validate_on_runs`, issue 5's "early stopping on
-/// a validation run"): when the part the base cannot express does not carry from one run to
+/// The leave-one-run-out gate (`LstmRecipe::validate_on_runs`, early stopping on a
+/// validation run): when the part the base cannot express does not carry from one run to
 /// the other (here only one of the two runs has it, so what the LSTM learns from that run
 /// makes the other worse, and the other run teaches it nothing), the LSTM is left out, with
 /// each run's figure reported; without that gate (and without validation blocks, so that the
@@ -535,7 +536,7 @@ fn direct_recipe_base_is_the_mean_over_runs() {
 /// terms tailored to the default equation on a held-out run of another profile (both
 /// measured here on the same data; the claim is a reduction by at least 40 %: the sweep in
 /// `docs/experiments/lstm-recipes.md` measured 49–71 % over 8 held-out cases), and keep the scale
-/// factor below the issue's 10 ppm.
+/// factor below the 10 ppm target.
 #[test]
 fn selected_terms_beat_the_tailored_terms_on_a_variant_unit() {
     let unit = FogUnit {

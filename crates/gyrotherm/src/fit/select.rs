@@ -89,7 +89,7 @@ fn segment(nr: usize, fold: usize, folds: usize) -> (usize, usize) {
 
 /// Blocked cross-validated RMS residual of each candidate (see the module doc); infinite for
 /// a candidate that could not be fitted on some fold.
-pub fn cross_validate(
+pub(crate) fn cross_validate(
     train: &[TargetSet],
     cands: &[Candidate],
     folds: usize,
