@@ -159,7 +159,7 @@ pub fn extrapolation_warnings(model: &ModelFile, log: &TestLog) -> Vec<String> {
 
 /// Warnings for a seen temperature range (°C) and temperature-rate range (°C/s) outside the
 /// model's training ranges. A margin of 2 % of the training span absorbs sensor noise.
-pub fn range_warnings(
+pub(crate) fn range_warnings(
     model: &ModelFile,
     temp_c: (f64, f64),
     rate_c_per_s: (f64, f64),
