@@ -10,7 +10,7 @@
 //! - [`published`], [`residual`], [`generic`], [`direct`]: one recipe each.
 //! - [`select`]: choosing a residual recipe's least-squares terms by blocked cross-validation.
 //! - [`terms`]: the term sets (tailored, generic, the ladder) the bases are built from.
-//! - [`error`]: [`FitError`].
+//! - [`error`]: why a fit was refused ([`FitError`]).
 //!
 //! Least squares itself (with or without per-run offsets) is [`crate::baseline`]; LSTM
 //! training is [`crate::nn`].
