@@ -41,7 +41,10 @@ fn coarse_short_heating_only_log_trains_and_says_how() {
     });
     assert_eq!(log.len(), 320);
     let linear = fit(&[("imu.csv", &log)], &FitConfig::new(Method::Linear));
-    assert!(linear.model.bias.is_some(), "the linear fit is the yardstick");
+    assert!(
+        linear.model.bias.is_some(),
+        "the linear fit is the yardstick"
+    );
     let out = fit(&[("imu.csv", &log)], &thermal());
     let report = out
         .bias_training
@@ -53,12 +56,19 @@ fn coarse_short_heating_only_log_trains_and_says_how() {
     // Half the 4785 s between the first and the last sample.
     assert!(notes.contains("lags up to 2392 s"), "notes: {notes}");
     assert!(notes.contains("terms `minimal`"), "notes: {notes}");
-    assert!(report.lags_s.iter().all(|t| *t <= 2392.5 + 1e-6), "{report:?}");
+    assert!(
+        report.lags_s.iter().all(|t| *t <= 2392.5 + 1e-6),
+        "{report:?}"
+    );
     assert!(matches!(out.model.bias, Some(SubModel::Baseline { .. })));
     let comp = compensate_log(&out.model, &log).unwrap();
     assert!(comp.gyro_comp_dps.iter().all(|v| v.is_finite()));
     // τ = 105 s: the multiple of 15 s nearest 100 s.
-    let bs = |x: &[f64]| bias_stability_dph(x, 15.0, 105.0).unwrap().bias_stability_dph;
+    let bs = |x: &[f64]| {
+        bias_stability_dph(x, 15.0, 105.0)
+            .unwrap()
+            .bias_stability_dph
+    };
     let lin = compensate_log(&linear.model, &log).unwrap();
     assert!(
         bs(&comp.gyro_comp_dps) <= bs(&lin.gyro_comp_dps) * 1.05,
@@ -120,7 +130,11 @@ fn beats_linear_held_out_on_a_family_unit() {
     let st = run(cfg("seed-shock", 1, false));
     let tb = run(cfg("seed-shock", 2, true));
     let test = run(cfg("slow-ramp", 3, false));
-    let bs = |x: &[f64]| bias_stability_dph(x, 1.0, 100.0).unwrap().bias_stability_dph;
+    let bs = |x: &[f64]| {
+        bias_stability_dph(x, 1.0, 100.0)
+            .unwrap()
+            .bias_stability_dph
+    };
     let logs = [("static.csv", &st), ("table.csv", &tb)];
     let lin = fit(&logs, &FitConfig::new(Method::Linear));
     let th = fit(&logs, &thermal());

@@ -38,11 +38,18 @@ fn drawn_parameters_lie_in_the_documented_ranges() {
             ("sf_c1", u.sf_c1_ppm_per_c, r.sf_c1_ppm_per_c),
             ("sf_c2", u.sf_c2_ppm_per_c2, r.sf_c2_ppm_per_c2),
             ("sf_c3", u.sf_c3_ppm_per_c3, r.sf_c3_ppm_per_c3),
-            ("sf_rate", u.sf_rate_ppm_per_c_per_s, r.sf_rate_ppm_per_c_per_s),
+            (
+                "sf_rate",
+                u.sf_rate_ppm_per_c_per_s,
+                r.sf_rate_ppm_per_c_per_s,
+            ),
             ("sf_stress", u.sf_stress_ppm_per_c, r.sf_stress_ppm_per_c),
         ];
         for (name, v, range) in abs_checks {
-            assert!(within(v.abs(), range), "seed {seed}: |{name}| = {v} outside {range:?}");
+            assert!(
+                within(v.abs(), range),
+                "seed {seed}: |{name}| = {v} outside {range:?}"
+            );
         }
         let plain = [
             ("case_tau_s", u.case_tau_s, r.node_tau_s),
@@ -55,11 +62,18 @@ fn drawn_parameters_lie_in_the_documented_ranges() {
             ("rate_sat_c_per_s", u.rate_sat_c_per_s, r.rate_sat_c_per_s),
             ("sf_offset_ppm", u.sf_offset_ppm, r.sf_offset_ppm),
             ("arw", u.arw_deg_rt_h, r.arw_deg_rt_h),
-            ("bias_instability", u.bias_instability_dph, r.bias_instability_dph),
+            (
+                "bias_instability",
+                u.bias_instability_dph,
+                r.bias_instability_dph,
+            ),
             ("rrw", u.rrw_dph_rt_h, r.rrw_dph_rt_h),
         ];
         for (name, v, range) in plain {
-            assert!(within(v, range), "seed {seed}: {name} = {v} outside {range:?}");
+            assert!(
+                within(v, range),
+                "seed {seed}: {name} = {v} outside {range:?}"
+            );
         }
         assert_eq!(u.sensor_resolution_c, 0.0625, "DS18B20 12-bit step");
         if u.mount_tau_s > 0.0 {
@@ -78,9 +92,18 @@ fn drawn_parameters_lie_in_the_documented_ranges() {
         nodes[u.sensor_node as usize] += 1;
     }
     // 300 fair draws: each count is far from 0 and 300 (binomial, p = 1/2 or about 1/6..1/2).
-    assert!((100..=200).contains(&mounts), "{mounts} of 300 with a mount");
-    assert!((100..=200).contains(&negative_c1), "{negative_c1} of 300 negative");
-    assert!(nodes.iter().all(|n| *n > 20), "sensor nodes drawn {nodes:?}");
+    assert!(
+        (100..=200).contains(&mounts),
+        "{mounts} of 300 with a mount"
+    );
+    assert!(
+        (100..=200).contains(&negative_c1),
+        "{negative_c1} of 300 negative"
+    );
+    assert!(
+        nodes.iter().all(|n| *n > 20),
+        "sensor nodes drawn {nodes:?}"
+    );
 }
 
 /// One seed names one unit; another seed another.
@@ -194,7 +217,10 @@ fn sensor_on_the_coil_reads_the_coil() {
             far_from_case += 1;
         }
     }
-    assert!(far_from_case > 1000, "the coil never differed from the case");
+    assert!(
+        far_from_case > 1000,
+        "the coil never differed from the case"
+    );
 }
 
 fn thermal_bias_dph(s: &gyrotherm::sim::SimSeries, unit: &FogUnit, i: usize) -> f64 {
@@ -225,7 +251,11 @@ fn gradient_shupe_follows_the_rate_of_the_case_coil_difference() {
         let want = 2.0 * (case_rate(&s, &unit, i) - coil_rate(&s, &unit, i));
         let got = thermal_bias_dph(&s, &unit, i);
         peak = peak.max(got.abs());
-        assert!((got - want).abs() < 1e-9, "t={}: got {got} want {want}", s.time_s[i]);
+        assert!(
+            (got - want).abs() < 1e-9,
+            "t={}: got {got} want {want}",
+            s.time_s[i]
+        );
         // Central difference over ±0.5 s (2 Hz): the same within the chamber's curvature.
         let d = |x: &[f64]| x[i + 1] - x[i - 1];
         let numeric = 2.0 * (d(&s.case_c) - d(&s.coil_c));
@@ -253,13 +283,24 @@ fn saturating_rate_term_is_a_tanh_of_the_coil_rate() {
     for i in 0..s.coil_c.len() {
         let want = 0.03 * (coil_rate(&s, &unit, i) / 0.005).tanh();
         let got = thermal_bias_dph(&s, &unit, i);
-        assert!(got.abs() <= 0.03, "t={}: {got} beyond the amplitude", s.time_s[i]);
-        assert!((got - want).abs() < 1e-9, "t={}: got {got} want {want}", s.time_s[i]);
+        assert!(
+            got.abs() <= 0.03,
+            "t={}: {got} beyond the amplitude",
+            s.time_s[i]
+        );
+        assert!(
+            (got - want).abs() < 1e-9,
+            "t={}: got {got} want {want}",
+            s.time_s[i]
+        );
         if got.abs() > 0.9 * 0.03 {
             near_saturation += 1;
         }
     }
-    assert!(near_saturation > 100, "the airborne climb never saturated the term");
+    assert!(
+        near_saturation > 100,
+        "the airborne climb never saturated the term"
+    );
 }
 
 /// The scale factor's new terms: cubic in the coil temperature, per coil rate, per stress lag
@@ -279,9 +320,8 @@ fn scale_factor_terms_follow_the_coil_states() {
     let mut peak = 0.0f64;
     for i in 0..s.coil_c.len() {
         let dt = s.coil_c[i] - unit.ref_temp_c;
-        let want_ppm = 4e-4 * dt * dt * dt
-            + 150.0 * coil_rate(&s, &unit, i)
-            + 0.3 * (s.coil_c[i] - stress);
+        let want_ppm =
+            4e-4 * dt * dt * dt + 150.0 * coil_rate(&s, &unit, i) + 0.3 * (s.coil_c[i] - stress);
         let got_ppm = (s.true_scale[i] - 1.0) * 1e6;
         peak = peak.max(got_ppm.abs());
         // K is stored as 1 + 1e-6·(…): 1e-16 of K is 1e-10 ppm; allow 1e-6 ppm.

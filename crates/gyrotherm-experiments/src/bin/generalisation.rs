@@ -213,7 +213,16 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                 .filter_map(|(n, t)| {
                     t.as_ref().and_then(|t| {
                         t.lstm_verdict
-                            .map(|v| format!("{n}:{}", if v == gyrotherm::fit::LstmVerdict::Kept { "lstm" } else { "ls" }))
+                            .map(|v| {
+                                format!(
+                                    "{n}:{}",
+                                    if v == gyrotherm::fit::LstmVerdict::Kept {
+                                        "lstm"
+                                    } else {
+                                        "ls"
+                                    }
+                                )
+                            })
                             .or_else(|| {
                                 t.thermal.as_ref().map(|r| {
                                     format!(
@@ -286,9 +295,12 @@ fn run() -> Result<(), String> {
         "confirm" => CONFIRM_BASE_SEED,
         f => return Err(format!("--family {f:?}: use design or confirm")),
     };
-    let units: u64 = get("--units").map_or(Ok(30), |v| v.parse().map_err(|e| format!("--units: {e}")))?;
-    let first: u64 = get("--first").map_or(Ok(0), |v| v.parse().map_err(|e| format!("--first: {e}")))?;
-    let threads: usize = get("--threads").map_or(Ok(2), |v| v.parse().map_err(|e| format!("--threads: {e}")))?;
+    let units: u64 =
+        get("--units").map_or(Ok(30), |v| v.parse().map_err(|e| format!("--units: {e}")))?;
+    let first: u64 =
+        get("--first").map_or(Ok(0), |v| v.parse().map_err(|e| format!("--first: {e}")))?;
+    let threads: usize =
+        get("--threads").map_or(Ok(2), |v| v.parse().map_err(|e| format!("--threads: {e}")))?;
     let methods: Vec<String> = get("--methods")
         .unwrap_or_else(|| "linear,poly,generic,residual,published,thermal".into())
         .split(',')
@@ -345,15 +357,30 @@ fn run() -> Result<(), String> {
     let errors = errors.into_inner().unwrap_or_else(|p| p.into_inner());
     let cases = results.into_inner().unwrap_or_else(|p| p.into_inner());
     if let Some(path) = get("--cases") {
-        let mut text = String::from("unit_seed\tsetting\tmethod\tprofile\tx_floor\tsf_ppm\tout20_err_dps\tfit_s\tnote\n");
+        let mut text = String::from(
+            "unit_seed\tsetting\tmethod\tprofile\tx_floor\tsf_ppm\tout20_err_dps\tfit_s\tnote\n",
+        );
         let mut sorted = cases.clone();
         sorted.sort_by(|a, b| {
-            (a.unit_seed, &a.setting, &a.method, a.profile).cmp(&(b.unit_seed, &b.setting, &b.method, b.profile))
+            (a.unit_seed, &a.setting, &a.method, a.profile).cmp(&(
+                b.unit_seed,
+                &b.setting,
+                &b.method,
+                b.profile,
+            ))
         });
         for c in &sorted {
             text.push_str(&format!(
                 "{}\t{}\t{}\t{}\t{:.4}\t{:.3}\t{:.3e}\t{:.2}\t{}\n",
-                c.unit_seed, c.setting, c.method, c.profile, c.x_floor, c.sf_ppm, c.out20_err_dps, c.fit_s, c.note
+                c.unit_seed,
+                c.setting,
+                c.method,
+                c.profile,
+                c.x_floor,
+                c.sf_ppm,
+                c.out20_err_dps,
+                c.fit_s,
+                c.note
             ));
         }
         std::fs::write(&path, text).map_err(|e| format!("{path}: {e}"))?;

@@ -38,9 +38,16 @@ fn main() {
         .map_or(500, |v| v.parse().expect("--every"));
     println!("{:?}", random_unit(unit_seed));
     let s0 = unit_seed * 100;
-    let tr = [log(&sim(unit_seed, "seed-shock", s0 + 1, false)), log(&sim(unit_seed, "seed-shock", s0 + 2, true))];
+    let tr = [
+        log(&sim(unit_seed, "seed-shock", s0 + 1, false)),
+        log(&sim(unit_seed, "seed-shock", s0 + 2, true)),
+    ];
     let names = ["static", "table"];
-    let named: Vec<NamedLog> = tr.iter().zip(names).map(|(log, name)| NamedLog { name, log }).collect();
+    let named: Vec<NamedLog> = tr
+        .iter()
+        .zip(names)
+        .map(|(log, name)| NamedLog { name, log })
+        .collect();
     let test = sim(unit_seed, &profile, s0 + 51, false);
     let mut cols = Vec::new();
     for m in a[2].split(',') {
@@ -63,7 +70,12 @@ fn main() {
             println!("{m} scale: {:?}", t.thermal);
         }
         let same = profile == "seed-shock";
-        let table = sim(unit_seed, &profile, if same { s0 + 2 } else { s0 + 52 }, true);
+        let table = sim(
+            unit_seed,
+            &profile,
+            if same { s0 + 2 } else { s0 + 52 },
+            true,
+        );
         let ct = compensate_log(&fit.model, &log(&table)).expect("compensate table");
         let rep = gyrotherm::metrics::scale_factor::scale_factor(
             &table.time_s,
@@ -83,10 +95,18 @@ fn main() {
                 .join(" ")
         );
         let c = compensate_log(&fit.model, &log(&test)).expect("compensate");
-        let r: Vec<f64> = c.gyro_comp_dps.iter().zip(&test.noise_dps).map(|(g, n)| (g - n) * 3600.0).collect();
+        let r: Vec<f64> = c
+            .gyro_comp_dps
+            .iter()
+            .zip(&test.noise_dps)
+            .map(|(g, n)| (g - n) * 3600.0)
+            .collect();
         cols.push((m.to_owned(), r));
     }
-    let mean_all: Vec<f64> = cols.iter().map(|(_, r)| r.iter().sum::<f64>() / r.len() as f64).collect();
+    let mean_all: Vec<f64> = cols
+        .iter()
+        .map(|(_, r)| r.iter().sum::<f64>() / r.len() as f64)
+        .collect();
     print!("{:>7} {:>7} {:>7}", "t_s", "T_c", "coil");
     for (m, _) in &cols {
         print!(" {m:>9}");
@@ -96,7 +116,10 @@ fn main() {
     let tbm = tb.iter().sum::<f64>() / tb.len() as f64;
     let mut i = 0;
     while i + 100 <= test.time_s.len() {
-        print!("{:>7.0} {:>7.2} {:>7.2}", test.time_s[i], test.temp_c[i], test.coil_c[i]);
+        print!(
+            "{:>7.0} {:>7.2} {:>7.2}",
+            test.time_s[i], test.temp_c[i], test.coil_c[i]
+        );
         for ((_, r), m) in cols.iter().zip(&mean_all) {
             print!(" {:>9.4}", r[i..i + 100].iter().sum::<f64>() / 100.0 - m);
         }

@@ -140,11 +140,7 @@ fn term(n: usize, parts: &[(usize, u8)]) -> Vec<u8> {
 pub fn basis(kind: Basis, lags: usize) -> Terms {
     let n = 2 + lags;
     let d = |j: usize| 2 + j;
-    let mut p = vec![
-        term(n, &[]),
-        term(n, &[(0, 1)]),
-        term(n, &[(0, 2)]),
-    ];
+    let mut p = vec![term(n, &[]), term(n, &[(0, 1)]), term(n, &[(0, 2)])];
     if kind != Basis::Minimal {
         p.push(term(n, &[(0, 3)]));
     }
@@ -469,8 +465,7 @@ fn cv_scores(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -
                 if t.n < 1.0 {
                     continue;
                 }
-                let offset = (t.sy - t.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>())
-                    / t.n;
+                let offset = (t.sy - t.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>()) / t.n;
                 let (a, b) = fold_range(d.n_steps[r], f, folds);
                 for (k, &st) in d.step[r].iter().enumerate() {
                     if st >= a && st < b {
@@ -574,7 +569,10 @@ struct Allowance {
 }
 
 fn allowance(runs: &[RunData], cfg: &ThermalConfig) -> Result<Allowance, ThermalError> {
-    let labelled: usize = runs.iter().map(|r| r.mask.iter().filter(|m| **m).count()).sum();
+    let labelled: usize = runs
+        .iter()
+        .map(|r| r.mask.iter().filter(|m| **m).count())
+        .sum();
     let longest_s = runs
         .iter()
         .map(|r| r.log.time_s.last().copied().unwrap_or(0.0) - r.log.time_s[0])
@@ -747,9 +745,19 @@ pub fn identify(
         let d = design(runs, lags, &terms)?;
         if al.folds == 0 {
             // No cross-validation: the in-sample RMS at the fixed ridge strength.
-            return Ok((in_sample_rms(&d, nc, cfg.fallback_ridge), cfg.fallback_ridge));
+            return Ok((
+                in_sample_rms(&d, nc, cfg.fallback_ridge),
+                cfg.fallback_ridge,
+            ));
         }
-        let (s, l) = best_ridge(&d, nc, al.folds, al.gap_steps, &lambdas, cfg.ridge_tolerance);
+        let (s, l) = best_ridge(
+            &d,
+            nc,
+            al.folds,
+            al.gap_steps,
+            &lambdas,
+            cfg.ridge_tolerance,
+        );
         let Some(ak) = &joint else {
             return Ok((s, l));
         };
@@ -944,8 +952,18 @@ pub fn fit_target(
         }
         (None, cfg.fallback_ridge)
     } else {
-        let (s, l) = best_ridge(&d, nc, folds, id.gap_steps, &cfg.ridge_grid, cfg.ridge_tolerance);
-        (s.is_finite().then_some(s), if s.is_finite() { l } else { cfg.fallback_ridge })
+        let (s, l) = best_ridge(
+            &d,
+            nc,
+            folds,
+            id.gap_steps,
+            &cfg.ridge_grid,
+            cfg.ridge_tolerance,
+        );
+        (
+            s.is_finite().then_some(s),
+            if s.is_finite() { l } else { cfg.fallback_ridge },
+        )
     };
     let stats: Vec<Stats> = (0..d.x.len())
         .map(|r| {
@@ -1002,7 +1020,10 @@ mod tests {
         }
         let (g, b, _) = centred_normal(&[s], nc);
         let beta = ridge_solve(&g, &b, nc, 0.0).unwrap();
-        assert!((beta[0] - 3.0).abs() < 1e-9 && (beta[1] + 1.0).abs() < 1e-9, "{beta:?}");
+        assert!(
+            (beta[0] - 3.0).abs() < 1e-9 && (beta[1] + 1.0).abs() < 1e-9,
+            "{beta:?}"
+        );
         // A strong penalty shrinks the coefficients towards zero.
         let shrunk = ridge_solve(&g, &b, nc, 1e3).unwrap();
         assert!(shrunk[0].abs() < 0.1 && shrunk[1].abs() < 0.1, "{shrunk:?}");
@@ -1011,7 +1032,13 @@ mod tests {
     /// Every basis stays within the flight crate's 16 terms, and starts with the constant.
     #[test]
     fn bases_fit_the_flight_crate() {
-        for kind in [Basis::Full, Basis::Small, Basis::Linear, Basis::Lean, Basis::Minimal] {
+        for kind in [
+            Basis::Full,
+            Basis::Small,
+            Basis::Linear,
+            Basis::Lean,
+            Basis::Minimal,
+        ] {
             for lags in 1..=3 {
                 let t = basis(kind, lags);
                 t.validate().unwrap();

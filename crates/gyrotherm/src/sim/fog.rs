@@ -226,7 +226,10 @@ impl FogUnit {
             ("sf_c1_ppm_per_c", self.sf_c1_ppm_per_c),
             ("sf_c2_ppm_per_c2", self.sf_c2_ppm_per_c2),
             ("sensor_offset_c", self.sensor_offset_c),
-            ("shupe_grad_dph_per_c_per_s", self.shupe_grad_dph_per_c_per_s),
+            (
+                "shupe_grad_dph_per_c_per_s",
+                self.shupe_grad_dph_per_c_per_s,
+            ),
             ("rate_sat_dph", self.rate_sat_dph),
             ("sf_c3_ppm_per_c3", self.sf_c3_ppm_per_c3),
             ("sf_rate_ppm_per_c_per_s", self.sf_rate_ppm_per_c_per_s),
@@ -292,7 +295,8 @@ impl FogUnit {
         let dt = coil_c - self.ref_temp_c;
         1.0 + 1e-6
             * (self.sf_offset_ppm
-                + (self.sf_c1_ppm_per_c + (self.sf_c2_ppm_per_c2 + self.sf_c3_ppm_per_c3 * dt) * dt)
+                + (self.sf_c1_ppm_per_c
+                    + (self.sf_c2_ppm_per_c2 + self.sf_c3_ppm_per_c3 * dt) * dt)
                     * dt
                 + self.sf_rate_ppm_per_c_per_s * coil_rate_c_per_s
                 + self.sf_stress_ppm_per_c * (coil_c - stress_c))

@@ -35,8 +35,8 @@ pub mod table;
 use std::path::PathBuf;
 
 pub use chamber::ChamberParams;
-pub use fault::FaultParams;
 pub use family::{random_unit, UnitRanges};
+pub use fault::FaultParams;
 pub use fog::{FogUnit, SensorNode, ThermalState, EARTH_RATE_DPH};
 pub use profile::{Profile, Segment, BUILTIN_PROFILES};
 
