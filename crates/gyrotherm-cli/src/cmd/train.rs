@@ -18,8 +18,9 @@ pub struct FitArgs {
     /// it beats the least-squares base on validation blocks. `generic`: the same on a
     /// generic linear + T² base. `direct`: an LSTM alone on the thermal-state inputs.
     /// `published`: He et al. 2024 exactly (whole run, T and dT inputs, 1000 Adam steps at
-    /// lr 0.01).
-    #[arg(long, default_value = "residual", value_parser = ["residual", "generic", "direct", "published"])]
+    /// lr 0.01). `thermal`: thermal time constants identified from the logs and a ridge fit
+    /// on them (no LSTM); degrades on short or coarse logs and says how.
+    #[arg(long, default_value = "residual", value_parser = ["residual", "thermal", "generic", "direct", "published"])]
     pub recipe: String,
     /// LSTM training epochs (default: the recipe's).
     #[arg(long)]
@@ -188,6 +189,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         let Some(sub) = sub else { continue };
         eprintln!("  {name} model: {}", sub.kind());
         let Some(t) = t else { continue };
+        if let Some(r) = &t.thermal {
+            eprintln!("    {}", r.describe());
+        }
         if let Some(sel) = &t.selection {
             eprintln!(
                 "    least-squares terms by time-segment cross-validation (RMS, * chosen): {}",

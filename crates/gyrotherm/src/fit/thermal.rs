@@ -258,6 +258,35 @@ pub struct ThermalReport {
     pub notes: Vec<String>,
 }
 
+impl ThermalReport {
+    /// One paragraph for the user: the lags, how they and the ridge strength were chosen, and
+    /// every degradation taken.
+    pub fn describe(&self) -> String {
+        let lags: Vec<String> = self.lags_s.iter().map(|t| format!("{t:.0}")).collect();
+        let mut out = format!(
+            "thermal lags {} s identified on the {} ({} candidates); terms `{}`, ridge \
+             strength {:.0e} ",
+            lags.join(", "),
+            self.identified_on,
+            self.candidates,
+            self.basis,
+            self.ridge
+        );
+        match (self.folds, self.cv_rms) {
+            (0, _) => out.push_str("(fixed: no cross-validation)"),
+            (f, Some(rms)) => out.push_str(&format!(
+                "by {f}-fold time-segment cross-validation (RMS {rms:.3e})"
+            )),
+            (f, None) => out.push_str(&format!("by {f}-fold time-segment cross-validation")),
+        }
+        for n in &self.notes {
+            out.push_str("; ");
+            out.push_str(n);
+        }
+        out
+    }
+}
+
 /// The identification: the feature spec the model reads, and its report.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Identified {
