@@ -473,7 +473,7 @@ fn cv_scores(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -
         .collect();
     for f in 0..folds {
         let mut train = Vec::with_capacity(nr);
-        for r in 0..nr {
+        for (r, tot) in total.iter().enumerate() {
             let (a, b) = fold_range(d.n_steps[r], f, folds);
             let (ga, gb) = (a.saturating_sub(gap), b + gap);
             let mut out = Stats::new(nc);
@@ -482,7 +482,7 @@ fn cv_scores(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -
                     out.add(&d.x[r][k * nc..(k + 1) * nc], d.y[r][k], 1.0);
                 }
             }
-            train.push(total[r].minus(&out));
+            train.push(tot.minus(&out));
         }
         let (g, b, _) = centred_normal(&train, nc);
         for (li, &lam) in lambdas.iter().enumerate() {
@@ -620,7 +620,7 @@ fn allowance(runs: &[RunData], cfg: &ThermalConfig) -> Result<Allowance, Thermal
         .iter()
         .flat_map(|r| r.log.temp_c.iter().copied())
         .fold(f64::NEG_INFINITY, f64::max);
-    if !(tmax - tmin > 0.5) {
+    if tmax.is_nan() || tmin.is_nan() || tmax - tmin <= 0.5 {
         return Err(ThermalError::ConstantTemperature);
     }
     let needed = 3 + runs.len();
@@ -898,8 +898,7 @@ fn in_sample_rms(d: &Design, nc: usize, lambda: f64) -> f64 {
         return f64::INFINITY;
     };
     let mut ss = 0.0;
-    for r in 0..d.x.len() {
-        let s = &stats[r];
+    for (r, s) in stats.iter().enumerate() {
         if s.n < 1.0 {
             continue;
         }

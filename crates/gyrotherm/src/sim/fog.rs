@@ -36,9 +36,9 @@
 //! differentiation).
 //!
 //! Scale factor (dimensionless, Ĝ = B + K·G, He et al. eq. (1),(2)): with ΔT on the coil,
-//! K = 1 + 1e-6·(`sf_offset_ppm` + `sf_c1_ppm_per_c`·ΔT + `sf_c2_ppm_per_c2`·ΔT²
-//! + `sf_c3_ppm_per_c3`·ΔT³ + `sf_rate_ppm_per_c_per_s`·dT_coil/dt
-//! + `sf_stress_ppm_per_c`·(T_coil - S)) (fiber length and refractive index, source
+//! K = 1 + 1e-6·(`sf_offset_ppm` + `sf_c1_ppm_per_c`·ΔT + `sf_c2_ppm_per_c2`·ΔT² +
+//! `sf_c3_ppm_per_c3`·ΔT³ + `sf_rate_ppm_per_c_per_s`·dT_coil/dt +
+//! `sf_stress_ppm_per_c`·(T_coil - S)) (fiber length and refractive index, source
 //! wavelength; the lag comes from the coil node). The rate derivatives are evaluated from the
 //! node equations (d T/dt = (drive - T)/τ), not by numerical differentiation. The terms after
 //! the stress term are zero for the default unit; [`super::family`] draws units that use them.
