@@ -84,7 +84,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         logs.push((path.display().to_string(), log));
     }
     let named = named(&logs);
-    let cfg = args.fit.compare_config(gyrotherm::targets::BIAS_WINDOW_S)?;
+    let cfg = args
+        .fit
+        .compare_config(gyrotherm::compare::BIAS_STABILITY_TAU_S)?;
     eprintln!("gyrotherm: fitting linear, poly and lstm models on the training runs ...");
     let cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
     for fit in &cmp.fits {

@@ -208,7 +208,7 @@ impl fmt::Display for AllanError {
 impl std::error::Error for AllanError {}
 
 /// One point of a deviation curve.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct AllanPoint {
     /// Averaging factor m (τ = m·τ0).
     pub m: usize,

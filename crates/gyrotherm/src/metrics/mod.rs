@@ -6,10 +6,17 @@
 //! - [`scale_factor`]: scale factor, nonlinearity, asymmetry and the scale-factor thermal
 //!   error from a rate-table log.
 //! - [`repeatability`]: sample standard deviation over repeated runs.
+//! - [`evaluate`]: all of these for one rate column of a log ([`Evaluation`]).
 //!
 //! Inputs are rates in °/s; results carry their unit in the field name.
 
+pub mod evaluation;
 pub mod scale_factor;
+
+pub use evaluation::{
+    evaluate, Evaluation, EvaluationError, EvaluationOptions, RatePoint, ScaleAtTime,
+    ScaleFactorFigures,
+};
 
 pub use scale_factor::{
     detect_segments, scale_factor, RateSegment, ScaleFactorError, ScaleFactorOptions,

@@ -22,7 +22,7 @@ use super::figures::{
 use super::html::{write_report, ReportContent, ReportFigure, Table};
 use super::ReportError;
 use crate::allan::{self, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
-use crate::compare::{CompareConfig, Comparison, Figures, MethodResult, TestResult};
+use crate::compare::{CompareConfig, Comparison, MethodResult, TestResult};
 use crate::csvlog::TestLog;
 use crate::features::{centred_moving_average, feature_names};
 use crate::fit::NamedLog;
@@ -721,105 +721,27 @@ fn fmt_num(v: f64) -> String {
     }
 }
 
-fn cell(v: Option<f64>, digits: usize) -> String {
-    match v {
-        Some(x) if x.is_finite() => format!("{x:.digits$}"),
-        _ => "-".into(),
-    }
-}
-
-/// The comparison table with the numbers `gyrotherm compare` prints: per held-out log, bias
-/// stability (static) or the scale-factor figures and output ranges (rate table), raw and
-/// per method, and the noise floor of simulated logs.
+/// The comparison table of `gyrotherm compare` ([`Comparison::table`]) as the report's HTML
+/// table: one row per figure, the held-out log named on its first row, a noise-floor column.
 pub fn comparison_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
-    let methods: Vec<Method> = cmp.fits.iter().map(|f| f.model.method).collect();
-    let mut headers = vec![
-        "held-out log".to_owned(),
-        "figure".to_owned(),
-        "raw".to_owned(),
-    ];
-    headers.extend(methods.iter().map(|m| m.as_str().to_owned()));
+    let t = cmp.table(cfg);
+    let mut headers = vec!["held-out log".to_owned(), "figure".to_owned()];
+    headers.extend(t.columns.iter().cloned());
     headers.push("noise floor".to_owned());
     let mut rows = Vec::new();
-    for t in &cmp.tests {
-        let name = format!(
-            "{} ({})",
-            t.name,
-            if t.is_static { "static" } else { "rate table" }
-        );
-        let all: Vec<&Figures> = std::iter::once(&t.raw)
-            .chain(methods.iter().map(|m| {
-                t.methods
-                    .iter()
-                    .find(|r| r.method == *m)
-                    .map(|r| &r.figures)
-                    .unwrap_or(&EMPTY_FIGURES)
-            }))
-            .collect();
-        let mut row = |first: bool, figure: String, cells: Vec<String>, floor: String| {
-            let mut r = vec![if first { name.clone() } else { String::new() }, figure];
-            r.extend(cells);
-            r.push(floor);
-            rows.push(r);
-        };
-        if t.is_static {
-            row(
-                true,
-                format!("bias stability (°/h, τ = {} s)", fmt_num(cfg.tau_s)),
-                all.iter().map(|f| cell(f.bias_stability_dph, 5)).collect(),
-                cell(t.floor_dph, 5),
-            );
-            if let (Some(_), Some(fl)) = (t.raw.bias_stability_dph, t.floor_dph) {
-                row(
-                    false,
-                    "× noise floor".to_owned(),
-                    all.iter()
-                        .map(|f| cell(f.bias_stability_dph.map(|b| b / fl), 2))
-                        .collect(),
-                    String::new(),
-                );
-            }
-        } else {
-            row(
-                true,
-                "SF error max |K(t) − 1| (ppm)".to_owned(),
-                all.iter().map(|f| cell(f.sf_error_ppm, 1)).collect(),
-                String::new(),
-            );
-            row(
-                false,
-                "SF thermal error vs room K (ppm)".to_owned(),
-                all.iter()
-                    .map(|f| cell(f.sf_thermal_error_ppm, 1))
-                    .collect(),
-                String::new(),
-            );
-            for (k, r) in t.raw.rate_ranges.iter().enumerate() {
-                row(
-                    false,
-                    format!("output at {:+} °/s (°/s)", r.table_dps),
-                    all.iter()
-                        .map(|f| {
-                            f.rate_ranges
-                                .get(k)
-                                .map(|r| format!("{:.5}..{:.5}", r.min_dps, r.max_dps))
-                                .unwrap_or_else(|| "-".into())
-                        })
-                        .collect(),
-                    String::new(),
-                );
-            }
+    for block in &t.blocks {
+        for (k, r) in block.rows.iter().enumerate() {
+            let mut row = vec![
+                if k == 0 { block.title() } else { String::new() },
+                r.figure.label(),
+            ];
+            row.extend(r.cells.iter().cloned());
+            row.push(r.floor.clone().unwrap_or_default());
+            rows.push(row);
         }
     }
     Table { headers, rows }
 }
-
-static EMPTY_FIGURES: Figures = Figures {
-    bias_stability_dph: None,
-    sf_error_ppm: None,
-    sf_thermal_error_ppm: None,
-    rate_ranges: Vec::new(),
-};
 
 /// Key-value facts of the models: method, recipe and epochs, seed, training ranges, data
 /// digest, inputs.
