@@ -174,9 +174,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         m.training.rate_range_c_per_s.max * 60.0
     );
     // The training runs of each target, in the order the fit saw them.
-    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) = named
-        .iter()
-        .partition(|l| gyrotherm::targets::is_static(l.log));
+    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) =
+        named.iter().partition(|l| l.log.is_static());
     for (name, sub, t, runs) in [
         ("bias", &m.bias, &outcome.bias_training, &static_names),
         (

@@ -178,8 +178,9 @@ pub fn stop_segment_bias_dph(
     let m = samples_per_mean(period, tau_s)?;
     let mut means = Vec::new();
     let mut used = Vec::new();
-    for seg in scale_factor::detect_segments(time_s, rate_dps, table_dps, settle_s, 1e-9) {
-        if seg.table_dps != 0.0 {
+    let tol = crate::table_segments::RATE_TOLERANCE_DPS;
+    for seg in scale_factor::detect_segments(time_s, rate_dps, table_dps, settle_s, tol) {
+        if seg.table_dps.abs() > tol {
             continue;
         }
         let t0 = time_s[seg.start] + settle_s;

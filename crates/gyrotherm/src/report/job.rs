@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use super::figure::FigureFiles;
 use super::figures::{
-    allan_figure, bias_figure, compensation_figure, loss_figure, moving_average, rate_table_figure,
+    allan_figure, bias_figure, compensation_figure, loss_figure, rate_table_figure,
     raw_output_figure, scale_factor_figure, temperature_figure, AllanCurve, AllanPointPlot,
     BiasData, CompensationData, LossCurve, NamedSeries, NoiseLine, NoiseTerm, RateAxis,
     RateSegment, RateTableData, RawOutputData, ScaleFactorData, TemperatureData,
@@ -24,10 +24,11 @@ use super::ReportError;
 use crate::allan::{self, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
 use crate::compare::{CompareConfig, Comparison, MethodResult, TestResult};
 use crate::csvlog::TestLog;
-use crate::features::{centred_moving_average, feature_names};
+use crate::features::feature_names;
 use crate::fit::NamedLog;
 use crate::metrics::{self, ScaleFactorOptions, DPS_TO_DPH};
 use crate::model::{Method, ModelFile};
+use crate::moving_average::{centred_moving_average, windowed_mean};
 use crate::sim::CHAMBER_TEMP_COL;
 
 /// Averaging window of the raw-output and compensation figures, s (He et al. 2024 use 100 s).
@@ -393,7 +394,7 @@ pub fn temperature_rate_c_per_min(time_s: &[f64], temp_c: &[f64]) -> Vec<f64> {
     // (non-finite or non-increasing samples) gets the plain windowed mean.
     let smooth = centred_moving_average(&time_s[..n], &temp_c[..n], TEMP_RATE_SMOOTHING_S)
         .map(|s| s.values)
-        .unwrap_or_else(|_| moving_average(&time_s[..n], &temp_c[..n], TEMP_RATE_SMOOTHING_S));
+        .unwrap_or_else(|_| windowed_mean(&time_s[..n], &temp_c[..n], TEMP_RATE_SMOOTHING_S));
     let dt = if n >= 2 {
         (time_s[n - 1] - time_s[0]) / (n - 1) as f64
     } else {
@@ -534,13 +535,14 @@ fn rate_table_figures(
         b.note(6, &format!("{} has no non-zero table rate", l.name));
         return Ok(());
     }
-    let segs = crate::targets::segments(table);
+    let tol = crate::table_segments::RATE_TOLERANCE_DPS;
+    let segs = crate::table_segments::segments(table, tol);
     // (table rate °/s, time s, error before °/h, error after °/h)
     type RateErrors = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
     let mut data: Vec<RateErrors> = Vec::new();
     for &w in &chosen {
         let (mut x, mut before, mut after) = (Vec::new(), Vec::new(), Vec::new());
-        for s in segs.iter().filter(|s| s.rate_dps == w) {
+        for s in segs.iter().filter(|s| (s.rate_dps - w).abs() <= tol) {
             if !x.is_empty() {
                 // A gap between segments: the figure breaks its lines at non-finite values.
                 x.push(f64::NAN);
