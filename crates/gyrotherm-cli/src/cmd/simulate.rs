@@ -10,7 +10,7 @@ use gyrotherm::sim::{self, FogUnit, Profile, SimConfig, BUILTIN_PROFILES};
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
     /// Built-in chamber profile (see --list-profiles).
-    #[arg(long, default_value = "seed-shock", conflicts_with = "profile_file")]
+    #[arg(long, default_value = "seed-shock", conflicts_with = "profile_file", value_parser = super::common::builtin_profile())]
     profile: String,
     /// User profile: text file of `duration_s,target_c` rows (set point starts at the first
     /// row's target; each later row ramps linearly to its target; `#` comments).
