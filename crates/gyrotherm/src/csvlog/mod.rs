@@ -14,10 +14,13 @@
 //! [`LogErrorKind`]): missing columns, non-numeric or non-finite fields, empty file, short
 //! or long rows (a short last row is a truncated file), time not strictly increasing,
 //! duplicate timestamps, and gaps longer than [`GAP_FACTOR`] nominal sample periods (the
-//! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`reader`]).
+//! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`LogReader`]).
 
+mod columns;
 mod error;
-pub mod reader;
+mod gaps;
+mod number;
+mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
