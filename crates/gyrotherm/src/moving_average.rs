@@ -100,9 +100,9 @@ pub fn centred_mean(
     prefix.push(0.0);
     counts.push(0usize);
     let (mut acc, mut cnt) = (0.0, 0usize);
-    for j in 0..n {
+    for (j, &v) in x.iter().enumerate().take(n) {
         if used(j) {
-            acc += x[j] - x0;
+            acc += v - x0;
             cnt += 1;
         }
         prefix.push(acc);
