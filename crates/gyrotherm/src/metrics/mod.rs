@@ -19,8 +19,8 @@ pub use evaluation::{
 };
 
 pub use scale_factor::{
-    detect_segments, scale_factor, RateSegment, ScaleFactorError, ScaleFactorOptions,
-    ScaleFactorReport, SegmentScale,
+    scale_factor, RateSegment, ScaleFactorError, ScaleFactorOptions, ScaleFactorReport,
+    SegmentScale,
 };
 
 use std::fmt;
@@ -92,7 +92,7 @@ pub(crate) fn mean(v: &[f64]) -> f64 {
 }
 
 /// Sample standard deviation (n − 1); None for fewer than two values.
-pub fn sample_std(v: &[f64]) -> Option<f64> {
+pub(crate) fn sample_std(v: &[f64]) -> Option<f64> {
     if v.len() < 2 {
         return None;
     }
@@ -166,7 +166,7 @@ pub fn bias_stability_dph(
 /// τ-means are taken inside each stop segment after `settle_s` (a mean never spans a table
 /// rate; a segment's remainder shorter than τ is dropped), and the bias stability is their
 /// sample std (n − 1), °/h. The bias is the mean of the used stop samples, °/h.
-pub fn stop_segment_bias_dph(
+pub(crate) fn stop_segment_bias_dph(
     time_s: &[f64],
     rate_dps: &[f64],
     table_dps: &[f64],

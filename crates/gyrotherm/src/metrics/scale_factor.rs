@@ -135,7 +135,7 @@ impl std::error::Error for ScaleFactorError {}
 
 /// Runs of constant commanded rate ([`crate::table_segments::segments`] with tolerance
 /// `rate_tol_dps`), each averaged after dropping `settle_s`.
-pub fn detect_segments(
+pub(crate) fn detect_segments(
     time_s: &[f64],
     output_dps: &[f64],
     table_dps: &[f64],

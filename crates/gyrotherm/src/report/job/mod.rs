@@ -1,5 +1,5 @@
-//! The full report of a held-out comparison (`gyrotherm report`): the eight figures of
-//! issue 6 computed from the logs and the [`Comparison`], the comparison table, the model
+//! The full report of a held-out comparison (`gyrotherm report`): the eight figures
+//! ([`FIGURE_STEMS`]) computed from the logs and the [`Comparison`], the comparison table, the model
 //! metadata and the warnings, written as `DIR/index.html` beside one PNG and SVG per figure.
 //!
 //! Figures that cannot apply to the data given (no rate-table held-out log, no LSTM fitted,
