@@ -54,9 +54,10 @@ impl LstmRecipe {
 }
 
 impl Default for LstmRecipe {
-    /// [`LstmRecipe::residual`].
+    /// The thermal recipe ([`super::thermal`]): chosen on a family of simulated units
+    /// (docs/experiments/generalisation.md).
     fn default() -> Self {
-        Self::residual()
+        Self::of_kind(super::RecipeKind::Thermal)
     }
 }
 

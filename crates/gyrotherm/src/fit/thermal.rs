@@ -574,7 +574,7 @@ fn run_data<'a>(
         }
         .map_err(|message| ThermalError::Targets {
             run: (*name).to_owned(),
-            message,
+            message: message.to_string(),
         })?;
         if t.labelled() > 0 {
             out.push(RunData {
