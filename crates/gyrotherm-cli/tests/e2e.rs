@@ -375,7 +375,11 @@ fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
             ])
             .arg(&path),
     );
-    let out = run_ok(gyrotherm().args(["evaluate", "--json", "--input"]).arg(&path));
+    let out = run_ok(
+        gyrotherm()
+            .args(["evaluate", "--json", "--input"])
+            .arg(&path),
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["tau_s"].as_f64(), Some(105.0));
     assert!(String::from_utf8_lossy(&out.stderr).contains("nearest 100 s"));
