@@ -11,10 +11,20 @@
 //!   per step (1 s), so the cost does not matter.
 //! - [`baseline`]: evaluation of fitted linear/polynomial baseline models (f64).
 //! - [`compensator`]: bias and scale factor to corrected rate, G = (Ĝ − B)/K (eq. 4 of the
-//!   paper).
+//!   paper), riding through temperature-sensor faults with a [`Status`] per sample.
 //! - [`error`]: what the core refuses instead of panicking.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code)]
+// Panic-freedom, checked: no indexing that can fail, no unwrap/expect/panic (tests may).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::indexing_slicing,
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic
+    )
+)]
 
 pub mod baseline;
 pub mod compensator;
@@ -22,6 +32,6 @@ pub mod error;
 pub mod features;
 pub mod lstm;
 
-pub use compensator::{Compensator, Corrected, TargetModel};
+pub use compensator::{Compensator, Corrected, Status, TargetModel, TempLimits};
 pub use error::{Channel, InputError};
 pub use features::FeatureSpec;
