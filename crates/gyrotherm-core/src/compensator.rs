@@ -46,9 +46,9 @@
 
 use crate::baseline::BaselineModel;
 use crate::error::{Channel, InputError};
-use core::fmt;
 use crate::features::{FeaturePipeline, FeatureSpec, Features, SpecError, MAX_FEATURES};
 use crate::lstm::{Lstm, LstmWeights};
+use core::fmt;
 
 /// Hidden units of the flight LSTM: 8, as published (He et al. 2024, §2).
 pub const HIDDEN: usize = 8;

@@ -91,7 +91,10 @@ fn rejected_samples_leave_the_state_untouched() {
     assert_eq!(a.step(f64::NAN, 0.01, 23.09).status, Status::Held);
     for i in 31..60 {
         let t = i as f64;
-        let (x, y) = (a.step(t, 0.01, 20.0 + 0.1 * t), b.step(t, 0.01, 20.0 + 0.1 * t));
+        let (x, y) = (
+            a.step(t, 0.01, 20.0 + 0.1 * t),
+            b.step(t, 0.01, 20.0 + 0.1 * t),
+        );
         assert_eq!(x, y);
         assert_eq!(x.status, Status::Ok);
     }
@@ -107,7 +110,11 @@ fn held_then_degraded_then_ok() {
     assert_eq!((o.bias_dps, o.scale, o.rate_dps), (0.0, 1.0, 0.5));
     assert_eq!(c.step(1.0, 0.5, 20.0).status, Status::Ok);
     for i in 2..=61 {
-        assert_eq!(c.step(i as f64, 0.5, f64::NAN).status, Status::Held, "t = {i}");
+        assert_eq!(
+            c.step(i as f64, 0.5, f64::NAN).status,
+            Status::Held,
+            "t = {i}"
+        );
     }
     assert_eq!(c.step(61.5, 0.5, f64::NAN).status, Status::Degraded);
     assert_eq!(c.step(62.0, 0.5, 20.1).status, Status::Ok);
@@ -136,7 +143,10 @@ fn rate_limit_rejects_jumps_and_recovers_after_a_real_move() {
     }
     let want = 0.02 + (10.0 - limits.step_allowance_c) / limits.max_rate_c_per_s;
     let got = first_ok.expect("recovers");
-    assert!(got >= want && got < want + 0.5 + 1e-9, "ok again at {got} s, want ≈{want} s");
+    assert!(
+        got >= want && got < want + 0.5 + 1e-9,
+        "ok again at {got} s, want ≈{want} s"
+    );
 }
 
 /// After a NaN burst the rate feature bridges the gap with the true elapsed time: equal to

@@ -101,7 +101,8 @@ pub fn compensator(model: &ModelFile) -> Result<Compensator, String> {
     let spec = model.feature_spec()?;
     let bias = target_model(model.bias.as_ref(), 0.0).map_err(|e| format!("bias: {e}"))?;
     let scale = target_model(model.scale.as_ref(), 1.0).map_err(|e| format!("scale: {e}"))?;
-    Compensator::new(spec, bias, scale).map_err(|e| e.to_string())
+    let limits = model.features.temp_sensor.to_core()?;
+    Compensator::with_limits(spec, bias, scale, limits).map_err(|e| e.to_string())
 }
 
 /// Compensate a whole log with the flight compensator. The error names the sample.
@@ -114,9 +115,7 @@ pub fn compensate_log(model: &ModelFile, log: &TestLog) -> Result<Compensated, S
         gyro_comp_dps: Vec::with_capacity(n),
     };
     for i in 0..n {
-        let c = comp
-            .step(log.time_s[i], log.gyro_dps[i], log.temp_c[i])
-            .map_err(|e| format!("sample {} (time {} s): {e}", i + 1, log.time_s[i]))?;
+        let c = comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
         out.bias_dps.push(c.bias_dps);
         out.scale.push(c.scale);
         out.gyro_comp_dps.push(c.rate_dps);
@@ -220,9 +219,7 @@ pub fn compensate_stream<R: std::io::Read, W: std::io::Write>(
     let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
     let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
     while let Some(s) = reader.next_sample().map_err(|e| e.to_string())? {
-        let c = comp
-            .step(s.time_s, s.gyro_dps, s.temp_c)
-            .map_err(|e| format!("{}:{}: {e}", source.display(), reader.line()))?;
+        let c = comp.step(s.time_s, s.gyro_dps, s.temp_c);
         if let Some(f) = comp.features() {
             let f = f.as_slice();
             if let [t, r, ..] = f {

@@ -13,6 +13,7 @@ pub mod atomic_file;
 pub mod baseline;
 pub mod compare;
 pub mod compensate;
+pub mod compensate_lines;
 pub mod csvlog;
 pub mod features;
 pub mod fit;

@@ -1,6 +1,6 @@
 //! `gyrotherm compensate`: apply a fitted model to a log (file to file, or `--stream` on
-//! stdin/stdout). Both run the flight compensator of `gyrotherm-core`, so their numbers are
-//! identical.
+//! stdin/stdout), with a status per line. Both run the flight compensator of `gyrotherm-core`,
+//! so their numbers are identical (see `gyrotherm::compensate_lines`).
 
 use std::cell::RefCell;
 use std::io::{BufWriter, Read, Write};
@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use std::rc::Rc;
 
 use anyhow::Context as _;
-use gyrotherm::compensate::compensate_stream;
+use gyrotherm::compensate_lines::{compensate_lines, Mode};
 use gyrotherm::model::ModelFile;
 
 use super::common::LogArgs;
@@ -22,12 +22,12 @@ pub struct CompensateArgs {
     /// Log to compensate (CSV). Not with --stream.
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub input: Option<PathBuf>,
-    /// Output CSV: every input column, then bias_dps, scale and gyro_comp_dps (°/s).
+    /// Output CSV: every input column, then bias_dps, scale, gyro_comp_dps (°/s) and status
+    /// (ok, held, degraded, invalid).
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub out: Option<PathBuf>,
     /// Read CSV on stdin and write one output line per input line on stdout, flushed as it
-    /// goes (the flight path). Give --sample-period to start output at once; otherwise the
-    /// first line comes after 100 input lines (the sample-period estimate).
+    /// goes (the flight path). A malformed line is written as `invalid` and the stream goes on.
     #[arg(long)]
     pub stream: bool,
     #[command(flatten)]
@@ -36,6 +36,17 @@ pub struct CompensateArgs {
 
 pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
     let model = ModelFile::load(&args.model).map_err(anyhow::Error::msg)?;
+    anyhow::ensure!(
+        args.log.fill_gaps.is_none(),
+        "--fill-gaps does not apply to compensate: the compensator bridges time gaps itself and \
+         writes one output line per input line"
+    );
+    if args.log.sample_period.is_some() {
+        eprintln!(
+            "gyrotherm: note: --sample-period is not needed by compensate (output starts with \
+             the first line); ignored"
+        );
+    }
     let opts = args.log.read_options();
     let summary = if args.stream {
         // Rows are handed on as they are made and stdout is flushed whenever the input has
@@ -45,20 +56,21 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             64 * 1024,
             std::io::stdout().lock(),
         )));
-        let input = FlushBeforeRead {
+        let input = std::io::BufReader::new(FlushBeforeRead {
             inner: std::io::stdin().lock(),
             out: Rc::clone(&out),
-        };
-        let summary = compensate_stream(
+        });
+        let summary = compensate_lines(
             &model,
             input,
             "<stdin>".as_ref(),
             &opts,
             DeferredFlush(Rc::clone(&out)),
+            Mode::Stream,
             true,
-        )
-        .map_err(anyhow::Error::msg)?;
+        )?;
         out.borrow_mut().flush()?;
+        eprintln!("gyrotherm: {}", summary.describe());
         summary
     } else {
         let (Some(input), Some(out)) = (&args.input, &args.out) else {
@@ -68,31 +80,44 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("cannot open {}", input.display()))?;
         let summary =
             gyrotherm::atomic_file::write_atomically(out, |w: &mut BufWriter<std::fs::File>| {
-                let s = compensate_stream(
+                let s = compensate_lines(
                     &model,
                     std::io::BufReader::new(&file),
                     input,
                     &opts,
                     &mut *w,
+                    Mode::Strict,
                     false,
-                )
-                .map_err(std::io::Error::other)?;
+                )?;
                 w.flush()?;
-                Ok::<_, std::io::Error>(s)
+                Ok::<_, gyrotherm::compensate_lines::LinesError>(s)
             })
-            .with_context(|| format!("cannot compensate into {}", out.display()))?;
+            .map_err(|e| match e {
+                gyrotherm::compensate_lines::LinesError::Io(io) => anyhow::Error::new(io)
+                    .context(format!("cannot compensate into {}", out.display())),
+                other => anyhow::Error::new(other),
+            })?;
         eprintln!(
-            "gyrotherm: wrote {} ({} rows{})",
+            "gyrotherm: wrote {} ({})",
             out.display(),
-            summary.rows,
-            if summary.filled_rows > 0 {
-                format!(", {} made by gap filling", summary.filled_rows)
-            } else {
-                String::new()
-            }
+            summary.describe()
         );
         summary
     };
+    if summary.held + summary.degraded + summary.invalid > 0 {
+        eprintln!(
+            "gyrotherm: temperature faults ridden through: {} held, {} degraded; {} invalid \
+             (no rate: gyro not finite{})",
+            summary.held,
+            summary.degraded,
+            summary.invalid,
+            if summary.malformed > 0 {
+                " or malformed line"
+            } else {
+                ""
+            }
+        );
+    }
     for w in &summary.warnings {
         eprintln!("gyrotherm: warning: {w}");
     }
