@@ -321,7 +321,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             None => {
                 let keep = fields.len() == headers.len();
                 for k in 0..headers.len() {
-                    writer.push_raw(if keep { &fields[k] } else { b"" });
+                    writer.push_raw(fields.get(k).filter(|_| keep).map_or(&b""[..], |f| f));
                 }
                 for _ in 0..3 {
                     writer.push_raw(b"");
