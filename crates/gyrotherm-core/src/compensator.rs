@@ -80,6 +80,10 @@ pub enum ModelError {
     FeatureCount { expected: usize, got: usize },
     /// The temperature-sensor limits are unusable.
     Limits(LimitsError),
+    /// A baseline model cannot be built.
+    Baseline(crate::baseline::BaselineError),
+    /// LSTM weights refused (wrong shape or not finite).
+    Weights(crate::lstm::WeightError),
 }
 
 impl core::fmt::Display for ModelError {
@@ -93,6 +97,8 @@ impl core::fmt::Display for ModelError {
                 write!(f, "model takes {got} features, the spec gives {expected}")
             }
             ModelError::Limits(e) => write!(f, "temperature-sensor limits: {e}"),
+            ModelError::Baseline(e) => write!(f, "baseline: {e}"),
+            ModelError::Weights(e) => write!(f, "lstm weights: {e}"),
         }
     }
 }

@@ -12,6 +12,7 @@
 //! - [`baseline`]: evaluation of fitted linear/polynomial baseline models (f64).
 //! - [`compensator`]: bias and scale factor to corrected rate, G = (Ĝ − B)/K (eq. 4 of the
 //!   paper), riding through temperature-sensor faults with a [`Status`] per sample.
+//! - [`static_model`]: a model as plain static data (`gyrotherm export --lang rust`).
 //! - [`error`]: what the core refuses instead of panicking.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code)]
@@ -31,6 +32,7 @@ pub mod compensator;
 pub mod error;
 pub mod features;
 pub mod lstm;
+pub mod static_model;
 
 pub use compensator::{Compensator, Corrected, Status, TargetModel, TempLimits};
 pub use error::{Channel, InputError};

@@ -22,7 +22,7 @@ pub struct Compensated {
 }
 
 /// Widen an LSTM to the flight input count: input columns beyond `input_size` get weight 0.
-fn padded_core_lstm(
+pub fn padded_core_lstm(
     params: &LstmParams,
 ) -> Result<gyrotherm_core::lstm::LstmWeights<LSTM_INPUTS, HIDDEN>, String> {
     let i = params.input_size;

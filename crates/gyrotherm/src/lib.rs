@@ -15,6 +15,7 @@ pub mod compare;
 pub mod compensate;
 pub mod compensate_lines;
 pub mod csvlog;
+pub mod export;
 pub mod features;
 pub mod fit;
 pub mod metrics;
