@@ -21,9 +21,8 @@ use super::{f32_lit, f64_lit};
 
 /// An f64 constant as C source (exact: shortest round-trip decimal).
 fn d(v: f64) -> String {
-    let s = f64_lit(v);
-    // "1e0" is a valid C floating constant; keep it.
-    s
+    // `1e0` is a valid C floating constant.
+    f64_lit(v)
 }
 
 /// An f32 constant as C source.
