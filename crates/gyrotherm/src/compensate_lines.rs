@@ -115,45 +115,84 @@ impl From<std::io::Error> for LinesError {
     }
 }
 
-/// Split one CSV line into `fields` (unquoted). Returns false on a broken quote.
-fn split_fields(line: &[u8], fields: &mut Vec<Vec<u8>>) -> bool {
-    fields.clear();
-    let mut cur = Vec::new();
-    let mut i = 0;
-    let mut quoted = false;
-    let mut at_start = true;
-    while i < line.len() {
-        let b = line[i];
-        if quoted {
-            if b == b'"' {
-                if line.get(i + 1) == Some(&b'"') {
-                    cur.push(b'"');
-                    i += 1;
-                } else {
-                    quoted = false;
+/// The fields of one CSV line, as byte ranges: into the line itself when it holds no quote
+/// (the usual log line: no copy), else into `buf`, which holds the unquoted fields. Reused
+/// from line to line, so a steady stream allocates nothing.
+#[derive(Default)]
+struct Fields {
+    ranges: Vec<std::ops::Range<usize>>,
+    buf: Vec<u8>,
+    quoted: bool,
+}
+
+impl Fields {
+    /// Split `line`; false on a broken quote.
+    fn split(&mut self, line: &[u8]) -> bool {
+        self.ranges.clear();
+        self.quoted = line.contains(&b'"');
+        if !self.quoted {
+            let mut start = 0;
+            for (i, &b) in line.iter().enumerate() {
+                if b == b',' {
+                    self.ranges.push(start..i);
+                    start = i + 1;
                 }
-            } else {
-                cur.push(b);
             }
-        } else if b == b',' {
-            fields.push(std::mem::take(&mut cur));
-            at_start = true;
-            i += 1;
-            continue;
-        } else if b == b'"' && at_start {
-            quoted = true;
-        } else {
-            cur.push(b);
+            self.ranges.push(start..line.len());
+            return true;
         }
-        at_start = false;
-        i += 1;
+        self.buf.clear();
+        let mut start = 0;
+        let mut quoted = false;
+        let mut at_start = true;
+        let mut i = 0;
+        while i < line.len() {
+            let b = line[i];
+            if quoted {
+                if b == b'"' {
+                    if line.get(i + 1) == Some(&b'"') {
+                        self.buf.push(b'"');
+                        i += 1;
+                    } else {
+                        quoted = false;
+                    }
+                } else {
+                    self.buf.push(b);
+                }
+            } else if b == b',' {
+                self.ranges.push(start..self.buf.len());
+                start = self.buf.len();
+                at_start = true;
+                i += 1;
+                continue;
+            } else if b == b'"' && at_start {
+                quoted = true;
+            } else {
+                self.buf.push(b);
+            }
+            at_start = false;
+            i += 1;
+        }
+        self.ranges.push(start..self.buf.len());
+        !quoted
     }
-    fields.push(cur);
-    !quoted
+
+    fn len(&self) -> usize {
+        self.ranges.len()
+    }
+
+    /// Field `k` of `line` (the line last split), empty past the end.
+    fn get<'a>(&'a self, line: &'a [u8], k: usize) -> &'a [u8] {
+        let src = if self.quoted { &self.buf[..] } else { line };
+        self.ranges
+            .get(k)
+            .and_then(|r| src.get(r.clone()))
+            .unwrap_or(&[])
+    }
 }
 
 fn parse_number(raw: &[u8]) -> Option<f64> {
-    std::str::from_utf8(raw).ok()?.trim().parse().ok()
+    crate::csvlog::reader::parse_f64(raw)
 }
 
 /// Compensate `input` (CSV with a header) into `output`; see the module doc. `source` names
@@ -211,7 +250,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         LinesError::Log(LogError::new(kind, source, Some(line), column, message))
     };
     let mut summary = LinesSummary::default();
-    let mut fields: Vec<Vec<u8>> = Vec::new();
+    let mut fields = Fields::default();
     let mut last_time: Option<(f64, u64)> = None;
     let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
     let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
@@ -230,7 +269,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         summary.rows += 1;
         // Parse; `None` is a malformed line (with the reason for strict mode).
         let parsed: Result<(f64, f64, f64), LinesError> = (|| {
-            if !split_fields(line, &mut fields) || fields.len() != headers.len() {
+            if !fields.split(line) || fields.len() != headers.len() {
                 return Err(err(
                     LogErrorKind::FieldCount,
                     line_no,
@@ -243,7 +282,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                     ),
                 ));
             }
-            let time_s = match parse_number(&fields[ti]) {
+            let time_s = match parse_number(fields.get(line, ti)) {
                 Some(t) if t.is_finite() => t,
                 _ => {
                     return Err(err(
@@ -253,7 +292,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                         format!(
                             "{:?} is not a finite time; fix the value or comment the line out \
                              with '#'",
-                            String::from_utf8_lossy(&fields[ti])
+                            String::from_utf8_lossy(fields.get(line, ti))
                         ),
                     ))
                 }
@@ -271,7 +310,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                     ));
                 }
             }
-            let gyro = match parse_number(&fields[gi]) {
+            let gyro = match parse_number(fields.get(line, gi)) {
                 Some(g) => g * gyro_scale,
                 None => {
                     return Err(err(
@@ -281,13 +320,13 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                         format!(
                             "{:?} is not a number; fix the value or comment the line out \
                              with '#'",
-                            String::from_utf8_lossy(&fields[gi])
+                            String::from_utf8_lossy(fields.get(line, gi))
                         ),
                     ))
                 }
             };
             // A temperature that is not a number is a sensor fault: NaN, held.
-            let temp = parse_number(&fields[ci]).unwrap_or(f64::NAN);
+            let temp = parse_number(fields.get(line, ci)).unwrap_or(f64::NAN);
             Ok((time_s, gyro, temp))
         })();
         let c: Option<Corrected> = match parsed {
@@ -300,8 +339,8 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         };
         match c {
             Some(c) => {
-                for f in &fields {
-                    writer.push_raw(f);
+                for k in 0..fields.len() {
+                    writer.push_raw(fields.get(line, k));
                 }
                 writer.push_f64(c.bias_dps);
                 writer.push_f64(c.scale);
@@ -321,7 +360,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             None => {
                 let keep = fields.len() == headers.len();
                 for k in 0..headers.len() {
-                    writer.push_raw(fields.get(k).filter(|_| keep).map_or(&b""[..], |f| f));
+                    writer.push_raw(if keep { fields.get(line, k) } else { b"" });
                 }
                 for _ in 0..3 {
                     writer.push_raw(b"");
@@ -350,13 +389,19 @@ pub fn compensate_lines<R: BufRead, W: Write>(
 
 #[cfg(test)]
 mod tests {
-    use super::split_fields;
+    use super::Fields;
 
     #[test]
-    fn splits_quoted_fields() {
-        let mut f = Vec::new();
-        assert!(split_fields(br#"1,"a,""b""",,x"#, &mut f));
-        assert_eq!(f, [&b"1"[..], b"a,\"b\"", b"", b"x"]);
-        assert!(!split_fields(br#"1,"open"#, &mut f));
+    fn splits_plain_and_quoted_fields() {
+        let mut f = Fields::default();
+        let line = br#"1,"a,""b""",,x"#;
+        assert!(f.split(line));
+        let got: Vec<&[u8]> = (0..f.len()).map(|k| f.get(line, k)).collect();
+        assert_eq!(got, [&b"1"[..], b"a,\"b\"", b"", b"x"]);
+        let line = b"0.5,1e-3,,NaN";
+        assert!(f.split(line));
+        let got: Vec<&[u8]> = (0..f.len()).map(|k| f.get(line, k)).collect();
+        assert_eq!(got, [&b"0.5"[..], b"1e-3", b"", b"NaN"]);
+        assert!(!f.split(br#"1,"open"#));
     }
 }
