@@ -216,3 +216,182 @@ fn runs(v: &[f64], f: impl Fn(usize) -> bool) -> Vec<usize> {
     }
     out
 }
+
+/// `train` stores the sensor limits given on its command line; a model file written before
+/// the limits existed (no `temp_sensor`) loads with the defaults and compensates the same as
+/// one with the defaults written out; unusable limits are refused with the flags named.
+#[test]
+fn sensor_limits_are_set_at_train_and_old_files_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let log = d.join("s.csv");
+    let mut text = String::from("time_s,gyro_dps,temp_c\n");
+    for i in 0..600 {
+        let temp = 20.0 + 5.0 * (i as f64 / 60.0).sin();
+        text.push_str(&format!(
+            "{i},{},{temp}\n",
+            0.0027 + 1e-5 * temp + 1e-6 * ((i * 7919) % 13) as f64
+        ));
+    }
+    std::fs::write(&log, &text).unwrap();
+    let model = d.join("m.json");
+    run_ok(
+        gyrotherm()
+            .args([
+                "train",
+                "--method",
+                "linear",
+                "--temp-max",
+                "80",
+                "--temp-max-rate",
+                "0.5",
+                "--input",
+            ])
+            .arg(&log)
+            .arg("--out")
+            .arg(&model),
+    );
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(m["features"]["temp_sensor"]["max_c"], 80.0);
+    assert_eq!(m["features"]["temp_sensor"]["max_rate_c_per_s"], 0.5);
+    assert_eq!(m["features"]["temp_sensor"]["min_c"], -60.0);
+    // Old file: no temp_sensor. Same output as the defaults written out.
+    m["features"].as_object_mut().unwrap().remove("temp_sensor");
+    let old = d.join("old.json");
+    std::fs::write(&old, m.to_string()).unwrap();
+    m["features"]["temp_sensor"] = serde_json::json!({"min_c": -60.0, "max_c": 100.0,
+        "max_rate_c_per_s": 2.0, "step_allowance_c": 1.0, "degraded_after_s": 60.0});
+    let explicit = d.join("explicit.json");
+    std::fs::write(&explicit, m.to_string()).unwrap();
+    let outs: Vec<Vec<u8>> = [&old, &explicit]
+        .iter()
+        .map(|p| {
+            run_ok(
+                gyrotherm()
+                    .args(["compensate", "--stream", "--model"])
+                    .arg(p)
+                    .stdin(Stdio::from(std::fs::File::open(&log).unwrap())),
+            )
+            .stdout
+        })
+        .collect();
+    assert!(outs[0] == outs[1]);
+    let out = gyrotherm()
+        .args([
+            "train",
+            "--method",
+            "linear",
+            "--temp-min",
+            "90",
+            "--temp-max",
+            "80",
+            "--input",
+        ])
+        .arg(&log)
+        .arg("--out")
+        .arg(d.join("bad.json"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--temp-min") && err.contains("min < max"),
+        "{err}"
+    );
+}
+
+/// A stream never stops on a bad line: malformed lines are `invalid` with empty outputs, a
+/// NaN or implausible temperature is `held`, a NaN gyro `invalid`; one output line per input
+/// data line. Batch mode stops on the malformed line, naming file, line and column.
+#[test]
+fn stream_rides_through_bad_lines_and_batch_stays_strict() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut text = String::from("# a comment\ntime_s,gyro_dps,temp_c,note\n");
+    for i in 0..200 {
+        let (g, t) = match i {
+            50 => ("0.003".to_owned(), "NaN".to_owned()),
+            60 => ("0.003".to_owned(), "85.0".to_owned()),
+            70 => ("0.003".to_owned(), "-127.0".to_owned()),
+            80 => ("NaN".to_owned(), "20".to_owned()),
+            _ => ("0.003".to_owned(), format!("{}", 20.0 + 0.01 * i as f64)),
+        };
+        match i {
+            90 => text.push_str("90,0.003\n"),
+            100 => text.push_str("abc,0.003,21,x\n"),
+            _ => text.push_str(&format!("{i},{g},{t},\"n,{i}\"\n")),
+        }
+    }
+    let log = d.join("bad.csv");
+    std::fs::write(&log, &text).unwrap();
+    let model = d.join("m.json");
+    let train_log = d.join("train.csv");
+    let mut t = String::from("time_s,gyro_dps,temp_c\n");
+    for i in 0..600 {
+        let temp = 20.0 + 5.0 * (i as f64 / 60.0).sin();
+        t.push_str(&format!(
+            "{i},{},{temp}\n",
+            0.0027 + 1e-5 * temp + 1e-6 * ((i * 7919) % 13) as f64
+        ));
+    }
+    std::fs::write(&train_log, t).unwrap();
+    run_ok(
+        gyrotherm()
+            .args(["train", "--method", "linear", "--input"])
+            .arg(&train_log)
+            .arg("--out")
+            .arg(&model),
+    );
+    let out = run_ok(
+        gyrotherm()
+            .args(["compensate", "--stream", "--model"])
+            .arg(&model)
+            .stdin(Stdio::from(std::fs::File::open(&log).unwrap())),
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 201, "header + one line per data line");
+    assert_eq!(
+        lines[0],
+        "time_s,gyro_dps,temp_c,note,bias_dps,scale,gyro_comp_dps,status"
+    );
+    let status = |i: usize| lines[i + 1].rsplit(',').next().unwrap();
+    for i in [50, 60, 70] {
+        assert_eq!(status(i), "held", "{}", lines[i + 1]);
+    }
+    assert_eq!(status(80), "invalid");
+    assert!(lines[81].ends_with(",,invalid"), "{}", lines[81]);
+    // Wrong field count: empty fields (the first quoted, so the line is not blank).
+    assert_eq!(lines[91], "\"\",,,,,,,invalid");
+    assert_eq!(lines[101], "abc,0.003,21,x,,,,invalid");
+    assert_eq!(status(0), "ok");
+    assert_eq!(status(199), "ok");
+    assert!(
+        lines[2].contains("\"n,1\""),
+        "quoted field passed through: {}",
+        lines[2]
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("held 3") && stderr.contains("invalid 3") && stderr.contains("2 malformed"),
+        "{stderr}"
+    );
+    // Batch: strict about the malformed line.
+    let out = gyrotherm()
+        .args(["compensate", "--model"])
+        .arg(&model)
+        .arg("--input")
+        .arg(&log)
+        .arg("--out")
+        .arg(d.join("o.csv"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("bad.csv:93") && err.contains("2 fields"),
+        "{err}"
+    );
+    assert!(!d.join("o.csv").exists(), "no partial output");
+}

@@ -10,7 +10,8 @@ use std::rc::Rc;
 
 use anyhow::Context as _;
 use gyrotherm::compensate_lines::{compensate_lines, Mode};
-use gyrotherm::model::ModelFile;
+use gyrotherm::model::{ModelFile, TempSensorDef};
+use gyrotherm_core::TempLimits;
 
 use super::common::LogArgs;
 
@@ -149,5 +150,46 @@ impl Write for DeferredFlush<'_> {
     }
     fn flush(&mut self) -> std::io::Result<()> {
         Ok(())
+    }
+}
+
+/// Temperature-sensor fault limits stored in the model at `train` (see `gyrotherm compensate`:
+/// a reading outside the range or changing faster than the rate limit is held).
+#[derive(Debug, Clone, clap::Args)]
+pub struct TempSensorArgs {
+    /// Lowest plausible temperature reading, °C.
+    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.min_c)]
+    pub temp_min: f64,
+    /// Highest plausible temperature reading, °C.
+    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.max_c)]
+    pub temp_max: f64,
+    /// Fastest plausible temperature change, °C/s.
+    #[arg(long, value_name = "C_PER_S", default_value_t = TempLimits::DEFAULT.max_rate_c_per_s)]
+    pub temp_max_rate: f64,
+    /// Temperature change always allowed between two readings (noise, resolution), °C.
+    #[arg(long, value_name = "C", default_value_t = TempLimits::DEFAULT.step_allowance_c)]
+    pub temp_step_allowance: f64,
+    /// Seconds without a good temperature before the output is `degraded` instead of `held`.
+    #[arg(long, value_name = "S", default_value_t = TempLimits::DEFAULT.degraded_after_s)]
+    pub degraded_after: f64,
+}
+
+impl TempSensorArgs {
+    /// The model-file form, checked.
+    pub fn to_def(&self) -> anyhow::Result<TempSensorDef> {
+        let def = TempSensorDef {
+            min_c: self.temp_min,
+            max_c: self.temp_max,
+            max_rate_c_per_s: self.temp_max_rate,
+            step_allowance_c: self.temp_step_allowance,
+            degraded_after_s: self.degraded_after,
+        };
+        def.to_core().map_err(|e| {
+            anyhow::anyhow!(
+                "temperature-sensor limits (--temp-min, --temp-max, --temp-max-rate, \
+                 --temp-step-allowance, --degraded-after): {e}"
+            )
+        })?;
+        Ok(def)
     }
 }

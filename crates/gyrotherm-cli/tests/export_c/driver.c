@@ -1,4 +1,5 @@
-/* Test driver for the generated C model: reads a gyrotherm CSV log on stdin (header with
+/* Test driver for the generated C model: reads a gyrotherm CSV log (the file named by the
+ * first argument, else stdin; header with
  * time_s, gyro_dps, temp_c), calls gt_step per data line and prints
  * `status,rate_dps,bias_dps,scale` per line (%.17g, so the doubles round-trip; rate empty when
  * the status is invalid). A field that is not a number is read as NaN. */
@@ -36,14 +37,19 @@ static double number(const char *s)
     return v;
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    FILE *in = stdin;
     static char line[MAX_LINE];
     char *fields[MAX_FIELDS];
     int ti = -1, gi = -1, ci = -1, n, i;
     gt_state s;
     static const char *names[] = {"ok", "held", "degraded", "invalid"};
-    if (fgets(line, sizeof line, stdin) == NULL) {
+    if (argc > 1 && (in = fopen(argv[1], "r")) == NULL) {
+        fprintf(stderr, "driver: cannot open %s\n", argv[1]);
+        return 2;
+    }
+    if (fgets(line, sizeof line, in) == NULL) {
         return 2;
     }
     line[strcspn(line, "\r\n")] = '\0';
@@ -63,7 +69,7 @@ int main(void)
     }
     gt_init(&s);
     printf("status,gyro_comp_dps,bias_dps,scale\n");
-    while (fgets(line, sizeof line, stdin) != NULL) {
+    while (fgets(line, sizeof line, in) != NULL) {
         double rate, bias, scale;
         gt_status st;
         line[strcspn(line, "\r\n")] = '\0';
