@@ -82,7 +82,7 @@ impl LinesSummary {
 #[non_exhaustive]
 pub enum LinesError {
     /// The model cannot be turned into a compensator.
-    Model(String),
+    Model(crate::compensate::CompensateError),
     /// The input (header, or a malformed line in [`Mode::Strict`]): file, line, column, fix.
     Log(LogError),
     /// Reading the input or writing the output failed.
@@ -104,7 +104,7 @@ impl std::error::Error for LinesError {
         match self {
             LinesError::Io(e) => Some(e),
             LinesError::Log(e) => Some(e),
-            LinesError::Model(_) => None,
+            LinesError::Model(e) => Some(e),
         }
     }
 }
@@ -234,7 +234,14 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         col(&opts.gyro_col),
         col(&opts.temp_col),
     ) else {
-        return Err(LinesError::Model("column mapping".into()));
+        // The log reader checked the mapping above; this cannot happen.
+        return Err(LinesError::Log(LogError::new(
+            LogErrorKind::MissingColumn,
+            source,
+            Some(line_no),
+            None,
+            "a mapped column is missing from the header",
+        )));
     };
     let gyro_scale = match opts.gyro_unit {
         GyroUnit::Dps => 1.0,

@@ -19,14 +19,17 @@ use gyrotherm_core::compensator::{HIDDEN, LSTM_INPUTS};
 use gyrotherm_core::features::MAX_FEATURES;
 use gyrotherm_core::static_model::{StaticBaseline, StaticLstm, StaticModel, StaticTarget};
 
-use crate::model::{ModelFile, SubModel};
+use crate::compensate::CompensateError;
+use crate::model::{ModelFile, ModelFileError, SubModel, Target};
 
 /// Why a model cannot be exported.
 #[derive(Debug)]
 #[non_exhaustive]
 pub enum ExportError {
-    /// The model cannot be turned into flight form (the message says why).
-    Model(String),
+    /// The model file fails its checks.
+    Model(ModelFileError),
+    /// The model cannot be turned into flight form.
+    Flight(CompensateError),
     /// Writing an output file failed.
     Io {
         path: PathBuf,
@@ -37,7 +40,8 @@ pub enum ExportError {
 impl std::fmt::Display for ExportError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            ExportError::Model(m) => write!(f, "model cannot be exported: {m}"),
+            ExportError::Model(e) => write!(f, "model cannot be exported: {e}"),
+            ExportError::Flight(e) => write!(f, "model cannot be exported: {e}"),
             ExportError::Io { path, source } => {
                 write!(f, "cannot write {}: {source}", path.display())
             }
@@ -49,7 +53,8 @@ impl std::error::Error for ExportError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             ExportError::Io { source, .. } => Some(source),
-            ExportError::Model(_) => None,
+            ExportError::Model(e) => Some(e),
+            ExportError::Flight(e) => Some(e),
         }
     }
 }
@@ -71,22 +76,31 @@ pub fn static_model(model: &ModelFile) -> Result<StaticModel, ExportError> {
     model.validate().map_err(err)?;
     let spec = model.feature_spec().map_err(err)?;
     let limits = model.features.temp_sensor.to_core().map_err(err)?;
-    let target = |sub: Option<&SubModel>, absent: f64, name: &str| {
-        static_target(sub, absent).map_err(|e| ExportError::Model(format!("{name}: {e}")))
+    let target = |sub: Option<&SubModel>, absent: f64, target: Target| {
+        static_target(sub, absent).map_err(|e| {
+            ExportError::Flight(CompensateError::InTarget {
+                target,
+                source: Box::new(e),
+            })
+        })
     };
     Ok(StaticModel {
         spec,
         limits,
-        bias: target(model.bias.as_ref(), 0.0, "bias")?,
-        scale: target(model.scale.as_ref(), 1.0, "scale")?,
+        bias: target(model.bias.as_ref(), 0.0, Target::Bias)?,
+        scale: target(model.scale.as_ref(), 1.0, Target::Scale)?,
     })
 }
 
-fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, String> {
+fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, CompensateError> {
     let Some(sub) = sub else {
         return Ok(StaticTarget::constant(absent));
     };
-    let baseline = match sub.baseline_core().transpose()? {
+    let baseline = match sub
+        .baseline_core()
+        .transpose()
+        .map_err(CompensateError::Baseline)?
+    {
         None => None,
         Some(b) => {
             let mut s = StaticBaseline {
@@ -96,9 +110,10 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, St
                 coefficients: [0.0; gyrotherm_core::baseline::MAX_TERMS],
             };
             for j in 0..b.n_terms() {
-                let (p, c) = b.term(j).ok_or("baseline term missing")?;
-                s.powers[j][..p.len()].copy_from_slice(p);
-                s.coefficients[j] = c;
+                if let Some((p, c)) = b.term(j) {
+                    s.powers[j][..p.len()].copy_from_slice(p);
+                    s.coefficients[j] = c;
+                }
             }
             Some(s)
         }
@@ -118,7 +133,7 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, St
             let w = crate::compensate::padded_core_lstm(params)?;
             let n = input_norm.mean.len();
             if n > MAX_FEATURES {
-                return Err(format!("{n} LSTM inputs, at most {MAX_FEATURES}"));
+                return Err(CompensateError::LstmInputs { inputs: n });
             }
             let mut mean = [0.0; MAX_FEATURES];
             let mut std = [1.0; MAX_FEATURES];
