@@ -191,8 +191,9 @@ impl Fields {
     }
 }
 
+/// A numeric field (ASCII spaces around it allowed), as the log reader parses it.
 fn parse_number(raw: &[u8]) -> Option<f64> {
-    crate::csvlog::reader::parse_f64(raw)
+    std::str::from_utf8(raw.trim_ascii()).ok()?.parse().ok()
 }
 
 /// Compensate `input` (CSV with a header) into `output`; see the module doc. `source` names
