@@ -1,3 +1,9 @@
+#![allow(
+    clippy::indexing_slicing,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic
+)]
 //! LSTM cell + linear read-out, f32 inference, one sample at a time.
 //!
 //! The published compensator (He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004, §2):
