@@ -50,6 +50,19 @@ fn bench_oadev(c: &mut Criterion) {
 
 criterion_group!(benches, bench_oadev);
 
+/// CPU time of the process so far (user + system, all threads; Linux `/proc/self/stat`,
+/// 100 ticks a second): on a shared machine, the work done, which wall time is not.
+fn cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which ends with the last ')'): utime is the 12th,
+    // stime the 13th.
+    let rest = stat.get(stat.rfind(')')? + 2..)?;
+    let mut f = rest.split_whitespace().skip(11);
+    let user: f64 = f.next()?.parse().ok()?;
+    let sys: f64 = f.next()?.parse().ok()?;
+    Some((user + sys) / 100.0)
+}
+
 fn main() {
     if let Some(n) = std::env::var("GYROTHERM_ALLAN_N")
         .ok()
@@ -60,10 +73,14 @@ fn main() {
             ("gyrotherm_oadev_octave_fixed_alpha_s", NoiseModel::Alpha(0)),
         ] {
             let y = white(n);
-            let t = Instant::now();
+            let (t, cpu0) = (Instant::now(), cpu_s());
             let pts = deviation_owned(y, 1.0, DevKind::Oadev, &TauSet::Octave, noise).unwrap();
             let s = t.elapsed().as_secs_f64();
-            println!("{label}={s:.3} n={n} taus={}", pts.len());
+            let cpu = match (cpu0, cpu_s()) {
+                (Some(a), Some(b)) => format!(" cpu_s={:.2}", b - a),
+                _ => String::new(),
+            };
+            println!("{label}={s:.3} n={n} taus={}{cpu}", pts.len());
         }
         if let Some(kb) = std::fs::read_to_string("/proc/self/status")
             .ok()
