@@ -446,17 +446,13 @@ impl<const I: usize, const H: usize> Lstm<I, H> {
             }
         }
         let [zi, zf, zg, zo] = &z;
-        let mut c = [0.0f32; H];
-        for (cj, ((fj, c0), (ij, gj))) in c
-            .iter_mut()
-            .zip(zf.iter().zip(&self.c).zip(zi.iter().zip(zg)))
-        {
-            *cj = fj * c0 + ij * (2.0 * gj - 1.0);
-        }
-        let mut tc = c;
-        for v in tc.iter_mut() {
-            *v *= 2.0;
-        }
+        // Lane j of each row; j < H always, so the fallback is never taken (and is compiled
+        // out), but no index can panic.
+        let lane = |row: &[f32; H], j: usize| row.get(j).copied().unwrap_or(0.0);
+        let c: [f32; H] = core::array::from_fn(|j| {
+            lane(zf, j) * lane(&self.c, j) + lane(zi, j) * (2.0 * lane(zg, j) - 1.0)
+        });
+        let mut tc: [f32; H] = core::array::from_fn(|j| 2.0 * lane(&c, j));
         for v in tc.iter_mut() {
             *v = sigmoid(*v);
         }
