@@ -32,4 +32,4 @@ awk -v a="$a" -v b="$b" -v na="$steps_a" -v nb="$steps_b" 'BEGIN {
 a=$(ir target/release/examples/train_bench 1 f32 single)
 b=$(ir target/release/examples/train_bench 3 f32 single)
 awk -v a="$a" -v b="$b" 'BEGIN {
-  printf "train_epoch_instructions=%.4g (%.1f per step of 30,000; train_bench 1 vs 3 epochs: %d vs %d Ir)\n", (b - a) / 2, (b - a) / 2 / 30000, a, b }'
+  printf "train_epoch_instructions=%.0f (%.1f per step of 30,000; train_bench 1 vs 3 epochs: %d vs %d Ir)\n", (b - a) / 2, (b - a) / 2 / 30000, a, b }'
