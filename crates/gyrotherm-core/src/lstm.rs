@@ -1,9 +1,3 @@
-#![allow(
-    clippy::indexing_slicing,
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic
-)]
 //! LSTM cell + linear read-out, f32 inference, one sample at a time.
 //!
 //! The published compensator (He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004, §2):
@@ -29,13 +23,6 @@
 //! - [`Lstm`]: the weights repacked for the step loop plus the state (h, c). [`Lstm::step`]
 //!   is panic-free and allocation-free for every input; a non-finite input is refused and the
 //!   state is left untouched.
-
-#![deny(
-    clippy::indexing_slicing,
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic
-)]
 
 use core::fmt;
 
