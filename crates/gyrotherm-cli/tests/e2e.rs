@@ -2,23 +2,10 @@
 //! path against the batch path, and the error messages a user sees.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::Stdio;
 
-fn gyrotherm() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
-}
-
-fn run_ok(cmd: &mut Command) -> Output {
-    let out = cmd.output().expect("run gyrotherm");
-    assert!(
-        out.status.success(),
-        "gyrotherm failed ({:?}):\nstdout: {}\nstderr: {}",
-        out.status,
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
+mod cli;
+use cli::{gyrotherm, run_ok};
 
 fn simulate(dir: &Path, name: &str, profile: &str, seed: u64, table: bool) -> PathBuf {
     let path = dir.join(name);

@@ -8,23 +8,10 @@
 //! without the base value as input; moving average and lag levels).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 
-fn gyrotherm() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
-}
-
-fn run_ok(cmd: &mut Command) -> Output {
-    let out = cmd.output().expect("run");
-    assert!(
-        out.status.success(),
-        "{cmd:?} failed ({:?}):\nstdout: {}\nstderr: {}",
-        out.status,
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
+mod cli;
+use cli::{gyrotherm, run_ok};
 
 fn have_gcc() -> bool {
     Command::new("gcc")
@@ -33,17 +20,7 @@ fn have_gcc() -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
-fn simulate(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
-    let path = dir.join(name);
-    run_ok(
-        gyrotherm()
-            .arg("simulate")
-            .args(args)
-            .arg("--out")
-            .arg(&path),
-    );
-    path
-}
+use cli::simulate_args as simulate;
 
 /// Deterministic weights in [-0.5, 0.5) (a 64-bit LCG, Knuth's MMIX constants).
 struct Lcg(u64);

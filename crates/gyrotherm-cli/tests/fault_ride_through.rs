@@ -3,36 +3,12 @@
 //! with a bias stability within 10 % of the same run without faults, no NaN anywhere, one
 //! output line per input line, and the stream and batch outputs identical.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::Stdio;
 
-fn gyrotherm() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
-}
+mod cli;
+use cli::{gyrotherm, run_ok};
 
-fn run_ok(cmd: &mut Command) -> Output {
-    let out = cmd.output().expect("run gyrotherm");
-    assert!(
-        out.status.success(),
-        "gyrotherm failed ({:?}):\nstdout: {}\nstderr: {}",
-        out.status,
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn simulate(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
-    let path = dir.join(name);
-    run_ok(
-        gyrotherm()
-            .arg("simulate")
-            .args(args)
-            .arg("--out")
-            .arg(&path),
-    );
-    path
-}
+use cli::simulate_args as simulate;
 
 /// Columns of a CSV text by header name.
 fn column(text: &str, name: &str) -> Vec<String> {
