@@ -75,27 +75,13 @@ pub fn target_model(sub: Option<&SubModel>, absent: f64) -> Result<TargetModel, 
         .baseline_core()
         .transpose()
         .map_err(CompensateError::Baseline)?;
-    let lstm = match sub {
-        SubModel::Lstm {
-            params,
-            input_norm,
-            target_norm,
+    let lstm = match sub.lstm() {
+        Some((params, input_norm, target_norm)) => {
+            Some(core_lstm(params, input_norm, target_norm)?)
         }
-        | SubModel::Residual {
-            params,
-            input_norm,
-            target_norm,
-            ..
-        } => Some(core_lstm(params, input_norm, target_norm)?),
-        SubModel::Baseline { .. } => None,
+        None => None,
     };
-    let lstm_reads_base = matches!(
-        sub,
-        SubModel::Residual {
-            lstm_reads_base: true,
-            ..
-        }
-    );
+    let lstm_reads_base = sub.reads_base();
     Ok(TargetModel {
         offset: 0.0,
         baseline,
