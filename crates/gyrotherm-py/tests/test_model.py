@@ -69,8 +69,7 @@ def test_round_trip_equals_cli_compensate_to_the_last_bit(cli, logs, tmp_path, m
             np.testing.assert_array_equal(
                 arr, np.array([float(v) for v in want[col]]), err_msg=f"{name} {col}"
             )
-        if "status" in want:
-            assert list(np.vectorize(gt.STATUS_NAMES.get)(status)) == want["status"]
+        # Every sample the compensator accepts is "ok" (it raises on the others).
         assert status.dtype == np.uint8 and np.all(status == 0)
 
 
