@@ -60,6 +60,11 @@ create_exception!(
     "A sample the compensator refuses (non-finite input, time not increasing)."
 );
 
+/// A Python exception of type `E` carrying a library error's message (what the CLI prints).
+pub(crate) fn py_err<E: pyo3::PyTypeInfo>(e: impl std::fmt::Display) -> PyErr {
+    PyErr::new::<E, _>(e.to_string())
+}
+
 #[pymodule]
 fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();

@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::allan::slice;
 use crate::logs::{read, LogOptions};
-use crate::{CompensationError, FitError, LogError, ModelError};
+use crate::{py_err, CompensationError, FitError, LogError, ModelError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RawModel>()?;
@@ -58,7 +58,7 @@ impl RawModel {
     /// Parse and check model JSON text.
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<RawModel> {
-        let file = ModelFile::from_json(text).map_err(ModelError::new_err)?;
+        let file = ModelFile::from_json(text).map_err(py_err::<ModelError>)?;
         Ok(RawModel {
             file,
             training_notes: Vec::new(),
@@ -71,7 +71,7 @@ impl RawModel {
     }
 
     fn to_json(&self) -> PyResult<String> {
-        let mut text = self.file.to_json().map_err(ModelError::new_err)?;
+        let mut text = self.file.to_json().map_err(py_err::<ModelError>)?;
         text.push('\n');
         Ok(text)
     }
@@ -148,7 +148,7 @@ impl RawModel {
                 compensate_log(&self.file, &log)
                     .map(|out| (out, extrapolation_warnings(&self.file, &log)))
             })
-            .map_err(CompensationError::new_err)?;
+            .map_err(py_err::<CompensationError>)?;
         let status = compensation_status(out.bias_dps.len());
         Ok((
             out.bias_dps.into_pyarray(py),
@@ -195,7 +195,7 @@ impl RawModel {
     fn summary(&self) -> PyResult<String> {
         let m = &self.file;
         let t = &m.training;
-        let spec = m.feature_spec().map_err(ModelError::new_err)?;
+        let spec = m.feature_spec().map_err(py_err::<ModelError>)?;
         let mut s = format!(
             "gyrotherm model (format {}, method {})\n",
             m.format_version,
@@ -288,8 +288,7 @@ impl FitSettings {
     /// The same checks and mapping as the CLI's `FitArgs::fit_config`.
     fn config(&self) -> PyResult<FitConfig> {
         let mut cfg = FitConfig::new(parse_method(&self.method)?);
-        let kind =
-            gyrotherm::fit::lstm::RecipeKind::parse(&self.recipe).map_err(FitError::new_err)?;
+        let kind = gyrotherm::RecipeKind::parse(&self.recipe).map_err(py_err::<FitError>)?;
         cfg.recipe = LstmRecipe::of_kind(kind);
         if let Some(e) = self.epochs {
             if e == 0 {
