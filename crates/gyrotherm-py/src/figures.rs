@@ -1,6 +1,6 @@
 //! Gyro figures: bias stability, noise terms from the OADEV curve, scale-factor figures.
 
-use gyrotherm::allan::{self, DevKind, NoiseModel, NoiseTerm, TauSet};
+use gyrotherm::allan::{self, DevKind, NoiseModel, TauSet};
 use gyrotherm::metrics::{self, ScaleFactorOptions};
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
@@ -46,14 +46,14 @@ fn bias_stability(
     Ok((b.bias_stability_dph, b.means, b.samples_per_mean))
 }
 
-/// Noise terms of a rate column (°/s) read off its octave OADEV curve, in the layout of the
-/// `noise` object of `gyrotherm allan --json`.
+/// Noise terms of a rate column (°/s) read off its octave OADEV curve, as JSON text: the
+/// library's `NoiseTerms` serialised, the `noise` object of `gyrotherm allan --json`.
 #[pyfunction]
-fn noise_terms<'py>(
-    py: Python<'py>,
-    rate_dps: PyReadonlyArray1<'py, f64>,
+fn noise_terms(
+    py: Python<'_>,
+    rate_dps: PyReadonlyArray1<'_, f64>,
     rate_hz: f64,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<String> {
     let x = slice(&rate_dps, "rate_dps")?;
     let period = sample_period(rate_hz)?;
     let terms = py
@@ -68,32 +68,7 @@ fn noise_terms<'py>(
             .map(|points| allan::noise_terms(&points, metrics::DPS_TO_DPH))
         })
         .map_err(allan_err)?;
-    let d = PyDict::new(py);
-    let rows: [(&str, &str, Option<NoiseTerm>); 5] = [
-        ("arw_deg_rt_h", "arw", terms.arw_deg_rt_h),
-        (
-            "bias_instability_dph",
-            "bias_instability",
-            terms.bias_instability_dph,
-        ),
-        ("rrw_deg_h_rt_h", "rrw", terms.rrw_deg_h_rt_h),
-        (
-            "quantization_arcsec",
-            "quantization",
-            terms.quantization_arcsec,
-        ),
-        ("rate_ramp_deg_h2", "rate_ramp", terms.rate_ramp_deg_h2),
-    ];
-    let fin = |v: f64| v.is_finite().then_some(v);
-    for (name, key, term) in rows {
-        d.set_item(name, term.and_then(|t| fin(t.value)))?;
-        d.set_item(format!("{key}_tau_s"), term.and_then(|t| fin(t.tau_read_s)))?;
-        d.set_item(
-            format!("{key}_fit_tau_s"),
-            term.map(|t| (fin(t.fit_tau_min_s), fin(t.fit_tau_max_s))),
-        )?;
-    }
-    Ok(d)
+    serde_json::to_string(&terms).map_err(metrics_err)
 }
 
 /// Scale-factor figures of a rate-table log, in the layout of `gyrotherm evaluate --json`.

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from typing import Any, Dict, Optional
 
 import numpy as np
@@ -27,12 +28,12 @@ def bias_stability(rate_dps, rate_hz: float, tau_s: float = 100.0) -> float:
 
 def noise_terms(rate_dps, rate_hz: float) -> Dict[str, Any]:
     """Noise terms read off the octave OADEV curve of a rate (°/s) sampled at ``rate_hz``,
-    as ``gyrotherm allan --json`` gives them: ``arw_deg_rt_h`` (angle random walk, °/√h),
-    ``bias_instability_dph`` (°/h), ``rrw_deg_h_rt_h`` (rate random walk, °/h/√h),
-    ``quantization_arcsec``, ``rate_ramp_deg_h2`` (°/h²); each with ``<name>_tau_s`` (τ it was
-    read at) and ``<name>_fit_tau_s`` (the τ range of its slope). None where the curve has
-    no such region."""
-    return _g.noise_terms(_rates(rate_dps), float(rate_hz))
+    as the ``noise`` object of ``gyrotherm allan --json``: ``arw_deg_rt_h`` (angle random
+    walk, °/√h), ``bias_instability_dph`` (°/h), ``rrw_deg_h_rt_h`` (rate random walk,
+    °/h/√h), ``quantization_arcsec``, ``rate_ramp_deg_h2`` (°/h²). Each is a dict with
+    ``value``, ``tau_read_s`` (τ it was read at) and ``fit_tau_min_s``/``fit_tau_max_s``
+    (the τ range of its slope), or None where the curve has no such region."""
+    return json.loads(_g.noise_terms(_rates(rate_dps), float(rate_hz)))
 
 
 def scale_factor(
