@@ -116,7 +116,14 @@ fn train_compensate_evaluate_and_stream_equals_batch() {
             row.starts_with(in_row),
             "input columns not passed through: {row}"
         );
-        let f: Vec<f64> = row.split(',').map(|v| v.parse().unwrap()).collect();
+        // Every field but the last (status) is a number.
+        let f: Vec<f64> = row
+            .rsplit_once(',')
+            .unwrap()
+            .0
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
         let want = (f[gi] - f[bi]) / f[ki];
         assert!(
             (f[oi] - want).abs() <= 1e-15 * want.abs().max(1e-3),

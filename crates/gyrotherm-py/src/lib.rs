@@ -79,6 +79,12 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ONE_SIGMA_CI", gyrotherm::allan::ONE_SIGMA_CI)?;
     m.add("BIAS_WINDOW_S", gyrotherm::targets::BIAS_WINDOW_S)?;
     m.add("SETTLE_S", gyrotherm::targets::SETTLE_S)?;
+    m.add(
+        "STATUS_NAMES",
+        model::status_names()
+            .into_iter()
+            .collect::<std::collections::BTreeMap<_, _>>(),
+    )?;
     allan::register(m)?;
     figures::register(m)?;
     logs::register(m)?;

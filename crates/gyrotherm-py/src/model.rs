@@ -5,7 +5,8 @@ use std::io::{BufWriter, Write as _};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use gyrotherm::compensate::{compensate_log, compensate_stream, extrapolation_warnings};
+use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
+use gyrotherm::compensate_lines::{compensate_lines, LinesError, Mode};
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, LstmVerdict, NamedLog, Target};
 use gyrotherm::model::{Method, ModelFile};
@@ -145,50 +146,53 @@ impl RawModel {
         };
         let (out, warnings) = py
             .detach(|| {
-                compensate_log(&self.file, &log)
+                compensate_with_status(&self.file, &log)
                     .map(|out| (out, extrapolation_warnings(&self.file, &log)))
             })
             .map_err(py_err::<CompensationError>)?;
-        let status = compensation_status(out.bias_dps.len());
+        let (bias, scale, rate, status) = out;
         Ok((
-            out.bias_dps.into_pyarray(py),
-            out.scale.into_pyarray(py),
-            out.gyro_comp_dps.into_pyarray(py),
+            bias.into_pyarray(py),
+            scale.into_pyarray(py),
+            rate.into_pyarray(py),
             status.into_pyarray(py),
             warnings,
         ))
     }
 
     /// Compensate a CSV log into a CSV file exactly as `gyrotherm compensate --input --out`
-    /// does (same code, same bytes); returns (rows, rows made by gap filling, warnings).
+    /// does (same code, same bytes); returns (rows, ok, held, degraded, invalid, warnings).
     fn compensate_csv(
         &self,
         py: Python<'_>,
         input: PathBuf,
         out: PathBuf,
         options: LogOptions,
-    ) -> PyResult<(u64, u64, Vec<String>)> {
+    ) -> PyResult<(u64, u64, u64, u64, u64, Vec<String>)> {
         let opts = options.read_options()?;
         let summary = py.detach(|| -> Result<_, String> {
             let file = std::fs::File::open(&input)
                 .map_err(|e| format!("cannot open {}: {e}", input.display()))?;
             gyrotherm::atomic_file::write_atomically(&out, |w: &mut BufWriter<std::fs::File>| {
-                let s = compensate_stream(
+                let s = compensate_lines(
                     &self.file,
                     std::io::BufReader::new(&file),
                     &input,
                     &opts,
                     &mut *w,
+                    Mode::Strict,
                     false,
-                )
-                .map_err(std::io::Error::other)?;
+                )?;
                 w.flush()?;
-                Ok::<_, std::io::Error>(s)
+                Ok::<_, LinesError>(s)
             })
-            .map_err(|e| format!("cannot compensate into {}: {e}", out.display()))
+            .map_err(|e| match e {
+                LinesError::Io(io) => format!("cannot compensate into {}: {io}", out.display()),
+                other => other.to_string(),
+            })
         });
         let s = summary.map_err(CompensationError::new_err)?;
-        Ok((s.rows, s.filled_rows, s.warnings))
+        Ok((s.rows, s.ok, s.held, s.degraded, s.invalid, s.warnings))
     }
 
     /// A human-readable description of the model.
@@ -251,10 +255,36 @@ impl RawModel {
     }
 }
 
-/// Per-sample status codes: every sample the compensator returns is 0 ("ok"); a sample it
-/// refuses raises instead. Kept as an array so that richer statuses slot in unchanged.
-fn compensation_status(n: usize) -> Vec<u8> {
-    vec![0; n]
+type Columns = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<u8>);
+
+/// `compensate_log` with each sample's status code (`Status as u8`): the same flight
+/// compensator stepped over the same samples.
+fn compensate_with_status(model: &ModelFile, log: &TestLog) -> Result<Columns, CompensateError> {
+    let mut comp = compensator(model)?;
+    let n = log.len();
+    let mut out: Columns = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    for i in 0..n {
+        let c = comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
+        out.0.push(c.bias_dps);
+        out.1.push(c.scale);
+        out.2.push(c.rate_dps);
+        out.3.push(c.status as u8);
+    }
+    Ok(out)
+}
+
+/// Status code → name, as in the `status` column of the CLI's streaming output.
+pub fn status_names() -> Vec<(u8, &'static str)> {
+    use gyrotherm_core::compensator::Status;
+    [Status::Ok, Status::Held, Status::Degraded, Status::Invalid]
+        .into_iter()
+        .map(|s| (s as u8, s.as_str()))
+        .collect()
 }
 
 fn parse_method(name: &str) -> PyResult<Method> {

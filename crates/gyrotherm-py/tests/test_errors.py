@@ -124,18 +124,19 @@ def test_scale_factor_of_a_static_log_says_why(logs):
         gt.scale_factor(time_s=np.arange(1000.0), gyro_dps=np.zeros(1000), table_dps=np.zeros(1000))
 
 
-def test_compensate_refuses_bad_samples(logs):
+def test_compensate_gives_bad_samples_a_status(logs):
+    """The flight compensator never stops: a non-finite gyro sample is "invalid" (no rate),
+    the others go on; mismatched arrays are refused."""
     model = gt.fit(static=logs["static"], method="linear")
     t = np.arange(100.0)
     with pytest.raises(gt.CompensationError, match="differ in length"):
         model.compensate(t, np.zeros(99), np.full(100, 20.0))
     g = np.zeros(100)
     g[5] = np.nan
-    with pytest.raises(gt.CompensationError, match=r"sample 6 \(time 5 s\)"):
-        model.compensate(t, g, np.full(100, 20.0))
-    t2 = t.copy()
-    t2[50] = 10.0
-    with pytest.raises(gt.CompensationError, match=r"sample 51 \(time 10 s\)"):
-        model.compensate(t2, np.zeros(100), np.full(100, 20.0))
+    out = model.compensate(t, g, np.full(100, 20.0))
+    names = [gt.STATUS_NAMES[int(s)] for s in out.status]
+    assert names[5] == "invalid" and out.rate_dps[5] == 0.0
+    assert names[:5] == ["ok"] * 5 and names[6:] == ["ok"] * 94
+    assert set(gt.STATUS_NAMES.values()) == {"ok", "held", "degraded", "invalid"}
     with pytest.raises(TypeError):
         gt.Model("not a model")

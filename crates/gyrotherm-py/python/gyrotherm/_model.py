@@ -16,8 +16,10 @@ from ._logs import read_options
 PathLike = Union[str, "os.PathLike[str]"]
 Progress = Union[bool, Callable[[str, int, float], Any], None]
 
-#: Per-sample status codes of :meth:`Model.compensate`.
-STATUS_NAMES: Dict[int, str] = {0: "ok"}
+#: Per-sample status codes of :meth:`Model.compensate` (the flight compensator's): ok, held
+#: (temperature rejected, B and K held), degraded (no good temperature for too long),
+#: invalid (gyro sample not finite: no rate).
+STATUS_NAMES: Dict[int, str] = dict(_g.STATUS_NAMES)
 
 
 class GyrothermWarning(UserWarning):
@@ -93,7 +95,7 @@ class Model:
         """Compensate samples (time s increasing, gyro output °/s, temperature °C) with the
         flight compensator, sample by sample: the numbers ``gyrotherm compensate`` writes.
         Warns (``GyrothermWarning``) where the temperature or its rate leaves the training
-        range; raises ``gyrotherm.CompensationError`` for a sample it refuses."""
+        range. Every sample gets a status (``STATUS_NAMES``) instead of an exception."""
         arrays = [np.ascontiguousarray(a, dtype=np.float64) for a in (time_s, gyro_dps, temp_c)]
         for name, a in zip(("time_s", "gyro_dps", "temp_c"), arrays):
             if a.ndim != 1:
@@ -104,13 +106,20 @@ class Model:
 
     def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]:
         """``gyrotherm compensate --input INPUT --out OUT`` with the same log options: every
-        input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps``. Returns rows written,
-        rows made by gap filling and the extrapolation warnings (also issued as warnings)."""
-        rows, filled, warns = self._raw.compensate_csv(
+        input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps`` and ``status``. Returns
+        the rows written, the count per status and the extrapolation warnings (also issued as
+        warnings)."""
+        if options.get("fill_gaps") is not None:
+            raise _g.CompensationError(
+                "fill_gaps does not apply to compensate: the compensator bridges time gaps "
+                "itself and writes one output line per input line"
+            )
+        rows, ok, held, degraded, invalid, warns = self._raw.compensate_csv(
             os.fspath(input), os.fspath(out), read_options(options)
         )
         _warn(warns)
-        return {"rows": rows, "filled_rows": filled, "warnings": warns}
+        return {"rows": rows, "ok": ok, "held": held, "degraded": degraded,
+                "invalid": invalid, "warnings": warns}
 
     def summary(self) -> str:
         """What the model is, what it was trained on, and (after :func:`fit`) how training
