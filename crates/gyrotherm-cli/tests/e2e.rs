@@ -177,7 +177,8 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
     let test_s = simulate(dir.path(), "test_static.csv", "slow-ramp", 3, false);
     let out = run_ok(
         gyrotherm()
-            .args(["compare", "--json", "--train"])
+            // The residual recipe: this test reads its LSTM gate.
+            .args(["compare", "--json", "--recipe", "residual", "--train"])
             .arg(&train_s)
             .arg("--train")
             .arg(&train_t)
@@ -233,6 +234,8 @@ fn validate_on_runs_reports_each_left_out_log() {
                 "train",
                 "--method",
                 "lstm",
+                "--recipe",
+                "residual",
                 "--epochs",
                 "3",
                 "--validate-on-runs",
@@ -314,4 +317,71 @@ fn bad_inputs_say_where_and_exit_2() {
         err.contains("junk.json") && err.contains("format_version 99"),
         "{err}"
     );
+}
+
+/// `simulate --unit random --unit-seed N` writes the drawn unit beside the log, and the same
+/// seed gives the same unit as the library's `random_unit` (independent: the library call).
+#[test]
+fn simulate_random_unit_writes_its_parameters() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.csv");
+    run_ok(
+        gyrotherm()
+            .args([
+                "simulate",
+                "--profile",
+                "room-steady",
+                "--unit",
+                "random",
+                "--unit-seed",
+                "12",
+                "--out",
+            ])
+            .arg(&out),
+    );
+    let text = std::fs::read_to_string(dir.path().join("r.csv.unit.json")).unwrap();
+    let unit = gyrotherm::sim::FogUnit::from_json_str(&text, "sidecar").unwrap();
+    assert_eq!(unit, gyrotherm::sim::random_unit(12));
+    let bad = gyrotherm()
+        .args(["simulate", "--unit", "random", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--unit-seed"));
+}
+
+/// A log at one sample per 15 s (100 s is no multiple of it): evaluate takes the multiple
+/// nearest 100 s, 105 s = 7 × 15 s, and says so; `--tau` still chooses.
+#[test]
+fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("coarse.csv");
+    run_ok(
+        gyrotherm()
+            .args([
+                "simulate",
+                "--profile",
+                "room-steady",
+                "--rate-hz",
+                "0.06666666666666667",
+                "--out",
+            ])
+            .arg(&path),
+    );
+    let out = run_ok(
+        gyrotherm()
+            .args(["evaluate", "--json", "--input"])
+            .arg(&path),
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["tau_s"].as_f64(), Some(105.0));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nearest 100 s"));
+    let out = run_ok(
+        gyrotherm()
+            .args(["evaluate", "--json", "--tau", "150", "--input"])
+            .arg(&path),
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["tau_s"].as_f64(), Some(150.0));
 }

@@ -16,6 +16,14 @@ use gyrotherm::model::{Method, SubModel};
 use gyrotherm::sim::{simulate, FogUnit, SimConfig};
 use gyrotherm::targets::TargetSet;
 
+/// The residual recipe (the tests below are about it; the default recipe is `thermal`).
+fn residual_cfg() -> FitConfig {
+    FitConfig {
+        recipe: LstmRecipe::residual(),
+        ..FitConfig::new(Method::Lstm)
+    }
+}
+
 const TABLE_RATE_DPS: f64 = 20.0;
 
 fn sim(profile: &str, seed: u64, table: bool, truth: bool) -> TestLog {
@@ -66,7 +74,7 @@ fn residual_recipe_meets_the_issue_targets_on_a_held_out_profile() {
     let logs = [("static", &train_static), ("table", &train_table)];
 
     let linear = fit(&logs, &FitConfig::new(Method::Linear)).model;
-    let mut cfg = FitConfig::new(Method::Lstm);
+    let mut cfg = residual_cfg();
     // Few epochs keep the test cheap; the recipe's gate decides whether the LSTM stays.
     cfg.recipe.epochs = 10;
     let lstm = fit(&logs, &cfg).model;
@@ -239,7 +247,7 @@ fn residual_lstm_is_kept_when_it_learns_what_the_physical_terms_cannot() {
     let train_b = synthetic_log("fast-cycle", 4, 0.0, &C, &coupling);
     let test = synthetic_log("slow-ramp", 5, 0.0, &C, &coupling);
     let logs = [("a", &train_a), ("b", &train_b)];
-    let mut cfg = FitConfig::new(Method::Lstm);
+    let mut cfg = residual_cfg();
     cfg.recipe.epochs = 60;
     // The base the data were made from: this test is about the LSTM, not the term choice.
     cfg.recipe.base = BaseTerms::Tailored;
@@ -297,7 +305,7 @@ fn run_gate_drops_an_lstm_that_does_not_carry_to_another_run() {
     let train_a = synthetic_log("seed-shock", 3, 0.0, &C, &coupling);
     let train_b = synthetic_log("fast-cycle", 4, 0.0, &C, &none);
     let logs = [("a", &train_a), ("b", &train_b)];
-    let mut cfg = FitConfig::new(Method::Lstm);
+    let mut cfg = residual_cfg();
     cfg.recipe.epochs = 60;
     cfg.recipe.base = BaseTerms::Tailored;
     cfg.recipe.validation_every = 0;
@@ -338,7 +346,7 @@ fn run_gate_drops_an_lstm_that_does_not_carry_to_another_run() {
 fn residual_recipe_is_deterministic() {
     let log = sim("fast-cycle", 5, false, false);
     let logs = [("static", &log)];
-    let mut cfg = FitConfig::new(Method::Lstm);
+    let mut cfg = residual_cfg();
     cfg.recipe.epochs = 3;
     // No validation blocks: the LSTM is kept as trained, so the test covers its training.
     cfg.recipe.validation_every = 0;
@@ -359,7 +367,7 @@ fn residual_recipe_is_deterministic() {
 fn residual_lstm_can_read_the_base_prediction() {
     let log = sim("fast-cycle", 5, false, false);
     let logs = [("static", &log)];
-    let mut cfg = FitConfig::new(Method::Lstm);
+    let mut cfg = residual_cfg();
     cfg.recipe.epochs = 3;
     cfg.recipe.validation_every = 0;
     cfg.recipe.base_input = true;
@@ -403,7 +411,7 @@ fn published_recipe_is_kept() {
         gyrotherm::fit::recipe::feature_spec(&r),
         FeatureSpec::PUBLISHED
     );
-    assert_eq!(LstmRecipe::default().kind, RecipeKind::Residual);
+    assert_eq!(LstmRecipe::default().kind, RecipeKind::Thermal);
     assert!(RecipeKind::parse("fancy")
         .unwrap_err()
         .to_string()
@@ -419,8 +427,8 @@ fn published_recipe_is_kept() {
     }
     assert_eq!(LstmRecipe::generic().base, BaseTerms::LinearT2);
     assert_eq!(LstmRecipe::direct().base, BaseTerms::Constant);
-    assert_eq!(LstmRecipe::default().base, BaseTerms::Selected);
-    assert_eq!(LstmRecipe::default().scale_base, BaseTerms::Selected);
+    assert_eq!(LstmRecipe::residual().base, BaseTerms::Selected);
+    assert_eq!(LstmRecipe::residual().scale_base, BaseTerms::Selected);
     for b in [
         BaseTerms::Selected,
         BaseTerms::Tailored,
@@ -437,7 +445,7 @@ fn published_recipe_is_kept() {
         .contains("T3+fast"));
 
     let log = sim("seed-shock", 6, false, false);
-    let mut cfg = FitConfig::new(Method::Lstm);
+    let mut cfg = residual_cfg();
     cfg.recipe = LstmRecipe {
         epochs: 3,
         ..LstmRecipe::published()
@@ -552,7 +560,7 @@ fn selected_terms_beat_the_tailored_terms_on_a_variant_unit() {
     let test_static = sim_unit("slow-ramp", 11, false, false, unit.clone());
     let test_table = sim_unit("slow-ramp", 111, true, false, unit);
     let logs = [("static", &train_static), ("table", &train_table)];
-    let mut cfg = FitConfig::new(Method::Lstm);
+    let mut cfg = residual_cfg();
     cfg.recipe.epochs = 0; // the least-squares base alone: this test is about its terms
     let selected = fit(&logs, &cfg);
     cfg.recipe.base = BaseTerms::Tailored;

@@ -120,7 +120,9 @@ fn full_report_over_simulated_logs_draws_every_figure() {
     ];
     let (train_n, test_n) = (named(&train), named(&test));
     let mut cfg = CompareConfig::default();
-    // A few epochs: the figures, not the fit quality, are under test.
+    // A recipe with an LSTM (the training-loss figure needs one; the default `thermal` has
+    // none), and a few epochs: the figures, not the fit quality, are under test.
+    cfg.fit.recipe = gyrotherm::fit::LstmRecipe::residual();
     cfg.fit.recipe.epochs = 3;
     let cmp = run_compare(&train_n, &test_n, &cfg);
 

@@ -21,9 +21,10 @@ pub struct EvaluateArgs {
     /// Rate column to judge: gyro_dps (default) or a numeric extra column (*_dps, *_dph, *_rad_s).
     #[arg(long, default_value = "gyro_dps")]
     pub column: String,
-    /// Smoothing time of the bias stability, s.
-    #[arg(long, default_value_t = 100.0)]
-    pub tau: f64,
+    /// Smoothing time of the bias stability, s (default 100 s, or the multiple of the sample
+    /// period nearest to it when 100 s is not one).
+    #[arg(long)]
+    pub tau: Option<f64>,
     /// Time dropped at the start of each rate-table segment, s.
     #[arg(long, default_value_t = 10.0)]
     pub settle: f64,
@@ -45,8 +46,21 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         );
     };
     let rate_dps: Vec<f64> = values.iter().map(|v| v * to_dph / 3600.0).collect();
+    let tau_s = match args.tau {
+        Some(t) => t,
+        None => {
+            let (t, adjusted) = metrics::default_tau_s(tau0_s, 100.0);
+            if adjusted {
+                eprintln!(
+                    "gyrotherm: τ = {t} s, the multiple of the {tau0_s} s sample period nearest \
+                     100 s (100 s is not one; give --tau to choose)"
+                );
+            }
+            t
+        }
+    };
     let opts = EvaluationOptions {
-        tau_s: args.tau,
+        tau_s,
         settle_s: args.settle,
         reference_scale: args.reference_scale,
     };

@@ -31,9 +31,14 @@ pub struct SimulateArgs {
     /// Output sample rate, Hz.
     #[arg(long, default_value_t = 1.0, value_name = "HZ")]
     rate_hz: f64,
-    /// Unit parameter file (JSON); fields given override the default unit's.
-    #[arg(long, value_name = "FILE")]
+    /// Unit parameter file (JSON); fields given override the default unit's. `random` draws
+    /// a unit from the documented family ranges (`gyrotherm::sim::family`) with --unit-seed;
+    /// its parameters are written beside the log as `<out>.unit.json`.
+    #[arg(long, value_name = "FILE|random")]
     unit: Option<PathBuf>,
+    /// Seed of the random unit (`--unit random`; same seed, same unit).
+    #[arg(long, value_name = "N")]
+    unit_seed: Option<u64>,
     /// Latitude, degrees north (Earth-rate component).
     #[arg(long, default_value_t = sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     latitude: f64,
@@ -91,9 +96,17 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let unit = match &args.unit {
-        Some(path) => FogUnit::load(path)?,
-        None => FogUnit::default(),
+    let random = args.unit.as_deref() == Some(std::path::Path::new("random"));
+    let unit = match (&args.unit, args.unit_seed) {
+        (Some(_), Some(seed)) if random => sim::random_unit(seed),
+        (Some(_), None) if random => {
+            anyhow::bail!("--unit random needs --unit-seed N (the seed that names the unit)")
+        }
+        (_, Some(_)) => anyhow::bail!(
+            "--unit-seed applies to --unit random only; give `--unit random --unit-seed N`"
+        ),
+        (Some(path), None) => FogUnit::load(path)?,
+        (None, None) => FogUnit::default(),
     };
     if args.print_unit {
         println!("{}", serde_json::to_string_pretty(&unit)?);
@@ -132,6 +145,16 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
     let out = args.out.context("--out is required")?;
     let log = sim::simulate(&cfg)?;
     gyrotherm::sim::fault::write_log(&out, &log)?;
+    let sidecar = random.then(|| {
+        let mut p = out.clone().into_os_string();
+        p.push(".unit.json");
+        PathBuf::from(p)
+    });
+    if let Some(path) = &sidecar {
+        let json = serde_json::to_string_pretty(&cfg.unit)? + "\n";
+        gyrotherm::atomic_file::write_bytes_atomically(path, json.as_bytes())
+            .with_context(|| format!("cannot write the unit's parameters to {}", path.display()))?;
+    }
 
     let (tmin, tmax) = log
         .temp_c
@@ -162,5 +185,8 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         cfg.seed,
         out.display()
     );
+    if let Some(path) = sidecar {
+        eprintln!("the drawn unit's parameters: {}", path.display());
+    }
     Ok(ExitCode::SUCCESS)
 }

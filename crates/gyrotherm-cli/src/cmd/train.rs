@@ -15,7 +15,7 @@ use super::progress::TrainingBars;
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
     /// LSTM recipe.
-    #[arg(long, value_enum, default_value_t = RecipeArg::Residual)]
+    #[arg(long, value_enum, default_value_t = RecipeArg::Thermal)]
     pub recipe: RecipeArg,
     /// LSTM training epochs (default: the recipe's).
     #[arg(long)]
@@ -90,6 +90,10 @@ impl FitArgs {
 /// `--recipe` values (the library's `fit::lstm::RecipeKind`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum RecipeArg {
+    /// Thermal time constants identified from the logs and a ridge fit on them, no LSTM
+    /// (the default: chosen on a family of simulated units, docs/experiments/generalisation.md);
+    /// degrades on short or coarse logs and says how.
+    Thermal,
     /// Least squares on thermal-state inputs (T, dT, T − first-order lags of 300/1000/3000 s)
     /// plus an LSTM on its residual, kept only where it beats the least-squares base on
     /// validation blocks.
@@ -105,6 +109,7 @@ pub enum RecipeArg {
 impl From<RecipeArg> for RecipeKind {
     fn from(r: RecipeArg) -> RecipeKind {
         match r {
+            RecipeArg::Thermal => RecipeKind::Thermal,
             RecipeArg::Residual => RecipeKind::Residual,
             RecipeArg::Generic => RecipeKind::Generic,
             RecipeArg::Direct => RecipeKind::Direct,
@@ -212,6 +217,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         let Some(sub) = sub else { continue };
         eprintln!("  {name} model: {}", sub.kind());
         let Some(t) = t else { continue };
+        if let Some(r) = &t.thermal {
+            eprintln!("    {}", r.describe());
+        }
         if let Some(sel) = &t.selection {
             eprintln!(
                 "    least-squares terms by time-segment cross-validation (RMS, * chosen): {}",

@@ -38,6 +38,10 @@ pub enum FitError {
     LeastSquares(LsqError),
     /// LSTM training was refused.
     Train(TrainError),
+    /// The thermal recipe could not identify or fit its model.
+    Thermal(super::thermal::ThermalError),
+    /// The thermal recipe identifies its features from the logs: fit it through `fit_model`.
+    NeedsLogs,
     /// The fitted model did not pass the model file's checks.
     Model(ModelFileError),
     /// The fit of one target (bias or scale factor) failed.
@@ -91,6 +95,11 @@ impl std::fmt::Display for FitError {
             FitError::NoFeatureSteps => write!(f, "the training logs have no feature steps"),
             FitError::LeastSquares(e) => e.fmt(f),
             FitError::Train(e) => e.fmt(f),
+            FitError::Thermal(e) => e.fmt(f),
+            FitError::NeedsLogs => write!(
+                f,
+                "the thermal recipe identifies its features from the logs: fit it with fit_model"
+            ),
             FitError::Model(e) => e.fmt(f),
             FitError::Target { target, source } => match target {
                 Target::Bias => write!(f, "bias model: {source}"),
@@ -108,6 +117,7 @@ impl std::error::Error for FitError {
         match self {
             FitError::LeastSquares(e) => Some(e),
             FitError::Train(e) => Some(e),
+            FitError::Thermal(e) => Some(e),
             FitError::Model(e) => Some(e),
             FitError::Target { source, .. } => Some(source.as_ref()),
             _ => None,
@@ -124,6 +134,12 @@ impl From<LsqError> for FitError {
 impl From<TrainError> for FitError {
     fn from(e: TrainError) -> Self {
         FitError::Train(e)
+    }
+}
+
+impl From<super::thermal::ThermalError> for FitError {
+    fn from(e: super::thermal::ThermalError) -> Self {
+        FitError::Thermal(e)
     }
 }
 

@@ -8,6 +8,8 @@
 //! Modules, each one concept, imports running one way (down this list):
 //! - [`recipe`]: which LSTM recipe, its knobs, and what training reports ([`TrainSummary`]).
 //! - [`published`], [`residual`], [`generic`], [`direct`]: one recipe each.
+//! - [`thermal`]: the thermal-state recipe (lags identified from the data, ridge by
+//!   cross-validation; no LSTM).
 //! - [`select`]: choosing a residual recipe's least-squares terms by blocked cross-validation.
 //! - [`terms`]: the term sets (tailored, generic, the ladder) the bases are built from.
 //! - [`error`]: why a fit was refused ([`FitError`]).
@@ -23,6 +25,7 @@ pub mod recipe;
 pub mod residual;
 pub mod select;
 pub mod terms;
+pub mod thermal;
 
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
@@ -59,6 +62,8 @@ pub struct FitConfig {
     pub scale_window_s: f64,
     /// Random seed (LSTM initialisation and window order).
     pub seed: u64,
+    /// Settings of the thermal recipe ([`thermal`]).
+    pub thermal: thermal::ThermalConfig,
 }
 
 impl FitConfig {
@@ -71,6 +76,7 @@ impl FitConfig {
             settle_s: targets::SETTLE_S,
             scale_window_s: targets::SCALE_WINDOW_S,
             seed: 0,
+            thermal: thermal::ThermalConfig::default(),
         }
     }
 }
@@ -136,8 +142,17 @@ fn fit_one(
     sets: &[TargetSet],
     cfg: &FitConfig,
     target: Target,
+    identified: Option<&thermal::Identified>,
     progress: &mut dyn FnMut(usize, f64),
 ) -> Result<(SubModel, Option<TrainSummary>), FitError> {
+    if let Some(id) = identified {
+        let (sub, report) = thermal::fit_target(sets, &cfg.thermal, id, target == Target::Scale)?;
+        let summary = TrainSummary {
+            thermal: Some(report),
+            ..TrainSummary::default()
+        };
+        return Ok((sub, Some(summary)));
+    }
     match cfg.method {
         Method::Linear | Method::Poly => {
             let terms = baseline_terms(cfg, target, sets[0].table.n_features);
@@ -164,7 +179,21 @@ pub fn fit_model(
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
-    let spec = feature_spec(cfg);
+    let identified = if cfg.method == Method::Lstm && cfg.recipe.kind == RecipeKind::Thermal {
+        let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
+        Some(thermal::identify(
+            &named,
+            &cfg.thermal,
+            cfg.bias_window_s,
+            cfg.settle_s,
+            cfg.scale_window_s,
+        )?)
+    } else {
+        None
+    };
+    let spec = identified
+        .as_ref()
+        .map_or_else(|| feature_spec(cfg), |id| id.spec);
     let mut bias_sets = Vec::new();
     let mut scale_sets = Vec::new();
     for l in logs {
@@ -198,17 +227,25 @@ pub fn fit_model(
         let bias = s.spawn(|| {
             (!bias_sets.is_empty())
                 .then(|| {
-                    fit_one(&bias_sets, cfg, Target::Bias, &mut |e, l| {
-                        progress(Target::Bias, e, l)
-                    })
+                    fit_one(
+                        &bias_sets,
+                        cfg,
+                        Target::Bias,
+                        identified.as_ref(),
+                        &mut |e, l| progress(Target::Bias, e, l),
+                    )
                 })
                 .transpose()
         });
         let scale = (!scale_sets.is_empty())
             .then(|| {
-                fit_one(&scale_sets, cfg, Target::Scale, &mut |e, l| {
-                    progress(Target::Scale, e, l)
-                })
+                fit_one(
+                    &scale_sets,
+                    cfg,
+                    Target::Scale,
+                    identified.as_ref(),
+                    &mut |e, l| progress(Target::Scale, e, l),
+                )
             })
             .transpose();
         let bias = bias.join().unwrap_or(Err(FitError::ThreadPanicked {
@@ -278,6 +315,10 @@ impl LstmRecipe {
             RecipeKind::Residual => Self::residual(),
             RecipeKind::Generic => Self::generic(),
             RecipeKind::Direct => Self::direct(),
+            RecipeKind::Thermal => LstmRecipe {
+                kind: RecipeKind::Thermal,
+                ..Self::residual()
+            },
         }
     }
 }
@@ -305,5 +346,7 @@ pub fn fit_target(
         RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct => {
             residual::fit(train, recipe, target, n_in, seed, progress)
         }
+        // Its features come from the logs: `fit_model` identifies them and fits it.
+        RecipeKind::Thermal => Err(FitError::NeedsLogs),
     }
 }

@@ -20,6 +20,9 @@ pub enum RecipeKind {
     /// As `Residual` with a constant base only ([`BaseTerms::Constant`]): the LSTM models the
     /// whole bias from the thermal-state inputs (windowed truncated BPTT, early stopping).
     Direct,
+    /// Thermal time constants identified from the training data and a ridge fit on them, no
+    /// LSTM ([`super::thermal`]).
+    Thermal,
 }
 
 impl RecipeKind {
@@ -30,6 +33,7 @@ impl RecipeKind {
             RecipeKind::Residual => "residual",
             RecipeKind::Generic => "generic",
             RecipeKind::Direct => "direct",
+            RecipeKind::Thermal => "thermal",
         }
     }
 
@@ -40,6 +44,7 @@ impl RecipeKind {
             "residual" => Ok(RecipeKind::Residual),
             "generic" => Ok(RecipeKind::Generic),
             "direct" => Ok(RecipeKind::Direct),
+            "thermal" => Ok(RecipeKind::Thermal),
             _ => Err(UnknownRecipe {
                 name: name.to_owned(),
             }),
@@ -57,7 +62,7 @@ impl std::fmt::Display for UnknownRecipe {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "unknown LSTM recipe {:?}: use `residual` (default), `generic`, `direct` or \
+            "unknown LSTM recipe {:?}: use `residual` (default), `thermal`, `generic`, `direct` or \
              `published`",
             self.name
         )
@@ -146,6 +151,8 @@ pub struct TrainSummary {
     /// Whether the residual LSTM was kept, and if not which check left it out (`Residual`
     /// with an LSTM trained only).
     pub lstm_verdict: Option<LstmVerdict>,
+    /// What the thermal recipe identified and which degradations it took (`Thermal` only).
+    pub thermal: Option<super::thermal::ThermalReport>,
 }
 
 /// What became of a trained residual LSTM.
@@ -168,7 +175,9 @@ pub enum LstmVerdict {
 pub fn feature_spec(recipe: &LstmRecipe) -> FeatureSpec {
     match recipe.kind {
         RecipeKind::Published => FeatureSpec::PUBLISHED,
-        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct => {
+        // Thermal: the lags are identified from the logs (`thermal::identify`); this is the
+        // shape before identification.
+        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct | RecipeKind::Thermal => {
             FeatureSpec::THERMAL_STATE
         }
     }

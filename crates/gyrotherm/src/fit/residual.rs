@@ -54,9 +54,10 @@ impl LstmRecipe {
 }
 
 impl Default for LstmRecipe {
-    /// [`LstmRecipe::residual`].
+    /// The thermal recipe ([`super::thermal`]): chosen on a family of simulated units
+    /// (docs/experiments/generalisation.md).
     fn default() -> Self {
-        Self::residual()
+        Self::of_kind(super::RecipeKind::Thermal)
     }
 }
 
@@ -340,6 +341,7 @@ pub(crate) fn fit(
         selection,
         run_gate,
         lstm_verdict: Some(verdict),
+        thermal: None,
     };
     if verdict != LstmVerdict::Kept {
         // The LSTM predicted none of the held-out residual: the physical fit alone.

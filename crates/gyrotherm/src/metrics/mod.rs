@@ -145,6 +145,21 @@ fn samples_per_mean(sample_period_s: f64, tau_s: f64) -> Result<usize, MetricsEr
     Ok(m as usize)
 }
 
+/// The bias-stability smoothing time to use when none was asked for: `preferred_s` (100 s in
+/// He et al. 2024) when it is a whole number of sample periods, otherwise the whole multiple
+/// of the period nearest to it (at least one period). Returns `(τ, adjusted)`; a caller
+/// should say so when `adjusted` (a log at one sample per 15 s gets τ = 105 s).
+pub fn default_tau_s(sample_period_s: f64, preferred_s: f64) -> (f64, bool) {
+    if !(sample_period_s.is_finite() && sample_period_s > 0.0) {
+        return (preferred_s, false);
+    }
+    if samples_per_mean(sample_period_s, preferred_s).is_ok() {
+        return (preferred_s, false);
+    }
+    let m = (preferred_s / sample_period_s).round().max(1.0);
+    (m * sample_period_s, true)
+}
+
 /// Bias stability (GJB 2426A / IEEE 952): sample std (n − 1) of consecutive non-overlapping
 /// τ-means of `rate_dps`, in °/h. τ must be an integer multiple of `sample_period_s`.
 pub fn bias_stability_dph(

@@ -1,11 +1,15 @@
 //! The FOG unit: thermal nodes, bias and scale-factor physics, temperature sensor.
 //!
 //! Thermal nodes (first-order lags, sampled exactly: y += (u - y)·(1 - e^{-h/τ})):
-//! - case  T_case: lag of the chamber air, τ = `case_tau_s`;
+//! - mount T_mount (optional, `mount_tau_s > 0`): lag of the chamber air (mounting plate or
+//!   fixture between chamber and housing);
+//! - case  T_case: lag of the mounting node, or of the chamber air without one,
+//!   τ = `case_tau_s`;
 //! - coil  T_coil: lag of the case, τ = `coil_tau_s` (the fiber coil sits inside, potted);
 //! - stress state S: lag of the coil, τ = `stress_tau_s` (slow relaxation of the potting and
 //!   fiber jacket; makes the output depend on temperature history — hysteresis);
-//! - sensor T_sens: lag of the case, τ = `sensor_tau_s` (DS18B20 on the case).
+//! - sensor T_sens: lag of the node named by `sensor_node` (mount, case — the default, as in
+//!   He et al. 2024 — or coil), τ = `sensor_tau_s`.
 //!
 //! Bias, °/h, with ΔT = T_coil - `ref_temp_c` (He et al. 2024 eq. (3): B = B0 - Be):
 //! ```text
@@ -19,14 +23,25 @@
 //!                                                    potting's temperature-dependent stiffness
 //!                                                    (elasto-optic part, Mohr 1996)
 //!   + stress_dph_per_c·(T_coil - S)                  stress relaxation / hysteresis (°/h/°C)
+//!   + shupe_grad_dph_per_c_per_s·d(T_case - T_coil)/dt
+//!                                                    radial-gradient Shupe term: the rate of
+//!                                                    change of the gradient across the coil
+//!                                                    (Mohr 1996, transient thermal gradients)
+//!   + rate_sat_dph·tanh(dT_coil/dt / rate_sat_c_per_s)
+//!                                                    saturating rate term (potting that stops
+//!                                                    following the rate: tanh-like)
 //! ```
 //! For a first-order coil node dT_coil/dt = (T_case - T_coil)/τ_coil, so the Shupe term is
 //! also the case-to-coil gradient term; it is evaluated from that formula (no numerical
 //! differentiation).
 //!
 //! Scale factor (dimensionless, Ĝ = B + K·G, He et al. eq. (1),(2)): with ΔT on the coil,
-//! K = 1 + 1e-6·(`sf_offset_ppm` + `sf_c1_ppm_per_c`·ΔT + `sf_c2_ppm_per_c2`·ΔT²)
-//! (fiber length and refractive index, source wavelength; the lag comes from the coil node).
+//! K = 1 + 1e-6·(`sf_offset_ppm` + `sf_c1_ppm_per_c`·ΔT + `sf_c2_ppm_per_c2`·ΔT² +
+//! `sf_c3_ppm_per_c3`·ΔT³ + `sf_rate_ppm_per_c_per_s`·dT_coil/dt +
+//! `sf_stress_ppm_per_c`·(T_coil - S)) (fiber length and refractive index, source
+//! wavelength; the lag comes from the coil node). The rate derivatives are evaluated from the
+//! node equations (d T/dt = (drive - T)/τ), not by numerical differentiation. The terms after
+//! the stress term are zero for the default unit; [`super::family`] draws units that use them.
 //!
 //! Temperature sensor reading (the logged `temp_c`, DS18B20 class, He et al. sec. 3: ±0.5 °C
 //! accuracy, 0.0625 °C resolution): round((T_sens + offset + noise) / res)·res.
@@ -87,8 +102,41 @@ pub struct FogUnit {
     pub sensor_noise_c: f64,
     /// Temperature sensor resolution, °C (DS18B20 at 12 bits: 0.0625 °C); 0 = none.
     pub sensor_resolution_c: f64,
-    /// Temperature sensor thermal lag behind the case, s.
+    /// Temperature sensor thermal lag behind the node it sits on, s.
     pub sensor_tau_s: f64,
+    /// Mounting-node time constant (chamber air → mounting plate → case), s; 0: no mounting
+    /// node, the case follows the chamber air directly.
+    pub mount_tau_s: f64,
+    /// The node the temperature sensor sits on.
+    pub sensor_node: SensorNode,
+    /// Radial-gradient Shupe coefficient: bias per rate of change of T_case - T_coil,
+    /// °/h per °C/s.
+    pub shupe_grad_dph_per_c_per_s: f64,
+    /// Saturating rate term: amplitude A, °/h, of A·tanh(dT_coil/dt / r_s).
+    pub rate_sat_dph: f64,
+    /// Saturating rate term: the coil rate r_s at which it reaches tanh(1) of its amplitude,
+    /// °C/s (> 0).
+    pub rate_sat_c_per_s: f64,
+    /// Cubic scale-factor coefficient on the coil temperature, ppm/°C³.
+    pub sf_c3_ppm_per_c3: f64,
+    /// Scale factor per coil temperature rate, ppm per °C/s.
+    pub sf_rate_ppm_per_c_per_s: f64,
+    /// Scale factor per stress lag T_coil - S, ppm/°C.
+    pub sf_stress_ppm_per_c: f64,
+}
+
+/// Where the temperature sensor sits (the logged `temp_c` follows this node through the
+/// sensor's own lag).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SensorNode {
+    /// On the mounting plate (the case when the unit has no mounting node).
+    Mount,
+    /// On the housing (case), as in He et al. 2024's test set-up.
+    #[default]
+    Case,
+    /// On the fiber coil.
+    Coil,
 }
 
 impl Default for FogUnit {
@@ -123,6 +171,14 @@ impl Default for FogUnit {
             sensor_noise_c: 0.01,
             sensor_resolution_c: 0.0625,
             sensor_tau_s: 20.0,
+            mount_tau_s: 0.0,
+            sensor_node: SensorNode::Case,
+            shupe_grad_dph_per_c_per_s: 0.0,
+            rate_sat_dph: 0.0,
+            rate_sat_c_per_s: 0.01,
+            sf_c3_ppm_per_c3: 0.0,
+            sf_rate_ppm_per_c_per_s: 0.0,
+            sf_stress_ppm_per_c: 0.0,
         }
     }
 }
@@ -170,6 +226,14 @@ impl FogUnit {
             ("sf_c1_ppm_per_c", self.sf_c1_ppm_per_c),
             ("sf_c2_ppm_per_c2", self.sf_c2_ppm_per_c2),
             ("sensor_offset_c", self.sensor_offset_c),
+            (
+                "shupe_grad_dph_per_c_per_s",
+                self.shupe_grad_dph_per_c_per_s,
+            ),
+            ("rate_sat_dph", self.rate_sat_dph),
+            ("sf_c3_ppm_per_c3", self.sf_c3_ppm_per_c3),
+            ("sf_rate_ppm_per_c_per_s", self.sf_rate_ppm_per_c_per_s),
+            ("sf_stress_ppm_per_c", self.sf_stress_ppm_per_c),
         ];
         for (f, v) in finite {
             if !v.is_finite() {
@@ -181,6 +245,7 @@ impl FogUnit {
             ("coil_tau_s", self.coil_tau_s),
             ("stress_tau_s", self.stress_tau_s),
             ("sensor_tau_s", self.sensor_tau_s),
+            ("rate_sat_c_per_s", self.rate_sat_c_per_s),
         ];
         for (f, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -194,6 +259,7 @@ impl FogUnit {
             ("pulse_arcsec", self.pulse_arcsec),
             ("sensor_noise_c", self.sensor_noise_c),
             ("sensor_resolution_c", self.sensor_resolution_c),
+            ("mount_tau_s", self.mount_tau_s),
         ];
         for (f, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
@@ -213,10 +279,42 @@ impl FogUnit {
             + self.stress_dph_per_c * (coil_c - stress_c)
     }
 
-    /// Scale factor K (dimensionless, ≈ 1) at coil temperature `coil_c`.
+    /// Scale factor K (dimensionless, ≈ 1) at coil temperature `coil_c`, the rest of the
+    /// state at rest (no coil rate, stress state at the coil temperature).
     pub fn scale(&self, coil_c: f64) -> f64 {
+        self.scale_ppm_terms(coil_c, 0.0, coil_c)
+    }
+
+    /// Scale factor K of a thermal state: the coil polynomial plus the coil-rate and stress
+    /// terms.
+    pub fn scale_of_state(&self, s: &ThermalState) -> f64 {
+        self.scale_ppm_terms(s.coil_c, s.coil_rate_c_per_s(self), s.stress_c)
+    }
+
+    fn scale_ppm_terms(&self, coil_c: f64, coil_rate_c_per_s: f64, stress_c: f64) -> f64 {
         let dt = coil_c - self.ref_temp_c;
-        1.0 + 1e-6 * (self.sf_offset_ppm + (self.sf_c1_ppm_per_c + self.sf_c2_ppm_per_c2 * dt) * dt)
+        1.0 + 1e-6
+            * (self.sf_offset_ppm
+                + (self.sf_c1_ppm_per_c
+                    + (self.sf_c2_ppm_per_c2 + self.sf_c3_ppm_per_c3 * dt) * dt)
+                    * dt
+                + self.sf_rate_ppm_per_c_per_s * coil_rate_c_per_s
+                + self.sf_stress_ppm_per_c * (coil_c - stress_c))
+    }
+
+    /// The bias terms beyond [`FogUnit::thermal_bias_dph`], °/h: the radial-gradient Shupe
+    /// term on d(T_case - T_coil)/dt and the saturating rate term A·tanh(dT_coil/dt / r_s),
+    /// for the state `s` with chamber air at `air_c`.
+    pub fn gradient_and_saturation_bias_dph(&self, s: &ThermalState, air_c: f64) -> f64 {
+        let coil_rate = s.coil_rate_c_per_s(self);
+        let grad_rate = s.case_rate_c_per_s(self, air_c) - coil_rate;
+        self.shupe_grad_dph_per_c_per_s * grad_rate
+            + self.rate_sat_dph * libm::tanh(coil_rate / self.rate_sat_c_per_s)
+    }
+
+    /// Whether the unit has a mounting node between the chamber air and the case.
+    pub fn has_mount(&self) -> bool {
+        self.mount_tau_s > 0.0
     }
 }
 
@@ -228,6 +326,8 @@ pub(crate) fn lag_alpha(h_s: f64, tau_s: f64) -> f64 {
 /// Thermal state of the unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ThermalState {
+    /// Mounting-node temperature, °C (follows the chamber air when the unit has none).
+    pub mount_c: f64,
     /// Case temperature, °C.
     pub case_c: f64,
     /// Coil temperature, °C.
@@ -242,6 +342,7 @@ impl ThermalState {
     /// Everything in equilibrium at `temp_c`.
     pub fn steady(temp_c: f64) -> Self {
         ThermalState {
+            mount_c: temp_c,
             case_c: temp_c,
             coil_c: temp_c,
             stress_c: temp_c,
@@ -253,11 +354,25 @@ impl ThermalState {
     pub fn coil_rate_c_per_s(&self, unit: &FogUnit) -> f64 {
         (self.case_c - self.coil_c) / unit.coil_tau_s
     }
+
+    /// Case temperature rate, °C/s, with chamber air at `air_c`: (drive - T_case)/τ_case, the
+    /// drive being the mounting node, or the air when the unit has none.
+    pub fn case_rate_c_per_s(&self, unit: &FogUnit, air_c: f64) -> f64 {
+        let drive = if unit.has_mount() {
+            self.mount_c
+        } else {
+            air_c
+        };
+        (drive - self.case_c) / unit.case_tau_s
+    }
 }
 
 /// Precomputed lag factors for one integration step.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ThermalStep {
+    /// Mounting-node factor; None: no mounting node.
+    mount: Option<f64>,
+    sensor_node: SensorNode,
     case: f64,
     coil: f64,
     stress: f64,
@@ -267,6 +382,8 @@ pub(crate) struct ThermalStep {
 impl ThermalStep {
     pub(crate) fn new(unit: &FogUnit, h_s: f64) -> Self {
         ThermalStep {
+            mount: unit.has_mount().then(|| lag_alpha(h_s, unit.mount_tau_s)),
+            sensor_node: unit.sensor_node,
             case: lag_alpha(h_s, unit.case_tau_s),
             coil: lag_alpha(h_s, unit.coil_tau_s),
             stress: lag_alpha(h_s, unit.stress_tau_s),
@@ -277,10 +394,25 @@ impl ThermalStep {
     /// One step with chamber air at `air_c` (each node driven by its upstream node's value at
     /// the start of the step).
     pub(crate) fn advance(&self, s: &mut ThermalState, air_c: f64) {
-        let (case, coil) = (s.case_c, s.coil_c);
-        s.case_c += (air_c - case) * self.case;
+        let (mount, case, coil) = (s.mount_c, s.case_c, s.coil_c);
+        let case_drive = match self.mount {
+            Some(a) => {
+                s.mount_c += (air_c - mount) * a;
+                mount
+            }
+            None => {
+                s.mount_c = air_c;
+                air_c
+            }
+        };
+        let sensed = match (self.sensor_node, self.mount) {
+            (SensorNode::Mount, Some(_)) => mount,
+            (SensorNode::Mount, None) | (SensorNode::Case, _) => case,
+            (SensorNode::Coil, _) => coil,
+        };
+        s.case_c += (case_drive - case) * self.case;
         s.coil_c += (case - coil) * self.coil;
         s.stress_c += (coil - s.stress_c) * self.stress;
-        s.sensor_c += (case - s.sensor_c) * self.sensor;
+        s.sensor_c += (sensed - s.sensor_c) * self.sensor;
     }
 }

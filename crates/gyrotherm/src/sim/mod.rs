@@ -25,6 +25,7 @@
 //! conversion time, and non-vertical mounting (the Earth-rate term assumes the input axis up).
 
 pub mod chamber;
+pub mod family;
 pub mod fault;
 pub mod fog;
 pub mod noise;
@@ -34,8 +35,9 @@ pub mod table;
 use std::path::PathBuf;
 
 pub use chamber::ChamberParams;
+pub use family::{random_unit, UnitRanges};
 pub use fault::FaultParams;
-pub use fog::{FogUnit, ThermalState, EARTH_RATE_DPH};
+pub use fog::{FogUnit, SensorNode, ThermalState, EARTH_RATE_DPH};
 pub use profile::{Profile, Segment, BUILTIN_PROFILES};
 
 use crate::csvlog::{ExtraColumn, TestLog, NOISE_COL, TRUE_BIAS_COL, TRUE_SCALE_COL};
@@ -298,15 +300,17 @@ pub fn simulate_series(cfg: &SimConfig) -> Result<SimSeries, SimError> {
     for i in 0..n {
         let t_s = i as f64 / cfg.sample_rate_hz;
         let sp_c = setpoint.at(t_s);
+        let air_c = chamber.air_c(t_s);
         let bias_dph = unit.bias0_dph
             + earth_dph
             + unit.thermal_bias_dph(
                 thermal.coil_c,
                 thermal.coil_rate_c_per_s(unit),
                 thermal.stress_c,
-            );
+            )
+            + unit.gradient_and_saturation_bias_dph(&thermal, air_c);
         let bias_dps = bias_dph / 3600.0;
-        let k = unit.scale(thermal.coil_c);
+        let k = unit.scale_of_state(&thermal);
         let omega_dps = cfg
             .table_rate_dps
             .map_or(0.0, |r| table::table_rate_dps(r, cfg.table_segment_s, t_s));
@@ -331,7 +335,7 @@ pub fn simulate_series(cfg: &SimConfig) -> Result<SimSeries, SimError> {
         s.true_scale.push(k);
         s.noise_dps.push(gyro_dps - signal_dps);
         s.setpoint_c.push(sp_c);
-        s.chamber_c.push(chamber.air_c(t_s));
+        s.chamber_c.push(air_c);
         s.case_c.push(thermal.case_c);
         s.coil_c.push(thermal.coil_c);
         s.stress_c.push(thermal.stress_c);

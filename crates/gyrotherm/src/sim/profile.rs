@@ -50,7 +50,7 @@ pub struct Profile {
 }
 
 /// Names of the built-in profiles, with a one-line description each.
-pub const BUILTIN_PROFILES: [(&str, &str); 4] = [
+pub const BUILTIN_PROFILES: [(&str, &str); 6] = [
     (
         "seed-shock",
         "the published shock test (He et al. 2024): 22 °C, 3 °C/min to -40 °C, soak 9000 s, \
@@ -69,6 +69,16 @@ pub const BUILTIN_PROFILES: [(&str, &str); 4] = [
     (
         "room-steady",
         "constant 22 °C set point for 10,000 s (noise and static checks)",
+    ),
+    (
+        "shock-5",
+        "seed-shock at 5 °C/min: 22 °C, 5 °C/min to -40 °C, soak 9000 s, 5 °C/min to +60 °C, \
+         soak 9000 s, back to 22 °C; 28,400 s",
+    ),
+    (
+        "airborne",
+        "a flight: soak at +50 °C on the ground for 3600 s, climb to -45 °C in 600 s \
+         (9.5 °C/min), cruise 4 h, descend to +20 °C in 1800 s, 3000 s on the ground; 23,400 s",
     ),
 ];
 
@@ -111,6 +121,26 @@ impl Profile {
                 (2000.0, 22.0),
             ],
             "room-steady" => &[(10000.0, 22.0)],
+            // The seed-shock test at the faster rate of a shock chamber.
+            "shock-5" => &[
+                (3000.0, 22.0),
+                (744.0, -40.0), // 62 °C / (5 °C/min)
+                (9000.0, -40.0),
+                (1200.0, 60.0), // 100 °C / (5 °C/min)
+                (9000.0, 60.0),
+                (456.0, 22.0), // 38 °C / (5 °C/min)
+                (5000.0, 22.0),
+            ],
+            // The seed paper's motivating case (He et al. 2024, introduction: +50 °C on the
+            // ground to about -50 °C at altitude): a gyro soaked on a hot apron, a climb,
+            // hours of cruise, the descent.
+            "airborne" => &[
+                (3600.0, 50.0),
+                (600.0, -45.0), // 95 °C in 10 min
+                (14400.0, -45.0),
+                (1800.0, 20.0), // 65 °C in 30 min
+                (3000.0, 20.0),
+            ],
             _ => {
                 let names: Vec<&str> = BUILTIN_PROFILES.iter().map(|p| p.0).collect();
                 return Err(SimError::Config(format!(

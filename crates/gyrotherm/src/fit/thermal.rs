@@ -1,0 +1,1077 @@
+//! The thermal-state recipe: thermal time constants identified from the training data, and a
+//! ridge fit whose strength is chosen by blocked cross-validation in time.
+//!
+//! A gyro's bias and scale factor follow the temperatures of nodes the log does not see (the
+//! coil, a mounting plate, a slow stress state); with one sensor they are first-order lags of
+//! the logged temperature (a chain of lags is a sum of parallel ones with the same time
+//! constants). Fixed lags of 300, 1000 and 3000 s fit the units they were chosen on; here the
+//! lags are identified by **variable projection** (Golub & Pereyra 1973, SIAM J. Numer. Anal.
+//! 10(2), DOI 10.1137/0710036): for given time constants the model is linear in its
+//! coefficients, which are projected out by (ridge) least squares, leaving a search over the
+//! time constants alone — a grid over triples in log τ, then a coordinate search refining the
+//! best. Each candidate is scored by blocked cross-validation (each run cut into contiguous
+//! folds, a gap either side of the left-out one, the residual's per-run mean removed: Roberts
+//! et al. 2017, DOI 10.1111/ecog.02881), so a lag that only fits the noise does not win.
+//!
+//! The terms are one generous polynomial over `x = (T, dT, D1, D2, D3)`, `Dj = T - lag_τj(T)`
+//! ([`basis`]), not a subset picked by name; **ridge** regression (Hoerl & Kennard 1970,
+//! Technometrics 12(1)) on RMS-scaled, per-run-centred columns keeps the redundant ones small,
+//! its strength chosen from [`ThermalConfig::ridge_grid`] by the same cross-validation. Each
+//! training run keeps its own offset (turn-on repeatability); the model keeps their mean. The
+//! result is a least-squares sub-model the flight compensator evaluates as it is (no LSTM).
+//!
+//! Short or coarse logs (80 minutes at one sample per 15 s, one heating ramp): the recipe
+//! degrades rather than refuse — fewer folds, lags bounded by the run length, fewer lags,
+//! fewer terms, a fixed ridge strength without cross-validation — and says each step in
+//! [`ThermalReport::notes`]. It refuses only data no method could fit (fewer labelled steps
+//! than a linear fit needs, a constant temperature).
+
+use std::fmt;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::baseline::Terms;
+use crate::csvlog::TestLog;
+use crate::features::{extract_series, FeatureSpec, LagOutputs};
+use crate::model::SubModel;
+use crate::targets::{self, TargetSet};
+
+/// Settings of the thermal-state recipe.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThermalConfig {
+    /// Lags to identify (1 to 3; fewer when the runs are short).
+    pub n_lags: usize,
+    /// Range of the time constants searched, s (the upper end is also bounded by
+    /// [`ThermalConfig::max_tau_fraction`] of the longest training run).
+    pub tau_range_s: (f64, f64),
+    /// Grid points over `tau_range_s` (log-spaced) for the first search.
+    pub tau_grid: usize,
+    /// Longest time constant as a fraction of the longest training run.
+    pub max_tau_fraction: f64,
+    /// Blocked cross-validation folds per run (fewer when the runs are short).
+    pub folds: usize,
+    /// Steps left out either side of a validation fold (the bias target is a 100 s moving
+    /// average; scaled down with the step count on coarse logs).
+    pub gap_s: f64,
+    /// Ridge strengths tried, relative to unit-RMS columns (penalty λ·n·Σ β_j² on the scaled
+    /// coefficients).
+    pub ridge_grid: Vec<f64>,
+    /// Ridge strength used when the runs are too short to cross-validate.
+    pub fallback_ridge: f64,
+    /// Which terms the bias model gets, and the lag identification uses ([`basis`]).
+    pub basis: Basis,
+    /// Which terms the scale-factor model gets.
+    pub scale_basis: Basis,
+    /// Least ratio between neighbouring time constants (close lags are nearly collinear,
+    /// and their large opposite coefficients extrapolate badly).
+    pub min_lag_ratio: f64,
+    /// Identify the lags on the bias and the scale factor together (the sum of their
+    /// cross-validated scores, each relative to its target's spread) when both kinds of run
+    /// are given; otherwise on the bias alone.
+    pub joint: bool,
+    /// The strongest ridge whose cross-validated score is within this relative margin of the
+    /// best is taken (prefer the smoother fit when the data cannot tell them apart).
+    pub ridge_tolerance: f64,
+}
+
+impl Default for ThermalConfig {
+    fn default() -> Self {
+        ThermalConfig {
+            n_lags: 3,
+            tau_range_s: (60.0, 12000.0),
+            tau_grid: 9,
+            max_tau_fraction: 0.5,
+            folds: 5,
+            gap_s: 200.0,
+            ridge_grid: (0..=9).map(|k| 10f64.powi(-9 + k)).collect(),
+            fallback_ridge: 1e-4,
+            basis: Basis::Lean,
+            scale_basis: Basis::Full,
+            min_lag_ratio: 3.0,
+            joint: true,
+            ridge_tolerance: 0.0,
+        }
+    }
+}
+
+/// The term sets of the recipe (over `T, dT, D1..Dn`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Basis {
+    /// `1, T, T², T³, Dj, T·Dj (j ≤ 2), D1², D1·D2, D2², D1³`.
+    Full,
+    /// `1, T, T², T³, Dj, T·D1, D1²` (fewer second-order terms).
+    Small,
+    /// `1, T, T², T³, Dj, T·Dj`: a cubic in T, every lag difference linear with a
+    /// temperature-dependent slope; nothing of higher order in the lag differences, so a
+    /// faster temperature change than in training extrapolates linearly.
+    Linear,
+    /// `1, T, T², T³, Dj, T·D1`: as `Linear`, the temperature-dependent slope on the fastest
+    /// lag only (the Shupe term's temperature coefficient).
+    Lean,
+    /// `1, T, T², Dj` (short runs).
+    Minimal,
+}
+
+impl Basis {
+    /// Name as in the benchmark and the report.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Basis::Full => "full",
+            Basis::Small => "small",
+            Basis::Linear => "linear",
+            Basis::Lean => "lean",
+            Basis::Minimal => "minimal",
+        }
+    }
+}
+
+/// Monomial powers over `n` features from (feature, power) pairs.
+fn term(n: usize, parts: &[(usize, u8)]) -> Vec<u8> {
+    let mut p = vec![0u8; n];
+    for &(i, q) in parts {
+        p[i] += q;
+    }
+    p
+}
+
+/// The terms over `x = (T, dT, D1, …, D_lags)` (feature 0 is T, 1 is dT, 2.. the lag
+/// differences, fastest lag first). The 20 s rate dT is no term: the fastest lag difference
+/// carries the rate, smoothed, where dT carries the sensor's 0.0625 °C steps.
+pub fn basis(kind: Basis, lags: usize) -> Terms {
+    let n = 2 + lags;
+    let d = |j: usize| 2 + j;
+    let mut p = vec![term(n, &[]), term(n, &[(0, 1)]), term(n, &[(0, 2)])];
+    if kind != Basis::Minimal {
+        p.push(term(n, &[(0, 3)]));
+    }
+    for j in 0..lags {
+        p.push(term(n, &[(d(j), 1)]));
+    }
+    match kind {
+        Basis::Minimal => {}
+        Basis::Lean => {
+            if lags >= 1 {
+                p.push(term(n, &[(0, 1), (d(0), 1)]));
+            }
+        }
+        Basis::Linear => {
+            for j in 0..lags {
+                p.push(term(n, &[(0, 1), (d(j), 1)]));
+            }
+        }
+        Basis::Small => {
+            if lags >= 1 {
+                p.push(term(n, &[(0, 1), (d(0), 1)]));
+                p.push(term(n, &[(d(0), 2)]));
+            }
+        }
+        Basis::Full => {
+            for j in 0..lags.min(2) {
+                p.push(term(n, &[(0, 1), (d(j), 1)]));
+            }
+            if lags >= 1 {
+                p.push(term(n, &[(d(0), 2)]));
+            }
+            if lags >= 2 {
+                p.push(term(n, &[(d(0), 1), (d(1), 1)]));
+                p.push(term(n, &[(d(1), 2)]));
+            }
+            if lags >= 1 {
+                p.push(term(n, &[(d(0), 3)]));
+            }
+        }
+    }
+    Terms {
+        n_features: n,
+        powers: p,
+    }
+}
+
+/// Why the recipe could not fit.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum ThermalError {
+    /// No static and no rate-table run gave labelled steps.
+    NoTargets,
+    /// The targets of run `run` could not be computed.
+    Targets { run: String, message: String },
+    /// Fewer labelled steps than even a linear fit with per-run offsets needs.
+    TooFewSteps { steps: usize, needed: usize },
+    /// The logged temperature does not vary in the training runs.
+    ConstantTemperature,
+    /// The feature pipeline refused the identified spec (a bug if it happens).
+    Features(String),
+    /// The least-squares system could not be solved.
+    Singular,
+}
+
+impl fmt::Display for ThermalError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ThermalError::NoTargets => write!(
+                f,
+                "no training run has labelled steps: give a static run (bias) or a rate-table \
+                 run with stop segments between the rates (scale factor)"
+            ),
+            ThermalError::Targets { run, message } => write!(f, "{run}: {message}"),
+            ThermalError::TooFewSteps { steps, needed } => write!(
+                f,
+                "{steps} labelled steps, fewer than the {needed} a linear fit needs: log longer \
+                 runs (at least a temperature ramp and a soak)"
+            ),
+            ThermalError::ConstantTemperature => write!(
+                f,
+                "the temperature does not vary in the training runs: no thermal model can be \
+                 fitted; log a run through a temperature change"
+            ),
+            ThermalError::Features(m) => write!(f, "features: {m}"),
+            ThermalError::Singular => write!(
+                f,
+                "the least-squares system is singular even with the ridge penalty: the runs \
+                 carry too little variation"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ThermalError {}
+
+/// What the recipe identified and how, for the user and the model's record.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ThermalReport {
+    /// Identified time constants, s, fastest first.
+    pub lags_s: Vec<f64>,
+    /// Which target identified them (`bias`, `scale factor`, or both).
+    pub identified_on: String,
+    /// Cross-validated RMS residual at the identified lags, target units (None without
+    /// cross-validation).
+    pub cv_rms: Option<f64>,
+    /// Candidate lag sets scored.
+    pub candidates: usize,
+    /// Ridge strength chosen for this target.
+    pub ridge: f64,
+    /// Folds of the cross-validation (0: none).
+    pub folds: usize,
+    /// Terms of this target's fit.
+    pub basis: String,
+    /// Each degradation taken, in words (empty: none).
+    pub notes: Vec<String>,
+}
+
+impl ThermalReport {
+    /// One paragraph for the user: the lags, how they and the ridge strength were chosen, and
+    /// every degradation taken.
+    pub fn describe(&self) -> String {
+        let lags: Vec<String> = self.lags_s.iter().map(|t| format!("{t:.0}")).collect();
+        let mut out = format!(
+            "thermal lags {} s identified on the {} ({} candidates); terms `{}`, ridge \
+             strength {:.0e} ",
+            lags.join(", "),
+            self.identified_on,
+            self.candidates,
+            self.basis,
+            self.ridge
+        );
+        match (self.folds, self.cv_rms) {
+            (0, _) => out.push_str("(fixed: no cross-validation)"),
+            (f, Some(rms)) => out.push_str(&format!(
+                "by {f}-fold time-segment cross-validation (RMS {rms:.3e})"
+            )),
+            (f, None) => out.push_str(&format!("by {f}-fold time-segment cross-validation")),
+        }
+        for n in &self.notes {
+            out.push_str("; ");
+            out.push_str(n);
+        }
+        out
+    }
+}
+
+/// The identification: the feature spec the model reads, and its report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Identified {
+    pub spec: FeatureSpec,
+    pub report: ThermalReport,
+    /// The basis and folds the data allow (used for both targets).
+    pub basis: Basis,
+    pub folds: usize,
+    pub gap_steps: usize,
+}
+
+/// One run's labelled steps for the search: temperature and time per step, target, mask.
+struct RunData<'a> {
+    log: &'a TestLog,
+    target: Vec<f64>,
+    mask: Vec<bool>,
+}
+
+/// Per-run design matrices (labelled rows only) for given lags and a term set.
+struct Design {
+    /// Row-major, `terms.len() - 1` columns (no constant), per run.
+    x: Vec<Vec<f64>>,
+    y: Vec<Vec<f64>>,
+    /// Row index (step) of each labelled row, per run (for the folds).
+    step: Vec<Vec<usize>>,
+    /// Steps per run (for the fold boundaries).
+    n_steps: Vec<usize>,
+}
+
+fn spec_with(lags: &[f64]) -> Result<FeatureSpec, ThermalError> {
+    FeatureSpec::THERMAL_STATE
+        .with_lags(lags, LagOutputs::DiffFromT)
+        .map_err(|e| ThermalError::Features(e.to_string()))
+}
+
+fn design(runs: &[RunData], lags: &[f64], terms: &Terms) -> Result<Design, ThermalError> {
+    let spec = spec_with(lags)?;
+    let nc = terms.len() - 1;
+    let mut d = Design {
+        x: Vec::new(),
+        y: Vec::new(),
+        step: Vec::new(),
+        n_steps: Vec::new(),
+    };
+    for r in runs {
+        let table = extract_series(&r.log.time_s, &r.log.temp_c, &spec)
+            .map_err(|e| ThermalError::Features(e.to_string()))?;
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        let mut step = Vec::new();
+        for k in 0..table.n_rows().min(r.mask.len()) {
+            if r.mask[k] {
+                x.extend_from_slice(&terms.design_row(table.row(k))[1..]);
+                debug_assert_eq!(x.len() % nc.max(1), 0);
+                y.push(r.target[k]);
+                step.push(k);
+            }
+        }
+        d.x.push(x);
+        d.y.push(y);
+        d.step.push(step);
+        d.n_steps.push(table.n_rows());
+    }
+    Ok(d)
+}
+
+/// Sufficient statistics of a set of rows: n, Σx, Σy, Σxxᵀ (upper), Σxy, Σy².
+#[derive(Clone)]
+struct Stats {
+    n: f64,
+    sx: Vec<f64>,
+    sy: f64,
+    sxx: Vec<f64>,
+    sxy: Vec<f64>,
+}
+
+impl Stats {
+    fn new(nc: usize) -> Self {
+        Stats {
+            n: 0.0,
+            sx: vec![0.0; nc],
+            sy: 0.0,
+            sxx: vec![0.0; nc * nc],
+            sxy: vec![0.0; nc],
+        }
+    }
+    fn add(&mut self, x: &[f64], y: f64, sign: f64) {
+        let nc = self.sx.len();
+        self.n += sign;
+        self.sy += sign * y;
+        for i in 0..nc {
+            let xi = sign * x[i];
+            self.sx[i] += xi;
+            self.sxy[i] += xi * y;
+            let row = &mut self.sxx[i * nc..];
+            for j in i..nc {
+                row[j] += xi * x[j];
+            }
+        }
+    }
+    fn minus(&self, o: &Stats) -> Stats {
+        let sub = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p - q).collect();
+        Stats {
+            n: self.n - o.n,
+            sx: sub(&self.sx, &o.sx),
+            sy: self.sy - o.sy,
+            sxx: sub(&self.sxx, &o.sxx),
+            sxy: sub(&self.sxy, &o.sxy),
+        }
+    }
+}
+
+/// Per-run-centred normal equations from per-run statistics: G = Σ_r (Sxx − n x̄x̄ᵀ),
+/// g = Σ_r (Sxy − n x̄ ȳ).
+fn centred_normal(stats: &[Stats], nc: usize) -> (Vec<f64>, Vec<f64>, f64) {
+    let mut g = vec![0.0; nc * nc];
+    let mut b = vec![0.0; nc];
+    let mut n = 0.0;
+    for s in stats {
+        if s.n < 1.0 {
+            continue;
+        }
+        n += s.n;
+        for i in 0..nc {
+            b[i] += s.sxy[i] - s.sx[i] * s.sy / s.n;
+            for j in i..nc {
+                let v = s.sxx[i * nc + j] - s.sx[i] * s.sx[j] / s.n;
+                g[i * nc + j] += v;
+            }
+        }
+    }
+    for i in 0..nc {
+        for j in 0..i {
+            g[i * nc + j] = g[j * nc + i];
+        }
+    }
+    (g, b, n)
+}
+
+/// Ridge solution on RMS-scaled columns: (G + λ·n·diag(G)/n… ) — the penalty is
+/// λ·Σ_j G_jj·β_j², i.e. λ·n·Σ (s_j β_j)² with s_j the column's centred RMS.
+fn ridge_solve(g: &[f64], b: &[f64], nc: usize, lambda: f64) -> Option<Vec<f64>> {
+    if nc == 0 {
+        return Some(Vec::new());
+    }
+    // Scale to unit diagonal for conditioning, solve, scale back.
+    let s: Vec<f64> = (0..nc).map(|i| g[i * nc + i].max(0.0).sqrt()).collect();
+    if s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return None;
+    }
+    let a = DMatrix::from_fn(nc, nc, |i, j| {
+        g[i * nc + j] / (s[i] * s[j]) + if i == j { lambda } else { 0.0 }
+    });
+    let rhs = DVector::from_fn(nc, |i, _| b[i] / s[i]);
+    let sol = match a.clone().cholesky() {
+        Some(ch) => ch.solve(&rhs),
+        None => a.svd(true, true).solve(&rhs, 1e-14).ok()?,
+    };
+    let beta: Vec<f64> = (0..nc).map(|i| sol[i] / s[i]).collect();
+    beta.iter().all(|v| v.is_finite()).then_some(beta)
+}
+
+/// Contiguous fold `f` of `folds` over `n` steps: `[a, b)`.
+fn fold_range(n: usize, f: usize, folds: usize) -> (usize, usize) {
+    (n * f / folds, n * (f + 1) / folds)
+}
+
+/// Blocked cross-validated RMS residual (per-run means removed) for each ridge strength.
+fn cv_scores(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -> Vec<f64> {
+    let nr = d.x.len();
+    let total: Vec<Stats> = (0..nr)
+        .map(|r| {
+            let mut s = Stats::new(nc);
+            for (k, y) in d.y[r].iter().enumerate() {
+                s.add(&d.x[r][k * nc..(k + 1) * nc], *y, 1.0);
+            }
+            s
+        })
+        .collect();
+    // Out-of-fold residuals per λ, per run.
+    let mut resid: Vec<Vec<Vec<f64>>> = lambdas
+        .iter()
+        .map(|_| d.y.iter().map(|y| vec![f64::NAN; y.len()]).collect())
+        .collect();
+    for f in 0..folds {
+        let mut train = Vec::with_capacity(nr);
+        for (r, tot) in total.iter().enumerate() {
+            let (a, b) = fold_range(d.n_steps[r], f, folds);
+            let (ga, gb) = (a.saturating_sub(gap), b + gap);
+            let mut out = Stats::new(nc);
+            for (k, &st) in d.step[r].iter().enumerate() {
+                if st >= ga && st < gb {
+                    out.add(&d.x[r][k * nc..(k + 1) * nc], d.y[r][k], 1.0);
+                }
+            }
+            train.push(tot.minus(&out));
+        }
+        let (g, b, _) = centred_normal(&train, nc);
+        for (li, &lam) in lambdas.iter().enumerate() {
+            let Some(beta) = ridge_solve(&g, &b, nc, lam) else {
+                continue;
+            };
+            for r in 0..nr {
+                let t = &train[r];
+                if t.n < 1.0 {
+                    continue;
+                }
+                let offset = (t.sy - t.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>()) / t.n;
+                let (a, b) = fold_range(d.n_steps[r], f, folds);
+                for (k, &st) in d.step[r].iter().enumerate() {
+                    if st >= a && st < b {
+                        let x = &d.x[r][k * nc..(k + 1) * nc];
+                        let p: f64 = x.iter().zip(&beta).map(|(u, v)| u * v).sum::<f64>() + offset;
+                        resid[li][r][k] = d.y[r][k] - p;
+                    }
+                }
+            }
+        }
+    }
+    resid
+        .iter()
+        .map(|runs| {
+            let (mut ss, mut n) = (0.0, 0usize);
+            for v in runs {
+                if v.iter().any(|x| !x.is_finite()) {
+                    return f64::INFINITY;
+                }
+                if v.is_empty() {
+                    continue;
+                }
+                let m = v.iter().sum::<f64>() / v.len() as f64;
+                ss += v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
+                n += v.len();
+            }
+            if n == 0 {
+                f64::INFINITY
+            } else {
+                (ss / n as f64).sqrt()
+            }
+        })
+        .collect()
+}
+
+/// Best (score, λ) for a design: the strongest λ within `tol` of the least score.
+fn best_ridge(
+    d: &Design,
+    nc: usize,
+    folds: usize,
+    gap: usize,
+    lambdas: &[f64],
+    tol: f64,
+) -> (f64, f64) {
+    let scores = cv_scores(d, nc, folds, gap, lambdas);
+    let least = scores.iter().copied().fold(f64::INFINITY, f64::min);
+    scores
+        .into_iter()
+        .zip(lambdas.iter().copied())
+        .filter(|(s, _)| s.is_finite() && *s <= least * (1.0 + tol))
+        .fold((f64::INFINITY, f64::NAN), |best, (s, l)| {
+            if best.1.is_nan() || l > best.1 {
+                (s, l)
+            } else {
+                best
+            }
+        })
+}
+
+fn run_data<'a>(
+    logs: &[(&'a str, &'a TestLog)],
+    bias: bool,
+    bias_window_s: f64,
+    settle_s: f64,
+    scale_window_s: f64,
+) -> Result<Vec<RunData<'a>>, ThermalError> {
+    let spec = FeatureSpec::PUBLISHED;
+    let mut out = Vec::new();
+    for (name, log) in logs {
+        if targets::is_static(log) != bias {
+            continue;
+        }
+        let t = if bias {
+            targets::bias_targets(log, &spec, bias_window_s)
+        } else {
+            targets::scale_targets(log, &spec, settle_s, scale_window_s)
+        }
+        .map_err(|message| ThermalError::Targets {
+            run: (*name).to_owned(),
+            message: message.to_string(),
+        })?;
+        if t.labelled() > 0 {
+            out.push(RunData {
+                log,
+                target: t.target,
+                mask: t.mask,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// What the training runs allow: folds, gap, lag range, lag count, basis; with notes.
+struct Allowance {
+    folds: usize,
+    gap_steps: usize,
+    tau_max_s: f64,
+    n_lags: usize,
+    basis: Basis,
+    notes: Vec<String>,
+}
+
+fn allowance(runs: &[RunData], cfg: &ThermalConfig) -> Result<Allowance, ThermalError> {
+    let labelled: usize = runs
+        .iter()
+        .map(|r| r.mask.iter().filter(|m| **m).count())
+        .sum();
+    let longest_s = runs
+        .iter()
+        .map(|r| r.log.time_s.last().copied().unwrap_or(0.0) - r.log.time_s[0])
+        .fold(0.0f64, f64::max);
+    let period = runs
+        .iter()
+        .map(|r| r.log.sample_period_s())
+        .filter(|p| p.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let mut notes = Vec::new();
+    let tmin = runs
+        .iter()
+        .flat_map(|r| r.log.temp_c.iter().copied())
+        .fold(f64::INFINITY, f64::min);
+    let tmax = runs
+        .iter()
+        .flat_map(|r| r.log.temp_c.iter().copied())
+        .fold(f64::NEG_INFINITY, f64::max);
+    if tmax.is_nan() || tmin.is_nan() || tmax - tmin <= 0.5 {
+        return Err(ThermalError::ConstantTemperature);
+    }
+    let needed = 3 + runs.len();
+    if labelled < needed {
+        return Err(ThermalError::TooFewSteps {
+            steps: labelled,
+            needed,
+        });
+    }
+    // Steps per fold: each fold should hold at least 40 labelled steps per term it checks.
+    let per_run_min = runs
+        .iter()
+        .map(|r| r.mask.iter().filter(|m| **m).count())
+        .min()
+        .unwrap_or(0);
+    let mut folds = cfg.folds;
+    while folds > 2 && per_run_min / folds < 40 {
+        folds -= 1;
+    }
+    if per_run_min / folds < 20 {
+        folds = 0;
+        notes.push(format!(
+            "no cross-validation: {per_run_min} labelled steps in the shortest run are too few \
+             for folds; ridge strength fixed at {:.0e}",
+            cfg.fallback_ridge
+        ));
+    } else if folds < cfg.folds {
+        notes.push(format!(
+            "{folds} cross-validation folds instead of {} (short runs: {per_run_min} labelled \
+             steps)",
+            cfg.folds
+        ));
+    }
+    let step = period.max(1.0);
+    let gap_steps = ((cfg.gap_s / step).round() as usize).min(per_run_min / 10);
+    let mut tau_max_s = cfg.tau_range_s.1;
+    let bound = cfg.max_tau_fraction * longest_s;
+    if bound < tau_max_s {
+        tau_max_s = bound.max(cfg.tau_range_s.0);
+        notes.push(format!(
+            "lags up to {tau_max_s:.0} s only ({}% of the {longest_s:.0} s run) instead of {:.0} s",
+            (100.0 * cfg.max_tau_fraction).round(),
+            cfg.tau_range_s.1
+        ));
+    }
+    let tau_min_s = cfg.tau_range_s.0.max(3.0 * period);
+    // Each lag needs room: a factor 2 between neighbours.
+    let mut n_lags = cfg.n_lags.clamp(1, 3);
+    while n_lags > 1 && tau_min_s * cfg.min_lag_ratio.powi(n_lags as i32 - 1) > tau_max_s {
+        n_lags -= 1;
+    }
+    if n_lags < cfg.n_lags {
+        notes.push(format!(
+            "{n_lags} lag(s) instead of {}: the runs are too short to tell more apart",
+            cfg.n_lags
+        ));
+    }
+    let mut basis = cfg.basis;
+    // Ten labelled steps per term at least (each step is one target value).
+    while basis != Basis::Minimal && labelled < 100 * self::basis(basis, n_lags).len() {
+        basis = match basis {
+            Basis::Full => Basis::Small,
+            Basis::Small => Basis::Linear,
+            Basis::Linear => Basis::Lean,
+            _ => Basis::Minimal,
+        };
+    }
+    if basis != cfg.basis {
+        notes.push(format!(
+            "terms `{}` instead of `{}`: {labelled} labelled steps",
+            basis.name(),
+            cfg.basis.name()
+        ));
+    }
+    Ok(Allowance {
+        folds,
+        gap_steps,
+        tau_max_s,
+        n_lags,
+        basis,
+        notes,
+    })
+}
+
+/// Identify the lags from the training logs (the static runs' bias, or without static runs
+/// the rate-table runs' scale factor) and return the feature spec the model will read.
+pub fn identify(
+    logs: &[(&str, &TestLog)],
+    cfg: &ThermalConfig,
+    bias_window_s: f64,
+    settle_s: f64,
+    scale_window_s: f64,
+) -> Result<Identified, ThermalError> {
+    let bias_runs = run_data(logs, true, bias_window_s, settle_s, scale_window_s)?;
+    let scale_runs = run_data(logs, false, bias_window_s, settle_s, scale_window_s)?;
+    let (runs, on) = if bias_runs.is_empty() {
+        (&scale_runs, "scale factor")
+    } else {
+        (&bias_runs, "bias")
+    };
+    if runs.is_empty() {
+        return Err(ThermalError::NoTargets);
+    }
+    let al = allowance(runs, cfg)?;
+    // The scale factor joins the identification when it can be cross-validated too.
+    let joint = (cfg.joint && !bias_runs.is_empty() && !scale_runs.is_empty())
+        .then(|| allowance(&scale_runs, cfg).ok())
+        .flatten()
+        .filter(|a| a.folds > 0 && al.folds > 0);
+    let on = if joint.is_some() {
+        "bias and scale factor"
+    } else {
+        on
+    };
+    let tau_min = cfg.tau_range_s.0.max(
+        3.0 * runs
+            .iter()
+            .map(|r| r.log.sample_period_s())
+            .fold(0.0f64, f64::max),
+    );
+    let terms = basis(al.basis, al.n_lags);
+    let nc = terms.len() - 1;
+    let scale_terms = basis(cfg.scale_basis, al.n_lags);
+    let lambdas: Vec<f64> = if al.folds == 0 {
+        vec![cfg.fallback_ridge]
+    } else {
+        cfg.ridge_grid.clone()
+    };
+    // Each target's score relative to its own spread, so that the two can be added.
+    let spread = |rs: &[RunData]| {
+        let (mut ss, mut n) = (0.0, 0usize);
+        for r in rs {
+            let v: Vec<f64> = r
+                .target
+                .iter()
+                .zip(&r.mask)
+                .filter(|(t, m)| **m && t.is_finite())
+                .map(|(t, _)| *t)
+                .collect();
+            if v.is_empty() {
+                continue;
+            }
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            ss += v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
+            n += v.len();
+        }
+        (ss / n.max(1) as f64).sqrt().max(f64::MIN_POSITIVE)
+    };
+    let (ref_main, ref_scale) = (spread(runs), spread(&scale_runs));
+    let score = |lags: &[f64]| -> Result<(f64, f64), ThermalError> {
+        let d = design(runs, lags, &terms)?;
+        if al.folds == 0 {
+            // No cross-validation: the in-sample RMS at the fixed ridge strength.
+            return Ok((
+                in_sample_rms(&d, nc, cfg.fallback_ridge),
+                cfg.fallback_ridge,
+            ));
+        }
+        let (s, l) = best_ridge(
+            &d,
+            nc,
+            al.folds,
+            al.gap_steps,
+            &lambdas,
+            cfg.ridge_tolerance,
+        );
+        let Some(ak) = &joint else {
+            return Ok((s, l));
+        };
+        let dk = design(&scale_runs, lags, &scale_terms)?;
+        let (sk, _) = best_ridge(
+            &dk,
+            scale_terms.len() - 1,
+            ak.folds,
+            ak.gap_steps,
+            &lambdas,
+            cfg.ridge_tolerance,
+        );
+        Ok((s / ref_main + sk / ref_scale, l))
+    };
+    // 1. Grid over increasing lag tuples, neighbours at least one grid step apart.
+    let g = cfg.tau_grid.max(al.n_lags + 1);
+    let (lo, hi) = (tau_min.ln(), al.tau_max_s.max(tau_min * 1.01).ln());
+    let grid: Vec<f64> = (0..g)
+        .map(|i| (lo + (hi - lo) * i as f64 / (g - 1) as f64).exp())
+        .collect();
+    let mut tuples: Vec<Vec<usize>> = vec![vec![]];
+    for _ in 0..al.n_lags {
+        let mut next = Vec::new();
+        for t in &tuples {
+            let start = t.last().map_or(0, |v| v + 1);
+            for i in start..g {
+                if let Some(&p) = t.last() {
+                    if grid[i] < grid[p] * cfg.min_lag_ratio * 0.999 {
+                        continue;
+                    }
+                }
+                let mut u = t.clone();
+                u.push(i);
+                next.push(u);
+            }
+        }
+        tuples = next;
+    }
+    let mut candidates = 0;
+    let mut best = (f64::INFINITY, f64::NAN, Vec::new());
+    for t in &tuples {
+        let lags: Vec<f64> = t.iter().map(|&i| grid[i]).collect();
+        let (s, l) = score(&lags)?;
+        candidates += 1;
+        if s < best.0 {
+            best = (s, l, lags);
+        }
+    }
+    if best.2.is_empty() {
+        return Err(ThermalError::Singular);
+    }
+    // 2. Coordinate search in log τ around the best, step factor halving in log.
+    let mut step = ((hi - lo) / (g - 1) as f64 / 2.0).exp();
+    for _ in 0..3 {
+        let mut improved = true;
+        while improved {
+            improved = false;
+            for j in 0..best.2.len() {
+                for f in [step, 1.0 / step] {
+                    let mut lags = best.2.clone();
+                    lags[j] = (lags[j] * f).clamp(tau_min, al.tau_max_s);
+                    let ok = lags.windows(2).all(|w| w[1] >= w[0] * cfg.min_lag_ratio);
+                    if !ok || lags == best.2 {
+                        continue;
+                    }
+                    let (s, l) = score(&lags)?;
+                    candidates += 1;
+                    if s < best.0 * (1.0 - 1e-4) {
+                        best = (s, l, lags);
+                        improved = true;
+                    }
+                }
+            }
+        }
+        step = step.sqrt();
+    }
+    let lags = best.2;
+    let spec = spec_with(&lags)?;
+    Ok(Identified {
+        spec,
+        report: ThermalReport {
+            lags_s: lags,
+            identified_on: on.to_owned(),
+            cv_rms: (al.folds > 0 && joint.is_none()).then_some(best.0),
+            candidates,
+            ridge: best.1,
+            folds: al.folds,
+            basis: al.basis.name().to_owned(),
+            notes: al.notes,
+        },
+        basis: al.basis,
+        folds: al.folds,
+        gap_steps: al.gap_steps,
+    })
+}
+
+fn in_sample_rms(d: &Design, nc: usize, lambda: f64) -> f64 {
+    let stats: Vec<Stats> = (0..d.x.len())
+        .map(|r| {
+            let mut s = Stats::new(nc);
+            for (k, y) in d.y[r].iter().enumerate() {
+                s.add(&d.x[r][k * nc..(k + 1) * nc], *y, 1.0);
+            }
+            s
+        })
+        .collect();
+    let (g, b, n) = centred_normal(&stats, nc);
+    let Some(beta) = ridge_solve(&g, &b, nc, lambda) else {
+        return f64::INFINITY;
+    };
+    let mut ss = 0.0;
+    for (r, s) in stats.iter().enumerate() {
+        if s.n < 1.0 {
+            continue;
+        }
+        let off = (s.sy - s.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>()) / s.n;
+        for (k, y) in d.y[r].iter().enumerate() {
+            let x = &d.x[r][k * nc..(k + 1) * nc];
+            let p: f64 = x.iter().zip(&beta).map(|(u, v)| u * v).sum::<f64>() + off;
+            ss += (y - p) * (y - p);
+        }
+    }
+    (ss / n.max(1.0)).sqrt()
+}
+
+/// Fit one target on training sets whose features are the identified spec's: ridge over
+/// [`basis`], strength by blocked cross-validation (or the fallback), per-run offsets
+/// averaged into the constant.
+pub fn fit_target(
+    sets: &[TargetSet],
+    cfg: &ThermalConfig,
+    id: &Identified,
+    scale: bool,
+) -> Result<(SubModel, ThermalReport), ThermalError> {
+    let lags = id.report.lags_s.len();
+    let mut kind = if scale { cfg.scale_basis } else { id.basis };
+    let labelled: usize = sets.iter().map(|s| s.labelled()).sum();
+    while kind != Basis::Minimal && labelled < 100 * basis(kind, lags).len() {
+        kind = match kind {
+            Basis::Full => Basis::Small,
+            Basis::Small => Basis::Linear,
+            Basis::Linear => Basis::Lean,
+            _ => Basis::Minimal,
+        };
+    }
+    let terms = basis(kind, lags);
+    let nc = terms.len() - 1;
+    let mut d = Design {
+        x: Vec::new(),
+        y: Vec::new(),
+        step: Vec::new(),
+        n_steps: Vec::new(),
+    };
+    for s in sets {
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        let mut step = Vec::new();
+        for k in 0..s.table.n_rows() {
+            if s.mask[k] && s.target[k].is_finite() {
+                x.extend_from_slice(&terms.design_row(s.table.row(k))[1..]);
+                y.push(s.target[k]);
+                step.push(k);
+            }
+        }
+        d.x.push(x);
+        d.y.push(y);
+        d.step.push(step);
+        d.n_steps.push(s.table.n_rows());
+    }
+    let needed = nc + 1 + sets.len();
+    if labelled < needed {
+        return Err(ThermalError::TooFewSteps {
+            steps: labelled,
+            needed,
+        });
+    }
+    let per_run_min = d.y.iter().map(Vec::len).min().unwrap_or(0);
+    let folds = if id.folds == 0 || per_run_min / id.folds.max(1) < 20 {
+        0
+    } else {
+        id.folds
+    };
+    let mut notes = id.report.notes.clone();
+    let (cv, lambda) = if folds == 0 {
+        if id.folds > 0 {
+            notes.push(format!(
+                "no cross-validation for this target ({per_run_min} labelled steps); ridge \
+                 strength fixed at {:.0e}",
+                cfg.fallback_ridge
+            ));
+        }
+        (None, cfg.fallback_ridge)
+    } else {
+        let (s, l) = best_ridge(
+            &d,
+            nc,
+            folds,
+            id.gap_steps,
+            &cfg.ridge_grid,
+            cfg.ridge_tolerance,
+        );
+        (
+            s.is_finite().then_some(s),
+            if s.is_finite() { l } else { cfg.fallback_ridge },
+        )
+    };
+    let stats: Vec<Stats> = (0..d.x.len())
+        .map(|r| {
+            let mut s = Stats::new(nc);
+            for (k, y) in d.y[r].iter().enumerate() {
+                s.add(&d.x[r][k * nc..(k + 1) * nc], *y, 1.0);
+            }
+            s
+        })
+        .collect();
+    let (g, b, _) = centred_normal(&stats, nc);
+    let beta = ridge_solve(&g, &b, nc, lambda).ok_or(ThermalError::Singular)?;
+    // The constant: the labelled-step-weighted mean of the per-run offsets.
+    let (mut c0, mut n) = (0.0, 0.0);
+    for s in &stats {
+        if s.n >= 1.0 {
+            c0 += s.sy - s.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>();
+            n += s.n;
+        }
+    }
+    let mut coefficients = vec![c0 / n];
+    coefficients.extend_from_slice(&beta);
+    let report = ThermalReport {
+        cv_rms: cv,
+        ridge: lambda,
+        folds,
+        basis: kind.name().to_owned(),
+        notes,
+        ..id.report.clone()
+    };
+    Ok((
+        SubModel::Baseline {
+            terms,
+            coefficients,
+        },
+        report,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ridge with λ = 0 is ordinary least squares: on y = 2 + 3·x1 − x2 exactly, the centred
+    /// normal equations give the coefficients back (independent: the generating formula).
+    #[test]
+    fn ridge_without_penalty_recovers_exact_coefficients() {
+        let nc = 2;
+        let mut s = Stats::new(nc);
+        for k in 0..50 {
+            let x1 = (k as f64 * 0.37).sin();
+            let x2 = (k as f64 * 0.11).cos() + 0.1 * k as f64;
+            s.add(&[x1, x2], 2.0 + 3.0 * x1 - x2, 1.0);
+        }
+        let (g, b, _) = centred_normal(&[s], nc);
+        let beta = ridge_solve(&g, &b, nc, 0.0).unwrap();
+        assert!(
+            (beta[0] - 3.0).abs() < 1e-9 && (beta[1] + 1.0).abs() < 1e-9,
+            "{beta:?}"
+        );
+        // A strong penalty shrinks the coefficients towards zero.
+        let shrunk = ridge_solve(&g, &b, nc, 1e3).unwrap();
+        assert!(shrunk[0].abs() < 0.1 && shrunk[1].abs() < 0.1, "{shrunk:?}");
+    }
+
+    /// Every basis stays within the flight crate's 16 terms, and starts with the constant.
+    #[test]
+    fn bases_fit_the_flight_crate() {
+        for kind in [
+            Basis::Full,
+            Basis::Small,
+            Basis::Linear,
+            Basis::Lean,
+            Basis::Minimal,
+        ] {
+            for lags in 1..=3 {
+                let t = basis(kind, lags);
+                t.validate().unwrap();
+                assert!(t.powers[0].iter().all(|p| *p == 0));
+            }
+        }
+    }
+}
