@@ -218,6 +218,24 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
         "one static log: no run gate"
     );
     assert!(model("linear")["bias_lstm_validation_improvement"].is_null());
+    // A model is named by what it holds: the label says "LSTM" exactly when a sub-model has one.
+    let lstm_kept = ["bias_model", "scale_model"].iter().any(|k| {
+        model("lstm")[*k]
+            .as_str()
+            .is_some_and(|s| s.contains("lstm"))
+    });
+    let label = model("lstm")["label"].as_str().unwrap();
+    assert_eq!(
+        label,
+        if lstm_kept {
+            "LS + LSTM"
+        } else {
+            "thermal-state LS"
+        },
+        "{:?}",
+        model("lstm")
+    );
+    assert_eq!(model("linear")["label"], "linear");
 }
 
 /// `--validate-on-runs` with two static logs: the output names each log with its figure for

@@ -661,6 +661,20 @@ pub fn data_digest(logs: &[&TestLog]) -> String {
 }
 
 impl ModelFile {
+    /// What the model holds, as a column name: `linear` and `poly` for the classic fits; for
+    /// the `lstm` method, `LS + LSTM` when a least-squares base carries a residual LSTM,
+    /// `LSTM` when a network alone predicts, and `thermal-state LS` when no LSTM was kept (the
+    /// method's gates left it out), so a table never calls a model without an LSTM "lstm".
+    pub fn label(&self) -> &'static str {
+        let subs = || [&self.bias, &self.scale].into_iter().flatten();
+        match self.method {
+            Method::Lstm if subs().any(|s| matches!(s, SubModel::Residual { .. })) => "LS + LSTM",
+            Method::Lstm if subs().any(|s| matches!(s, SubModel::Lstm { .. })) => "LSTM",
+            Method::Lstm => "thermal-state LS",
+            m => m.as_str(),
+        }
+    }
+
     /// The core feature spec of this model.
     pub fn feature_spec(&self) -> Result<FeatureSpec, ModelFileError> {
         self.features.to_spec()

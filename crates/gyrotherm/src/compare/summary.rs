@@ -33,6 +33,9 @@ pub struct TestSummary {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelSummary {
     pub method: &'static str,
+    /// What the model holds ([`ModelFile::label`](crate::model::ModelFile::label)): the
+    /// name its column has in the table.
+    pub label: &'static str,
     /// Kind of the bias and scale-factor sub-models (None: not fitted).
     pub bias_model: Option<&'static str>,
     pub scale_model: Option<&'static str>,
@@ -77,6 +80,7 @@ impl Comparison {
                     let (b, s) = (f.bias_training.as_ref(), f.scale_training.as_ref());
                     ModelSummary {
                         method: f.model.method.as_str(),
+                        label: f.model.label(),
                         bias_model: f.model.bias.as_ref().map(|b| b.kind()),
                         scale_model: f.model.scale.as_ref().map(|b| b.kind()),
                         bias_epochs: b.map(|t| t.epochs),

@@ -13,8 +13,8 @@ impl Comparison {
             .map(|f| {
                 let part = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
                 let mut line = format!(
-                    "{:>6}: bias model {}, scale-factor model {}",
-                    f.model.method.as_str(),
+                    "{:>16}: bias model {}, scale-factor model {}",
+                    f.model.label(),
                     part(&f.model.bias),
                     part(&f.model.scale)
                 );
@@ -22,7 +22,7 @@ impl Comparison {
                     .iter()
                     .any(|s| matches!(s, Some(SubModel::Lstm { .. } | SubModel::Residual { .. })));
                 if f.model.method == Method::Lstm && !lstm_kept {
-                    line.push_str(" (no residual LSTM beat its least-squares base on the validation data, so none was kept)");
+                    line.push_str(" (holds no LSTM: the recipe has none, or no LSTM beat its least-squares base on the validation data)");
                 }
                 line
             })
@@ -33,7 +33,7 @@ impl Comparison {
     pub fn table(&self, cfg: &CompareConfig) -> ComparisonTable {
         let methods: Vec<Method> = self.fits.iter().map(|f| f.model.method).collect();
         let mut columns = vec!["raw".to_owned()];
-        columns.extend(methods.iter().map(|m| m.as_str().to_owned()));
+        columns.extend(self.fits.iter().map(|f| f.model.label().to_owned()));
         let empty = Performance::default();
         let blocks = self
             .tests
