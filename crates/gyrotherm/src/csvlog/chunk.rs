@@ -11,7 +11,7 @@
 
 use memchr::memchr;
 
-use super::number::parse_f64;
+use super::number::{parse_decimal_prefix, parse_f64};
 use super::reader::Sample;
 
 /// Blocks at least this long are split in two and parsed on two threads.
@@ -24,11 +24,37 @@ pub(super) struct Layout {
     pub(super) delimiter: u8,
     /// Fields per row (the header's count).
     pub(super) ncols: usize,
-    pub(super) time: usize,
-    pub(super) gyro: usize,
-    pub(super) temp: usize,
-    pub(super) table: Option<usize>,
+    /// Role of each field: 0 time, 1 gyro, 2 temperature, 3 table rate, 4 passed through.
+    pub(super) roles: Vec<u8>,
+    pub(super) has_table: bool,
     pub(super) gyro_scale: f64,
+}
+
+impl Layout {
+    /// Roles of `ncols` fields.
+    pub(super) fn roles(
+        ncols: usize,
+        time: usize,
+        gyro: usize,
+        temp: usize,
+        table: Option<usize>,
+    ) -> Vec<u8> {
+        (0..ncols)
+            .map(|k| {
+                if k == time {
+                    0
+                } else if k == gyro {
+                    1
+                } else if k == temp {
+                    2
+                } else if Some(k) == table {
+                    3
+                } else {
+                    4
+                }
+            })
+            .collect()
+    }
 }
 
 /// One accepted row: its sample, 1-based line and the byte range of its text (without the
@@ -113,56 +139,56 @@ pub(super) fn parse_lines(
 
 /// Split `text` (one line, no terminator) and parse its mapped fields; None for anything
 /// the CSV path must judge (quote, CR, wrong field count, a field that is not a finite
-/// number).
+/// number). One pass: a number is parsed where it starts and must end at a delimiter.
 #[inline]
 fn parse_row(text: &[u8], lay: &Layout, vals: &mut [f64; 4]) -> Option<Sample> {
-    let mut k = 0;
-    let mut start = 0;
     let d = lay.delimiter;
-    let mut i = 0;
-    while i <= text.len() {
-        let b = if i < text.len() { text[i] } else { d };
-        if b == d {
-            if k >= lay.ncols {
+    let last = lay.roles.len() - 1;
+    let mut pos = 0;
+    for (k, &role) in lay.roles.iter().enumerate() {
+        let end = if role < 4 {
+            let (v, end) = number_at(text, pos, d)?;
+            vals[usize::from(role)] = v;
+            end
+        } else {
+            let end = memchr(d, &text[pos..]).map_or(text.len(), |j| pos + j);
+            if memchr::memchr2(b'"', b'\r', &text[pos..end]).is_some() {
                 return None;
             }
-            let role = if k == lay.time {
-                0
-            } else if k == lay.gyro {
-                1
-            } else if k == lay.temp {
-                2
-            } else if Some(k) == lay.table {
-                3
-            } else {
-                4
-            };
-            let field = &text[start..i];
-            if role < 4 {
-                let v = parse_f64(field)?;
-                if !v.is_finite() {
-                    return None;
-                }
-                vals[role] = v;
-            } else if field.iter().any(|&c| c == b'"' || c == b'\r') {
+            end
+        };
+        if k < last {
+            if end == text.len() {
                 return None;
             }
-            k += 1;
-            start = i + 1;
-        } else if b == b'"' || b == b'\r' {
+            pos = end + 1;
+        } else if end != text.len() {
             return None;
         }
-        i += 1;
-    }
-    if k != lay.ncols {
-        return None;
     }
     Some(Sample {
         time_s: vals[0],
         gyro_dps: vals[1] * lay.gyro_scale,
         temp_c: vals[2],
-        table_dps: lay.table.map(|_| vals[3]),
+        table_dps: lay.has_table.then_some(vals[3]),
     })
+}
+
+/// The finite number in the field starting at `pos`, and where the field ends.
+#[inline(always)]
+fn number_at(text: &[u8], pos: usize, d: u8) -> Option<(f64, usize)> {
+    let rest = &text[pos..];
+    if let Some((v, n)) = parse_decimal_prefix(rest) {
+        if rest.get(n).is_none_or(|&b| b == d) {
+            return Some((v, pos + n));
+        }
+    }
+    let end = memchr(d, rest).map_or(text.len(), |j| pos + j);
+    let field = &text[pos..end];
+    if memchr::memchr2(b'"', b'\r', field).is_some() {
+        return None;
+    }
+    parse_f64(field).filter(|v| v.is_finite()).map(|v| (v, end))
 }
 
 /// Field `i` of a fast-path row's text.

@@ -115,7 +115,7 @@ struct Fast<R> {
 }
 
 /// Block size of the fast path.
-const BLOCK_BYTES: usize = 1 << 20;
+const BLOCK_BYTES: usize = 2 << 20;
 
 /// Streaming reader of a test log.
 ///
@@ -265,11 +265,9 @@ impl<R: Read> LogReader<R> {
         let lay = Layout {
             delimiter: b',',
             ncols,
-            time: cols.time,
-            gyro: cols.gyro,
-            temp: cols.temp,
-            table: cols.table,
+            has_table: cols.table.is_some(),
             gyro_scale,
+            roles: Layout::roles(ncols, cols.time, cols.gyro, cols.temp, cols.table),
         };
         Ok(LogReader {
             src: Source {
