@@ -11,8 +11,8 @@
 
 use memchr::memchr;
 
+use super::gaps::Sample;
 use super::number::{parse_decimal_prefix, parse_f64};
-use super::reader::Sample;
 
 /// Blocks at least this long are split in two and parsed on two threads.
 pub(super) const PARALLEL_MIN_BYTES: usize = 256 * 1024;

@@ -23,7 +23,7 @@ use std::cell::OnceCell;
 use super::chunk::{self, parse_lines, Layout, Row, PARALLEL_MIN_BYTES};
 use super::columns::{check_options, map_columns, Columns};
 use super::error::{LogError, LogErrorKind as Kind};
-use super::gaps::{gap_verdict, Fill, GapVerdict};
+use super::gaps::{gap_verdict, Fill, GapVerdict, Sample};
 use super::number::parse_f64;
 use super::{GyroUnit, ReadOptions, ReadReport};
 
@@ -33,23 +33,6 @@ pub const PERIOD_ESTIMATE_STEPS: usize = 100;
 /// A step longer than this many nominal periods is a gap: one missing sample (a step of two
 /// periods) must be caught, while jitter of half a period must not be.
 pub const GAP_FACTOR: f64 = 1.5;
-
-/// Most samples one gap may be filled with; beyond it the gap is reported as too long, so
-/// that a tiny period and a large limit cannot exhaust memory.
-pub const MAX_FILL_SAMPLES_PER_GAP: usize = 10_000_000;
-
-/// One validated row: finite numbers, gyro converted to °/s.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sample {
-    /// Time, s (strictly increasing along the log).
-    pub time_s: f64,
-    /// Gyro output, °/s (converted from the file's unit).
-    pub gyro_dps: f64,
-    /// Temperature, °C.
-    pub temp_c: f64,
-    /// Rate-table input rate, °/s (None: the log has no table column).
-    pub table_dps: Option<f64>,
-}
 
 /// Where rows come from: the fast path (plain rows in newline-aligned blocks, parsed on two
 /// threads, see [`super::chunk`]) until it meets a line it cannot judge, then the CSV path
@@ -1096,10 +1079,14 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// One sample as handed out: the bits of time, gyro, temperature, table rate; line;
+    /// whether filled; the raw record.
+    type Out = (u64, u64, u64, Option<u64>, u64, bool, Vec<Vec<u8>>);
+
     /// Everything a reader hands out, and how it ends.
     #[derive(Debug, PartialEq)]
     struct Run {
-        samples: Vec<(u64, u64, u64, Option<u64>, u64, bool, Vec<Vec<u8>>)>,
+        samples: Vec<Out>,
         end: Result<(u64, Option<u64>, usize), String>,
     }
 
