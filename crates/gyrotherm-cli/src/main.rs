@@ -40,6 +40,8 @@ enum Command {
     Compare(cmd::compare::CompareArgs),
     /// Write an HTML report with figures for a held-out comparison.
     Report(cmd::report::ReportArgs),
+    /// Write a model as flight code: C99 or a Rust module for gyrotherm-core.
+    Export(cmd::export::ExportArgs),
 }
 
 fn main() -> ExitCode {
@@ -53,6 +55,7 @@ fn main() -> ExitCode {
         Command::Compensate(a) => cmd::compensate::run(a),
         Command::Compare(a) => cmd::compare::run(a),
         Command::Report(a) => cmd::report::run(a),
+        Command::Export(a) => cmd::export::run(a),
     };
     match result {
         Ok(code) => code,

@@ -28,7 +28,7 @@ pub struct Compensated {
 }
 
 /// Widen an LSTM to the flight input count: input columns beyond `input_size` get weight 0.
-fn padded_core_lstm(
+pub fn padded_core_lstm(
     params: &LstmParams,
 ) -> Result<gyrotherm_core::lstm::LstmWeights<LSTM_INPUTS, HIDDEN>, CompensateError> {
     let i = params.input_size;
@@ -115,7 +115,12 @@ pub fn compensator(model: &ModelFile) -> Result<Compensator, CompensateError> {
     };
     let bias = target_model(model.bias.as_ref(), 0.0).map_err(in_target(Target::Bias))?;
     let scale = target_model(model.scale.as_ref(), 1.0).map_err(in_target(Target::Scale))?;
-    Compensator::new(spec, bias, scale).map_err(CompensateError::Flight)
+    let limits = model
+        .features
+        .temp_sensor
+        .to_core()
+        .map_err(CompensateError::Model)?;
+    Compensator::with_limits(spec, bias, scale, limits).map_err(CompensateError::Flight)
 }
 
 /// Compensate a whole log with the flight compensator. The error names the sample.
@@ -128,13 +133,7 @@ pub fn compensate_log(model: &ModelFile, log: &TestLog) -> Result<Compensated, C
         gyro_comp_dps: Vec::with_capacity(n),
     };
     for i in 0..n {
-        let c = comp
-            .step(log.time_s[i], log.gyro_dps[i], log.temp_c[i])
-            .map_err(|source| CompensateError::Sample {
-                sample: i + 1,
-                time_s: log.time_s[i],
-                source,
-            })?;
+        let c = comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
         out.bias_dps.push(c.bias_dps);
         out.scale.push(c.scale);
         out.gyro_comp_dps.push(c.rate_dps);
@@ -241,13 +240,7 @@ pub fn compensate_stream<R: std::io::Read, W: std::io::Write>(
     let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
     let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
     while let Some(s) = reader.next_sample().map_err(CompensateError::Log)? {
-        let c = comp
-            .step(s.time_s, s.gyro_dps, s.temp_c)
-            .map_err(|e| CompensateError::Line {
-                path: source.to_path_buf(),
-                line: reader.line(),
-                source: e,
-            })?;
+        let c = comp.step(s.time_s, s.gyro_dps, s.temp_c);
         if let Some(f) = comp.features() {
             let f = f.as_slice();
             if let [t, r, ..] = f {
