@@ -1,7 +1,10 @@
 //! Streaming, validating reader: one CSV record in, one checked [`Sample`] out.
 //!
-//! The reader keeps a single reused [`csv::ByteRecord`] for the current row, so reading a log
-//! costs no allocation per row; pass-through fields are handed out as raw bytes of that record.
+//! Rows are read in newline-aligned blocks of plain rows parsed on two threads (the fast
+//! path, [`super::chunk`]); at the first line the fast path cannot judge (a quote, a lone
+//! CR, an error) the csv crate takes over from that line, so errors keep their exact line,
+//! column and text. Either way reading costs no allocation per row; pass-through fields are
+//! handed out as raw bytes of the row.
 //!
 //! # Nominal sample period and gaps
 //! The nominal period is the median (the lower middle value for an even count) of the first
