@@ -229,6 +229,35 @@ impl SubModel {
         }
     }
 
+    /// The LSTM part, if any: parameters, input and target normalisation.
+    pub fn lstm(&self) -> Option<(&LstmParams, &ZScore, &ZScore)> {
+        match self {
+            SubModel::Lstm {
+                params,
+                input_norm,
+                target_norm,
+            }
+            | SubModel::Residual {
+                params,
+                input_norm,
+                target_norm,
+                ..
+            } => Some((params, input_norm, target_norm)),
+            SubModel::Baseline { .. } => None,
+        }
+    }
+
+    /// Whether the residual LSTM reads the least-squares base value as one more input.
+    pub fn reads_base(&self) -> bool {
+        matches!(
+            self,
+            SubModel::Residual {
+                lstm_reads_base: true,
+                ..
+            }
+        )
+    }
+
     /// A baseline sub-model from a fit.
     pub fn from_fit(fit: &baseline::BaselineFit) -> SubModel {
         SubModel::Baseline {

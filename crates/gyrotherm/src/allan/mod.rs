@@ -26,8 +26,7 @@ pub mod noise_id;
 mod streaming;
 mod terms;
 
-use edf::{chi2_inv, edf_greenhall};
-pub use edf::{edf_simple, ONE_SIGMA_CI};
+pub use edf::{chi2_inv, edf_greenhall, edf_simple, ONE_SIGMA_CI};
 use noise_id::lag1_noise_id_from_phase;
 pub use noise_id::{lag1_noise_id, NoiseId};
 pub use streaming::StreamingOadev;

@@ -118,18 +118,8 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, Co
             Some(s)
         }
     };
-    let lstm = match sub {
-        SubModel::Lstm {
-            params,
-            input_norm,
-            target_norm,
-        }
-        | SubModel::Residual {
-            params,
-            input_norm,
-            target_norm,
-            ..
-        } => {
+    let lstm = match sub.lstm() {
+        Some((params, input_norm, target_norm)) => {
             let w = crate::compensate::padded_core_lstm(params)?;
             let n = input_norm.mean.len();
             if n > MAX_FEATURES {
@@ -153,15 +143,9 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, Co
                 target_std: target_norm.std[0],
             })
         }
-        SubModel::Baseline { .. } => None,
+        None => None,
     };
-    let lstm_reads_base = matches!(
-        sub,
-        SubModel::Residual {
-            lstm_reads_base: true,
-            ..
-        }
-    );
+    let lstm_reads_base = sub.reads_base();
     Ok(StaticTarget {
         offset: 0.0,
         baseline,
