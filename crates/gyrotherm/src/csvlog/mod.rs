@@ -16,6 +16,7 @@
 //! duplicate timestamps, and gaps longer than [`GAP_FACTOR`] nominal sample periods (the
 //! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`LogReader`]).
 
+mod chunk;
 mod columns;
 mod error;
 mod gaps;
@@ -24,7 +25,8 @@ mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
-pub use reader::{LogReader, Sample, GAP_FACTOR, MAX_FILL_SAMPLES_PER_GAP, PERIOD_ESTIMATE_STEPS};
+pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
+pub use reader::{LogReader, GAP_FACTOR, PERIOD_ESTIMATE_STEPS};
 pub use writer::{format_f64, LogWriter};
 
 use std::fs::File;
