@@ -2,7 +2,7 @@
 //!
 //! The model steps at a fixed period on the **time axis** (1 s by default), not per sample, so a
 //! log at 1 Hz and the same temperature history logged at 100 Hz give identical model inputs
-//! (issue 5). [`FeaturePipeline::push`] takes `(time_s, temp_c)` per sample and emits a
+//! (the model must not depend on the logger's rate). [`FeaturePipeline::push`] takes `(time_s, temp_c)` per sample and emits a
 //! [`Step`] when the sample reaches the next step boundary; between boundaries it holds.
 //!
 //! # Step boundaries and the value at a step
@@ -173,7 +173,7 @@ impl FeatureSpec {
     };
 
     /// The published inputs plus thermal-state lags of 300, 1000 and 3000 s exposed as
-    /// `T - y_j` (the inputs that helped generalisation in issue 5).
+    /// `T - y_j` (the inputs that helped held-out runs; docs/experiments/lstm-recipes.md).
     pub const THERMAL_STATE: FeatureSpec = FeatureSpec {
         step_period_s: 1.0,
         rate_lag_s: 20.0,

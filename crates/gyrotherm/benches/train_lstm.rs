@@ -1,6 +1,6 @@
 //! Training cost of the published network (I = 2, H = 8) on a 30,000-step run with full BPTT:
 //! one iteration = 10 epochs (forward, backward, Adam), so time/10 is s/epoch.
-//! Target (issue 4): 1000 epochs for both networks ≤ 10 s on 2 cores, i.e. ≤ 10 ms per epoch
+//! Target: 1000 epochs for both networks ≤ 10 s on 2 cores, i.e. ≤ 10 ms per epoch
 //! per network with the two on their own threads. Full 1000-epoch wall time:
 //! `cargo run -p gyrotherm --release --example train_bench`.
 //! Run: `cargo bench -p gyrotherm --bench train_lstm`.

@@ -1,4 +1,4 @@
-//! Throughput and peak memory of reading a large test log (issue 2's 10-million-row bench).
+//! Throughput and peak memory of reading a large test log (the 10-million-row bench of `bench/read_log.sh`).
 //!
 //! ```text
 //! read_log_bench gen PATH ROWS [--table]   write a realistic 100 Hz log

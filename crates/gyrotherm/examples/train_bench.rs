@@ -2,7 +2,7 @@
 //! hidden 8, 2 inputs, for two networks (bias and scale factor) on two threads.
 //!
 //! `cargo run -p gyrotherm --release --example train_bench -- [epochs] [f32|f64] [pair|single]`
-//! (defaults: 1000 f32 pair). Target (issue 4): ≤ 10 s for both networks on a 2-core machine.
+//! (defaults: 1000 f32 pair). Target: ≤ 10 s for both networks on a 2-core machine.
 
 use std::time::Instant;
 

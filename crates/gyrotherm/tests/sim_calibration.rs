@@ -1,7 +1,7 @@
 //! Calibration of the default simulated unit against the published raw figures
 //! (He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004) and the measurements recorded
-//! in issue 5 ("What is known already"). Ranges come from issue 2 (raw figures) and issue 5
-//! (noise floor, linear-fit and thermal-state held-out residuals), not from this code's output.
+//! for the project's held-out work. Ranges come from the paper's raw figures and those
+//! measurements (noise floor, linear-fit and thermal-state held-out residuals), not from this code's output.
 
 use gyrotherm::sim::{simulate_series, SimConfig, SimSeries};
 use nalgebra::{DMatrix, DVector};
@@ -19,7 +19,7 @@ fn bias_stability_dph(x_dps: &[f64], rate_hz: f64, tau_s: f64) -> f64 {
     var.sqrt() * 3600.0
 }
 
-/// dT = (T(t) - T(t-20 s)) / 20 s on the logged temperature (issue 5; paper: 20 samples at
+/// dT = (T(t) - T(t-20 s)) / 20 s on the logged temperature (paper: 20 samples at
 /// 1 Hz), 0 for the first 20 s.
 fn dtemp(temp_c: &[f64], rate_hz: f64) -> Vec<f64> {
     let k = (20.0 * rate_hz).round() as usize;
@@ -46,7 +46,7 @@ fn lag(x: &[f64], rate_hz: f64, tau_s: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Feature sets of issue 5: "linear" = [1, T, dT]; "thermal" = [1, T, dT, L300(T),
+/// Feature sets of the held-out work: "linear" = [1, T, dT]; "thermal" = [1, T, dT, L300(T),
 /// L1000(T), L3000(T)] (differences from T are linear combinations of these).
 fn features(s: &SimSeries, thermal: bool) -> Vec<Vec<f64>> {
     let t = &s.temp_c;
@@ -156,7 +156,7 @@ fn default_unit_noise_floor() {
 /// Issue 5: a linear fit on (T, dT) trained on one run leaves roughly 0.015-0.035 °/h on a
 /// held-out run (history matters beyond T and dT), while a linear fit on thermal-state inputs
 /// (lags of 300/1000/3000 s) gets to about 1.6-2.0× the noise floor. Tolerances: linear
-/// 0.012-0.05 °/h (issue 5's range, widened by ~20 % each side for one seed), thermal-state
+/// 0.012-0.05 °/h (the measured range, widened by ~20 % each side for one seed), thermal-state
 /// 1.2-2.5× the floor, and thermal-state must beat linear.
 #[test]
 fn default_unit_history_matters_beyond_t_and_dt() {

@@ -142,7 +142,7 @@ pub enum SensorNode {
 impl Default for FogUnit {
     /// The built-in unit, tuned so that its raw figures on `seed-shock` at 1 Hz match He et al.
     /// 2024 (static bias stability 0.13861 °/h over 100 s means; ~20.009 °/s at +20 °/s), and
-    /// the held-out fits of issue 5. Measured (seed 7, 1 Hz): raw bias stability 0.137 °/h,
+    /// the held-out fits recorded in docs/experiments/. Measured (seed 7, 1 Hz): raw bias stability 0.137 °/h,
     /// noise-only floor 0.0078 °/h, +20 °/s output 20.0103 °/s cold / 20.0092 °/s hot; a
     /// (T, dT) linear fit trained on `seed-shock` leaves 0.031 °/h on another `seed-shock`
     /// run, 0.016 on `slow-ramp`, 0.047 on `fast-cycle`. Checked in `tests/sim_calibration.rs`.
