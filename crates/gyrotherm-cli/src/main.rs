@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
+mod signals;
 
 /// Remove temperature-induced errors from fiber optic gyroscope (FOG) test logs.
 #[derive(Debug, Parser)]
@@ -44,6 +45,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    signals::remove_temp_files_on_termination();
     let result = match cli.command {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Simulate(a) => cmd::simulate::run(a),
