@@ -60,7 +60,8 @@ impl StreamingOadev {
     }
 
     /// Adds samples. A non-finite sample is an error naming its index in the whole stream;
-    /// the samples before it in this chunk are kept.
+    /// the samples before it in this chunk are kept. A finite sample so large that the sums
+    /// overflow is an error too ([`AllanError::TooLarge`]); the state is then spent.
     pub fn push(&mut self, samples: &[f64]) -> Result<(), AllanError> {
         let len = self.ring.len();
         for &v in samples {
@@ -69,6 +70,7 @@ impl StreamingOadev {
                     index: self.phase_points - 1,
                 });
             }
+            let raw = v;
             let off = *self.offset.get_or_insert(v);
             let v = v - off;
             let t = self.sum + v;
@@ -90,6 +92,12 @@ impl StreamingOadev {
                 let x_old = self.ring[(k_new - 2 * m) % len];
                 let d = x_new - 2.0 * x_mid + x_old;
                 *s += d * d;
+            }
+            if !(x_new.is_finite() && self.sums.iter().all(|s| s.is_finite())) {
+                return Err(AllanError::TooLarge {
+                    index: k_new - 1,
+                    value: raw,
+                });
             }
         }
         Ok(())

@@ -1,0 +1,95 @@
+//! Allan deviations of finite samples of any magnitude: finite results or a refusal naming
+//! the sample, never ∞ or a silent 0. The reference is the homogeneity of every deviation,
+//! σ(c·y) = |c|·σ(y), applied to the NIST SP 1065 NBS data set (p. 107), and exact for c a
+//! power of two.
+
+use gyrotherm::allan::{deviation, AllanError, DevKind, NoiseModel, StreamingOadev, TauSet};
+
+fn nbs_data() -> Vec<f64> {
+    let mut n: u64 = 1_234_567_890;
+    (0..1000)
+        .map(|_| {
+            let v = n as f64 / 2_147_483_647.0;
+            n = 16_807 * n % 2_147_483_647;
+            v
+        })
+        .collect()
+}
+
+const KINDS: [DevKind; 5] = [
+    DevKind::Adev,
+    DevKind::Oadev,
+    DevKind::Mdev,
+    DevKind::Hdev,
+    DevKind::Ohdev,
+];
+
+#[test]
+fn huge_and_tiny_samples_scale_exactly() {
+    let y = nbs_data();
+    for kind in KINDS {
+        let base = deviation(&y, 1.0, kind, &TauSet::Octave, NoiseModel::Alpha(0)).unwrap();
+        for k in [-1000, -600, -300, 300, 600, 1000] {
+            let c = 2f64.powi(k);
+            let scaled: Vec<f64> = y.iter().map(|v| v * c).collect();
+            let pts = deviation(&scaled, 1.0, kind, &TauSet::Octave, NoiseModel::Alpha(0))
+                .unwrap_or_else(|e| panic!("{kind:?} 2^{k}: {e}"));
+            assert_eq!(pts.len(), base.len());
+            for (p, b) in pts.iter().zip(&base) {
+                let want = b.dev * c;
+                assert!(
+                    p.dev.is_finite() && (p.dev - want).abs() <= 1e-12 * want,
+                    "{kind:?} 2^{k} m={}: {} want {want}",
+                    p.m,
+                    p.dev
+                );
+                assert!((p.hi - b.hi * c).abs() <= 1e-12 * b.hi * c);
+            }
+        }
+    }
+    // And the scaled NBS set still gives NIST's OADEV at τ = 1 (2.922319e-01).
+    let c = 2f64.powi(1000);
+    let scaled: Vec<f64> = y.iter().map(|v| v * c).collect();
+    let p = deviation(
+        &scaled,
+        1.0,
+        DevKind::Oadev,
+        &TauSet::Seconds(vec![1.0]),
+        NoiseModel::Alpha(0),
+    )
+    .unwrap();
+    assert!((p[0].dev / c - 2.922319e-01).abs() / 2.922319e-01 < 1e-6);
+}
+
+#[test]
+fn samples_near_the_largest_f64_are_refused_naming_the_largest() {
+    let mut y: Vec<f64> = (0..200)
+        .map(|i| if i % 2 == 0 { 1.5e308 } else { -1.5e308 })
+        .collect();
+    y[77] = -1.7e308;
+    for kind in KINDS {
+        match deviation(&y, 1.0, kind, &TauSet::Octave, NoiseModel::Alpha(0)) {
+            Err(AllanError::TooLarge { index, value }) => {
+                assert_eq!((index, value), (77, -1.7e308), "{kind:?}");
+            }
+            Ok(pts) => {
+                for p in pts {
+                    assert!(p.dev.is_finite() && p.hi.is_finite(), "{kind:?} {p:?}");
+                }
+            }
+            Err(e) => panic!("{kind:?}: {e}"),
+        }
+    }
+    let err = deviation(&y, 1.0, DevKind::Adev, &TauSet::Octave, NoiseModel::Alpha(0))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("sample 77 is -1.7e308"), "{err}");
+}
+
+#[test]
+fn streaming_oadev_refuses_an_overflowing_sample() {
+    let mut s = StreamingOadev::octave(8, 1.0).unwrap();
+    s.push(&[0.0, 1.0, 2.0]).unwrap();
+    let err = s.push(&[1e300, -1e300, 1e300]).unwrap_err();
+    assert!(matches!(err, AllanError::TooLarge { .. }), "{err}");
+}
