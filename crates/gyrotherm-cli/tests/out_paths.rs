@@ -58,7 +58,11 @@ fn out_through_a_symlink_writes_the_target_and_keeps_the_link() {
     std::fs::write(dir.path().join("real.csv"), "old").unwrap();
     std::os::unix::fs::symlink("real.csv", dir.path().join("link.csv")).unwrap();
     let out = simulate_to(dir.path(), "link.csv");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let link = dir.path().join("link.csv");
     assert!(std::fs::symlink_metadata(&link)
         .unwrap()
@@ -81,7 +85,11 @@ fn out_to_a_fifo_writes_into_it() {
         std::thread::spawn(move || tx.send(std::fs::read_to_string(fifo).unwrap()));
     }
     let out = simulate_to(dir.path(), "pipe");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // A writer that replaced the FIFO instead never opened it: the reader waits for ever.
     let text = rx
         .recv_timeout(Duration::from_secs(20))
@@ -97,7 +105,11 @@ fn out_to_a_link_to_dev_null_keeps_the_link_and_the_device() {
     let dir = tempfile::tempdir().unwrap();
     std::os::unix::fs::symlink("/dev/null", dir.path().join("sink")).unwrap();
     let out = simulate_to(dir.path(), "sink");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(
         std::fs::read_link(dir.path().join("sink")).unwrap(),
         Path::new("/dev/null")
@@ -119,7 +131,11 @@ fn out_to_dev_null_succeeds_and_leaves_it_a_device() {
     ));
     let dir = tempfile::tempdir().unwrap();
     let out = simulate_to(dir.path(), "/dev/null");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(std::fs::metadata("/dev/null")
         .unwrap()
         .file_type()
@@ -130,7 +146,11 @@ fn out_to_dev_null_succeeds_and_leaves_it_a_device() {
 fn out_dash_is_standard_output() {
     let dir = tempfile::tempdir().unwrap();
     let out = simulate_to(dir.path(), "-");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.starts_with("time_s,gyro_dps,temp_c\n"), "{text}");
     assert_eq!(text.lines().count(), 31);
@@ -141,7 +161,11 @@ fn out_dash_is_standard_output() {
 fn out_dev_stdout_is_standard_output() {
     let dir = tempfile::tempdir().unwrap();
     let out = simulate_to(dir.path(), "/dev/stdout");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert_eq!(text.lines().count(), 31);
 }
@@ -154,7 +178,10 @@ fn out_to_a_directory_is_refused_naming_it() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("d is a directory"), "{err}");
-    assert_eq!(entries(dir.path().join("d").as_path()), Vec::<String>::new());
+    assert_eq!(
+        entries(dir.path().join("d").as_path()),
+        Vec::<String>::new()
+    );
 }
 
 /// A compensate run reading a FIFO is stopped by SIGTERM while its output is half written:
@@ -217,7 +244,12 @@ fn sigterm_mid_write_removes_the_temporary_file() {
     let status = child.wait().unwrap();
     drop(w);
     let mut err = String::new();
-    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
     assert!(!status.success(), "{err}");
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
     assert_eq!(entries(d), ["in.fifo", "m.json", "out.csv"]);

@@ -432,7 +432,10 @@ mod tests {
             Destination::Replace(dir.path().join("sub/new.csv"))
         );
         write_bytes_atomically(&a, b"new").unwrap();
-        assert_eq!(std::fs::read(dir.path().join("sub/new.csv")).unwrap(), b"new");
+        assert_eq!(
+            std::fs::read(dir.path().join("sub/new.csv")).unwrap(),
+            b"new"
+        );
         assert!(std::fs::symlink_metadata(&a)
             .unwrap()
             .file_type()
@@ -494,9 +497,8 @@ mod tests {
             // As the signal handler would, from another thread (limited to this test's
             // folder: other tests write files at the same time).
             let mine = |p: &Path| p.starts_with(dir.path());
-            let removed = std::thread::scope(|s| {
-                s.spawn(|| remove_temp_files_where(mine)).join().unwrap()
-            });
+            let removed =
+                std::thread::scope(|s| s.spawn(|| remove_temp_files_where(mine)).join().unwrap());
             assert_eq!(removed, 1);
             Ok(())
         });

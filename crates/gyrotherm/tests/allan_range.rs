@@ -80,9 +80,15 @@ fn samples_near_the_largest_f64_are_refused_naming_the_largest() {
             Err(e) => panic!("{kind:?}: {e}"),
         }
     }
-    let err = deviation(&y, 1.0, DevKind::Adev, &TauSet::Octave, NoiseModel::Alpha(0))
-        .unwrap_err()
-        .to_string();
+    let err = deviation(
+        &y,
+        1.0,
+        DevKind::Adev,
+        &TauSet::Octave,
+        NoiseModel::Alpha(0),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("sample 77 is -1.7e308"), "{err}");
 }
 
@@ -92,4 +98,32 @@ fn streaming_oadev_refuses_an_overflowing_sample() {
     s.push(&[0.0, 1.0, 2.0]).unwrap();
     let err = s.push(&[1e300, -1e300, 1e300]).unwrap_err();
     assert!(matches!(err, AllanError::TooLarge { .. }), "{err}");
+}
+
+#[test]
+fn streaming_oadev_scales_exactly_like_the_batch_one() {
+    let y = nbs_data();
+    for k in [-1000, -500, 0, 500, 1000] {
+        let c = 2f64.powi(k);
+        let scaled: Vec<f64> = y.iter().map(|v| v * c).collect();
+        let batch = deviation(
+            &scaled,
+            1.0,
+            DevKind::Oadev,
+            &TauSet::Octave,
+            NoiseModel::Alpha(0),
+        )
+        .unwrap();
+        let mut s = StreamingOadev::octave(256, 1.0).unwrap();
+        s.push(&scaled).unwrap();
+        for (a, b) in s.points(Some(0)).iter().zip(&batch) {
+            assert!(
+                a.dev > 0.0 && (a.dev - b.dev).abs() <= 1e-12 * b.dev,
+                "2^{k} m={}: streaming {} batch {}",
+                a.m,
+                a.dev,
+                b.dev
+            );
+        }
+    }
 }

@@ -520,17 +520,21 @@ fn scale_points(
         p.hi *= scale;
         let bounds_ok = !p.edf.is_finite() || (p.lo.is_finite() && p.hi.is_finite());
         if !(p.dev.is_finite() && bounds_ok) {
-            let (index, value) = samples
-                .iter()
-                .copied()
-                .enumerate()
-                .fold((0, 0.0f64), |(i, m), (j, v)| {
-                    if v.abs() > m.abs() {
-                        (j, v)
-                    } else {
-                        (i, m)
-                    }
-                });
+            let (index, value) =
+                samples
+                    .iter()
+                    .copied()
+                    .enumerate()
+                    .fold(
+                        (0, 0.0f64),
+                        |(i, m), (j, v)| {
+                            if v.abs() > m.abs() {
+                                (j, v)
+                            } else {
+                                (i, m)
+                            }
+                        },
+                    );
             return Err(AllanError::TooLarge { index, value });
         }
     }
