@@ -172,7 +172,7 @@ fn lstm_training_from_the_cli_writes_a_loadable_model() {
 
 /// `compare --json`: the raw figure equals what `evaluate` computes on the same log (an
 /// independent path through the metrics), the noise floor equals `evaluate` on the truth
-/// column, the `lstm` method is below the linear fit (the held-out sweep of `fit::lstm`:
+/// column, the `lstm` method is below the linear fit (`docs/experiments/confirmation.md`:
 /// 41–81 % below in 16 of 16 confirmation cases), and the models say why a residual LSTM was
 /// or was not kept.
 #[test]
@@ -226,7 +226,7 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
 }
 
 /// `--validate-on-runs` with two static logs: the output names each log with its figure for
-/// the LSTM trained without it (the leave-one-run-out gate of `fit::lstm`).
+/// the LSTM trained without it (`fit::LstmRecipe::validate_on_runs`).
 #[test]
 fn validate_on_runs_reports_each_left_out_log() {
     let dir = tempfile::tempdir().unwrap();

@@ -6,7 +6,7 @@
 //! Run: `cargo bench -p gyrotherm --bench train_lstm`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use gyrotherm::train::{train_lstm, Precision, Sequence, TrainConfig};
+use gyrotherm::nn::{train_lstm, Precision, Sequence, TrainConfig};
 
 const EPOCHS_PER_ITER: usize = 10;
 

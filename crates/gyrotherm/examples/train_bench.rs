@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use gyrotherm::train::{train_lstm, train_pair, Precision, Sequence, TrainConfig};
+use gyrotherm::nn::{train_lstm, train_pair, Precision, Sequence, TrainConfig};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -11,6 +11,14 @@
 //! over a feature that does not vary in the training data is refused first with the feature's
 //! value (e.g. a run at constant temperature). The coefficients are for the raw (unscaled)
 //! monomials, so `gyrotherm_core::baseline::BaselineModel` evaluates them directly.
+//!
+//! The same least squares with one offset per training run (the "within" estimator, for
+//! fits over several runs whose turn-on bias differs) is in `fixed_effects`, used by the LSTM
+//! recipes' bases and by term selection.
+
+mod fixed_effects;
+
+pub(crate) use fixed_effects::{fit_fixed_effects, FixedEffectsFit};
 
 use crate::features::FeatureTable;
 use gyrotherm_core::baseline::{BaselineError, BaselineModel, MAX_POWER, MAX_TERMS};
@@ -52,6 +60,26 @@ impl Default for PolyDegrees {
             cross: true,
         }
     }
+}
+
+/// Monomial powers over `n` features from (feature, power) pairs, e.g. `monomial(5, &[(0, 1),
+/// (2, 1)])` is `T·D300` over the thermal-state features.
+pub(crate) fn monomial(n: usize, parts: &[(usize, u8)]) -> Vec<u8> {
+    let mut p = vec![0u8; n];
+    for &(i, q) in parts {
+        p[i] = q;
+    }
+    p
+}
+
+/// Ground evaluation of `Σ c_j·m_j(x)`: the design row of `terms` at `x` times `coefficients`.
+pub(crate) fn evaluate(terms: &Terms, coefficients: &[f64], x: &[f64]) -> f64 {
+    terms
+        .design_row(x)
+        .iter()
+        .zip(coefficients)
+        .map(|(a, c)| a * c)
+        .sum()
 }
 
 impl Terms {
@@ -107,34 +135,30 @@ impl Terms {
 
     /// Shapes and limits the flight crate can evaluate: 1..=MAX_TERMS distinct terms, each with
     /// `n_features` powers ≤ MAX_POWER, `n_features ≤ MAX_FEATURES`.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), TermsError> {
         if self.n_features > MAX_FEATURES {
-            return Err(format!(
-                "terms over {} features, at most {MAX_FEATURES} supported",
-                self.n_features
-            ));
+            return Err(TermsError::TooManyFeatures {
+                n_features: self.n_features,
+            });
         }
         if self.powers.is_empty() || self.powers.len() > MAX_TERMS {
-            return Err(format!(
-                "{} terms: need 1 to {MAX_TERMS}",
-                self.powers.len()
-            ));
+            return Err(TermsError::TermCount {
+                terms: self.powers.len(),
+            });
         }
         for (j, p) in self.powers.iter().enumerate() {
             if p.len() != self.n_features {
-                return Err(format!(
-                    "term {j} has {} powers, expected one per feature ({})",
-                    p.len(),
-                    self.n_features
-                ));
+                return Err(TermsError::PowerCount {
+                    term: j,
+                    powers: p.len(),
+                    n_features: self.n_features,
+                });
             }
             if let Some(&q) = p.iter().find(|&&q| q > MAX_POWER) {
-                return Err(format!(
-                    "term {j} has power {q}, at most {MAX_POWER} supported"
-                ));
+                return Err(TermsError::PowerTooHigh { term: j, power: q });
             }
             if self.powers[..j].contains(p) {
-                return Err(format!("term {j} repeats an earlier term"));
+                return Err(TermsError::Repeated { term: j });
             }
         }
         Ok(())
@@ -179,6 +203,53 @@ impl Terms {
     }
 }
 
+/// A term list the flight crate cannot evaluate.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum TermsError {
+    /// More features than the flight crate's `MAX_FEATURES`.
+    TooManyFeatures { n_features: usize },
+    /// No terms, or more than the flight crate's `MAX_TERMS`.
+    TermCount { terms: usize },
+    /// Term `term` has `powers` powers for `n_features` features.
+    PowerCount {
+        term: usize,
+        powers: usize,
+        n_features: usize,
+    },
+    /// Term `term` has a power above the flight crate's `MAX_POWER`.
+    PowerTooHigh { term: usize, power: u8 },
+    /// Term `term` repeats an earlier term.
+    Repeated { term: usize },
+}
+
+impl std::fmt::Display for TermsError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TermsError::TooManyFeatures { n_features } => write!(
+                f,
+                "terms over {n_features} features, at most {MAX_FEATURES} supported"
+            ),
+            TermsError::TermCount { terms } => write!(f, "{terms} terms: need 1 to {MAX_TERMS}"),
+            TermsError::PowerCount {
+                term,
+                powers,
+                n_features,
+            } => write!(
+                f,
+                "term {term} has {powers} powers, expected one per feature ({n_features})"
+            ),
+            TermsError::PowerTooHigh { term, power } => write!(
+                f,
+                "term {term} has power {power}, at most {MAX_POWER} supported"
+            ),
+            TermsError::Repeated { term } => write!(f, "term {term} repeats an earlier term"),
+        }
+    }
+}
+
+impl std::error::Error for TermsError {}
+
 /// A fitted baseline.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BaselineFit {
@@ -197,12 +268,7 @@ pub struct BaselineFit {
 impl BaselineFit {
     /// Prediction for one feature vector (ground evaluation: design row · coefficients).
     pub fn predict_row(&self, x: &[f64]) -> f64 {
-        self.terms
-            .design_row(x)
-            .iter()
-            .zip(&self.coefficients)
-            .map(|(a, c)| a * c)
-            .sum()
+        evaluate(&self.terms, &self.coefficients, x)
     }
 
     /// Predictions for every row of `table`.
@@ -229,9 +295,15 @@ pub fn to_core(terms: &Terms, coefficients: &[f64]) -> Result<BaselineModel, Bas
 
 /// Why a fit was refused.
 #[derive(Debug, Clone, PartialEq)]
-pub enum FitError {
+#[non_exhaustive]
+pub enum LsqError {
     /// Terms, rows, target or mask do not fit together.
     Shape(String),
+    /// The term list itself cannot be evaluated in flight.
+    Terms(TermsError),
+    /// Term `term` (counted from the constant, 0) does not vary within the training runs
+    /// (fixed-effects fit: after each run's mean is removed).
+    ConstantTerm { term: usize },
     /// A target value at `row` is not finite.
     NonFiniteTarget { row: usize, value: f64 },
     /// Fewer usable rows than terms.
@@ -256,19 +328,24 @@ fn long_name(feature: &str) -> String {
     }
 }
 
-impl std::fmt::Display for FitError {
+impl std::fmt::Display for LsqError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            FitError::Shape(m) => write!(f, "baseline fit: {m}"),
-            FitError::NonFiniteTarget { row, value } => write!(
+            LsqError::Shape(m) => write!(f, "baseline fit: {m}"),
+            LsqError::Terms(e) => write!(f, "baseline fit: {e}"),
+            LsqError::ConstantTerm { term } => write!(
+                f,
+                "term {term} does not vary within the training runs: cannot fit it"
+            ),
+            LsqError::NonFiniteTarget { row, value } => write!(
                 f,
                 "baseline fit: target at step {row} is {value}; mask it out or fix the log"
             ),
-            FitError::TooFewSamples { used, terms } => write!(
+            LsqError::TooFewSamples { used, terms } => write!(
                 f,
                 "baseline fit: {used} usable steps for {terms} terms; use a longer log"
             ),
-            FitError::ConstantFeature {
+            LsqError::ConstantFeature {
                 feature,
                 unit,
                 mean,
@@ -291,7 +368,7 @@ impl std::fmt::Display for FitError {
                     "the training log's {what} is constant ({mean:.1} {unit} ± {spread}): cannot fit the {term} coefficient; use a log that spans {range}"
                 )
             }
-            FitError::RankDeficient { ratio, terms } => write!(
+            LsqError::RankDeficient { ratio, terms } => write!(
                 f,
                 "baseline fit: the terms {} are (nearly) linearly dependent over the training data (singular value ratio {ratio:.1e} < {RANK_TOL:.0e}); drop one of them or use a log that varies them independently",
                 terms.join(", ")
@@ -300,7 +377,14 @@ impl std::fmt::Display for FitError {
     }
 }
 
-impl std::error::Error for FitError {}
+impl std::error::Error for LsqError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            LsqError::Terms(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 /// Fit `terms` to `target` (one value per row of `table`); `mask[r] == false` leaves row `r`
 /// out (e.g. steps without a scale-factor label).
@@ -309,7 +393,7 @@ pub fn fit(
     target: &[f64],
     mask: Option<&[bool]>,
     terms: &Terms,
-) -> Result<BaselineFit, FitError> {
+) -> Result<BaselineFit, LsqError> {
     fit_rows(
         &table.rows,
         table.n_features,
@@ -330,30 +414,30 @@ pub fn fit_rows(
     target: &[f64],
     mask: Option<&[bool]>,
     terms: &Terms,
-) -> Result<BaselineFit, FitError> {
-    terms.validate().map_err(FitError::Shape)?;
+) -> Result<BaselineFit, LsqError> {
+    terms.validate().map_err(LsqError::Terms)?;
     if terms.n_features != n_features {
-        return Err(FitError::Shape(format!(
+        return Err(LsqError::Shape(format!(
             "terms are over {} features, the data has {n_features}",
             terms.n_features
         )));
     }
     if n_features == 0 || rows.len() % n_features != 0 {
-        return Err(FitError::Shape(format!(
+        return Err(LsqError::Shape(format!(
             "{} values is not a whole number of rows of {n_features}",
             rows.len()
         )));
     }
     let n_rows = rows.len() / n_features;
     if target.len() != n_rows {
-        return Err(FitError::Shape(format!(
+        return Err(LsqError::Shape(format!(
             "{} target values for {n_rows} feature rows",
             target.len()
         )));
     }
     if let Some(m) = mask {
         if m.len() != n_rows {
-            return Err(FitError::Shape(format!(
+            return Err(LsqError::Shape(format!(
                 "mask has {} entries for {n_rows} rows",
                 m.len()
             )));
@@ -362,7 +446,7 @@ pub fn fit_rows(
     let used: Vec<usize> = (0..n_rows).filter(|&r| mask.is_none_or(|m| m[r])).collect();
     for &r in &used {
         if !target[r].is_finite() {
-            return Err(FitError::NonFiniteTarget {
+            return Err(LsqError::NonFiniteTarget {
                 row: r,
                 value: target[r],
             });
@@ -371,14 +455,14 @@ pub fn fit_rows(
             .iter()
             .position(|v| !v.is_finite())
         {
-            return Err(FitError::Shape(format!(
+            return Err(LsqError::Shape(format!(
                 "feature {k} at step {r} is not finite"
             )));
         }
     }
     let p = terms.len();
     if used.len() < p {
-        return Err(FitError::TooFewSamples {
+        return Err(LsqError::TooFewSamples {
             used: used.len(),
             terms: p,
         });
@@ -401,7 +485,7 @@ pub fn fit_rows(
             let mean = sum / used.len() as f64;
             let std =
                 (col.map(|v| (v - mean) * (v - mean)).sum::<f64>() / used.len() as f64).sqrt();
-            return Err(FitError::ConstantFeature {
+            return Err(LsqError::ConstantFeature {
                 feature: name(i),
                 unit: units.get(i).copied().unwrap_or("").to_owned(),
                 mean,
@@ -423,7 +507,7 @@ pub fn fit_rows(
     for (j, s) in scale.iter_mut().enumerate() {
         let rms = (x.column(j).norm_squared() / n as f64).sqrt();
         if !(rms.is_finite() && rms > 0.0) {
-            return Err(FitError::RankDeficient {
+            return Err(LsqError::RankDeficient {
                 ratio: 0.0,
                 terms: vec![terms.name(j, names)],
             });
@@ -455,11 +539,11 @@ pub fn fit_rows(
                 }
             }
         }
-        return Err(FitError::RankDeficient { ratio, terms: dep });
+        return Err(LsqError::RankDeficient { ratio, terms: dep });
     }
     let c_scaled = svd
         .solve(&y, 0.0)
-        .map_err(|e| FitError::Shape(format!("SVD solve failed: {e}")))?;
+        .map_err(|e| LsqError::Shape(format!("SVD solve failed: {e}")))?;
     let resid = &x * &c_scaled - &y;
     let coefficients: Vec<f64> = c_scaled.iter().zip(&scale).map(|(c, s)| c / s).collect();
     Ok(BaselineFit {

@@ -1,12 +1,45 @@
 //! gyrotherm: the ground library for temperature compensation of fiber optic gyroscopes.
 //!
-//! Pure functions over plain data where possible; I/O at the edges.
-//! - [`csvlog`]: the test-log CSV format (read, validate, write).
-//! - [`sim`]: thermal-chamber + FOG simulator.
+//! Data flows one way, and each step is one module (no module imports one further down):
+//!
+//! ```text
+//! log ──► features ──► targets ──► fit ──► model ──► compensate ──► figures
+//! csvlog  features     targets     fit     model     compensate     compare, report
+//!  (sim)                           ├ baseline (least squares)
+//!                                  └ nn (LSTM training)
+//! ```
+//!
+//! - [`csvlog`]: the test-log CSV format (read, validate, write): [`read_log`] → [`TestLog`].
+//! - [`sim`]: thermal-chamber + FOG simulator, a source of logs ([`simulate`]).
+//! - [`features`]: the model inputs (temperature, its rate, thermal-state lags) of a log
+//!   ([`FeatureSpec`], [`FeatureTable`]).
+//! - [`targets`]: what the models learn: bias from static runs, scale factor from rate-table
+//!   runs ([`TargetSet`]).
+//! - [`fit`]: fit a compensation model from training logs ([`fit_model`], [`FitConfig`],
+//!   [`LstmRecipe`]); least squares is [`baseline`], the LSTM network and its training
+//!   [`nn`].
+//! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]).
+//! - [`compensate`]: run the flight compensator (`gyrotherm-core`) over a log or a CSV
+//!   stream ([`compensate_log`], [`compensate_stream`]).
 //! - [`allan`], [`metrics`]: the standard gyro figures (IEEE Std 952 / GJB 2426A).
-//! - [`baseline`], [`train`], [`model`]: fitting compensation models and their files.
-//! - [`report`]: figures and the HTML report.
-//! - [`atomic_file`]: outputs written to a temporary file and renamed into place.
+//! - [`compare`]: held-out comparison of methods (the numbers); [`report`]: the pictures and
+//!   the HTML report.
+//! - [`atomic_file`]: the output helper: every output is written to a temporary file and
+//!   renamed into place.
+//!
+//! ```no_run
+//! use gyrotherm::{compensate_log, fit_model, read_log, FitConfig, Method, ModelFile, NamedLog};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let (log, _) = read_log("static.csv".as_ref(), &Default::default())?;
+//! let logs = [NamedLog { name: "static.csv", log: &log }];
+//! let fitted = fit_model(&logs, &FitConfig::new(Method::Linear), &|_, _, _| {})?;
+//! fitted.model.save("model.json".as_ref())?;
+//! let model = ModelFile::load("model.json".as_ref())?;
+//! let out = compensate_log(&model, &log)?;
+//! println!("{} samples compensated", out.gyro_comp_dps.len());
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod allan;
 pub mod atomic_file;
@@ -18,7 +51,15 @@ pub mod features;
 pub mod fit;
 pub mod metrics;
 pub mod model;
+pub mod nn;
 pub mod report;
 pub mod sim;
 pub mod targets;
-pub mod train;
+
+pub use compensate::{compensate_log, compensate_stream, compensator, CompensateError};
+pub use csvlog::{read_log, write_log, LogError, ReadOptions, TestLog};
+pub use features::{FeatureSpec, FeatureTable};
+pub use fit::{fit_model, FitConfig, FitError, FitOutcome, LstmRecipe, NamedLog, RecipeKind};
+pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
+pub use sim::{simulate, SimConfig};
+pub use targets::TargetSet;

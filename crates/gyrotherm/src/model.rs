@@ -18,12 +18,13 @@
 //! version first, then the fields (unknown fields are refused), then shapes and finiteness.
 
 use crate::atomic_file::write_bytes_atomically;
+use crate::baseline::TermsError;
 use crate::baseline::{self, Terms};
 use crate::csvlog::TestLog;
 use crate::features::FeatureTable;
-use crate::train::params::LstmParams;
-use crate::train::zscore::ZScore;
-use gyrotherm_core::baseline::BaselineModel;
+use crate::nn::params::{LstmParams, ParamsError};
+use crate::nn::zscore::ZScore;
+use gyrotherm_core::baseline::{BaselineError, BaselineModel};
 use gyrotherm_core::features::{FeatureSpec, LagOutputs, MAX_LAGS};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -102,11 +103,14 @@ impl FeatureDef {
     }
 
     /// The core spec, checked.
-    pub fn to_spec(&self) -> Result<FeatureSpec, String> {
+    pub fn to_spec(&self) -> Result<FeatureSpec, ModelFileError> {
         if self.lag_tau_s.len() > MAX_LAGS {
-            return Err(format!(
-                "{} lag time constants, at most {MAX_LAGS} supported",
-                self.lag_tau_s.len()
+            return Err(ModelFileError::invalid(
+                "features",
+                format!(
+                    "{} lag time constants, at most {MAX_LAGS} supported",
+                    self.lag_tau_s.len()
+                ),
             ));
         }
         let base = FeatureSpec {
@@ -121,7 +125,7 @@ impl FeatureDef {
             LagOutputsDef::Both => LagOutputs::Both,
         };
         base.with_lags(&self.lag_tau_s, outputs)
-            .map_err(|e| e.to_string())
+            .map_err(ModelFileError::Features)
     }
 }
 
@@ -141,7 +145,7 @@ pub enum SubModel {
         coefficients: Vec<f64>,
     },
     /// A baseline plus an LSTM fitted to its residual: y = baseline(x) + lstm(x) (a residual
-    /// LSTM on top of a physical fit, issue 5); with `lstm_reads_base`,
+    /// LSTM on top of a physical fit); with `lstm_reads_base`,
     /// y = baseline(x) + lstm(x, baseline(x)): the LSTM reads the features followed by the
     /// baseline's value (`n_features + 1` inputs).
     Residual {
@@ -176,7 +180,7 @@ impl SubModel {
     }
 
     /// The flight evaluator of a baseline sub-model (None for an LSTM).
-    pub fn baseline_core(&self) -> Option<Result<BaselineModel, String>> {
+    pub fn baseline_core(&self) -> Option<Result<BaselineModel, BaselineError>> {
         match self {
             SubModel::Baseline {
                 terms,
@@ -186,13 +190,13 @@ impl SubModel {
                 terms,
                 coefficients,
                 ..
-            } => Some(baseline::to_core(terms, coefficients).map_err(|e| e.to_string())),
+            } => Some(baseline::to_core(terms, coefficients)),
             SubModel::Lstm { .. } => None,
         }
     }
 
     /// Shapes and finiteness for `n_features` inputs; the message names the tensor at fault.
-    pub fn validate(&self, n_features: usize) -> Result<(), String> {
+    pub fn validate(&self, n_features: usize) -> Result<(), SubModelError> {
         match self {
             SubModel::Residual {
                 terms,
@@ -209,11 +213,11 @@ impl SubModel {
                 .validate(n_features)?;
                 let lstm_inputs = n_features + usize::from(*lstm_reads_base);
                 if lstm_inputs > gyrotherm_core::features::MAX_FEATURES {
-                    return Err(format!(
+                    return Err(SubModelError::Invalid(format!(
                         "lstm_reads_base: {n_features} features plus the base value exceed the \
                          flight LSTM's {} inputs",
                         gyrotherm_core::features::MAX_FEATURES
-                    ));
+                    )));
                 }
                 SubModel::Lstm {
                     params: params.clone(),
@@ -223,7 +227,7 @@ impl SubModel {
                 .validate(lstm_inputs)
                 .map_err(|e| {
                     if *lstm_reads_base {
-                        format!("{e} (lstm_reads_base: the features plus the base value)")
+                        SubModelError::ReadsBase(Box::new(e))
                     } else {
                         e
                     }
@@ -234,12 +238,12 @@ impl SubModel {
                 input_norm,
                 target_norm,
             } => {
-                params.validate()?;
+                params.validate().map_err(SubModelError::Params)?;
                 if params.input_size != n_features {
-                    return Err(format!(
+                    return Err(SubModelError::Invalid(format!(
                         "params.input_size is {} but the feature definition gives {n_features} features",
                         params.input_size
-                    ));
+                    )));
                 }
                 check_norm("input_norm", input_norm, n_features)?;
                 check_norm("target_norm", target_norm, 1)
@@ -248,22 +252,24 @@ impl SubModel {
                 terms,
                 coefficients,
             } => {
-                terms.validate().map_err(|e| format!("terms: {e}"))?;
+                terms.validate().map_err(SubModelError::Terms)?;
                 if terms.n_features != n_features {
-                    return Err(format!(
+                    return Err(SubModelError::Invalid(format!(
                         "terms.n_features is {} but the feature definition gives {n_features} features",
                         terms.n_features
-                    ));
+                    )));
                 }
                 if coefficients.len() != terms.len() {
-                    return Err(format!(
+                    return Err(SubModelError::Invalid(format!(
                         "coefficients has {} values for {} terms",
                         coefficients.len(),
                         terms.len()
-                    ));
+                    )));
                 }
                 if let Some(k) = coefficients.iter().position(|c| !c.is_finite()) {
-                    return Err(format!("coefficients[{k}] is not finite"));
+                    return Err(SubModelError::Invalid(format!(
+                        "coefficients[{k}] is not finite"
+                    )));
                 }
                 Ok(())
             }
@@ -271,24 +277,64 @@ impl SubModel {
     }
 }
 
-fn check_norm(name: &str, z: &ZScore, channels: usize) -> Result<(), String> {
+fn check_norm(name: &str, z: &ZScore, channels: usize) -> Result<(), SubModelError> {
     if z.mean.len() != channels || z.std.len() != channels {
-        return Err(format!(
+        return Err(SubModelError::Invalid(format!(
             "{name} has {} means and {} stds, expected {channels} each",
             z.mean.len(),
             z.std.len()
-        ));
+        )));
     }
     if let Some(k) = z.mean.iter().position(|v| !v.is_finite()) {
-        return Err(format!("{name}.mean[{k}] is not finite"));
+        return Err(SubModelError::Invalid(format!(
+            "{name}.mean[{k}] is not finite"
+        )));
     }
     if let Some(k) = z.std.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-        return Err(format!(
+        return Err(SubModelError::Invalid(format!(
             "{name}.std[{k}] is {}: must be finite and > 0",
             z.std[k]
-        ));
+        )));
     }
     Ok(())
+}
+
+/// A sub-model that cannot be evaluated: the tensor or field at fault.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum SubModelError {
+    /// The LSTM parameters.
+    Params(ParamsError),
+    /// The least-squares terms.
+    Terms(TermsError),
+    /// A field's value (the message names the field).
+    Invalid(String),
+    /// The LSTM part, which reads the features plus the base value.
+    ReadsBase(Box<SubModelError>),
+}
+
+impl std::fmt::Display for SubModelError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SubModelError::Params(e) => e.fmt(f),
+            SubModelError::Terms(e) => write!(f, "terms: {e}"),
+            SubModelError::Invalid(m) => f.write_str(m),
+            SubModelError::ReadsBase(e) => {
+                write!(f, "{e} (lstm_reads_base: the features plus the base value)")
+            }
+        }
+    }
+}
+
+impl std::error::Error for SubModelError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            SubModelError::Params(e) => Some(e),
+            SubModelError::Terms(e) => Some(e),
+            SubModelError::ReadsBase(e) => Some(e.as_ref()),
+            SubModelError::Invalid(_) => None,
+        }
+    }
 }
 
 /// A closed range.
@@ -377,20 +423,119 @@ pub struct ModelFile {
     pub training: TrainingInfo,
 }
 
-/// A model file that cannot be read or written: the file and what is wrong.
+/// A model that cannot be read, checked or written: the file, the field and the value at
+/// fault.
 #[derive(Debug)]
-pub struct ModelError {
-    pub path: PathBuf,
-    pub message: String,
+#[non_exhaustive]
+pub enum ModelFileError {
+    /// The file could not be read.
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The file could not be written.
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// An error in the model file at `path`.
+    InFile {
+        path: PathBuf,
+        source: Box<ModelFileError>,
+    },
+    /// A model that fails its checks was not saved.
+    NotSaved(Box<ModelFileError>),
+    /// The text is not JSON.
+    NotJson(serde_json::Error),
+    /// A field is missing, unknown or of the wrong type.
+    Fields(serde_json::Error),
+    /// No `format_version` field.
+    MissingVersion,
+    /// A `format_version` this build does not read (the value as written).
+    UnsupportedVersion { found: String },
+    /// The feature definition cannot be built.
+    Features(gyrotherm_core::features::SpecError),
+    /// The `bias` or `scale` sub-model.
+    SubModel {
+        target: Target,
+        source: SubModelError,
+    },
+    /// A field's value (`field` names it, e.g. `training.final_loss`).
+    Invalid { field: String, problem: String },
 }
 
-impl std::fmt::Display for ModelError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}: {}", self.path.display(), self.message)
+impl ModelFileError {
+    fn invalid(field: &str, problem: String) -> Self {
+        ModelFileError::Invalid {
+            field: field.to_owned(),
+            problem,
+        }
     }
 }
 
-impl std::error::Error for ModelError {}
+impl std::fmt::Display for ModelFileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ModelFileError::Read { path, source } => {
+                write!(f, "{}: cannot read model file: {source}", path.display())
+            }
+            ModelFileError::Write { path, source } => write!(f, "{}: {source}", path.display()),
+            ModelFileError::InFile { path, source } => write!(f, "{}: {source}", path.display()),
+            ModelFileError::NotSaved(e) => write!(f, "not saved: {e}"),
+            ModelFileError::NotJson(e) => write!(f, "not valid JSON: {e}"),
+            ModelFileError::Fields(e) => e.fmt(f),
+            ModelFileError::MissingVersion => f.write_str("missing field `format_version`"),
+            ModelFileError::UnsupportedVersion { found } => write!(
+                f,
+                "unsupported format_version {found}: this gyrotherm ({}) reads version {}; use a \
+                 matching gyrotherm or re-train",
+                env!("CARGO_PKG_VERSION"),
+                supported_list()
+            ),
+            ModelFileError::Features(e) => write!(f, "features: {e}"),
+            ModelFileError::SubModel { target, source } => {
+                write!(f, "{}: {source}", target.as_str())
+            }
+            ModelFileError::Invalid { field, problem } if field.is_empty() => f.write_str(problem),
+            ModelFileError::Invalid { field, problem } => write!(f, "{field}: {problem}"),
+        }
+    }
+}
+
+impl std::error::Error for ModelFileError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ModelFileError::Read { source, .. } | ModelFileError::Write { source, .. } => {
+                Some(source)
+            }
+            ModelFileError::InFile { source, .. } | ModelFileError::NotSaved(source) => {
+                Some(source.as_ref())
+            }
+            ModelFileError::NotJson(e) | ModelFileError::Fields(e) => Some(e),
+            ModelFileError::Features(e) => Some(e),
+            ModelFileError::SubModel { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
+
+/// Which of the two sub-models of a model file (and which target a fit is for).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    /// Bias, °/s.
+    Bias,
+    /// Scale factor K, dimensionless.
+    Scale,
+}
+
+impl Target {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Target::Bias => "bias",
+            Target::Scale => "scale",
+        }
+    }
+}
 
 /// `gyrotherm <version>`, for [`TrainingInfo::created_by`].
 pub fn created_by() -> String {
@@ -430,34 +575,41 @@ pub fn data_digest(logs: &[&TestLog]) -> String {
 
 impl ModelFile {
     /// The core feature spec of this model.
-    pub fn feature_spec(&self) -> Result<FeatureSpec, String> {
+    pub fn feature_spec(&self) -> Result<FeatureSpec, ModelFileError> {
         self.features.to_spec()
     }
 
     /// Check everything [`load`](Self::load) checks after parsing; the message names the field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ModelFileError> {
         if !SUPPORTED_VERSIONS.contains(&self.format_version) {
-            return Err(unsupported(self.format_version));
+            return Err(ModelFileError::UnsupportedVersion {
+                found: self.format_version.to_string(),
+            });
         }
-        let spec = self
-            .features
-            .to_spec()
-            .map_err(|e| format!("features: {e}"))?;
+        let spec = self.features.to_spec()?;
         let nf = spec.n_features();
         if self.bias.is_none() && self.scale.is_none() {
-            return Err("neither a bias nor a scale model: nothing to compensate".to_owned());
+            return Err(ModelFileError::invalid(
+                "",
+                "neither a bias nor a scale model: nothing to compensate".to_owned(),
+            ));
         }
-        for (name, sub) in [("bias", &self.bias), ("scale", &self.scale)] {
+        for (target, sub) in [(Target::Bias, &self.bias), (Target::Scale, &self.scale)] {
             let Some(sub) = sub else { continue };
+            let name = target.as_str();
             if matches!(self.method, Method::Linear | Method::Poly)
                 && matches!(sub, SubModel::Lstm { .. } | SubModel::Residual { .. })
             {
-                return Err(format!(
-                    "{name}: an lstm sub-model in a model whose method is {}",
-                    self.method.as_str()
+                return Err(ModelFileError::invalid(
+                    name,
+                    format!(
+                        "an lstm sub-model in a model whose method is {}",
+                        self.method.as_str()
+                    ),
                 ));
             }
-            sub.validate(nf).map_err(|e| format!("{name}: {e}"))?;
+            sub.validate(nf)
+                .map_err(|source| ModelFileError::SubModel { target, source })?;
         }
         let t = &self.training;
         for (name, r) in [
@@ -465,69 +617,82 @@ impl ModelFile {
             ("rate_range_c_per_s", t.rate_range_c_per_s),
         ] {
             if !(r.min.is_finite() && r.max.is_finite() && r.min <= r.max) {
-                return Err(format!(
-                    "training.{name}: min {} and max {} must be finite with min ≤ max",
-                    r.min, r.max
+                return Err(ModelFileError::invalid(
+                    &format!("training.{name}"),
+                    format!(
+                        "min {} and max {} must be finite with min ≤ max",
+                        r.min, r.max
+                    ),
                 ));
             }
         }
         let d = &t.data_digest_sha256;
         if d.len() != 64 || !d.bytes().all(|b| b.is_ascii_hexdigit()) {
-            return Err(format!(
-                "training.data_digest_sha256 {d:?} is not 64 hexadecimal digits"
+            return Err(ModelFileError::invalid(
+                "training.data_digest_sha256",
+                format!("{d:?} is not 64 hexadecimal digits"),
             ));
         }
         if let Some(l) = t.final_loss {
             if !l.is_finite() {
-                return Err(format!("training.final_loss is {l}"));
+                return Err(ModelFileError::Invalid {
+                    field: "training.final_loss".to_owned(),
+                    problem: format!("{l}, must be finite"),
+                });
             }
         }
         Ok(())
     }
 
     /// The JSON text (pretty, shortest round-trip floats), after [`validate`](Self::validate).
-    pub fn to_json(&self) -> Result<String, String> {
+    pub fn to_json(&self) -> Result<String, ModelFileError> {
         self.validate()?;
-        serde_json::to_string_pretty(self).map_err(|e| e.to_string())
+        serde_json::to_string_pretty(self).map_err(ModelFileError::Fields)
     }
 
     /// Parse and check JSON text.
-    pub fn from_json(text: &str) -> Result<ModelFile, String> {
+    pub fn from_json(text: &str) -> Result<ModelFile, ModelFileError> {
         // Version first, so that a newer file gets "unsupported version", not a field error.
-        let v: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| format!("not valid JSON: {e}"))?;
+        let v: serde_json::Value = serde_json::from_str(text).map_err(ModelFileError::NotJson)?;
         match v.get("format_version") {
-            None => return Err("missing field `format_version`".to_owned()),
+            None => return Err(ModelFileError::MissingVersion),
             Some(fv) => match fv.as_u64() {
                 Some(n) if SUPPORTED_VERSIONS.contains(&(n as u32)) && n <= u32::MAX as u64 => {}
-                _ => return Err(unsupported_value(fv)),
+                _ => {
+                    return Err(ModelFileError::UnsupportedVersion {
+                        found: fv.to_string(),
+                    })
+                }
             },
         }
-        let m: ModelFile = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        let m: ModelFile = serde_json::from_str(text).map_err(ModelFileError::Fields)?;
         m.validate()?;
         Ok(m)
     }
 
     /// Write to `path` atomically (temporary file + rename), after validating.
-    pub fn save(&self, path: &Path) -> Result<(), ModelError> {
-        let err = |message: String| ModelError {
+    pub fn save(&self, path: &Path) -> Result<(), ModelFileError> {
+        let mut text = self.to_json().map_err(|e| ModelFileError::InFile {
             path: path.to_path_buf(),
-            message,
-        };
-        let mut text = self.to_json().map_err(|e| err(format!("not saved: {e}")))?;
+            source: Box::new(ModelFileError::NotSaved(Box::new(e))),
+        })?;
         text.push('\n');
-        write_bytes_atomically(path, text.as_bytes()).map_err(|e| err(e.to_string()))
+        write_bytes_atomically(path, text.as_bytes()).map_err(|source| ModelFileError::Write {
+            path: path.to_path_buf(),
+            source,
+        })
     }
 
     /// Read and check a model file.
-    pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
-        let err = |message: String| ModelError {
+    pub fn load(path: &Path) -> Result<ModelFile, ModelFileError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Read {
             path: path.to_path_buf(),
-            message,
-        };
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| err(format!("cannot read model file: {e}")))?;
-        Self::from_json(&text).map_err(err)
+            source,
+        })?;
+        Self::from_json(&text).map_err(|e| ModelFileError::InFile {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })
     }
 }
 
@@ -537,20 +702,4 @@ fn supported_list() -> String {
         .map(|v| v.to_string())
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-fn unsupported(v: u32) -> String {
-    format!(
-        "unsupported format_version {v}: this gyrotherm ({}) reads version {}; use a matching gyrotherm or re-train",
-        env!("CARGO_PKG_VERSION"),
-        supported_list()
-    )
-}
-
-fn unsupported_value(v: &serde_json::Value) -> String {
-    format!(
-        "unsupported format_version {v}: this gyrotherm ({}) reads version {}; use a matching gyrotherm or re-train",
-        env!("CARGO_PKG_VERSION"),
-        supported_list()
-    )
 }

@@ -1,9 +1,9 @@
 //! Training behaviour: the loss curve, determinism, masks, early stopping, truncated BPTT,
 //! and the exported f32 flight network against the f64 training forward pass.
 
-use gyrotherm::train::{
-    evaluate_mse, flatten, init_params, loss_and_grad, loss_and_grad_in, predict, train_lstm,
-    train_normalised, train_pair, Bptt, Precision, Sequence, StopReason, TrainConfig, WindowStart,
+use gyrotherm::nn::{
+    evaluate_mse, init_params, loss_and_grad, predict, train_lstm, train_normalised, train_pair,
+    Bptt, Precision, Sequence, StopReason, TrainConfig, WindowStart,
 };
 use gyrotherm_core::lstm::Lstm;
 
@@ -245,7 +245,8 @@ fn bad_input_is_refused_with_a_message() {
 }
 
 /// The exported f32 flight network, stepped sample by sample, against the f64 training-side
-/// forward pass over a 30,000-step run (issue 4: within 1e-5 relative).
+/// forward pass over a 30,000-step run (the export must agree within 1e-5 relative: f32 rounding over
+/// the run, far below a wrong weight's effect).
 #[test]
 fn core_f32_matches_training_forward_over_30000_steps() {
     // Error relative to max(|y_t|, RMS of y over the run): pointwise relative error is
@@ -259,7 +260,7 @@ fn core_f32_matches_training_forward_over_30000_steps() {
     // Normalised inputs: a chamber cycle scaled to about ±1.7 and its rate, z-scored.
     let temp = chamber_temp_c(30_000);
     let raw = inputs(&temp);
-    let z = gyrotherm::train::ZScore::fit(&raw, 2);
+    let z = gyrotherm::nn::ZScore::fit(&raw, 2);
     let x: Vec<f64> = raw
         .iter()
         .enumerate()
@@ -293,45 +294,5 @@ fn core_f32_matches_training_forward_over_30000_steps() {
 fn to_core_refuses_wrong_size() {
     let p = init_params(2, 8, 0);
     let e = p.to_core::<2, 4>().unwrap_err();
-    assert!(e.contains("hidden_size 8"), "{e}");
-}
-
-/// The f32 kernel (the training default) against the f64 one, whose gradient is checked by
-/// finite differences and against PyTorch: loss and every gradient within 1e-4 of the largest
-/// gradient magnitude. f32 rounding (ε = 6e-8) summed over T = 3000 steps: √T·ε ≈ 3e-6 if the
-/// errors are random, T·ε ≈ 2e-4 if they all add up; a wrong term would be off by O(1).
-#[test]
-fn f32_kernel_gradient_matches_f64() {
-    const REL_TOL: f64 = 1e-4;
-    let temp = chamber_temp_c(3000);
-    let z = gyrotherm::train::ZScore::fit(&inputs(&temp), 2);
-    let x: Vec<f64> = inputs(&temp)
-        .iter()
-        .enumerate()
-        .map(|(k, v)| z.apply(k % 2, *v))
-        .collect();
-    let y: Vec<f64> = lagged_bias(&temp).iter().map(|v| v * 5.0).collect();
-    for (i, h) in [(2, 8), (2, 5)] {
-        let x = &x[..];
-        let p = init_params(i, h, 11);
-        let runs = [Sequence::new(x, &y)];
-        let (l64, g64) = loss_and_grad_in(&p, &runs, Precision::F64).unwrap();
-        let (l32, g32) = loss_and_grad_in(&p, &runs, Precision::F32).unwrap();
-        assert!(
-            (l32 - l64).abs() <= REL_TOL * l64,
-            "H={h} loss f64 {l64}, f32 {l32}"
-        );
-        let (g64, g32) = (flatten(&g64), flatten(&g32));
-        let scale = g64.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let worst = g64
-            .iter()
-            .zip(&g32)
-            .map(|(a, b)| (a - b).abs() / scale)
-            .fold(0.0, f64::max);
-        println!("I={i} H={h}: f32 gradient max err / max |g| = {worst:e}");
-        assert!(
-            worst <= REL_TOL,
-            "H={h}: f32 gradient off by {worst:e} of max |g|"
-        );
-    }
+    assert!(e.to_string().contains("hidden_size 8"), "{e}");
 }

@@ -6,8 +6,8 @@ use gyrotherm::features::FeatureSpec;
 use gyrotherm::model::{
     data_digest, sha256_hex, FeatureDef, Method, ModelFile, Range, SubModel, TrainingInfo,
 };
-use gyrotherm::train::params::LstmParams;
-use gyrotherm::train::zscore::ZScore;
+use gyrotherm::nn::params::LstmParams;
+use gyrotherm::nn::zscore::ZScore;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -239,6 +239,7 @@ fn non_finite_weights_are_refused() {
     assert!(m
         .validate()
         .unwrap_err()
+        .to_string()
         .contains("coefficients[2] is not finite"));
 }
 
@@ -269,19 +270,32 @@ fn inconsistent_content_is_refused() {
     assert!(m
         .validate()
         .unwrap_err()
+        .to_string()
         .contains("an lstm sub-model in a model whose method is linear"));
     let mut m = poly_model();
     m.bias = None;
-    assert!(m.validate().unwrap_err().contains("nothing to compensate"));
+    assert!(m
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("nothing to compensate"));
     let mut m = poly_model();
     m.training.temp_range_c = Range {
         min: 5.0,
         max: -5.0,
     };
-    assert!(m.validate().unwrap_err().contains("temp_range_c"));
+    assert!(m
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("temp_range_c"));
     let mut m = poly_model();
     m.training.data_digest_sha256 = "abc".into();
-    assert!(m.validate().unwrap_err().contains("64 hexadecimal"));
+    assert!(m
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("64 hexadecimal"));
     let dir = tempfile::tempdir().unwrap();
     let e = ModelFile::load(&dir.path().join("absent.json")).unwrap_err();
     assert!(e.to_string().contains("cannot read model file"), "{e}");
@@ -428,9 +442,9 @@ fn residual_reading_the_base_round_trips_and_is_checked() {
     gyrotherm::compensate::compensator(&back).unwrap();
 
     // Wrong input counts, either way round, are refused with the count named.
-    let e = residual_model(true, 5).validate().unwrap_err();
+    let e = residual_model(true, 5).validate().unwrap_err().to_string();
     assert!(e.contains("input_size is 5") && e.contains("6"), "{e}");
-    let e = residual_model(false, 6).validate().unwrap_err();
+    let e = residual_model(false, 6).validate().unwrap_err().to_string();
     assert!(e.contains("input_size is 6"), "{e}");
 
     // An older file (no `lstm_reads_base` key) loads as features-only.

@@ -67,8 +67,7 @@ impl FitArgs {
     /// The library's fit configuration for `method`.
     pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
         let mut cfg = FitConfig::new(method);
-        let kind =
-            gyrotherm::fit::lstm::RecipeKind::parse(&self.recipe).map_err(anyhow::Error::msg)?;
+        let kind = gyrotherm::fit::RecipeKind::parse(&self.recipe).map_err(anyhow::Error::msg)?;
         cfg.recipe = gyrotherm::fit::LstmRecipe::of_kind(kind);
         if let Some(e) = self.epochs {
             anyhow::ensure!(e > 0, "--epochs must be at least 1");

@@ -3,10 +3,26 @@
 //! Static logs train the bias model, rate-table logs the scale-factor model (He et al. 2024,
 //! DOI 10.19452/j.issn1007-5453.2024.02.004, §2: two separate networks, because the
 //! magnitudes differ). Methods: `linear` (bias = c0 + c1·T + c2·dT, the paper's comparison),
-//! `poly` (degree n in T, m in dT, optional T·dT), `lstm` (see [`lstm`]).
+//! `poly` (degree n in T, m in dT, optional T·dT), `lstm` (an [`LstmRecipe`]).
+//!
+//! Modules, each one concept, imports running one way (down this list):
+//! - [`recipe`]: which LSTM recipe, its knobs, and what training reports ([`TrainSummary`]).
+//! - [`published`], [`residual`], [`generic`], [`direct`]: one recipe each.
+//! - [`select`]: choosing a residual recipe's least-squares terms by blocked cross-validation.
+//! - [`terms`]: the term sets (tailored, generic, the ladder) the bases are built from.
+//! - [`error`]: why a fit was refused ([`FitError`]).
+//!
+//! Least squares itself (with or without per-run offsets) is [`crate::baseline`]; LSTM
+//! training is [`crate::nn`].
 
-pub mod lstm;
+pub mod direct;
+pub mod error;
+pub mod generic;
+pub mod published;
+pub mod recipe;
+pub mod residual;
 pub mod select;
+pub mod terms;
 
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
@@ -14,31 +30,17 @@ use crate::features::{FeatureSpec, FeatureTable};
 use crate::model::{self, FeatureDef, Method, ModelFile, SubModel, TrainingInfo};
 use crate::targets::{self, TargetSet};
 
-pub use lstm::{LstmRecipe, LstmVerdict, RecipeKind, RecipeTarget, TrainSummary};
+pub use crate::model::Target;
+pub use error::FitError;
+pub use recipe::{LstmRecipe, LstmVerdict, RecipeKind, TrainSummary, UnknownRecipe};
+pub use select::TermSelection;
+pub use terms::BaseTerms;
 
 /// A training log and the name it is reported under (its file name).
 #[derive(Debug, Clone, Copy)]
 pub struct NamedLog<'a> {
     pub name: &'a str,
     pub log: &'a TestLog,
-}
-
-/// Which of the two models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Target {
-    /// Bias, °/s.
-    Bias,
-    /// Scale factor K, dimensionless.
-    Scale,
-}
-
-impl Target {
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            Target::Bias => "bias",
-            Target::Scale => "scale",
-        }
-    }
 }
 
 /// How to fit.
@@ -86,7 +88,7 @@ pub struct FitOutcome {
 pub fn feature_spec(cfg: &FitConfig) -> FeatureSpec {
     match cfg.method {
         Method::Linear | Method::Poly => FeatureSpec::PUBLISHED,
-        Method::Lstm => lstm::feature_spec(&cfg.recipe),
+        Method::Lstm => recipe::feature_spec(&cfg.recipe),
     }
 }
 
@@ -107,7 +109,7 @@ fn baseline_terms(cfg: &FitConfig, target: Target, n_features: usize) -> Terms {
 }
 
 /// Fit a baseline on the labelled steps of all runs.
-fn fit_baseline(sets: &[TargetSet], terms: &Terms) -> Result<SubModel, String> {
+fn fit_baseline(sets: &[TargetSet], terms: &Terms) -> Result<SubModel, FitError> {
     let first = &sets[0].table;
     let mut rows = Vec::new();
     let mut target = Vec::new();
@@ -125,8 +127,7 @@ fn fit_baseline(sets: &[TargetSet], terms: &Terms) -> Result<SubModel, String> {
         &target,
         Some(&mask),
         terms,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok(SubModel::from_fit(&fit))
 }
 
@@ -136,7 +137,7 @@ fn fit_one(
     cfg: &FitConfig,
     target: Target,
     progress: &mut dyn FnMut(usize, f64),
-) -> Result<(SubModel, Option<TrainSummary>), String> {
+) -> Result<(SubModel, Option<TrainSummary>), FitError> {
     match cfg.method {
         Method::Linear | Method::Poly => {
             let terms = baseline_terms(cfg, target, sets[0].table.n_features);
@@ -147,11 +148,7 @@ fn fit_one(
                 Target::Bias => 0,
                 Target::Scale => 1,
             });
-            let t = match target {
-                Target::Bias => RecipeTarget::Bias,
-                Target::Scale => RecipeTarget::Scale,
-            };
-            let (sub, summary) = lstm::fit_target(sets, &cfg.recipe, t, seed, progress)?;
+            let (sub, summary) = fit_target(sets, &cfg.recipe, target, seed, progress)?;
             Ok((sub, Some(summary)))
         }
     }
@@ -163,9 +160,9 @@ pub fn fit_model(
     logs: &[NamedLog],
     cfg: &FitConfig,
     progress: &(dyn Fn(Target, usize, f64) + Sync),
-) -> Result<FitOutcome, String> {
+) -> Result<FitOutcome, FitError> {
     if logs.is_empty() {
-        return Err("no training logs given".into());
+        return Err(FitError::NoLogs);
     }
     let spec = feature_spec(cfg);
     let mut bias_sets = Vec::new();
@@ -173,23 +170,29 @@ pub fn fit_model(
     for l in logs {
         if targets::is_static(l.log) {
             bias_sets.push(
-                targets::bias_targets(l.log, &spec, cfg.bias_window_s)
-                    .map_err(|e| format!("{}: {e}", l.name))?,
+                targets::bias_targets(l.log, &spec, cfg.bias_window_s).map_err(|message| {
+                    FitError::Targets {
+                        run: l.name.to_owned(),
+                        message,
+                    }
+                })?,
             );
         } else {
             let s = targets::scale_targets(l.log, &spec, cfg.settle_s, cfg.scale_window_s)
-                .map_err(|e| format!("{}: {e}", l.name))?;
+                .map_err(|message| FitError::Targets {
+                    run: l.name.to_owned(),
+                    message,
+                })?;
             if s.labelled() == 0 {
-                return Err(format!(
-                    "{}: no rate segment has a stop segment on both sides, so no scale factor can be measured; log stop segments between the table rates",
-                    l.name
-                ));
+                return Err(FitError::NoScaleSegments {
+                    run: l.name.to_owned(),
+                });
             }
             scale_sets.push(s);
         }
     }
     if bias_sets.is_empty() && scale_sets.is_empty() {
-        return Err("no usable training logs".into());
+        return Err(FitError::NoUsableLogs);
     }
     let (bias, scale) = std::thread::scope(|s| {
         let bias = s.spawn(|| {
@@ -208,20 +211,26 @@ pub fn fit_model(
                 })
             })
             .transpose();
-        let bias = bias
-            .join()
-            .unwrap_or_else(|_| Err("bias training thread panicked".into()));
+        let bias = bias.join().unwrap_or(Err(FitError::ThreadPanicked {
+            target: Target::Bias,
+        }));
         (bias, scale)
     });
-    let bias = bias.map_err(|e| format!("bias model: {e}"))?;
-    let scale = scale.map_err(|e| format!("scale-factor model: {e}"))?;
+    let in_target = |target: Target| {
+        move |e: FitError| FitError::Target {
+            target,
+            source: Box::new(e),
+        }
+    };
+    let bias = bias.map_err(in_target(Target::Bias))?;
+    let scale = scale.map_err(in_target(Target::Scale))?;
     let tables: Vec<&FeatureTable> = bias_sets
         .iter()
         .chain(&scale_sets)
         .map(|s| &s.table)
         .collect();
     let (temp_range_c, rate_range_c_per_s) =
-        model::training_ranges(&tables).ok_or("the training logs have no feature steps")?;
+        model::training_ranges(&tables).ok_or(FitError::NoFeatureSteps)?;
     let lstm_summary = bias
         .as_ref()
         .and_then(|b| b.1.as_ref())
@@ -259,4 +268,42 @@ pub fn fit_model(
         bias_training,
         scale_training,
     })
+}
+
+impl LstmRecipe {
+    /// The recipe of a kind with its default knobs.
+    pub fn of_kind(kind: RecipeKind) -> Self {
+        match kind {
+            RecipeKind::Published => Self::published(),
+            RecipeKind::Residual => Self::residual(),
+            RecipeKind::Generic => Self::generic(),
+            RecipeKind::Direct => Self::direct(),
+        }
+    }
+}
+
+/// Fit one target (bias or scale factor) on the training runs with an LSTM recipe.
+pub fn fit_target(
+    train: &[TargetSet],
+    recipe: &LstmRecipe,
+    target: Target,
+    seed: u64,
+    progress: &mut dyn FnMut(usize, f64),
+) -> Result<(SubModel, TrainSummary), FitError> {
+    let n_in = train
+        .first()
+        .map(|t| t.table.n_features)
+        .ok_or(FitError::NoUsableLogs)?;
+    if let Some(t) = train.iter().find(|t| t.table.n_features != n_in) {
+        return Err(FitError::MixedFeatures {
+            first: n_in,
+            other: t.table.n_features,
+        });
+    }
+    match recipe.kind {
+        RecipeKind::Published => published::fit(train, recipe, n_in, seed, progress),
+        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct => {
+            residual::fit(train, recipe, target, n_in, seed, progress)
+        }
+    }
 }

@@ -1,13 +1,10 @@
 //! Choosing a least-squares term set from the training data: a small family of polynomial
 //! term sets over the thermal-state features, ranked by blocked cross-validation in time.
 //!
-//! A term set chosen from the simulator's own bias equation fits that simulator and no other
-//! unit (issue 5: on a unit with a 420 s coil, a Shupe temperature coefficient of 0.03 and a
-//! cubic bias term, the tailored set left 6.7–10.5 × the noise floor held out). So the family
-//! here is a generic ladder — a polynomial in T of degree 1 to 3, the lag differences linear,
-//! and none, the fastest lag's or the two fastest lags' second-order terms — and the data
-//! choose: each run is cut into [`FOLDS`] contiguous segments of its time axis; for each
-//! segment index every candidate is fitted on all runs with that segment (and a
+//! Why: a term set chosen from the simulator's own bias equation fits that simulator and no
+//! other unit (`docs/experiments/term-selection.md`). So the candidates are a generic ladder
+//! ([`super::terms::ladder`]) and the data choose: each run is cut into [`FOLDS`]
+//! contiguous segments of its time axis; for each segment index every candidate is fitted on all runs with that segment (and a
 //! [`GAP_STEPS`] margin either side, against leakage through the smoothed target) left out,
 //! and predicts the left-out steps, each run keeping its own offset fitted on the rest of the
 //! run. The score is the RMS of these out-of-fold residuals with each run's mean removed
@@ -16,15 +13,13 @@
 //! Roberts et al. 2017, "Cross-validation strategies for data with temporal, spatial,
 //! hierarchical, or phylogenetic structure", Ecography 40(8), DOI 10.1111/ecog.02881.
 
-use crate::baseline::Terms;
-use crate::fit::lstm::{fit_fixed_effects, FixedEffectsFit, RecipeTarget};
+use super::error::FitError;
+use super::terms::Candidate;
+use crate::baseline::{fit_fixed_effects, FixedEffectsFit};
 use crate::targets::TargetSet;
 
-/// Contiguous segments per run (folds of the blocked cross-validation). Chosen on the
-/// held-out sweep of the `fit::lstm` module doc, which makes its figures somewhat optimistic,
-/// and the choice is sensitive: with 3, 4 or 6 folds (and [`PARSIMONY_TOL`]) variant B got
-/// `T2` instead of `T3` in 6 of its 8 cases (6.6–9.9 × floor instead of 2.3–6.2); the default
-/// unit and variant C moved by at most 0.7 × floor.
+/// Contiguous segments per run (folds of the blocked cross-validation); chosen on the
+/// held-out sweep, and the choice is sensitive (`docs/experiments/term-selection.md`).
 pub const FOLDS: usize = 5;
 
 /// Steps left out of training either side of a validation segment: the bias target is a
@@ -32,20 +27,9 @@ pub const FOLDS: usize = 5;
 pub const GAP_STEPS: usize = 200;
 
 /// Relative margin within which a smaller term set is preferred to the best-scoring one: the
-/// spread of one set's cross-validated score over training seeds of one unit (`T2` on the
-/// default unit, seeds 3, 7, 21, 41: 2.41–2.96e-6 °/s, ±10 %). Measured on the held-out sweep
-/// (24 cases): against the plain least score it lowered the worst default-unit case from 2.11
-/// to 1.69 × floor and changed no variant-B case; 15 % instead turned variant B's `T3` into
-/// `T2` (4.7 → 9.9 × floor).
+/// spread of one set's cross-validated score over training seeds of one unit (±10 %;
+/// measured in `docs/experiments/term-selection.md`).
 pub const PARSIMONY_TOL: f64 = 0.10;
-
-/// A candidate least-squares term set and its name.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Candidate {
-    /// Short name, e.g. `T3+D300²`.
-    pub name: String,
-    pub terms: Terms,
-}
 
 /// How a term set was chosen.
 #[derive(Debug, Clone, PartialEq)]
@@ -79,80 +63,6 @@ impl TermSelection {
     }
 }
 
-/// Monomial powers over `n` features from (feature, power) pairs.
-fn term(n: usize, parts: &[(usize, u8)]) -> Vec<u8> {
-    let mut p = vec![0u8; n];
-    for &(i, q) in parts {
-        p[i] = q;
-    }
-    p
-}
-
-/// The ladder of term sets over [`crate::features::FeatureSpec::THERMAL_STATE`] features
-/// `x = (T, dT, D300, D1000, D3000)`, `Dτ = T - lag_τ(T)`: for a second-order part `none`,
-/// `fast` (`T·D300, D300²`) or `fast+mid` (also `T·D1000, D300·D1000, D1000²`) and T degree
-/// `d` = 1, 2, 3, the terms `1, T..T^d, D300, D1000, D3000` plus the second-order part; named
-/// `T<d>`, `T<d>+fast`, `T<d>+fast+mid`. 9 sets of 5 to 12 terms, all within the flight
-/// crate's 16. The 20 s rate dT is not a term: the lag differences carry the rate at the time
-/// scales that matter, and dT adds sensor noise (with dT and `T·dT` in, the scale factor left
-/// 64 ppm held out). `T2+fast` equals the former tailored [`crate::fit::lstm::bias_terms`].
-pub fn ladder() -> Vec<Candidate> {
-    let n = 5;
-    let (t, d300, d1000, d3000) = (0, 2, 3, 4);
-    let mut out = Vec::new();
-    for second in ["", "+fast", "+fast+mid"] {
-        for degree in 1..=3u8 {
-            let mut powers = vec![term(n, &[])];
-            for q in 1..=degree {
-                powers.push(term(n, &[(t, q)]));
-            }
-            // Ordered as the former tailored set where it overlaps.
-            if second.is_empty() {
-                powers.extend([d300, d1000, d3000].map(|i| term(n, &[(i, 1)])));
-            } else {
-                powers.push(term(n, &[(d300, 1)]));
-                powers.push(term(n, &[(t, 1), (d300, 1)]));
-                powers.push(term(n, &[(d300, 2)]));
-                powers.push(term(n, &[(d1000, 1)]));
-                powers.push(term(n, &[(d3000, 1)]));
-                if second == "+fast+mid" {
-                    powers.push(term(n, &[(t, 1), (d1000, 1)]));
-                    powers.push(term(n, &[(d300, 1), (d1000, 1)]));
-                    powers.push(term(n, &[(d1000, 2)]));
-                }
-            }
-            out.push(Candidate {
-                name: format!("T{degree}{second}"),
-                terms: Terms {
-                    n_features: n,
-                    powers,
-                },
-            });
-        }
-    }
-    out
-}
-
-/// The candidates [`crate::fit::lstm::BaseTerms::Selected`] chooses among: for the bias the
-/// [`ladder`] without its `fast+mid` sets, for the scale factor the whole ladder.
-///
-/// Why (held-out sweep, `examples/heldout_sweep.sh`, 3 units × 2 profiles × 2 seeds): with the
-/// `fast+mid` sets in, cross-validation on one `seed-shock` run twice chose `T3+fast+mid` for
-/// the bias, which left 2.2 × the noise floor held out where the smaller sets left 1.1–1.3;
-/// without them the bias choice was within 0.5 × floor of the best set of the ladder in all
-/// 12 cases. For the scale factor the `fast+mid` sets were chosen on the variant units and
-/// kept the error below 10 ppm where `T2+fast` left 13–18.
-pub fn candidates(target: RecipeTarget) -> Vec<Candidate> {
-    let all = ladder();
-    match target {
-        RecipeTarget::Bias => all
-            .into_iter()
-            .filter(|c| !c.name.ends_with("+mid"))
-            .collect(),
-        RecipeTarget::Scale => all,
-    }
-}
-
 /// Copies of `train` whose masks keep (`keep = true`) or drop the steps of segment `fold` of
 /// `folds` of each run (dropping also `gap` steps either side).
 fn fold_sets(train: &[TargetSet], fold: usize, folds: usize, gap: usize) -> Vec<TargetSet> {
@@ -179,7 +89,7 @@ fn segment(nr: usize, fold: usize, folds: usize) -> (usize, usize) {
 
 /// Blocked cross-validated RMS residual of each candidate (see the module doc); infinite for
 /// a candidate that could not be fitted on some fold.
-pub fn cross_validate(
+pub(crate) fn cross_validate(
     train: &[TargetSet],
     cands: &[Candidate],
     folds: usize,
@@ -257,9 +167,9 @@ pub fn select_terms(
     cands: &[Candidate],
     folds: usize,
     gap: usize,
-) -> Result<TermSelection, String> {
+) -> Result<TermSelection, FitError> {
     if cands.is_empty() {
-        return Err("no candidate term sets".into());
+        return Err(FitError::NoCandidates);
     }
     let cv_rms = cross_validate(train, cands, folds.max(2), gap);
     let best = cv_rms
@@ -280,13 +190,8 @@ pub fn select_terms(
                 .then(a.1.total_cmp(b.1))
         })
         .map(|(i, _)| i)
-        .ok_or_else(|| {
-            format!(
-                "no candidate term set could be fitted with a {}th of each training run left \
-                 out: the runs are too short or too uniform in temperature; log longer or more \
-                 varied runs",
-                folds.max(2)
-            )
+        .ok_or(FitError::NoCandidateFits {
+            folds: folds.max(2),
         })?;
     Ok(TermSelection {
         names: cands.iter().map(|c| c.name.clone()).collect(),

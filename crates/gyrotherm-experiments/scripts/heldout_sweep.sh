@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Held-out sweep for the residual recipe's term selection (issue 5): 3 units × 2 test
+# Held-out sweep for the residual recipe's term selection: 3 units × 2 test
 # profiles × 4 seed pairs, every base and every set of the ladder, run in parallel.
 # Usage: heldout_sweep.sh <heldout binary> <out dir> [extra heldout args]
 set -u

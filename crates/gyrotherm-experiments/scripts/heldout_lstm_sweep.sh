@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Held-out sweep for the residual LSTM on top of the selected base (issue 5): 3 units × 2 test
+# Held-out sweep for the residual LSTM on top of the selected base: 3 units × 2 test
 # profiles × 4 seed pairs × LSTM settings (gated default, forced on, tuned variants, two
 # training profiles), 2 runs at a time. Each output's SUMMARY line ends with
 # raw linear poly base lstm (× noise floor); compare the last two.

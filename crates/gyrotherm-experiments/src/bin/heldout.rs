@@ -1,10 +1,10 @@
-//! Held-out experiment for the LSTM recipes (issue 5): simulate training runs (static +
+//! Held-out experiment for the LSTM recipes: simulate training runs (static +
 //! rate-table) on some profiles and a held-out pair on another profile and seed, fit linear,
 //! poly and lstm, compensate the held-out runs with the flight compensator and print
 //! bias stability (°/h, τ = 100 s) raw / linear / poly / lstm / noise floor, the scale-factor
 //! thermal error (ppm) and the compensated +20 °/s output range per method.
 //!
-//! `cargo run -p gyrotherm --release --example heldout -- [--train seed-shock[,slow-ramp]]
+//! `cargo run -p gyrotherm-experiments --release --bin heldout -- [--train seed-shock[,slow-ramp]]
 //!  [--test slow-ramp] [--train-seed 7] [--test-seed 11] [--recipe residual|published]
 //!  [--epochs N] [--scale-lstm] [--patience N] [--lr X] [--validation-every K]
 //!  [--base B] [--scale-base B] [--bases B1,B2,...] [--no-lstm] [--base-input]
@@ -15,19 +15,17 @@
 //! LSTM (`LstmRecipe::validate_on_runs`).
 //!
 //! Bases `B`: `selected` (default), `tailored`, `linear`, `linear-t2`, `constant`,
-//! `family:<set>` (one set of `fit::select::ladder`, e.g. `family:T3+fast`). `--bases` adds a
+//! `family:<set>` (one set of `fit::terms::ladder`, e.g. `family:T3+fast`). `--bases` adds a
 //! row per base with its least-squares fit alone (bias and scale factor on that base);
 //! `--no-lstm` leaves out the full recipe's row. Env `HELDOUT_UNIT=<unit json>` swaps the
-//! simulated unit (`examples/heldout_units/`); `examples/heldout_sweep.sh` runs the sweep of
-//! the `fit::lstm` module doc; `examples/heldout_lstm_sweep.sh` the sweep of the residual LSTM's
-//! settings recorded there.
+//! simulated unit (`scripts/heldout_units/`); the scripts in `scripts/` run the sweeps
+//! recorded in `docs/experiments/` (each record names its script and command).
 
 use std::time::Instant;
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::lstm::BaseTerms;
-use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, NamedLog, RecipeKind};
+use gyrotherm::fit::{fit_model, BaseTerms, FitConfig, LstmRecipe, NamedLog, RecipeKind};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::Method;

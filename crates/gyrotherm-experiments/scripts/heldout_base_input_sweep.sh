@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Held-out sweep for the residual LSTM reading the base prediction (`--base-input`, issue 5):
+# Held-out sweep for the residual LSTM reading the base prediction (`--base-input`):
 # 3 units × 2 test profiles × 4 seed pairs × {gated, forced} × {features only, + base}, train
 # `seed-shock`. Each output's SUMMARY line ends with raw linear poly base lstm (× noise floor);
 # compare the last two. Runs whose output already holds a SUMMARY line are skipped.

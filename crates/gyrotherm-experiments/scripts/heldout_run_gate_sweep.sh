@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Held-out sweep for the leave-one-run-out gate of the residual LSTM (issue 5; table in the
-# module doc of `fit::lstm`): 3 units × 2 directions (train seed-shock + one profile, test the
+# Held-out sweep for the leave-one-run-out gate of the residual LSTM (record:
+# docs/experiments/lstm-run-gate.md): 3 units × 2 directions (train seed-shock + one profile, test the
 # other) × 8 seed pairs, without and with `--run-gate`, two at a time.
 # Usage: heldout_run_gate_sweep.sh <heldout binary> <out dir> [extra heldout args]
 # Files: <out>/<unit>.<test profile>.<train seed>.<blocks|rungate>.txt (SUMMARY line last).

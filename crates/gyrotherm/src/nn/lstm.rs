@@ -33,7 +33,7 @@ use core::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 /// The float type the kernel runs in: f64 (exact enough for the PyTorch test vector) or f32
 /// (twice the SIMD width).
-pub trait Real:
+pub(crate) trait Real:
     Copy
     + Default
     + PartialOrd
@@ -99,7 +99,7 @@ impl Real for f32 {
 /// Taylor polynomial to degree 13 (truncation < 2e-17 relative); 2ⁿ built in the exponent
 /// bits. Relative error a few ulps (checked against `f64::exp` in the tests).
 #[inline(always)]
-pub fn exp_f64(x: f64) -> f64 {
+pub(crate) fn exp_f64(x: f64) -> f64 {
     const LOG2E: f64 = core::f64::consts::LOG2_E;
     // fdlibm's split: ln2_hi has 32 trailing zero bits, so n·LN2_HI is exact.
     const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
@@ -135,7 +135,7 @@ pub fn exp_f64(x: f64) -> f64 {
 /// eˣ for f32: the flight crate's [`gyrotherm_core::lstm::exp`] (same polynomial, so training
 /// and flight agree to the bit on the activations).
 #[inline(always)]
-pub fn exp_f32(x: f32) -> f32 {
+pub(crate) fn exp_f32(x: f32) -> f32 {
     gyrotherm_core::lstm::exp(x)
 }
 
@@ -151,7 +151,7 @@ fn tanh<T: Real>(z: T) -> T {
 }
 
 /// Number of parameters of an I-input, H-hidden network with a 1-output head.
-pub fn param_count(input_size: usize, hidden_size: usize) -> usize {
+pub(crate) fn param_count(input_size: usize, hidden_size: usize) -> usize {
     4 * hidden_size * (input_size + hidden_size + 2) + hidden_size + 1
 }
 
@@ -164,29 +164,29 @@ pub(crate) struct Layout {
 }
 
 impl Layout {
-    pub fn w_ih(&self) -> core::ops::Range<usize> {
+    pub(crate) fn w_ih(&self) -> core::ops::Range<usize> {
         0..4 * self.h * self.i
     }
-    pub fn w_hh(&self) -> core::ops::Range<usize> {
+    pub(crate) fn w_hh(&self) -> core::ops::Range<usize> {
         let s = self.w_ih().end;
         s..s + 4 * self.h * self.h
     }
-    pub fn b_ih(&self) -> core::ops::Range<usize> {
+    pub(crate) fn b_ih(&self) -> core::ops::Range<usize> {
         let s = self.w_hh().end;
         s..s + 4 * self.h
     }
-    pub fn b_hh(&self) -> core::ops::Range<usize> {
+    pub(crate) fn b_hh(&self) -> core::ops::Range<usize> {
         let s = self.b_ih().end;
         s..s + 4 * self.h
     }
-    pub fn w_out(&self) -> core::ops::Range<usize> {
+    pub(crate) fn w_out(&self) -> core::ops::Range<usize> {
         let s = self.b_hh().end;
         s..s + self.h
     }
-    pub fn b_out(&self) -> usize {
+    pub(crate) fn b_out(&self) -> usize {
         self.w_out().end
     }
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.b_out() + 1
     }
 }
@@ -206,7 +206,7 @@ pub(crate) struct Packed<T> {
 }
 
 impl<T: Real> Packed<T> {
-    pub fn new(lay: Layout) -> Self {
+    pub(crate) fn new(lay: Layout) -> Self {
         let g4 = 4 * lay.h;
         Packed {
             lay,
@@ -219,7 +219,7 @@ impl<T: Real> Packed<T> {
     }
 
     /// Repack from the flat f64 parameter vector (no allocation).
-    pub fn load(&mut self, theta: &[f64]) {
+    pub(crate) fn load(&mut self, theta: &[f64]) {
         let lay = self.lay;
         let (ni, nh, g4) = (lay.i, lay.h, 4 * lay.h);
         let w_ih = &theta[lay.w_ih()];
@@ -259,7 +259,7 @@ pub(crate) struct Grads<T> {
 }
 
 impl<T: Real> Grads<T> {
-    pub fn new(lay: Layout) -> Self {
+    pub(crate) fn new(lay: Layout) -> Self {
         let g4 = 4 * lay.h;
         Grads {
             lay,
@@ -271,7 +271,7 @@ impl<T: Real> Grads<T> {
         }
     }
 
-    pub fn zero(&mut self) {
+    pub(crate) fn zero(&mut self) {
         for v in self
             .wx
             .iter_mut()
@@ -285,7 +285,7 @@ impl<T: Real> Grads<T> {
     }
 
     /// Add into the flat f64 gradient in PyTorch order.
-    pub fn add_to_flat(&self, grad: &mut [f64]) {
+    pub(crate) fn add_to_flat(&self, grad: &mut [f64]) {
         let lay = self.lay;
         let (ni, nh, g4) = (lay.i, lay.h, 4 * lay.h);
         let (wi, wh, bi, bh, wo, bo) = (

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Confirmation set for the default recipe (issue 5): seed pairs never used while choosing its
+# Confirmation set for the default recipe: seed pairs never used while choosing its
 # settings (those used 7→11, 21→23, 3→5, 41→43). Default unit, train seed-shock (static +
 # table), test slow-ramp and fast-cycle; prints the SUMMARY lines (×floor: raw linear poly
 # base lstm).

@@ -1,0 +1,19 @@
+//! The direct recipe: the LSTM models the whole bias from the thermal-state inputs, on a
+//! constant base holding the per-run offsets ([`BaseTerms::Constant`]; windowed truncated
+//! BPTT, early stopping, as [`super::residual`]). Kept for comparison: held out it left 2–4 ×
+//! the noise floor where a least-squares base left 1–1.4 (`docs/experiments/lstm-recipes.md`).
+
+use super::recipe::{LstmRecipe, RecipeKind};
+use super::terms::BaseTerms;
+
+impl LstmRecipe {
+    /// The direct LSTM: the residual recipe on a constant base ([`BaseTerms::Constant`]).
+    pub fn direct() -> Self {
+        LstmRecipe {
+            kind: RecipeKind::Direct,
+            base: BaseTerms::Constant,
+            scale_base: BaseTerms::Tailored,
+            ..Self::residual()
+        }
+    }
+}

@@ -1,0 +1,131 @@
+//! Why a fit was refused.
+
+use crate::baseline::LsqError;
+use crate::model::{ModelFileError, Target};
+use crate::nn::TrainError;
+
+/// Why [`fit_model`](super::fit_model) (or one recipe) could not fit a model. Each variant
+/// names the run, the target or the value at fault.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum FitError {
+    /// No training logs were given.
+    NoLogs,
+    /// None of the logs gave a usable target.
+    NoUsableLogs,
+    /// The targets of run `run` could not be computed.
+    Targets { run: String, message: String },
+    /// Rate-table run `run` has no rate segment between two stop segments.
+    NoScaleSegments { run: String },
+    /// The training runs use different feature definitions.
+    MixedFeatures { first: usize, other: usize },
+    /// The recipe reads `expected` features, the data has `found`.
+    FeatureCount { expected: usize, found: usize },
+    /// A fixed base term set (`family:<index>`) beyond the ladder.
+    NoSuchFamily { index: usize, ladder: usize },
+    /// No candidate term sets were given to choose among.
+    NoCandidates,
+    /// No candidate term set could be fitted on every fold of the cross-validation.
+    NoCandidateFits { folds: usize },
+    /// The training runs give no block past the burn-in for the residual LSTM.
+    RunsTooShort { block_steps: usize, burn_in: usize },
+    /// The training logs have no feature steps.
+    NoFeatureSteps,
+    /// A least-squares fit was refused.
+    LeastSquares(LsqError),
+    /// LSTM training was refused.
+    Train(TrainError),
+    /// The fitted model did not pass the model file's checks.
+    Model(ModelFileError),
+    /// The fit of one target (bias or scale factor) failed.
+    Target {
+        target: Target,
+        source: Box<FitError>,
+    },
+    /// The training thread of one target panicked.
+    ThreadPanicked { target: Target },
+}
+
+impl std::fmt::Display for FitError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FitError::NoLogs => write!(f, "no training logs given"),
+            FitError::NoUsableLogs => write!(f, "no usable training logs"),
+            FitError::Targets { run, message } => write!(f, "{run}: {message}"),
+            FitError::NoScaleSegments { run } => write!(
+                f,
+                "{run}: no rate segment has a stop segment on both sides, so no scale factor can \
+                 be measured; log stop segments between the table rates"
+            ),
+            FitError::MixedFeatures { first, other } => write!(
+                f,
+                "training runs have {first} and {other} features: all must use one feature \
+                 definition"
+            ),
+            FitError::FeatureCount { expected, found } => write!(
+                f,
+                "the residual recipe reads {expected} features (T, dT and three thermal-state \
+                 lags), the training data has {found}"
+            ),
+            FitError::NoSuchFamily { index, ladder } => {
+                write!(f, "base family:{index}: the ladder has {ladder} term sets")
+            }
+            FitError::NoCandidates => write!(f, "no candidate term sets"),
+            FitError::NoCandidateFits { folds } => write!(
+                f,
+                "no candidate term set could be fitted with a {folds}th of each training run left \
+                 out: the runs are too short or too uniform in temperature; log longer or more \
+                 varied runs"
+            ),
+            FitError::RunsTooShort {
+                block_steps,
+                burn_in,
+            } => write!(
+                f,
+                "no {block_steps}-step block with labelled steps past the {burn_in}-step \
+                 burn-in: the training runs are too short for the residual recipe"
+            ),
+            FitError::NoFeatureSteps => write!(f, "the training logs have no feature steps"),
+            FitError::LeastSquares(e) => e.fmt(f),
+            FitError::Train(e) => e.fmt(f),
+            FitError::Model(e) => e.fmt(f),
+            FitError::Target { target, source } => match target {
+                Target::Bias => write!(f, "bias model: {source}"),
+                Target::Scale => write!(f, "scale-factor model: {source}"),
+            },
+            FitError::ThreadPanicked { target } => {
+                write!(f, "{} training thread panicked", target.as_str())
+            }
+        }
+    }
+}
+
+impl std::error::Error for FitError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            FitError::LeastSquares(e) => Some(e),
+            FitError::Train(e) => Some(e),
+            FitError::Model(e) => Some(e),
+            FitError::Target { source, .. } => Some(source.as_ref()),
+            _ => None,
+        }
+    }
+}
+
+impl From<LsqError> for FitError {
+    fn from(e: LsqError) -> Self {
+        FitError::LeastSquares(e)
+    }
+}
+
+impl From<TrainError> for FitError {
+    fn from(e: TrainError) -> Self {
+        FitError::Train(e)
+    }
+}
+
+impl From<ModelFileError> for FitError {
+    fn from(e: ModelFileError) -> Self {
+        FitError::Model(e)
+    }
+}
