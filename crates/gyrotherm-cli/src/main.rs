@@ -41,6 +41,8 @@ enum Command {
     Compare(cmd::compare::CompareArgs),
     /// Write an HTML report with figures for a held-out comparison.
     Report(cmd::report::ReportArgs),
+    /// Check a model file, or re-seal one after a deliberate hand edit.
+    Model(cmd::model::ModelArgs),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +57,7 @@ fn main() -> ExitCode {
         Command::Compensate(a) => cmd::compensate::run(a),
         Command::Compare(a) => cmd::compare::run(a),
         Command::Report(a) => cmd::report::run(a),
+        Command::Model(a) => cmd::model::run(a),
     };
     match result {
         Ok(code) => code,
@@ -72,5 +75,7 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
     err.chain().any(|e| {
         e.downcast_ref::<std::io::Error>()
             .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            || e.downcast_ref::<gyrotherm::csvlog::LogError>()
+                .is_some_and(|l| l.kind == gyrotherm::csvlog::LogErrorKind::OutputClosed)
     })
 }

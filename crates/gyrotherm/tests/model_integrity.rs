@@ -58,7 +58,10 @@ fn a_saved_model_is_sealed_and_an_edit_is_caught_until_resealed() {
     write(dir.path(), "m.json", &edited);
     let e = ModelFile::load(&p).unwrap_err().to_string();
     assert!(e.contains(&p.display().to_string()), "{e}");
-    assert!(e.contains(CHECKSUM_KEY) && e.contains("gyrotherm model seal"), "{e}");
+    assert!(
+        e.contains(CHECKSUM_KEY) && e.contains("gyrotherm model seal"),
+        "{e}"
+    );
 
     // Re-sealed on purpose, it loads with the edited value.
     let (sealed, digest) = ModelFile::seal(&p).unwrap();

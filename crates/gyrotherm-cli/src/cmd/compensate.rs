@@ -35,7 +35,7 @@ pub struct CompensateArgs {
 }
 
 pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
-    let model = ModelFile::load(&args.model).map_err(anyhow::Error::msg)?;
+    let model = ModelFile::load(&args.model)?;
     let opts = args.log.read_options();
     let summary = if args.stream {
         // Rows are handed on as they are made and stdout is flushed whenever the input has
@@ -45,20 +45,29 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             64 * 1024,
             std::io::stdout().lock(),
         )));
+        let write_error = Rc::new(RefCell::new(None));
         let input = FlushBeforeRead {
             inner: std::io::stdin().lock(),
             out: Rc::clone(&out),
+            write_error: Rc::clone(&write_error),
         };
-        let summary = compensate_stream(
+        let result = compensate_stream(
             &model,
             input,
             "<stdin>".as_ref(),
             &opts,
             DeferredFlush(Rc::clone(&out)),
             true,
-        )
-        .map_err(anyhow::Error::msg)?;
-        out.borrow_mut().flush()?;
+        );
+        // A failed flush ends the input (see FlushBeforeRead): that error, not the input's
+        // state at that moment, is what went wrong.
+        if let Some(e) = write_error.borrow_mut().take() {
+            return Err(anyhow::Error::new(e).context("writing standard output"));
+        }
+        let summary = result?;
+        out.borrow_mut()
+            .flush()
+            .context("writing standard output")?;
         summary
     } else {
         let (Some(input), Some(out)) = (&args.input, &args.out) else {
@@ -101,15 +110,24 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
 
 type SharedOut<'a> = Rc<RefCell<BufWriter<std::io::StdoutLock<'a>>>>;
 
-/// Stdin that flushes stdout before every read, so no output line waits on more input.
+/// Stdin that flushes stdout before every read, so no output line waits on more input. A
+/// flush that fails (e.g. the reader of a pipe went away) is kept for the caller and ends the
+/// input, so it is not reported as a read error of stdin.
 struct FlushBeforeRead<'a, R> {
     inner: R,
     out: SharedOut<'a>,
+    write_error: Rc<RefCell<Option<std::io::Error>>>,
 }
 
 impl<R: Read> Read for FlushBeforeRead<'_, R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        self.out.borrow_mut().flush()?;
+        if self.write_error.borrow().is_some() {
+            return Ok(0);
+        }
+        if let Err(e) = self.out.borrow_mut().flush() {
+            *self.write_error.borrow_mut() = Some(e);
+            return Ok(0);
+        }
         self.inner.read(buf)
     }
 }

@@ -7,6 +7,7 @@ pub mod compare;
 pub mod compensate;
 pub mod demo;
 pub mod evaluate;
+pub mod model;
 pub mod progress;
 pub mod report;
 pub mod simulate;

@@ -256,13 +256,12 @@ pub fn write_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
         out.flush()
     })
     .map_err(|e| {
-        LogError::new(
-            LogErrorKind::Io,
-            path,
-            None,
-            None,
-            format!("cannot write: {e}"),
-        )
+        let kind = if e.kind() == std::io::ErrorKind::BrokenPipe {
+            LogErrorKind::OutputClosed
+        } else {
+            LogErrorKind::Io
+        };
+        LogError::new(kind, path, None, None, format!("cannot write: {e}"))
     })
 }
 
