@@ -85,7 +85,9 @@ fn run(data: &[u8]) -> Result<()> {
                 // unless the variation is lost in the offset's rounding.
                 let x0 = x.first().copied().unwrap_or(0.0);
                 let amax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let spread = x.iter().fold(0.0f64, |m, v| m.max((v / 2.0 - x0 / 2.0).abs()));
+                let spread = x
+                    .iter()
+                    .fold(0.0f64, |m, v| m.max((v / 2.0 - x0 / 2.0).abs()));
                 if kind == DevKind::Oadev && spread >= 1e-6 * amax {
                     let ms: Vec<usize> = points.iter().map(|p| p.m).collect();
                     let mut s = StreamingOadev::new(&ms, tau0).expect("same factors");

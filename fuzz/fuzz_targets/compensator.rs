@@ -92,12 +92,18 @@ fn run(data: &[u8]) -> Result<()> {
         match comp.step(t, gyro, temp) {
             Ok(c) => {
                 assert!(gyro.is_finite(), "accepted gyro {gyro}");
-                assert!(c.bias_dps.is_finite(), "{c:?} at t={t} T={temp} gyro={gyro}");
+                assert!(
+                    c.bias_dps.is_finite(),
+                    "{c:?} at t={t} T={temp} gyro={gyro}"
+                );
                 assert!(
                     c.scale.is_finite() && c.scale > 0.0,
                     "{c:?} at t={t} T={temp} gyro={gyro}"
                 );
-                assert!(c.rate_dps.is_finite(), "{c:?} at t={t} T={temp} gyro={gyro}");
+                assert!(
+                    c.rate_dps.is_finite(),
+                    "{c:?} at t={t} T={temp} gyro={gyro}"
+                );
             }
             // Every error is an `InputError`: a refused input, state untouched.
             Err(_) => {}

@@ -263,7 +263,9 @@ impl Compensator {
     /// Errors, each leaving the feature pipeline and the models untouched where the input is
     /// at fault: non-finite time, gyro or temperature, time not increasing. A model that gives a
     /// non-finite or non-positive scale factor is reported as
-    /// `NonFinite(Channel::Temperature)` (the temperature drove it out of range).
+    /// `NonFinite(Channel::Temperature)` (the temperature drove it out of range). A finite
+    /// gyro sample whose corrected rate is not finite (|Ĝ − B| / K beyond f64) is reported as
+    /// `NonFinite(Channel::Gyro)`: every `Ok` rate is finite.
     pub fn step(
         &mut self,
         time_s: f64,
@@ -286,10 +288,14 @@ impl Compensator {
             Some(v) => v,
             None => return Err(InputError::NonFinite(Channel::Temperature)),
         };
+        let rate_dps = (gyro_dps - bias_dps) / scale;
+        if !rate_dps.is_finite() {
+            return Err(InputError::NonFinite(Channel::Gyro));
+        }
         Ok(Corrected {
             bias_dps,
             scale,
-            rate_dps: (gyro_dps - bias_dps) / scale,
+            rate_dps,
         })
     }
 

@@ -127,3 +127,42 @@ fn streaming_oadev_scales_exactly_like_the_batch_one() {
         }
     }
 }
+
+/// Found by the `allan` fuzz target: a curve with a τ beyond f64 (from a huge τ0) made the
+/// noise-term read-out loop for ever on the NaN local slope. Now τ0·N must be finite, and
+/// the read-out ignores such points.
+#[test]
+fn huge_sample_period_is_refused_and_noise_terms_terminate() {
+    use gyrotherm::allan::{noise_terms, AllanPoint};
+    let y = nbs_data();
+    let e = deviation(
+        &y,
+        1e306,
+        DevKind::Oadev,
+        &TauSet::Octave,
+        NoiseModel::Alpha(0),
+    );
+    assert!(matches!(e, Err(AllanError::BadSamplePeriod(_))), "{e:?}");
+    let p = |tau_s: f64, dev: f64| AllanPoint {
+        m: 1,
+        tau_s,
+        dev,
+        n: 10,
+        alpha: 0,
+        edf: 5.0,
+        lo: dev,
+        hi: dev,
+    };
+    let pts = vec![
+        p(1.0, 1.0),
+        p(f64::INFINITY, 0.5),
+        p(4.0, 0.5),
+        p(f64::MAX, 0.4),
+    ];
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(noise_terms(&pts, 3600.0)).unwrap());
+    let terms = rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("noise_terms did not return");
+    assert!(terms.arw_deg_rt_h.is_some_and(|t| t.value.is_finite()));
+}

@@ -238,7 +238,8 @@ pub struct AllanPoint {
 
 /// Checks τ0 and the samples (finite).
 fn check_input(samples: &[f64], tau0_s: f64) -> Result<(), AllanError> {
-    if !(tau0_s.is_finite() && tau0_s > 0.0) {
+    // Every τ = m·τ0 (m ≤ N) must be finite too.
+    if !(tau0_s.is_finite() && tau0_s > 0.0 && (tau0_s * samples.len() as f64).is_finite()) {
         return Err(AllanError::BadSamplePeriod(tau0_s));
     }
     if let Some(index) = samples.iter().position(|v| !v.is_finite()) {
