@@ -1,9 +1,11 @@
 //! Ground-side features over a whole log: the flight pipeline
 //! ([`gyrotherm_core::features::FeaturePipeline`]) run sample by sample, so training and
-//! flight see bit-identical numbers; plus the centred moving average used to smooth the bias
-//! target (100 s in He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004).
+//! flight see bit-identical numbers. The centred moving average that smooths the bias target
+//! (100 s in He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004) lives in
+//! [`crate::moving_average`] and is re-exported here.
 
 use crate::csvlog::TestLog;
+pub use crate::moving_average::{centred_moving_average, MovingAverageError, Smoothed};
 use gyrotherm_core::error::InputError;
 pub use gyrotherm_core::features::{
     FeatureKind, FeaturePipeline, FeatureSpec, LagOutputs, SpecError, MAX_FEATURES, MAX_LAGS,
@@ -194,98 +196,4 @@ pub fn extract_series(
 /// Run the core pipeline over a whole log.
 pub fn extract(log: &TestLog, spec: &FeatureSpec) -> Result<FeatureTable, FeatureError> {
     extract_series(&log.time_s, &log.temp_c, spec)
-}
-
-/// A centred moving average and where it had its full window.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Smoothed {
-    /// The smoothed series, one value per input sample.
-    pub values: Vec<f64>,
-    /// True where the whole window `t ± W/2` lay inside the log.
-    pub full_window: Vec<bool>,
-}
-
-/// Centred moving average on the time axis: `y_i` = mean of the `x_j` with
-/// `|t_j - t_i| ≤ h_i` (inclusive, with a 1e-9·W tolerance for time-stamp round-off), where
-/// `h_i = min(W/2, t_i - t_0, t_end - t_i)`: near the ends the window **shrinks symmetrically**
-/// so it stays centred (a linear trend passes through unbiased; the first and last values are
-/// the raw samples). [`Smoothed::full_window`] marks the samples with the whole window, for
-/// callers that prefer to mask the edges out of a loss.
-///
-/// At 1 Hz, `W = 100 s` averages 101 samples (t-50 … t+50). O(N): two pointers over prefix
-/// sums of `x - x_0` (the offset keeps the sums small).
-///
-/// Errors: window not finite and > 0, different lengths, non-finite values, time not
-/// strictly increasing (each message names the sample).
-pub fn centred_moving_average(
-    time_s: &[f64],
-    x: &[f64],
-    window_s: f64,
-) -> Result<Smoothed, String> {
-    if !(window_s.is_finite() && window_s > 0.0) {
-        return Err(format!(
-            "moving-average window {window_s} s: must be finite and > 0"
-        ));
-    }
-    if time_s.len() != x.len() {
-        return Err(format!(
-            "{} time stamps but {} values: the columns must have the same length",
-            time_s.len(),
-            x.len()
-        ));
-    }
-    let n = x.len();
-    if n == 0 {
-        return Ok(Smoothed {
-            values: Vec::new(),
-            full_window: Vec::new(),
-        });
-    }
-    for i in 0..n {
-        if !time_s[i].is_finite() || !x[i].is_finite() {
-            return Err(format!("sample {i}: non-finite time or value"));
-        }
-        if i > 0 && time_s[i] <= time_s[i - 1] {
-            return Err(format!(
-                "sample {i}: time {} s does not increase from {} s",
-                time_s[i],
-                time_s[i - 1]
-            ));
-        }
-    }
-    let x0 = x[0];
-    let mut prefix = Vec::with_capacity(n + 1);
-    prefix.push(0.0);
-    let mut acc = 0.0;
-    for &v in x {
-        acc += v - x0;
-        prefix.push(acc);
-    }
-    let half = window_s / 2.0;
-    let tol = 1e-9 * window_s;
-    let (t_first, t_last) = (time_s[0], time_s[n - 1]);
-    let mut values = Vec::with_capacity(n);
-    let mut full_window = Vec::with_capacity(n);
-    // Window [lo, hi) in indices; both bounds are non-decreasing in i.
-    let (mut lo, mut hi) = (0usize, 0usize);
-    for i in 0..n {
-        let t = time_s[i];
-        let h = half.min(t - t_first).min(t_last - t);
-        while time_s[lo] < t - h - tol {
-            lo += 1;
-        }
-        if hi < i + 1 {
-            hi = i + 1;
-        }
-        while hi < n && time_s[hi] <= t + h + tol {
-            hi += 1;
-        }
-        let count = (hi - lo) as f64;
-        values.push(x0 + (prefix[hi] - prefix[lo]) / count);
-        full_window.push(h >= half);
-    }
-    Ok(Smoothed {
-        values,
-        full_window,
-    })
 }

@@ -24,6 +24,8 @@
 //! - [`allan`], [`metrics`]: the standard gyro figures (IEEE Std 952 / GJB 2426A).
 //! - [`compare`]: held-out comparison of methods (the numbers); [`report`]: the pictures and
 //!   the HTML report.
+//! - [`moving_average`], [`table_segments`]: the one centred moving average and the one
+//!   rate-table segmentation every step above uses.
 //! - [`atomic_file`]: the output helper: every output is written to a temporary file and
 //!   renamed into place.
 //!
@@ -51,9 +53,11 @@ pub mod features;
 pub mod fit;
 pub mod metrics;
 pub mod model;
+pub mod moving_average;
 pub mod nn;
 pub mod report;
 pub mod sim;
+pub mod table_segments;
 pub mod targets;
 
 pub use compensate::{compensate_log, compensate_stream, compensator, CompensateError};

@@ -9,8 +9,47 @@
 //!   between the means of the neighbouring stop segments. Steps with no label (stops, settle
 //!   time, a rate segment with no stop segment beside it) are masked out, not invented.
 
+use std::fmt;
+
 use crate::csvlog::TestLog;
-use crate::features::{centred_moving_average, extract, FeatureSpec, FeatureTable};
+use crate::features::{extract, FeatureError, FeatureSpec, FeatureTable};
+use crate::moving_average::{centred_moving_average, MovingAverageError};
+use crate::table_segments::{segments, Segment, RATE_TOLERANCE_DPS};
+
+/// Why training targets could not be made from a log.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum TargetError {
+    /// The features of the log could not be computed.
+    Features(FeatureError),
+    /// The gyro output could not be smoothed.
+    Smoothing(MovingAverageError),
+    /// A scale-factor target was asked of a log without a table column.
+    NoTable,
+}
+
+impl fmt::Display for TargetError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            TargetError::Features(e) => write!(f, "{e}"),
+            TargetError::Smoothing(e) => write!(f, "{e}"),
+            TargetError::NoTable => write!(
+                f,
+                "the log has no table_dps column: a scale-factor target needs a rate-table log"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for TargetError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            TargetError::Features(e) => Some(e),
+            TargetError::Smoothing(e) => Some(e),
+            TargetError::NoTable => None,
+        }
+    }
+}
 
 /// One run's training data for one target: features per step, the target per step and which
 /// steps count in the loss.
@@ -38,19 +77,22 @@ pub const SETTLE_S: f64 = 10.0;
 /// Default smoothing window of the output inside a rate segment, s.
 pub const SCALE_WINDOW_S: f64 = 60.0;
 
-/// True when a log is a static test (no table column, or a table column that is zero
-/// throughout).
+/// True when a log is a static test ([`TestLog::is_static`]: no table column, or a table
+/// column that is zero throughout).
 pub fn is_static(log: &TestLog) -> bool {
-    log.table_dps
-        .as_ref()
-        .is_none_or(|t| t.iter().all(|v| *v == 0.0))
+    log.is_static()
 }
 
 /// Bias target of a static log: centred `window_s` moving average of the gyro output at each
 /// feature step.
-pub fn bias_targets(log: &TestLog, spec: &FeatureSpec, window_s: f64) -> Result<TargetSet, String> {
-    let table = extract(log, spec).map_err(|e| e.to_string())?;
-    let smoothed = centred_moving_average(&log.time_s, &log.gyro_dps, window_s)?;
+pub fn bias_targets(
+    log: &TestLog,
+    spec: &FeatureSpec,
+    window_s: f64,
+) -> Result<TargetSet, TargetError> {
+    let table = extract(log, spec).map_err(TargetError::Features)?;
+    let smoothed = centred_moving_average(&log.time_s, &log.gyro_dps, window_s)
+        .map_err(TargetError::Smoothing)?;
     let mut target = Vec::with_capacity(table.n_rows());
     let mut mask = Vec::with_capacity(table.n_rows());
     for &i in &table.sample_index {
@@ -63,33 +105,6 @@ pub fn bias_targets(log: &TestLog, spec: &FeatureSpec, window_s: f64) -> Result<
         target,
         mask,
     })
-}
-
-/// A run of samples with one commanded table rate.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Segment {
-    /// First sample index.
-    pub start: usize,
-    /// One past the last sample index.
-    pub end: usize,
-    /// Commanded rate, °/s.
-    pub rate_dps: f64,
-}
-
-/// Runs of equal commanded rate in `table_dps`.
-pub fn segments(table_dps: &[f64]) -> Vec<Segment> {
-    let mut out: Vec<Segment> = Vec::new();
-    for (i, &r) in table_dps.iter().enumerate() {
-        match out.last_mut() {
-            Some(s) if s.rate_dps == r => s.end = i + 1,
-            _ => out.push(Segment {
-                start: i,
-                end: i + 1,
-                rate_dps: r,
-            }),
-        }
-    }
-    out
 }
 
 /// First sample of `seg` at least `settle_s` after its start.
@@ -106,18 +121,16 @@ pub fn scale_targets(
     spec: &FeatureSpec,
     settle_s: f64,
     window_s: f64,
-) -> Result<TargetSet, String> {
+) -> Result<TargetSet, TargetError> {
     let Some(table_dps) = &log.table_dps else {
-        return Err(
-            "the log has no table_dps column: a scale-factor target needs a rate-table log".into(),
-        );
+        return Err(TargetError::NoTable);
     };
-    let table = extract(log, spec).map_err(|e| e.to_string())?;
-    let segs = segments(table_dps);
+    let table = extract(log, spec).map_err(TargetError::Features)?;
+    let segs = segments(table_dps, RATE_TOLERANCE_DPS);
     // Stop segments: (centre time, mean output).
     let stops: Vec<(f64, f64)> = segs
         .iter()
-        .filter(|s| s.rate_dps == 0.0)
+        .filter(|s| s.is_stop(RATE_TOLERANCE_DPS))
         .filter_map(|s| {
             let a = settled_start(log, s, settle_s);
             (a < s.end).then(|| {
@@ -140,12 +153,13 @@ pub fn scale_targets(
         }
     };
     let mut k_sample = vec![f64::NAN; log.len()];
-    for s in segs.iter().filter(|s| s.rate_dps != 0.0) {
+    for s in segs.iter().filter(|s| !s.is_stop(RATE_TOLERANCE_DPS)) {
         let a = settled_start(log, s, settle_s);
         if a >= s.end {
             continue;
         }
-        let sm = centred_moving_average(&log.time_s[a..s.end], &log.gyro_dps[a..s.end], window_s)?;
+        let sm = centred_moving_average(&log.time_s[a..s.end], &log.gyro_dps[a..s.end], window_s)
+            .map_err(TargetError::Smoothing)?;
         for (j, f) in sm.values.iter().enumerate() {
             let i = a + j;
             if let Some(b) = bias_at(log.time_s[i]) {
@@ -230,9 +244,40 @@ mod tests {
     }
 
     #[test]
+    fn a_noisy_table_column_segments_the_same_for_targets_and_metrics() {
+        // A logged command column with round-off jitter (±1e-12 °/s, below
+        // RATE_TOLERANCE_DPS): the targets and the scale-factor figures must both see the
+        // 12 segments of 100 s that were commanded, not one segment per sample.
+        let rate = |t: f64| match (t as usize / 100) % 4 {
+            1 => 10.0,
+            3 => -10.0,
+            _ => 0.0,
+        };
+        let noisy = |t: f64| rate(t) + if (t as usize) % 2 == 0 { 1e-12 } else { -1e-12 };
+        let l = log(1200, |t, w| 2e-3 + 1e-7 * t + 1.0002 * w, Some(&noisy));
+        let ts = scale_targets(&l, &FeatureSpec::PUBLISHED, 5.0, 20.0).unwrap();
+        assert_eq!(ts.labelled(), 5 * 95, "labelled steps");
+        let table = l.table_dps.as_deref().unwrap();
+        let opts = crate::metrics::ScaleFactorOptions {
+            settle_s: 5.0,
+            ..Default::default()
+        };
+        let sf = crate::metrics::scale_factor(&l.time_s, &l.gyro_dps, table, &opts).unwrap();
+        let ours: Vec<(usize, usize)> = segments(table, RATE_TOLERANCE_DPS)
+            .iter()
+            .map(|s| (s.start, s.end))
+            .collect();
+        let theirs: Vec<(usize, usize)> = sf.segments.iter().map(|s| (s.start, s.end)).collect();
+        assert_eq!(ours.len(), 12);
+        assert_eq!(ours, theirs);
+        assert_eq!(sf.scale_over_time.len(), 6);
+    }
+
+    #[test]
     fn scale_target_needs_a_table() {
         let l = log(100, |_, _| 0.0, None);
         let e = scale_targets(&l, &FeatureSpec::PUBLISHED, 5.0, 20.0).unwrap_err();
-        assert!(e.contains("table_dps"), "{e}");
+        assert_eq!(e, TargetError::NoTable);
+        assert!(e.to_string().contains("table_dps"), "{e}");
     }
 }

@@ -1,6 +1,6 @@
-//! The test-log CSV format (issue 2): round trip, options, pass-through, and each class of
+//! The test-log CSV format: round trip, options, pass-through, and each class of
 //! bad input with its located message. Expected values come from the format's definition
-//! (issue 2) and from the unit definitions (1 °/h = 1/3600 °/s, 1 rad = 180/π °).
+//! (`csvlog` module doc) and from the unit definitions (1 °/h = 1/3600 °/s, 1 rad = 180/π °).
 
 use std::path::{Path, PathBuf};
 
@@ -581,7 +581,7 @@ fn finite() -> impl Strategy<Value = f64> {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// write_log then read_log gives an identical TestLog (issue 2: format round trip).
+    /// write_log then read_log gives an identical TestLog (the format's round-trip promise).
     #[test]
     fn round_trip_any_values(
         t0 in -1e6f64..1e6,

@@ -8,7 +8,7 @@ use html_refs::references;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
-use gyrotherm::report::figure::FigureFiles;
+use gyrotherm::report::FigureFiles;
 use gyrotherm::report::*;
 
 /// A synthetic run: a sine temperature cycle, a gyro lagging it, a bias following

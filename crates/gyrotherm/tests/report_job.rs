@@ -1,6 +1,7 @@
-//! The full report (`report::job`) over small simulated logs: every figure of issue 6 is
-//! written, decodes as a PNG of its stated size and is not blank; the page references only
-//! files that exist, carries the comparison numbers, and notes the figures that cannot apply.
+//! The full report (`report::write_full_report`) over small simulated logs: every figure of
+//! the report is written, decodes as a PNG of its stated size and is not blank; the page
+//! references only files that exist, carries the comparison numbers, and notes the figures
+//! that cannot apply.
 
 mod html_refs;
 use html_refs::references;
@@ -12,8 +13,8 @@ use gyrotherm::compare::{compare, CompareConfig, Comparison};
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::NamedLog;
 use gyrotherm::model::Method;
-use gyrotherm::report::job::FIGURE_STEMS;
 use gyrotherm::report::write_full_report;
+use gyrotherm::report::FIGURE_STEMS;
 use gyrotherm::sim::{simulate, Profile, Segment, SimConfig};
 
 /// A 3900 s cycle: 22 °C, down to -10 °C at 3.2 °C/min, soak, up to +50 °C at 3 °C/min,
@@ -168,7 +169,7 @@ fn full_report_over_simulated_logs_draws_every_figure() {
         "raw bias stability {raw_bs:.5} missing"
     );
     for m in &s.methods {
-        let v = m.figures.bias_stability_dph.unwrap();
+        let v = m.performance.bias_stability_dph.unwrap();
         assert!(
             html.contains(&format!("<td>{v:.5}</td>")),
             "{:?} {v:.5} missing",
@@ -275,7 +276,7 @@ fn measured_scale_factor_follows_simulator_truth() {
     let truth = log
         .extra_f64(gyrotherm::csvlog::TRUE_SCALE_COL)
         .expect("simulated with truth");
-    let p = gyrotherm::report::job::scale_factor_points(&log, &truth, 10.0).unwrap();
+    let p = gyrotherm::report::scale_factor_points(&log, &truth, 10.0).unwrap();
     // 3900 s in 300 s segments, +Ω / stop / −Ω / stop: 7 rate segments.
     assert_eq!(p.time_s.len(), 7, "rate segments: {:?}", p.time_s);
     for ((t, m), k) in p.time_s.iter().zip(&p.measured_ppm).zip(&p.predicted_ppm) {
@@ -286,6 +287,6 @@ fn measured_scale_factor_follows_simulator_truth() {
         );
     }
     // Wrong length and a static log are errors, not panics.
-    assert!(gyrotherm::report::job::scale_factor_points(&log, &truth[1..], 10.0).is_err());
-    assert!(gyrotherm::report::job::scale_factor_points(&sim(9, false), &truth, 10.0).is_err());
+    assert!(gyrotherm::report::scale_factor_points(&log, &truth[1..], 10.0).is_err());
+    assert!(gyrotherm::report::scale_factor_points(&sim(9, false), &truth, 10.0).is_err());
 }

@@ -1,5 +1,6 @@
 //! `gyrotherm allan`: Allan-family deviation of a rate column, with 68.3 % bounds and noise
-//! terms. JSON: `{"kind", "points": [{"tau_s", "dev", "n", "lo", "hi", …}], "noise": {…}}`.
+//! terms. JSON: `{"kind", "points": [{"tau_s", "dev", "n", "lo", "hi", …}], "noise":
+//! {"arw_deg_rt_h": {"value", "tau_read_s", "fit_tau_min_s", "fit_tau_max_s"} or null, …}}`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -7,11 +8,11 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
-use gyrotherm::csvlog::TestLog;
+use gyrotherm::csvlog::{rate_column_to_dph, TestLog};
 use gyrotherm::report;
+use serde::Serialize;
 
 use super::common::{read_log_reporting, LogArgs};
-use serde_json::{json, Value};
 
 #[derive(Debug, clap::Args)]
 pub struct AllanArgs {
@@ -23,9 +24,9 @@ pub struct AllanArgs {
     /// Column to analyse: gyro_dps (default), temp_c, table_dps or any numeric extra column.
     #[arg(long, default_value = "gyro_dps")]
     pub column: String,
-    /// Deviation: oadev, adev, mdev, hdev (non-overlapping Hadamard, as Stable32) or ohdev.
-    #[arg(long, default_value = "oadev", value_parser = parse_kind)]
-    pub kind: DevKind,
+    /// Deviation.
+    #[arg(long, value_enum, default_value_t = KindArg::Oadev)]
+    pub kind: KindArg,
     /// τ values: octave, decade, all, or seconds such as 1,10,100.
     #[arg(long, default_value = "octave", value_parser = parse_taus)]
     pub taus: TauSet,
@@ -42,8 +43,31 @@ pub struct AllanArgs {
     pub plot: Option<PathBuf>,
 }
 
-fn parse_kind(s: &str) -> Result<DevKind, String> {
-    s.parse().map_err(|e: allan::AllanError| e.to_string())
+/// `--kind` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum KindArg {
+    /// overlapping Allan deviation
+    Oadev,
+    /// non-overlapping Allan deviation
+    Adev,
+    /// modified Allan deviation
+    Mdev,
+    /// non-overlapping Hadamard deviation (as Stable32 "Hadamard")
+    Hdev,
+    /// overlapping Hadamard deviation
+    Ohdev,
+}
+
+impl From<KindArg> for DevKind {
+    fn from(k: KindArg) -> Self {
+        match k {
+            KindArg::Oadev => DevKind::Oadev,
+            KindArg::Adev => DevKind::Adev,
+            KindArg::Mdev => DevKind::Mdev,
+            KindArg::Hdev => DevKind::Hdev,
+            KindArg::Ohdev => DevKind::Ohdev,
+        }
+    }
 }
 
 fn parse_taus(s: &str) -> Result<TauSet, String> {
@@ -51,40 +75,16 @@ fn parse_taus(s: &str) -> Result<TauSet, String> {
 }
 
 /// Reads the log and picks a numeric column; returns (log, values, sample period s). The
-/// chosen column is moved out of the log (left empty there) to keep one copy in memory.
+/// gyro and temperature columns are moved out of the log to keep one copy in memory.
 pub(crate) fn read_column(
     input: &Path,
     column: &str,
     log_args: &LogArgs,
 ) -> anyhow::Result<(TestLog, Vec<f64>, f64)> {
     let mut log = read_log_reporting(input, log_args)?;
-    let values = match column {
-        "gyro_dps" => std::mem::take(&mut log.gyro_dps),
-        "temp_c" => std::mem::take(&mut log.temp_c),
-        "time_s" => log.time_s.clone(),
-        "table_dps" => match &log.table_dps {
-            Some(t) => t.clone(),
-            None => bail!("{}: no table_dps column in this log", input.display()),
-        },
-        name => match log.extra_f64(name) {
-            Some(v) => v,
-            None => {
-                let names: Vec<&str> = ["gyro_dps", "temp_c"]
-                    .into_iter()
-                    .chain(log.table_dps.as_ref().map(|_| "table_dps"))
-                    .chain(log.extra.iter().map(|c| c.name.as_str()))
-                    .collect();
-                if log.extra.iter().any(|c| c.name == name) {
-                    bail!("{}: column `{name}` is not all numeric", input.display());
-                }
-                bail!(
-                    "{}: no column `{name}`; available: {}",
-                    input.display(),
-                    names.join(", ")
-                );
-            }
-        },
-    };
+    let values = log
+        .take_column(column)
+        .with_context(|| input.display().to_string())?;
     let tau0_s = log.sample_period_s();
     if !(tau0_s.is_finite() && tau0_s > 0.0) {
         bail!(
@@ -95,57 +95,17 @@ pub(crate) fn read_column(
     Ok((log, values, tau0_s))
 }
 
-/// Factor from a column's unit (by its name suffix) to °/h, for rate columns.
-pub(crate) fn to_dph_factor(column: &str) -> Option<f64> {
-    if column.ends_with("_dps") {
-        Some(3600.0)
-    } else if column.ends_with("_dph") {
-        Some(1.0)
-    } else if column.ends_with("_rad_s") || column.ends_with("_rps") {
-        Some(3600.0 * 180.0 / std::f64::consts::PI)
-    } else {
-        None
-    }
-}
-
-fn num(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
-
-fn noise_json(t: &NoiseTerms) -> Value {
-    let mut obj = serde_json::Map::new();
-    let terms = [
-        ("arw_deg_rt_h", t.arw_deg_rt_h),
-        ("bias_instability_dph", t.bias_instability_dph),
-        ("rrw_deg_h_rt_h", t.rrw_deg_h_rt_h),
-        ("quantization_arcsec", t.quantization_arcsec),
-        ("rate_ramp_deg_h2", t.rate_ramp_deg_h2),
-    ];
-    for (name, term) in terms {
-        obj.insert(name.into(), term.map_or(Value::Null, |x| num(x.value)));
-        let key = name.split('_').next().unwrap_or(name);
-        let key = match name {
-            "bias_instability_dph" => "bias_instability",
-            "quantization_arcsec" => "quantization",
-            "rate_ramp_deg_h2" => "rate_ramp",
-            _ => key,
-        };
-        obj.insert(
-            format!("{key}_tau_s"),
-            term.map_or(Value::Null, |x| num(x.tau_read_s)),
-        );
-        obj.insert(
-            format!("{key}_fit_tau_s"),
-            term.map_or(Value::Null, |x| {
-                json!([num(x.fit_tau_min_s), num(x.fit_tau_max_s)])
-            }),
-        );
-    }
-    Value::Object(obj)
+/// `--json`: the curve and the noise terms as the library computed them.
+#[derive(Serialize)]
+struct AllanJson<'a> {
+    kind: &'static str,
+    column: &'a str,
+    samples: usize,
+    tau0_s: f64,
+    confidence: f64,
+    points: &'a [AllanPoint],
+    noise: Option<&'a NoiseTerms>,
+    noise_from: Option<&'static str>,
 }
 
 /// Unit of a column for the plot's σ axis when it is not a rate (rates are drawn in °/h).
@@ -167,13 +127,14 @@ fn plot(
     points: &[AllanPoint],
     noise: Option<&NoiseTerms>,
 ) -> anyhow::Result<()> {
-    let (factor, unit) = match to_dph_factor(&args.column) {
+    let (factor, unit) = match rate_column_to_dph(&args.column) {
         Some(f) => (f, "°/h".to_owned()),
         None => (1.0, plain_unit(&args.column)),
     };
-    let label = format!("{} of {}", args.kind.name().to_uppercase(), args.column);
+    let kind: DevKind = args.kind.into();
+    let label = format!("{} of {}", kind.name().to_uppercase(), args.column);
     let curve = report::allan_curve(&label, points, factor);
-    let lines = match (args.kind, noise) {
+    let lines = match (kind, noise) {
         (DevKind::Adev | DevKind::Oadev, Some(t)) => report::noise_lines(t, ""),
         _ => Vec::new(),
     };
@@ -190,18 +151,19 @@ fn plot(
 }
 
 pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
+    let kind: DevKind = args.kind.into();
     let mut w = std::io::stdout().lock();
     let (_log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
     let noise_model = args.alpha.map_or(NoiseModel::Identify, NoiseModel::Alpha);
-    let points = allan::deviation(&values, tau0_s, args.kind, &args.taus, noise_model)
-        .with_context(|| format!("{} of column {}", args.kind.name(), args.column))?;
+    let points = allan::deviation(&values, tau0_s, kind, &args.taus, noise_model)
+        .with_context(|| format!("{} of column {}", kind.name(), args.column))?;
     // Noise terms are defined on the Allan deviation: from this curve for adev/oadev, else
     // from an OADEV curve at the same τ.
-    let to_dph = to_dph_factor(&args.column);
+    let to_dph = rate_column_to_dph(&args.column);
     let (noise, noise_from) = match to_dph {
         None => (None, None),
         Some(f) => {
-            let curve: Vec<AllanPoint> = match args.kind {
+            let curve: Vec<AllanPoint> = match kind {
                 DevKind::Adev | DevKind::Oadev => points.clone(),
                 _ => {
                     let taus = TauSet::Seconds(points.iter().map(|p| p.tau_s).collect());
@@ -209,7 +171,7 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
                         .unwrap_or_default()
                 }
             };
-            let from = match args.kind {
+            let from = match kind {
                 DevKind::Adev => "adev",
                 _ => "oadev",
             };
@@ -220,32 +182,23 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
         plot(path, &args, &points, noise.as_ref())?;
     }
     if args.json {
-        let pts: Vec<Value> = points
-            .iter()
-            .map(|p| {
-                json!({
-                    "tau_s": num(p.tau_s), "m": p.m, "dev": num(p.dev), "n": p.n,
-                    "lo": num(p.lo), "hi": num(p.hi), "alpha": p.alpha, "edf": num(p.edf),
-                })
-            })
-            .collect();
-        let out = json!({
-            "kind": args.kind.name(),
-            "column": args.column,
-            "samples": values.len(),
-            "tau0_s": tau0_s,
-            "confidence": allan::ONE_SIGMA_CI,
-            "points": pts,
-            "noise": noise.as_ref().map_or(Value::Null, noise_json),
-            "noise_from": noise_from,
-        });
+        let out = AllanJson {
+            kind: kind.name(),
+            column: &args.column,
+            samples: values.len(),
+            tau0_s,
+            confidence: allan::ONE_SIGMA_CI,
+            points: &points,
+            noise: noise.as_ref(),
+            noise_from,
+        };
         writeln!(w, "{}", serde_json::to_string_pretty(&out)?)?;
         return Ok(ExitCode::SUCCESS);
     }
     writeln!(
         w,
         "{} of {} ({} samples, τ0 = {} s; 68.3 % bounds from Greenhall EDF)",
-        args.kind.name().to_uppercase(),
+        kind.name().to_uppercase(),
         args.column,
         values.len(),
         tau0_s

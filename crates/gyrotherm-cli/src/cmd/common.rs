@@ -135,6 +135,16 @@ pub fn named(logs: &[(String, TestLog)]) -> Vec<NamedLog<'_>> {
         .collect()
 }
 
+/// Values of the options that name a built-in chamber profile (`gyrotherm::sim`'s list,
+/// so the two cannot drift apart).
+pub fn builtin_profile() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        gyrotherm::sim::BUILTIN_PROFILES
+            .iter()
+            .map(|(name, what)| clap::builder::PossibleValue::new(*name).help(*what)),
+    )
+}
+
 fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),

@@ -6,10 +6,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::compare::{compare, CompareConfig, Comparison, Figures};
+use gyrotherm::compare::{compare, CompareConfig, Comparison};
 use gyrotherm::fit::NamedLog;
 use gyrotherm::model::Method;
-use serde_json::{json, Value};
 
 use super::common::LogArgs;
 use super::common::{named, read_logs};
@@ -53,9 +52,7 @@ pub fn run_comparison(
         }
     });
     bars.finish();
-    result
-        .map_err(anyhow::Error::msg)
-        .context("comparison failed")
+    result.context("comparison failed")
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
@@ -68,11 +65,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let mut out = std::io::stdout().lock();
     if args.json {
-        writeln!(
-            out,
-            "{}",
-            serde_json::to_string_pretty(&comparison_json(&cmp, &cfg))?
-        )?;
+        writeln!(out, "{}", serde_json::to_string_pretty(&cmp.summary(&cfg))?)?;
     } else {
         print_table(&mut out, &cmp, &cfg)?;
     }
@@ -84,169 +77,15 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn num(v: Option<f64>) -> Value {
-    match v {
-        Some(x) if x.is_finite() => json!(x),
-        _ => Value::Null,
-    }
-}
-
-fn figures_json(f: &Figures) -> Value {
-    json!({
-        "bias_stability_dph": num(f.bias_stability_dph),
-        "sf_error_ppm": num(f.sf_error_ppm),
-        "sf_thermal_error_ppm": num(f.sf_thermal_error_ppm),
-        "rate_ranges": f.rate_ranges.iter().map(|r| json!({
-            "table_dps": r.table_dps, "min_dps": r.min_dps, "max_dps": r.max_dps,
-        })).collect::<Vec<_>>(),
-    })
-}
-
-/// The comparison as JSON (kept stable for scripts).
-pub fn comparison_json(cmp: &Comparison, cfg: &CompareConfig) -> Value {
-    json!({
-        "tau_s": cfg.tau_s,
-        "tests": cmp.tests.iter().map(|t| {
-            let mut methods = serde_json::Map::new();
-            for m in &t.methods {
-                methods.insert(m.method.as_str().into(), figures_json(&m.figures));
-            }
-            json!({
-                "name": t.name,
-                "static": t.is_static,
-                "floor_dph": num(t.floor_dph),
-                "raw": figures_json(&t.raw),
-                "methods": methods,
-                "warnings": t.warnings,
-            })
-        }).collect::<Vec<_>>(),
-        "models": cmp.fits.iter().map(|f| json!({
-            "method": f.model.method.as_str(),
-            "bias_model": f.model.bias.as_ref().map(|b| b.kind()),
-            "scale_model": f.model.scale.as_ref().map(|b| b.kind()),
-            "bias_epochs": f.bias_training.as_ref().map(|t| t.epochs),
-            "bias_final_loss": f.bias_training.as_ref().map(|t| t.final_loss),
-            "scale_epochs": f.scale_training.as_ref().map(|t| t.epochs),
-            "scale_final_loss": f.scale_training.as_ref().map(|t| t.final_loss),
-            // Why a residual LSTM was kept or left out: the relative validation-loss
-            // reduction on the validation blocks and, with --validate-on-runs, on each
-            // left-out training run (fractions; null where not measured).
-            "bias_lstm_validation_improvement":
-                f.bias_training.as_ref().and_then(|t| t.val_improvement),
-            "bias_lstm_run_gate": f.bias_training.as_ref().and_then(|t| t.run_gate.clone()),
-            "scale_lstm_validation_improvement":
-                f.scale_training.as_ref().and_then(|t| t.val_improvement),
-            "scale_lstm_run_gate": f.scale_training.as_ref().and_then(|t| t.run_gate.clone()),
-        })).collect::<Vec<_>>(),
-    })
-}
-
-fn cell(v: Option<f64>, digits: usize) -> String {
-    match v {
-        Some(x) if x.is_finite() => format!("{x:.digits$}"),
-        _ => "-".into(),
-    }
-}
-
-/// The human table: one block per held-out log, one column per method.
+/// The human table: the models fitted, then one block per held-out log.
 pub fn print_table(
     w: &mut dyn Write,
     cmp: &Comparison,
     cfg: &CompareConfig,
 ) -> std::io::Result<()> {
-    use gyrotherm::model::SubModel;
-    for f in &cmp.fits {
-        let part = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
-        write!(
-            w,
-            "{:>6}: bias model {}, scale-factor model {}",
-            f.model.method.as_str(),
-            part(&f.model.bias),
-            part(&f.model.scale)
-        )?;
-        let lstm_kept = [&f.model.bias, &f.model.scale]
-            .iter()
-            .any(|s| matches!(s, Some(SubModel::Lstm { .. } | SubModel::Residual { .. })));
-        if f.model.method == Method::Lstm && !lstm_kept {
-            write!(w, " (no residual LSTM beat its least-squares base on the validation data, so none was kept)")?;
-        }
-        writeln!(w)?;
+    for line in cmp.model_lines() {
+        writeln!(w, "{line}")?;
     }
     writeln!(w)?;
-    for t in &cmp.tests {
-        let mut cols = vec!["raw".to_string()];
-        cols.extend(t.methods.iter().map(|m| m.method.as_str().to_string()));
-        let all: Vec<&Figures> = std::iter::once(&t.raw)
-            .chain(t.methods.iter().map(|m| &m.figures))
-            .collect();
-        writeln!(
-            w,
-            "held-out log {} ({})",
-            t.name,
-            if t.is_static { "static" } else { "rate table" }
-        )?;
-        write!(w, "  {:<36}", "figure")?;
-        for c in &cols {
-            write!(w, "{c:>22}")?;
-        }
-        if t.floor_dph.is_some() {
-            write!(w, "{:>22}", "noise floor")?;
-        }
-        writeln!(w)?;
-        if t.is_static {
-            write!(
-                w,
-                "  {:<36}",
-                format!("bias stability (°/h, τ={} s)", cfg.tau_s)
-            )?;
-            for f in &all {
-                write!(w, "{:>22}", cell(f.bias_stability_dph, 5))?;
-            }
-            if let Some(fl) = t.floor_dph {
-                write!(w, "{:>22}", cell(Some(fl), 5))?;
-            }
-            writeln!(w)?;
-            if let (Some(raw), Some(fl)) = (t.raw.bias_stability_dph, t.floor_dph) {
-                write!(w, "  {:<36}", "  × noise floor")?;
-                write!(w, "{:>22}", cell(Some(raw / fl), 2))?;
-                for m in &t.methods {
-                    write!(
-                        w,
-                        "{:>22}",
-                        cell(m.figures.bias_stability_dph.map(|b| b / fl), 2)
-                    )?;
-                }
-                writeln!(w)?;
-            }
-        } else {
-            write!(w, "  {:<36}", "SF error max |K(t)-1| (ppm)")?;
-            for f in &all {
-                write!(w, "{:>22}", cell(f.sf_error_ppm, 1))?;
-            }
-            writeln!(w)?;
-            write!(w, "  {:<36}", "SF thermal error vs room K (ppm)")?;
-            for f in &all {
-                write!(w, "{:>22}", cell(f.sf_thermal_error_ppm, 1))?;
-            }
-            writeln!(w)?;
-            for (k, r) in t.raw.rate_ranges.iter().enumerate() {
-                write!(
-                    w,
-                    "  {:<36}",
-                    format!("output at {:+} °/s (°/s)", r.table_dps)
-                )?;
-                for f in &all {
-                    let s = f
-                        .rate_ranges
-                        .get(k)
-                        .map(|r| format!("{:.5}..{:.5}", r.min_dps, r.max_dps))
-                        .unwrap_or_else(|| "-".into());
-                    write!(w, "{s:>22}")?;
-                }
-                writeln!(w)?;
-            }
-        }
-        writeln!(w)?;
-    }
-    Ok(())
+    cmp.table(cfg).write_text(w)
 }

@@ -9,7 +9,7 @@ use anyhow::Context as _;
 use gyrotherm::csvlog::{write_log, TestLog};
 use gyrotherm::sim::{simulate, SimConfig};
 
-use super::common::named;
+use super::common::{builtin_profile, named};
 use super::compare::{print_table, run_comparison};
 use super::train::FitArgs;
 
@@ -19,10 +19,10 @@ pub struct DemoArgs {
     #[arg(long, default_value = "gyrotherm-demo")]
     pub dir: PathBuf,
     /// Chamber profile of the training runs.
-    #[arg(long, default_value = "seed-shock")]
+    #[arg(long, default_value = "seed-shock", value_parser = builtin_profile())]
     pub train_profile: String,
     /// Chamber profile of the held-out runs (a different one: the test is held out).
-    #[arg(long, default_value = "slow-ramp")]
+    #[arg(long, default_value = "slow-ramp", value_parser = builtin_profile())]
     pub test_profile: String,
     /// Rate-table rate of the rate-table runs, °/s.
     #[arg(long, default_value_t = 20.0)]
@@ -84,7 +84,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         logs.push((path.display().to_string(), log));
     }
     let named = named(&logs);
-    let cfg = args.fit.compare_config(gyrotherm::targets::BIAS_WINDOW_S)?;
+    let cfg = args
+        .fit
+        .compare_config(gyrotherm::compare::BIAS_STABILITY_TAU_S)?;
     eprintln!("gyrotherm: fitting linear, poly and lstm models on the training runs ...");
     let cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
     for fit in &cmp.fits {

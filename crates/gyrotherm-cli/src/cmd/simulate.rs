@@ -4,12 +4,13 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
+use gyrotherm::metrics;
 use gyrotherm::sim::{self, FogUnit, Profile, SimConfig, BUILTIN_PROFILES};
 
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
     /// Built-in chamber profile (see --list-profiles).
-    #[arg(long, default_value = "seed-shock", conflicts_with = "profile_file")]
+    #[arg(long, default_value = "seed-shock", conflicts_with = "profile_file", value_parser = super::common::builtin_profile())]
     profile: String,
     /// User profile: text file of `duration_s,target_c` rows (set point starts at the first
     /// row's target; each later row ramps linearly to its target; `#` comments).
@@ -109,9 +110,12 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
             (a.min(t), b.max(t))
         });
     let stability = if cfg.table_rate_dps.is_none() {
-        match bias_stability_dph(&log.gyro_dps, cfg.sample_rate_hz, 100.0) {
-            Some(v) => format!("raw bias stability {v:.5} °/h (1σ of 100 s means)"),
-            None => "run too short for a 100 s bias stability".into(),
+        match metrics::bias_stability_dph(&log.gyro_dps, 1.0 / cfg.sample_rate_hz, 100.0) {
+            Ok(b) => format!(
+                "raw bias stability {:.5} °/h (1σ of 100 s means)",
+                b.bias_stability_dph
+            ),
+            Err(e) => format!("no 100 s bias stability ({e})"),
         }
     } else {
         format!("rate table ±{} °/s", cfg.table_rate_dps.unwrap_or(0.0))
@@ -128,21 +132,4 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         out.display()
     );
     Ok(ExitCode::SUCCESS)
-}
-
-/// Bias stability, °/h: sample standard deviation (n-1) of consecutive non-overlapping
-/// `tau_s` means (IEEE Std 952 / GJB 2426A); None with fewer than two means.
-// Local stand-in until the metrics module lands.
-fn bias_stability_dph(x_dps: &[f64], rate_hz: f64, tau_s: f64) -> Option<f64> {
-    let m = (tau_s * rate_hz).round().max(1.0) as usize;
-    let means: Vec<f64> = x_dps
-        .chunks_exact(m)
-        .map(|c| c.iter().sum::<f64>() / m as f64)
-        .collect();
-    if means.len() < 2 {
-        return None;
-    }
-    let mu = means.iter().sum::<f64>() / means.len() as f64;
-    let var = means.iter().map(|v| (v - mu).powi(2)).sum::<f64>() / (means.len() - 1) as f64;
-    Some(var.sqrt() * 3600.0)
 }

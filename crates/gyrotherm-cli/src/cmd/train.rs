@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
+use gyrotherm::fit::RecipeKind;
 use gyrotherm::fit::{fit_model, FitConfig, LstmVerdict, NamedLog, Target};
 use gyrotherm::model::Method;
 
@@ -13,14 +14,9 @@ use super::progress::TrainingBars;
 /// Fitting options shared by `train` and `compare`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
-    /// LSTM recipe. `residual` (default): least squares on thermal-state inputs (T, dT,
-    /// T − first-order lags of 300/1000/3000 s) plus an LSTM on its residual, kept only where
-    /// it beats the least-squares base on validation blocks. `generic`: the same on a
-    /// generic linear + T² base. `direct`: an LSTM alone on the thermal-state inputs.
-    /// `published`: He et al. 2024 exactly (whole run, T and dT inputs, 1000 Adam steps at
-    /// lr 0.01).
-    #[arg(long, default_value = "residual", value_parser = ["residual", "generic", "direct", "published"])]
-    pub recipe: String,
+    /// LSTM recipe.
+    #[arg(long, value_enum, default_value_t = RecipeArg::Residual)]
+    pub recipe: RecipeArg,
     /// LSTM training epochs (default: the recipe's).
     #[arg(long)]
     pub epochs: Option<usize>,
@@ -67,8 +63,7 @@ impl FitArgs {
     /// The library's fit configuration for `method`.
     pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
         let mut cfg = FitConfig::new(method);
-        let kind = gyrotherm::fit::RecipeKind::parse(&self.recipe).map_err(anyhow::Error::msg)?;
-        cfg.recipe = gyrotherm::fit::LstmRecipe::of_kind(kind);
+        cfg.recipe = gyrotherm::fit::LstmRecipe::of_kind(self.recipe.into());
         if let Some(e) = self.epochs {
             anyhow::ensure!(e > 0, "--epochs must be at least 1");
             cfg.recipe.epochs = e;
@@ -89,6 +84,32 @@ impl FitArgs {
         cfg.poly.cross = !self.no_cross;
         cfg.recipe.validate_on_runs = self.validate_on_runs;
         Ok(cfg)
+    }
+}
+
+/// `--recipe` values (the library's `fit::lstm::RecipeKind`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RecipeArg {
+    /// Least squares on thermal-state inputs (T, dT, T − first-order lags of 300/1000/3000 s)
+    /// plus an LSTM on its residual, kept only where it beats the least-squares base on
+    /// validation blocks.
+    Residual,
+    /// As `residual`, on a generic linear + T² base.
+    Generic,
+    /// An LSTM alone on the thermal-state inputs.
+    Direct,
+    /// He et al. 2024 exactly (whole run, T and dT inputs, 1000 Adam steps at lr 0.01).
+    Published,
+}
+
+impl From<RecipeArg> for RecipeKind {
+    fn from(r: RecipeArg) -> RecipeKind {
+        match r {
+            RecipeArg::Residual => RecipeKind::Residual,
+            RecipeArg::Generic => RecipeKind::Generic,
+            RecipeArg::Direct => RecipeKind::Direct,
+            RecipeArg::Published => RecipeKind::Published,
+        }
     }
 }
 
@@ -173,9 +194,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         m.training.rate_range_c_per_s.max * 60.0
     );
     // The training runs of each target, in the order the fit saw them.
-    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) = named
-        .iter()
-        .partition(|l| gyrotherm::targets::is_static(l.log));
+    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) =
+        named.iter().partition(|l| l.log.is_static());
     for (name, sub, t, runs) in [
         ("bias", &m.bias, &outcome.bias_training, &static_names),
         (

@@ -26,8 +26,10 @@ pub mod noise_id;
 mod streaming;
 mod terms;
 
-pub use edf::{chi2_inv, edf_greenhall, edf_simple, regularized_gamma_p, ONE_SIGMA_CI};
-pub use noise_id::{b1_noise_id_from_phase, lag1_noise_id, lag1_noise_id_from_phase, NoiseId};
+use edf::{chi2_inv, edf_greenhall};
+pub use edf::{edf_simple, ONE_SIGMA_CI};
+use noise_id::{b1_noise_id_from_phase, lag1_noise_id_from_phase};
+pub use noise_id::{lag1_noise_id, NoiseId};
 pub use streaming::StreamingOadev;
 pub use terms::{noise_terms, NoiseTerm, NoiseTerms};
 
@@ -216,7 +218,7 @@ impl fmt::Display for AllanError {
 impl std::error::Error for AllanError {}
 
 /// One point of a deviation curve.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct AllanPoint {
     /// Averaging factor m (τ = m·τ0).
     pub m: usize,

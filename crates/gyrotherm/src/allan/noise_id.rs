@@ -75,7 +75,7 @@ pub fn lag1_noise_id(samples: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
 /// [`super::phase_from_rate`]): the m-sample means are (θ_{(j+1)m} − θ_{jm})/m, O(1) each, so
 /// identification costs O(N/m) instead of O(N) per τ. (A constant offset of the means, such as
 /// the mean removed by `phase_from_rate`, goes away with the linear detrend.)
-pub fn lag1_noise_id_from_phase(phase: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
+pub(crate) fn lag1_noise_id_from_phase(phase: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
     if m == 0 || phase.is_empty() {
         return None;
     }
@@ -133,7 +133,7 @@ pub const B1_MIN_AVERAGES: usize = 4;
 /// [`b1_theory`]; for α ≥ 1 the ratio R(n) = MVAR/AVAR separates flicker PM (α = 1) from
 /// white PM (α = 2) (R(n) = 1/m for white PM; IEEE Std 1139 table for flicker PM with
 /// f_h = 1/(2τ0)). `phase` as made by [`super::phase_from_rate`].
-pub fn b1_noise_id_from_phase(phase: &[f64], m: usize) -> Option<i32> {
+pub(crate) fn b1_noise_id_from_phase(phase: &[f64], m: usize) -> Option<i32> {
     if m == 0 || phase.is_empty() {
         return None;
     }

@@ -21,7 +21,7 @@ use super::AllanPoint;
 pub const SLOPE_TOL: f64 = 0.2;
 
 /// One noise term.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct NoiseTerm {
     /// The coefficient, in the unit named by the field holding it.
     pub value: f64,
@@ -33,7 +33,7 @@ pub struct NoiseTerm {
 }
 
 /// All five terms; None where the curve shows no region of that slope.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct NoiseTerms {
     /// Angle random walk, °/√h.
     pub arw_deg_rt_h: Option<NoiseTerm>,

@@ -14,10 +14,13 @@
 //! [`LogErrorKind`]): missing columns, non-numeric or non-finite fields, empty file, short
 //! or long rows (a short last row is a truncated file), time not strictly increasing,
 //! duplicate timestamps, and gaps longer than [`GAP_FACTOR`] nominal sample periods (the
-//! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`reader`]).
+//! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`LogReader`]).
 
+mod columns;
 mod error;
-pub mod reader;
+mod gaps;
+mod number;
+mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
@@ -85,6 +88,87 @@ impl TestLog {
     pub fn extra_f64(&self, name: &str) -> Option<Vec<f64>> {
         let col = self.extra.iter().find(|c| c.name == name)?;
         col.values.iter().map(|v| v.trim().parse().ok()).collect()
+    }
+    /// True for a static test: no table column, or a table column that is zero throughout.
+    pub fn is_static(&self) -> bool {
+        self.table_dps
+            .as_ref()
+            .is_none_or(|t| t.iter().all(|v| *v == 0.0))
+    }
+    /// The numeric column `name` (a standard column or a numeric pass-through column). The
+    /// gyro and temperature columns are moved out (left empty here) so a long log is held
+    /// once; the others are copied.
+    pub fn take_column(&mut self, name: &str) -> Result<Vec<f64>, ColumnError> {
+        match name {
+            GYRO_COL => Ok(std::mem::take(&mut self.gyro_dps)),
+            TEMP_COL => Ok(std::mem::take(&mut self.temp_c)),
+            TIME_COL => Ok(self.time_s.clone()),
+            DEFAULT_TABLE_COL => self.table_dps.clone().ok_or(ColumnError::NoTable),
+            name => self.extra_f64(name).ok_or_else(|| {
+                if self.extra.iter().any(|c| c.name == name) {
+                    ColumnError::NotNumeric {
+                        name: name.to_owned(),
+                    }
+                } else {
+                    ColumnError::Missing {
+                        name: name.to_owned(),
+                        available: self.column_names(),
+                    }
+                }
+            }),
+        }
+    }
+    /// Names of the columns held: the standard ones present, then the pass-through ones.
+    pub fn column_names(&self) -> Vec<String> {
+        [GYRO_COL, TEMP_COL]
+            .into_iter()
+            .chain(self.table_dps.as_ref().map(|_| DEFAULT_TABLE_COL))
+            .chain(self.extra.iter().map(|c| c.name.as_str()))
+            .map(str::to_owned)
+            .collect()
+    }
+}
+
+/// Why [`TestLog::take_column`] has no numbers for a column.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ColumnError {
+    /// `table_dps` asked for on a log without one.
+    NoTable,
+    /// No column of that name.
+    Missing {
+        name: String,
+        available: Vec<String>,
+    },
+    /// The pass-through column holds a field that is not a number.
+    NotNumeric { name: String },
+}
+
+impl std::fmt::Display for ColumnError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ColumnError::NoTable => write!(f, "no table_dps column in this log"),
+            ColumnError::Missing { name, available } => {
+                write!(f, "no column `{name}`; available: {}", available.join(", "))
+            }
+            ColumnError::NotNumeric { name } => write!(f, "column `{name}` is not all numeric"),
+        }
+    }
+}
+
+impl std::error::Error for ColumnError {}
+
+/// Factor from a rate column's unit, read from its name suffix, to °/h: `*_dps` 3600,
+/// `*_dph` 1, `*_rad_s` / `*_rps` 3600·180/π; None for a name without a rate unit.
+pub fn rate_column_to_dph(column: &str) -> Option<f64> {
+    if column.ends_with("_dps") {
+        Some(3600.0)
+    } else if column.ends_with("_dph") {
+        Some(1.0)
+    } else if column.ends_with("_rad_s") || column.ends_with("_rps") {
+        Some(3600.0 * 180.0 / std::f64::consts::PI)
+    } else {
+        None
     }
 }
 

@@ -18,14 +18,17 @@ use std::path::{Path, PathBuf};
 
 use csv::ByteRecord;
 
+use super::columns::{check_options, map_columns, Columns};
 use super::error::{LogError, LogErrorKind as Kind};
-use super::{GyroUnit, ReadOptions, ReadReport, DEFAULT_TABLE_COL};
+use super::gaps::{gap_verdict, Fill, GapVerdict};
+use super::number::parse_f64;
+use super::{GyroUnit, ReadOptions, ReadReport};
 
 /// Number of leading time steps whose median is the nominal sample period.
 pub const PERIOD_ESTIMATE_STEPS: usize = 100;
 
-/// A step longer than this many nominal periods is a gap (issue 2: "a gap larger than 1.5
-/// sample periods").
+/// A step longer than this many nominal periods is a gap: one missing sample (a step of two
+/// periods) must be caught, while jitter of half a period must not be.
 pub const GAP_FACTOR: f64 = 1.5;
 
 /// Most samples one gap may be filled with; beyond it the gap is reported as too long, so
@@ -45,17 +48,6 @@ pub struct Sample {
     pub table_dps: Option<f64>,
 }
 
-/// Where the mapped columns sit in the header.
-#[derive(Debug, Clone)]
-struct Columns {
-    time: usize,
-    gyro: usize,
-    temp: usize,
-    table: Option<usize>,
-    /// Every other column, in file order.
-    extra: Vec<usize>,
-}
-
 /// The CSV side: parses and validates one record at a time (numbers, field count, time order).
 struct Source<R> {
     csv: csv::Reader<Tail<R>>,
@@ -70,16 +62,6 @@ struct Source<R> {
     rows: u64,
     /// Scratch record for looking one row ahead after a short row.
     peek: ByteRecord,
-}
-
-/// Gap filling in progress: `n` samples between `from` and `to`, `k` already handed out.
-#[derive(Debug, Clone, Copy)]
-struct Fill {
-    from: Sample,
-    to: Sample,
-    to_line: u64,
-    n: usize,
-    k: usize,
 }
 
 /// Streaming reader of a test log.
@@ -217,15 +199,7 @@ impl<R: Read> LogReader<R> {
     #[inline]
     pub fn next_sample(&mut self) -> Result<Option<Sample>, LogError> {
         if let Some(f) = self.fill.as_mut() {
-            if f.k < f.n {
-                f.k += 1;
-                let a = f.k as f64 / (f.n + 1) as f64;
-                let s = Sample {
-                    time_s: lerp(f.from.time_s, f.to.time_s, a),
-                    gyro_dps: lerp(f.from.gyro_dps, f.to.gyro_dps, a),
-                    temp_c: lerp(f.from.temp_c, f.to.temp_c, a),
-                    table_dps: f.from.table_dps,
-                };
+            if let Some(s) = f.next_filled() {
                 self.filled = true;
                 return Ok(Some(s));
             }
@@ -275,11 +249,8 @@ impl<R: Read> LogReader<R> {
              (period {period} s, {how})",
             p.time_s, s.time_s
         );
-        let n_f = (dt / period).round() - 1.0;
-        match self.fill_max_s {
-            Some(max) if dt <= max && n_f <= MAX_FILL_SAMPLES_PER_GAP as f64 => {
-                // dt > 1.5 period, so n_f >= 1.
-                let n = (n_f as usize).max(1);
+        match gap_verdict(dt, period, self.fill_max_s) {
+            GapVerdict::Fill(n) => {
                 self.report.filled_gaps += 1;
                 self.report.filled_samples += n;
                 self.fill = Some(Fill {
@@ -291,7 +262,7 @@ impl<R: Read> LogReader<R> {
                 });
                 self.next_sample()
             }
-            Some(max) => Err(LogError::new(
+            GapVerdict::TooLong(max) => Err(LogError::new(
                 Kind::GapTooLong,
                 &self.src.path,
                 Some(line),
@@ -301,7 +272,7 @@ impl<R: Read> LogReader<R> {
                      this line or raise --fill-gaps if interpolating {dt} s is acceptable"
                 ),
             )),
-            None => Err(LogError::new(
+            GapVerdict::NotAllowed => Err(LogError::new(
                 Kind::Gap,
                 &self.src.path,
                 Some(line),
@@ -626,59 +597,6 @@ impl<R: Read> Source<R> {
     }
 }
 
-/// Parse a numeric field: ASCII spaces around it allowed, Rust float syntax (which also
-/// accepts `NaN` and `inf`; the caller rejects those). Gives the same f64 as `str::parse`.
-#[inline(always)]
-pub(crate) fn parse_f64(raw: &[u8]) -> Option<f64> {
-    match parse_plain_decimal(raw) {
-        Some(v) => Some(v),
-        None => parse_f64_std(raw),
-    }
-}
-
-#[cold]
-#[inline(never)]
-fn parse_f64_std(raw: &[u8]) -> Option<f64> {
-    let t = raw.trim_ascii();
-    std::str::from_utf8(t).ok()?.parse().ok()
-}
-
-/// Exact powers of ten representable in f64 (10^22 is the largest, Clinger 1990).
-const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
-];
-
-/// Fast path for the usual log field `[+-]digits[.digits]`: when the digits form an integer
-/// `m ≤ 2^53` and there are at most 22 decimals, `m` and `10^d` are exact f64 values and one
-/// IEEE division rounds `m / 10^d` correctly, so the result equals `str::parse`'s (Clinger's
-/// fast path: W. D. Clinger, "How to read floating point numbers accurately", PLDI 1990).
-/// Anything else (exponent, spaces, 20+ digits, NaN, inf) gives None.
-#[inline(always)]
-pub(crate) fn parse_plain_decimal(s: &[u8]) -> Option<f64> {
-    let (neg, s) = match s.first() {
-        Some(b'-') => (true, &s[1..]),
-        Some(b'+') => (false, &s[1..]),
-        _ => (false, s),
-    };
-    let mut m: u64 = 0;
-    let mut i = digits(s, 0, &mut m);
-    let int_digits = i;
-    let mut frac_digits = 0;
-    if i < s.len() && s[i] == b'.' {
-        let start = i + 1;
-        i = digits(s, start, &mut m);
-        frac_digits = i - start;
-    }
-    let digits = int_digits + frac_digits;
-    // 19 digits cannot overflow u64, so `m` is exact when digits <= 19.
-    if i != s.len() || digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
-        return None;
-    }
-    let v = m as f64 / POW10[frac_digits];
-    Some(if neg { -v } else { v })
-}
-
 /// 1-based physical line where `rec`, just read, starts.
 ///
 /// The csv crate stamps a record with the position where reading began, which is before
@@ -730,256 +648,11 @@ impl<R: Read> Read for Tail<R> {
     }
 }
 
-/// Accumulate the decimal digits of `s` from `i` into `m` (wrapping; the caller bounds the
-/// count), eight at a time where it can; returns the index after the last digit.
-#[inline(always)]
-fn digits(s: &[u8], mut i: usize, m: &mut u64) -> usize {
-    while let Some(chunk) = s.get(i..i + 8) {
-        let mut word = [0u8; 8];
-        word.copy_from_slice(chunk);
-        let v = u64::from_le_bytes(word);
-        // All eight bytes in b'0'..=b'9' (SWAR test as in simdjson / fast_float).
-        let all_digits = (v.wrapping_add(0x4646_4646_4646_4646)
-            | v.wrapping_sub(0x3030_3030_3030_3030))
-            & 0x8080_8080_8080_8080
-            == 0;
-        if !all_digits {
-            break;
-        }
-        *m = m.wrapping_mul(100_000_000).wrapping_add(eight_digits(v));
-        i += 8;
-    }
-    while i < s.len() && s[i].is_ascii_digit() {
-        *m = m.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
-        i += 1;
-    }
-    i
-}
-
-/// Value of eight ASCII digits packed little-endian in `v` (first digit in the low byte).
-#[inline(always)]
-fn eight_digits(v: u64) -> u64 {
-    const MASK: u64 = 0x0000_00FF_0000_00FF;
-    const MUL1: u64 = 0x000F_4240_0000_0064; // 100 + (1_000_000 << 32)
-    const MUL2: u64 = 0x0000_2710_0000_0001; // 1 + (10_000 << 32)
-    let v = v.wrapping_sub(0x3030_3030_3030_3030);
-    let v = v.wrapping_mul(10).wrapping_add(v >> 8);
-    (((v & MASK).wrapping_mul(MUL1)).wrapping_add(((v >> 16) & MASK).wrapping_mul(MUL2))) >> 32
-}
-
-#[inline]
-fn lerp(a: f64, b: f64, t: f64) -> f64 {
-    a + (b - a) * t
-}
-
 fn csv_error(path: &Path, e: csv::Error) -> LogError {
     let line = e.position().map(|p| p.line());
     if let csv::ErrorKind::Io(io) = e.kind() {
         LogError::new(Kind::Io, path, line, None, format!("cannot read: {io}"))
     } else {
         LogError::new(Kind::Csv, path, line, None, format!("malformed CSV: {e}"))
-    }
-}
-
-fn check_options(path: &Path, opts: &ReadOptions) -> Result<(), LogError> {
-    let bad = |what: &str, v: f64| {
-        LogError::new(
-            Kind::BadOptions,
-            path,
-            None,
-            None,
-            format!("{what} must be a positive number of seconds, got {v}"),
-        )
-    };
-    if let Some(v) = opts.fill_gaps_max_s {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(bad("--fill-gaps", v));
-        }
-    }
-    if let Some(v) = opts.sample_period_s {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(bad("the sample period", v));
-        }
-    }
-    Ok(())
-}
-
-/// Find the mapped columns; a missing one names the columns found and the option to use.
-fn map_columns(
-    path: &Path,
-    line: u64,
-    headers: &[String],
-    opts: &ReadOptions,
-) -> Result<Columns, LogError> {
-    let find = |name: &str, flag: &str, what: &str| -> Result<Option<usize>, LogError> {
-        let mut hits = headers
-            .iter()
-            .enumerate()
-            .filter(|(_, h)| *h == name)
-            .map(|(i, _)| i);
-        let first = hits.next();
-        if let (Some(a), Some(b)) = (first, hits.next()) {
-            return Err(LogError::new(
-                Kind::DuplicateColumn,
-                path,
-                Some(line),
-                Some(name),
-                format!(
-                    "the header names this column twice (fields {} and {}); rename one, or \
-                     pick the {what} column with {flag} NAME",
-                    a + 1,
-                    b + 1
-                ),
-            ));
-        }
-        Ok(first)
-    };
-    let require = |name: &str, flag: &str, what: &str| -> Result<usize, LogError> {
-        find(name, flag, what)?.ok_or_else(|| missing_column(path, line, headers, name, flag, what))
-    };
-    let time = require(&opts.time_col, "--time-col", "time")?;
-    let gyro = require(&opts.gyro_col, "--gyro-col", "gyro")?;
-    let temp = require(&opts.temp_col, "--temp-col", "temperature")?;
-    let table = find(&opts.table_col, "--table-col", "table-rate")?;
-    if table.is_none() && opts.table_col != DEFAULT_TABLE_COL {
-        // Mapped explicitly, so its absence is not a static test but a mistake.
-        return Err(missing_column(
-            path,
-            line,
-            headers,
-            &opts.table_col,
-            "--table-col",
-            "table-rate",
-        ));
-    }
-    let roles = [
-        (time, &opts.time_col),
-        (gyro, &opts.gyro_col),
-        (temp, &opts.temp_col),
-    ];
-    for (k, (i, name)) in roles.iter().enumerate() {
-        let clash = roles[k + 1..]
-            .iter()
-            .map(|(j, n)| (*j, *n))
-            .chain(table.map(|j| (j, &opts.table_col)))
-            .find(|(j, _)| j == i);
-        if let Some((_, other)) = clash {
-            return Err(LogError::new(
-                Kind::BadOptions,
-                path,
-                Some(line),
-                Some(name),
-                format!("column {name} is mapped to two roles (also as {other}); map each role to its own column"),
-            ));
-        }
-    }
-    let extra = (0..headers.len())
-        .filter(|&i| i != time && i != gyro && i != temp && Some(i) != table)
-        .collect();
-    Ok(Columns {
-        time,
-        gyro,
-        temp,
-        table,
-        extra,
-    })
-}
-
-#[cold]
-fn missing_column(
-    path: &Path,
-    line: u64,
-    headers: &[String],
-    name: &str,
-    flag: &str,
-    what: &str,
-) -> LogError {
-    let found = headers
-        .iter()
-        .map(|h| format!("{h:?}"))
-        .collect::<Vec<_>>()
-        .join(", ");
-    let mut message =
-        format!("required column not found; the header (line {line}) has: {found}; name the {what} column with {flag} NAME");
-    if headers.len() == 1 {
-        for (sep, sep_name) in [(';', "';'"), ('\t', "tabs")] {
-            if headers[0].contains(sep) {
-                message.push_str(&format!(
-                    " (the file seems to separate fields with {sep_name}; gyrotherm reads \
-                     comma-separated files)"
-                ));
-            }
-        }
-    }
-    if !headers.is_empty() && headers.iter().all(|h| parse_f64(h.as_bytes()).is_some()) {
-        message.push_str(
-            " (the first line looks like data: add a header row such as time_s,gyro_dps,temp_c)",
-        );
-    }
-    LogError::new(Kind::MissingColumn, path, Some(line), Some(name), message)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use proptest::prelude::*;
-
-    /// The fast path must agree bit for bit with `str::parse` (the independent reference).
-    fn same_as_std(s: &str) {
-        let want: Option<f64> = s.trim_ascii().parse().ok();
-        let got = parse_f64(s.as_bytes());
-        assert_eq!(
-            got.map(f64::to_bits),
-            want.map(f64::to_bits),
-            "{s:?}: want {want:?} got {got:?}"
-        );
-    }
-
-    #[test]
-    fn decimal_parse_edge_cases() {
-        for s in [
-            "0",
-            "-0",
-            "+0",
-            "1.",
-            ".5",
-            ".",
-            "-",
-            "",
-            " 1.5 ",
-            "12345.000",
-            "0.0012345678901",
-            "23.4375",
-            "9007199254740993",
-            "9007199254740992",
-            "0.1",
-            "1e5",
-            "nan",
-            "inf",
-            "-infinity",
-            "1,5",
-            "00000000000000000001.5",
-            "1.00000000000000000000001",
-            "123456789012345678901234",
-            "4.9e-324",
-            "1.7976931348623157e308",
-            "0x10",
-            "1_0",
-        ] {
-            same_as_std(s);
-        }
-    }
-
-    proptest! {
-        #[test]
-        fn decimal_parse_matches_std(s in "[+-]?[0-9]{0,20}(\\.[0-9]{0,25})?") {
-            same_as_std(&s);
-        }
-
-        #[test]
-        fn decimal_parse_of_printed_f64_round_trips(v in any::<f64>().prop_filter("finite", |v| v.is_finite()), d in 0usize..17) {
-            same_as_std(&format!("{v}"));
-            same_as_std(&format!("{v:.d$}"));
-        }
     }
 }

@@ -14,7 +14,10 @@ pub enum FitError {
     /// None of the logs gave a usable target.
     NoUsableLogs,
     /// The targets of run `run` could not be computed.
-    Targets { run: String, message: String },
+    Targets {
+        run: String,
+        source: crate::targets::TargetError,
+    },
     /// Rate-table run `run` has no rate segment between two stop segments.
     NoScaleSegments { run: String },
     /// The training runs use different feature definitions.
@@ -51,7 +54,7 @@ impl std::fmt::Display for FitError {
         match self {
             FitError::NoLogs => write!(f, "no training logs given"),
             FitError::NoUsableLogs => write!(f, "no usable training logs"),
-            FitError::Targets { run, message } => write!(f, "{run}: {message}"),
+            FitError::Targets { run, source } => write!(f, "{run}: {source}"),
             FitError::NoScaleSegments { run } => write!(
                 f,
                 "{run}: no rate segment has a stop segment on both sides, so no scale factor can \

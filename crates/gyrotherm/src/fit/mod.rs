@@ -170,18 +170,18 @@ pub fn fit_model(
     for l in logs {
         if targets::is_static(l.log) {
             bias_sets.push(
-                targets::bias_targets(l.log, &spec, cfg.bias_window_s).map_err(|message| {
+                targets::bias_targets(l.log, &spec, cfg.bias_window_s).map_err(|source| {
                     FitError::Targets {
                         run: l.name.to_owned(),
-                        message,
+                        source,
                     }
                 })?,
             );
         } else {
             let s = targets::scale_targets(l.log, &spec, cfg.settle_s, cfg.scale_window_s)
-                .map_err(|message| FitError::Targets {
+                .map_err(|source| FitError::Targets {
                     run: l.name.to_owned(),
-                    message,
+                    source,
                 })?;
             if s.labelled() == 0 {
                 return Err(FitError::NoScaleSegments {

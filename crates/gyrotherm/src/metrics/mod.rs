@@ -6,14 +6,21 @@
 //! - [`scale_factor`]: scale factor, nonlinearity, asymmetry and the scale-factor thermal
 //!   error from a rate-table log.
 //! - [`repeatability`]: sample standard deviation over repeated runs.
+//! - [`evaluate`]: all of these for one rate column of a log ([`Evaluation`]).
 //!
 //! Inputs are rates in °/s; results carry their unit in the field name.
 
+pub mod evaluation;
 pub mod scale_factor;
 
+pub use evaluation::{
+    evaluate, Evaluation, EvaluationError, EvaluationOptions, RatePoint, ScaleAtTime,
+    ScaleFactorFigures,
+};
+
 pub use scale_factor::{
-    detect_segments, scale_factor, RateSegment, ScaleFactorError, ScaleFactorOptions,
-    ScaleFactorReport, SegmentScale,
+    scale_factor, RateSegment, ScaleFactorError, ScaleFactorOptions, ScaleFactorReport,
+    SegmentScale,
 };
 
 use std::fmt;
@@ -85,7 +92,7 @@ pub(crate) fn mean(v: &[f64]) -> f64 {
 }
 
 /// Sample standard deviation (n − 1); None for fewer than two values.
-pub fn sample_std(v: &[f64]) -> Option<f64> {
+pub(crate) fn sample_std(v: &[f64]) -> Option<f64> {
     if v.len() < 2 {
         return None;
     }
@@ -159,7 +166,7 @@ pub fn bias_stability_dph(
 /// τ-means are taken inside each stop segment after `settle_s` (a mean never spans a table
 /// rate; a segment's remainder shorter than τ is dropped), and the bias stability is their
 /// sample std (n − 1), °/h. The bias is the mean of the used stop samples, °/h.
-pub fn stop_segment_bias_dph(
+pub(crate) fn stop_segment_bias_dph(
     time_s: &[f64],
     rate_dps: &[f64],
     table_dps: &[f64],
@@ -171,8 +178,9 @@ pub fn stop_segment_bias_dph(
     let m = samples_per_mean(period, tau_s)?;
     let mut means = Vec::new();
     let mut used = Vec::new();
-    for seg in scale_factor::detect_segments(time_s, rate_dps, table_dps, settle_s, 1e-9) {
-        if seg.table_dps != 0.0 {
+    let tol = crate::table_segments::RATE_TOLERANCE_DPS;
+    for seg in scale_factor::detect_segments(time_s, rate_dps, table_dps, settle_s, tol) {
+        if seg.table_dps.abs() > tol {
             continue;
         }
         let t0 = time_s[seg.start] + settle_s;

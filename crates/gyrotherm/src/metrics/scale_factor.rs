@@ -33,7 +33,7 @@ impl Default for ScaleFactorOptions {
     fn default() -> Self {
         ScaleFactorOptions {
             settle_s: 10.0,
-            rate_tol_dps: 1e-9,
+            rate_tol_dps: crate::table_segments::RATE_TOLERANCE_DPS,
             reference_scale: None,
         }
     }
@@ -133,8 +133,9 @@ impl fmt::Display for ScaleFactorError {
 
 impl std::error::Error for ScaleFactorError {}
 
-/// Runs of constant commanded rate, each averaged after dropping `settle_s`.
-pub fn detect_segments(
+/// Runs of constant commanded rate ([`crate::table_segments::segments`] with tolerance
+/// `rate_tol_dps`), each averaged after dropping `settle_s`.
+pub(crate) fn detect_segments(
     time_s: &[f64],
     output_dps: &[f64],
     table_dps: &[f64],
@@ -142,35 +143,30 @@ pub fn detect_segments(
     rate_tol_dps: f64,
 ) -> Vec<RateSegment> {
     let n = time_s.len().min(output_dps.len()).min(table_dps.len());
-    let mut segs = Vec::new();
-    let mut start = 0;
-    while start < n {
-        let rate = table_dps[start];
-        let mut end = start + 1;
-        while end < n && (table_dps[end] - rate).abs() <= rate_tol_dps {
-            end += 1;
-        }
-        let t_settled = time_s[start] + settle_s;
-        let used: Vec<f64> = (start..end)
-            .filter(|&i| time_s[i] >= t_settled)
-            .map(|i| output_dps[i])
-            .collect();
-        segs.push(RateSegment {
-            start,
-            end,
-            table_dps: rate,
-            start_time_s: time_s[start],
-            end_time_s: time_s[end - 1],
-            used_samples: used.len(),
-            mean_output_dps: if used.is_empty() {
-                f64::NAN
-            } else {
-                super::mean(&used)
-            },
-        });
-        start = end;
-    }
-    segs
+    crate::table_segments::segments(&table_dps[..n], rate_tol_dps)
+        .into_iter()
+        .map(|seg| {
+            let (start, end) = (seg.start, seg.end);
+            let t_settled = time_s[start] + settle_s;
+            let used: Vec<f64> = (start..end)
+                .filter(|&i| time_s[i] >= t_settled)
+                .map(|i| output_dps[i])
+                .collect();
+            RateSegment {
+                start,
+                end,
+                table_dps: seg.rate_dps,
+                start_time_s: time_s[start],
+                end_time_s: time_s[end - 1],
+                used_samples: used.len(),
+                mean_output_dps: if used.is_empty() {
+                    f64::NAN
+                } else {
+                    super::mean(&used)
+                },
+            }
+        })
+        .collect()
 }
 
 /// Least squares F = K·Ω + F0; None with fewer than two distinct Ω.

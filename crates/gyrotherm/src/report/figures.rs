@@ -1,15 +1,16 @@
-//! The named figures of the report (issue 6, after the figures of He et al. 2024,
+//! The named figures of the report (after the figures of He et al. 2024,
 //! DOI 10.19452/j.issn1007-5453.2024.02.004), each a function over plain data, and the Allan
 //! figure that `gyrotherm allan --plot` reuses. Every function takes a path (with or
-//! without `.png`/`.svg`, see [`figure_paths`](super::figure::figure_paths)) and writes the
+//! without `.png`/`.svg`, see [`figure_paths`](super::plot::figure_paths)) and writes the
 //! PNG and the SVG.
 //!
 //! Units: time s, temperature °C, temperature rate °C/min, gyro output °/h, rate-table rate
 //! °/s, scale factor ppm.
 
+use crate::moving_average::windowed_mean;
 use std::path::Path;
 
-use super::figure::{
+use super::plot::{
     write_figure, Figure, FigureFiles, Panel, Series, SeriesStyle, FIGURE_HEIGHT_2_PANELS_PX,
     FIGURE_HEIGHT_PX, FIGURE_WIDTH_PX,
 };
@@ -100,7 +101,7 @@ pub struct RawOutputData<'a> {
 pub fn raw_output_figure(path: &Path, d: &RawOutputData) -> Result<FigureFiles, ReportError> {
     check_window(d.window_s, "raw output figure")?;
     check_len("raw output: gyro_dph", d.time_s, d.gyro_dph)?;
-    let avg = moving_average(d.time_s, d.gyro_dph, d.window_s);
+    let avg = windowed_mean(d.time_s, d.gyro_dph, d.window_s);
     let series = vec![
         Series::line("raw output", d.time_s, d.gyro_dph).with_color(GREY),
         Series::line(
@@ -452,40 +453,6 @@ pub fn allan_figure(
     write_figure(path, &figure)
 }
 
-/// Centred moving average of `y` over a time window of `window_s`: each output is the mean
-/// of the finite `y[j]` with `|t[j] − t[i]| <= window_s / 2` (NaN where there are none).
-/// `time_s` must be non-decreasing. O(n) with a running sum.
-pub fn moving_average(time_s: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
-    let n = time_s.len().min(y.len());
-    let half = window_s / 2.0;
-    let (mut lo, mut hi) = (0usize, 0usize);
-    let (mut sum, mut count) = (0.0f64, 0usize);
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        let t = time_s[i];
-        while hi < n && time_s[hi] <= t + half {
-            if y[hi].is_finite() {
-                sum += y[hi];
-                count += 1;
-            }
-            hi += 1;
-        }
-        while lo < hi && time_s[lo] < t - half {
-            if y[lo].is_finite() {
-                sum -= y[lo];
-                count -= 1;
-            }
-            lo += 1;
-        }
-        out.push(if count > 0 {
-            sum / count as f64
-        } else {
-            f64::NAN
-        });
-    }
-    out
-}
-
 /// Means of `y` over consecutive windows of `window_s` starting at `time_s[0]`: returns the
 /// window centres (s) and the means of the finite samples in each; empty windows are
 /// skipped. `time_s` must be non-decreasing.
@@ -553,28 +520,6 @@ fn fmt_num(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn moving_average_matches_direct_mean() {
-        // Independent computation: direct O(n·w) mean over the same window.
-        let t: Vec<f64> = (0..500).map(|i| i as f64 * 0.5).collect();
-        let y: Vec<f64> = t.iter().map(|x| (x * 0.3).sin() + 0.01 * x).collect();
-        let w = 10.0;
-        let got = moving_average(&t, &y, w);
-        for i in 0..t.len() {
-            let sel: Vec<f64> = (0..t.len())
-                .filter(|&j| (t[j] - t[i]).abs() <= w / 2.0)
-                .map(|j| y[j])
-                .collect();
-            let want = sel.iter().sum::<f64>() / sel.len() as f64;
-            // Running sums lose a few ulps per update; 1e-12 is far above that here.
-            assert!(
-                (got[i] - want).abs() < 1e-12,
-                "i={i} want {want} got {}",
-                got[i]
-            );
-        }
-    }
 
     #[test]
     fn window_means_of_a_ramp_are_its_centres() {

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::figure::FigureFiles;
+use super::plot::FigureFiles;
 use super::ReportError;
 use crate::atomic_file::write_bytes_atomically;
 

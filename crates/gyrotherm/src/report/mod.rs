@@ -2,28 +2,27 @@
 //!
 //! Everything here works over plain data (slices of `f64` and small structs), so the report
 //! does not depend on how the numbers were made.
-//! - [`figure`]: the generic figure writer (time series, x-y, log-log; one or more stacked
-//!   panels), written as PNG and SVG of a stated size, atomically.
+//! - `plot`: the generic plot writer ([`write_figure`]: time series, x-y, log-log; one or
+//!   more stacked panels), written as PNG and SVG of a stated size, atomically.
 //! - [`figures`]: the eight named figures of the report and the Allan figure that
-//!   `gyrotherm allan --plot` reuses.
+//!   `gyrotherm allan --plot` reuses, each a function over plain data.
 //! - [`html`]: `DIR/index.html`, self-contained (inline CSS, no script, no network).
-//! - [`job`]: the full report of a held-out comparison (`gyrotherm report`), from the logs
-//!   and a [`crate::compare::Comparison`].
-//! - [`decimate`]: min/max per pixel column, so long runs draw fast without losing extremes.
-//! - [`font`]: the embedded DejaVu Sans font; no system font or graphics library is used.
+//! - `job`: the full report of a held-out comparison ([`write_full_report`], used by
+//!   `gyrotherm report`), from the logs and a [`crate::compare::Comparison`].
+//! - `decimate`: min/max per pixel column, so long runs draw fast without losing extremes.
+//! - `font`: the embedded DejaVu Sans font; no system font or graphics library is used.
 
-pub mod decimate;
-pub mod figure;
+pub(crate) mod decimate;
 pub mod figures;
-pub mod font;
+pub(crate) mod font;
 pub mod html;
-pub mod job;
+pub(crate) mod job;
+pub(crate) mod plot;
 
 use std::fmt;
 use std::path::PathBuf;
 
 pub use decimate::decimate_min_max;
-pub use figure::{write_figure, Figure, FigureFiles, Panel, Series, SeriesStyle};
 pub use figures::{
     allan_figure, bias_figure, compensation_figure, loss_figure, rate_table_figure,
     raw_output_figure, scale_factor_figure, temperature_figure, AllanCurve, AllanPointPlot,
@@ -31,10 +30,18 @@ pub use figures::{
     RateSegment, RateTableData, RawOutputData, ScaleFactorData, TemperatureData,
 };
 pub use html::{write_report, ReportContent, ReportFigure, Table};
-pub use job::{allan_curve, noise_lines, write_full_report, write_full_report_with};
+pub use job::{
+    allan_curve, comparison_table, noise_lines, scale_factor_points, temperature_rate_c_per_min,
+    write_full_report, write_full_report_with, ScalePoints, FIGURE_STEMS, FIGURE_WINDOW_S,
+};
+pub use plot::{
+    figure_paths, write_figure, Figure, FigureFiles, Panel, Series, SeriesStyle,
+    FIGURE_HEIGHT_2_PANELS_PX, FIGURE_HEIGHT_PX, FIGURE_WIDTH_PX,
+};
 
 /// Why a figure or report could not be written.
 #[derive(Debug)]
+#[non_exhaustive]
 pub enum ReportError {
     /// Reading or writing `path` failed.
     Io {

@@ -7,12 +7,30 @@
 //! held-out log carries simulator truth (`noise_dps`), the bias stability of the noise alone is
 //! the physical floor no compensation can beat.
 
+//!
+//! The results serialise as [`ComparisonSummary`] (`gyrotherm compare --json`) and tabulate as
+//! one [`ComparisonTable`], written as text ([`ComparisonTable::write_text`]) and turned into
+//! the report's HTML table (`report::comparison_table`).
+
+mod summary;
+mod table;
+
+pub use summary::{ComparisonSummary, ModelSummary, TestSummary};
+pub use table::{ComparisonTable, TableBlock, TableFigure, TableRow};
+
+use std::fmt;
+
+use serde::Serialize;
+
 use crate::compensate::{compensate_log, extrapolation_warnings, Compensated};
 use crate::csvlog::{TestLog, NOISE_COL};
 use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, Target};
-use crate::metrics::{self, ScaleFactorOptions};
+use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
 use crate::model::Method;
 use crate::targets;
+
+/// Bias-stability smoothing time of the comparison, s (100 s: METHOD.md, He et al. 2024).
+pub const BIAS_STABILITY_TAU_S: f64 = 100.0;
 
 /// What to compare and how to judge.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,23 +50,24 @@ impl Default for CompareConfig {
         CompareConfig {
             methods: vec![Method::Linear, Method::Poly, Method::Lstm],
             fit: FitConfig::new(Method::Lstm),
-            tau_s: 100.0,
+            tau_s: BIAS_STABILITY_TAU_S,
             settle_s: targets::SETTLE_S,
         }
     }
 }
 
 /// Output range at one table rate: min and max of the segment means, °/s.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct RateRange {
     pub table_dps: f64,
     pub min_dps: f64,
     pub max_dps: f64,
 }
 
-/// Figures of one output column (raw or compensated) of one held-out log.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Figures {
+/// The performance figures (numbers, not pictures) of one output column, raw or compensated,
+/// of one held-out log.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Performance {
     /// Static logs: bias stability, °/h.
     pub bias_stability_dph: Option<f64>,
     /// Rate-table logs: max |K(t) − 1| over the rate segments, ppm.
@@ -64,7 +83,7 @@ pub struct Figures {
 #[derive(Debug, Clone)]
 pub struct MethodResult {
     pub method: Method,
-    pub figures: Figures,
+    pub performance: Performance,
     pub compensated: Compensated,
 }
 
@@ -73,7 +92,7 @@ pub struct MethodResult {
 pub struct TestResult {
     pub name: String,
     pub is_static: bool,
-    pub raw: Figures,
+    pub raw: Performance,
     /// Bias stability of the noise-only truth column, °/h (simulated logs).
     pub floor_dph: Option<f64>,
     pub methods: Vec<MethodResult>,
@@ -88,19 +107,89 @@ pub struct Comparison {
     pub tests: Vec<TestResult>,
 }
 
-/// Figures of `output_dps` on `log` (its table column decides static or rate-table).
-pub fn figures(
+/// Why a comparison could not be made.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum CompareError {
+    /// Fitting `method` on the training logs failed.
+    Fit {
+        method: Method,
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// Compensating the held-out log `log` failed.
+    Compensate {
+        log: String,
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// The figures of the held-out log `log` could not be computed.
+    Performance {
+        log: String,
+        source: PerformanceError,
+    },
+}
+
+impl fmt::Display for CompareError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CompareError::Fit { method, source } => write!(f, "{} fit: {source}", method.as_str()),
+            CompareError::Compensate { log, source } => write!(f, "{log}: {source}"),
+            CompareError::Performance { log, source } => write!(f, "{log}: {source}"),
+        }
+    }
+}
+
+impl std::error::Error for CompareError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            CompareError::Fit { source, .. } | CompareError::Compensate { source, .. } => {
+                Some(source.as_ref())
+            }
+            CompareError::Performance { source, .. } => Some(source),
+        }
+    }
+}
+
+/// Why the figures of an output column could not be computed.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum PerformanceError {
+    /// Bias stability of a static log.
+    BiasStability(MetricsError),
+    /// Scale factor of a rate-table log.
+    ScaleFactor(ScaleFactorError),
+}
+
+impl fmt::Display for PerformanceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PerformanceError::BiasStability(e) => write!(f, "{e}"),
+            PerformanceError::ScaleFactor(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for PerformanceError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            PerformanceError::BiasStability(e) => Some(e),
+            PerformanceError::ScaleFactor(e) => Some(e),
+        }
+    }
+}
+
+/// Performance of `output_dps` on `log` (its table column decides static or rate-table).
+pub fn performance(
     log: &TestLog,
     output_dps: &[f64],
     tau_s: f64,
     settle_s: f64,
-) -> Result<Figures, String> {
-    let mut f = Figures::default();
-    if targets::is_static(log) {
+) -> Result<Performance, PerformanceError> {
+    let mut f = Performance::default();
+    if log.is_static() {
         let period = log.sample_period_s();
         f.bias_stability_dph = Some(
             metrics::bias_stability_dph(output_dps, period, tau_s)
-                .map_err(|e| e.to_string())?
+                .map_err(PerformanceError::BiasStability)?
                 .bias_stability_dph,
         );
         return Ok(f);
@@ -110,8 +199,8 @@ pub fn figures(
         settle_s,
         ..Default::default()
     };
-    let r =
-        metrics::scale_factor(&log.time_s, output_dps, table, &opts).map_err(|e| e.to_string())?;
+    let r = metrics::scale_factor(&log.time_s, output_dps, table, &opts)
+        .map_err(PerformanceError::ScaleFactor)?;
     let ks: Vec<f64> = r
         .scale_over_time
         .iter()
@@ -155,22 +244,29 @@ pub fn compare(
     test: &[NamedLog],
     cfg: &CompareConfig,
     progress: &(dyn Fn(Method, Target, usize, f64) + Sync),
-) -> Result<Comparison, String> {
+) -> Result<Comparison, CompareError> {
     let mut fits = Vec::new();
     for &m in &cfg.methods {
         let fc = FitConfig {
             method: m,
             ..cfg.fit.clone()
         };
-        let fit = fit_model(train, &fc, &|t, e, l| progress(m, t, e, l))
-            .map_err(|e| format!("{} fit: {e}", m.as_str()))?;
+        let fit = fit_model(train, &fc, &|t, e, l| progress(m, t, e, l)).map_err(|e| {
+            CompareError::Fit {
+                method: m,
+                source: e.into(),
+            }
+        })?;
         fits.push(fit);
     }
     let mut tests = Vec::new();
     for t in test {
-        let raw = figures(t.log, &t.log.gyro_dps, cfg.tau_s, cfg.settle_s)
-            .map_err(|e| format!("{}: {e}", t.name))?;
-        let floor_dph = match (targets::is_static(t.log), t.log.extra_f64(NOISE_COL)) {
+        let perf_err = |source| CompareError::Performance {
+            log: t.name.to_owned(),
+            source,
+        };
+        let raw = performance(t.log, &t.log.gyro_dps, cfg.tau_s, cfg.settle_s).map_err(perf_err)?;
+        let floor_dph = match (t.log.is_static(), t.log.extra_f64(NOISE_COL)) {
             (true, Some(noise)) => {
                 metrics::bias_stability_dph(&noise, t.log.sample_period_s(), cfg.tau_s)
                     .ok()
@@ -181,9 +277,12 @@ pub fn compare(
         let mut methods = Vec::new();
         let mut warnings = Vec::new();
         for fit in &fits {
-            let comp = compensate_log(&fit.model, t.log).map_err(|e| format!("{}: {e}", t.name))?;
-            let figures = figures(t.log, &comp.gyro_comp_dps, cfg.tau_s, cfg.settle_s)
-                .map_err(|e| format!("{}: {e}", t.name))?;
+            let comp = compensate_log(&fit.model, t.log).map_err(|e| CompareError::Compensate {
+                log: t.name.to_owned(),
+                source: e.into(),
+            })?;
+            let performance = performance(t.log, &comp.gyro_comp_dps, cfg.tau_s, cfg.settle_s)
+                .map_err(perf_err)?;
             for w in extrapolation_warnings(&fit.model, t.log) {
                 let w = format!("{} ({} model): {w}", t.name, fit.model.method.as_str());
                 if !warnings.contains(&w) {
@@ -192,13 +291,13 @@ pub fn compare(
             }
             methods.push(MethodResult {
                 method: fit.model.method,
-                figures,
+                performance,
                 compensated: comp,
             });
         }
         tests.push(TestResult {
             name: t.name.to_owned(),
-            is_static: targets::is_static(t.log),
+            is_static: t.log.is_static(),
             raw,
             floor_dph,
             methods,

@@ -1,0 +1,226 @@
+//! The results table of a comparison, built once and rendered as text here
+//! ([`ComparisonTable::write_text`]) and as HTML by the report (`report::comparison_table`).
+
+use super::{CompareConfig, Comparison, Performance};
+use crate::model::{Method, SubModel};
+
+impl Comparison {
+    /// One line per fitted model: its sub-models, and why no residual LSTM was kept when
+    /// none was.
+    pub fn model_lines(&self) -> Vec<String> {
+        self.fits
+            .iter()
+            .map(|f| {
+                let part = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
+                let mut line = format!(
+                    "{:>6}: bias model {}, scale-factor model {}",
+                    f.model.method.as_str(),
+                    part(&f.model.bias),
+                    part(&f.model.scale)
+                );
+                let lstm_kept = [&f.model.bias, &f.model.scale]
+                    .iter()
+                    .any(|s| matches!(s, Some(SubModel::Lstm { .. } | SubModel::Residual { .. })));
+                if f.model.method == Method::Lstm && !lstm_kept {
+                    line.push_str(" (no residual LSTM beat its least-squares base on the validation data, so none was kept)");
+                }
+                line
+            })
+            .collect()
+    }
+
+    /// The results table, built once for every rendering.
+    pub fn table(&self, cfg: &CompareConfig) -> ComparisonTable {
+        let methods: Vec<Method> = self.fits.iter().map(|f| f.model.method).collect();
+        let mut columns = vec!["raw".to_owned()];
+        columns.extend(methods.iter().map(|m| m.as_str().to_owned()));
+        let empty = Performance::default();
+        let blocks = self
+            .tests
+            .iter()
+            .map(|t| {
+                let all: Vec<&Performance> = std::iter::once(&t.raw)
+                    .chain(methods.iter().map(|m| {
+                        t.methods
+                            .iter()
+                            .find(|r| r.method == *m)
+                            .map_or(&empty, |r| &r.performance)
+                    }))
+                    .collect();
+                let cells = |f: &dyn Fn(&Performance) -> String| all.iter().map(|p| f(p)).collect();
+                let mut rows = Vec::new();
+                if t.is_static {
+                    rows.push(TableRow {
+                        figure: TableFigure::BiasStability { tau_s: cfg.tau_s },
+                        cells: cells(&|p| cell(p.bias_stability_dph, 5)),
+                        floor: Some(cell(t.floor_dph, 5)),
+                    });
+                    if let (Some(_), Some(fl)) = (t.raw.bias_stability_dph, t.floor_dph) {
+                        rows.push(TableRow {
+                            figure: TableFigure::TimesNoiseFloor,
+                            cells: cells(&|p| cell(p.bias_stability_dph.map(|b| b / fl), 2)),
+                            floor: None,
+                        });
+                    }
+                } else {
+                    rows.push(TableRow {
+                        figure: TableFigure::SfError,
+                        cells: cells(&|p| cell(p.sf_error_ppm, 1)),
+                        floor: None,
+                    });
+                    rows.push(TableRow {
+                        figure: TableFigure::SfThermalError,
+                        cells: cells(&|p| cell(p.sf_thermal_error_ppm, 1)),
+                        floor: None,
+                    });
+                    for (k, r) in t.raw.rate_ranges.iter().enumerate() {
+                        rows.push(TableRow {
+                            figure: TableFigure::OutputAt {
+                                table_dps: r.table_dps,
+                            },
+                            cells: cells(&|p| {
+                                p.rate_ranges
+                                    .get(k)
+                                    .map(|r| format!("{:.5}..{:.5}", r.min_dps, r.max_dps))
+                                    .unwrap_or_else(|| "-".into())
+                            }),
+                            floor: None,
+                        });
+                    }
+                }
+                TableBlock {
+                    log: t.name.clone(),
+                    is_static: t.is_static,
+                    has_floor: t.floor_dph.is_some(),
+                    rows,
+                }
+            })
+            .collect();
+        ComparisonTable { columns, blocks }
+    }
+}
+
+fn cell(v: Option<f64>, digits: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.digits$}"),
+        _ => "-".into(),
+    }
+}
+
+/// The results table of a comparison: one block per held-out log, one column per output
+/// (raw, then each method), cells already formatted.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComparisonTable {
+    /// Output columns: `raw`, then the method names.
+    pub columns: Vec<String>,
+    pub blocks: Vec<TableBlock>,
+}
+
+/// The rows of one held-out log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableBlock {
+    pub log: String,
+    pub is_static: bool,
+    /// Whether the log carries the noise-only truth column (a noise-floor column).
+    pub has_floor: bool,
+    pub rows: Vec<TableRow>,
+}
+
+/// One figure across the outputs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableRow {
+    pub figure: TableFigure,
+    /// One cell per [`ComparisonTable::columns`].
+    pub cells: Vec<String>,
+    /// Noise-floor cell (bias-stability row only).
+    pub floor: Option<String>,
+}
+
+/// Which figure a row holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum TableFigure {
+    /// Bias stability, °/h, over `tau_s`.
+    BiasStability { tau_s: f64 },
+    /// Bias stability as a multiple of the noise floor.
+    TimesNoiseFloor,
+    /// max |K(t) − 1|, ppm.
+    SfError,
+    /// max |K(t) − K(room)|, ppm.
+    SfThermalError,
+    /// Range of the output at one table rate, °/s.
+    OutputAt { table_dps: f64 },
+}
+
+impl TableFigure {
+    /// The row label.
+    pub fn label(&self) -> String {
+        match self {
+            TableFigure::BiasStability { tau_s } => {
+                format!("bias stability (°/h, τ = {} s)", fmt_num(*tau_s))
+            }
+            TableFigure::TimesNoiseFloor => "× noise floor".to_owned(),
+            TableFigure::SfError => "SF error max |K(t) − 1| (ppm)".to_owned(),
+            TableFigure::SfThermalError => "SF thermal error vs room K (ppm)".to_owned(),
+            TableFigure::OutputAt { table_dps } => format!("output at {table_dps:+} °/s (°/s)"),
+        }
+    }
+}
+
+/// `100` rather than `100.0`.
+fn fmt_num(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{}", v as i64)
+    } else {
+        format!("{v}")
+    }
+}
+
+impl TableBlock {
+    /// `name (static)` or `name (rate table)`.
+    pub fn title(&self) -> String {
+        format!(
+            "{} ({})",
+            self.log,
+            if self.is_static {
+                "static"
+            } else {
+                "rate table"
+            }
+        )
+    }
+}
+
+impl ComparisonTable {
+    /// Plain text, fixed-width columns: per held-out log a title line, a header line and one
+    /// line per figure, then a blank line.
+    pub fn write_text(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+        for b in &self.blocks {
+            writeln!(w, "held-out log {}", b.title())?;
+            write!(w, "  {:<36}", "figure")?;
+            for c in &self.columns {
+                write!(w, "{c:>22}")?;
+            }
+            if b.has_floor {
+                write!(w, "{:>22}", "noise floor")?;
+            }
+            writeln!(w)?;
+            for r in &b.rows {
+                let label = match r.figure {
+                    TableFigure::TimesNoiseFloor => format!("  {}", r.figure.label()),
+                    _ => r.figure.label(),
+                };
+                write!(w, "  {label:<36}")?;
+                for c in &r.cells {
+                    write!(w, "{c:>22}")?;
+                }
+                if let (true, Some(f)) = (b.has_floor, &r.floor) {
+                    write!(w, "{f:>22}")?;
+                }
+                writeln!(w)?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    }
+}

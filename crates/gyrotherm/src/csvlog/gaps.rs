@@ -1,0 +1,63 @@
+//! Gap filling: a step longer than [`GAP_FACTOR`](super::GAP_FACTOR) nominal periods is a
+//! gap; with a fill limit it is filled by linear interpolation (gyro, temperature; the table
+//! rate holds the earlier sample's value), else it is an error.
+
+use super::reader::{Sample, MAX_FILL_SAMPLES_PER_GAP};
+
+/// Gap filling in progress: `n` samples between `from` and `to`, `k` already handed out.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Fill {
+    pub(super) from: Sample,
+    pub(super) to: Sample,
+    pub(super) to_line: u64,
+    pub(super) n: usize,
+    pub(super) k: usize,
+}
+
+impl Fill {
+    /// The next interpolated sample, None once all `n` are out.
+    #[inline]
+    pub(super) fn next_filled(&mut self) -> Option<Sample> {
+        if self.k >= self.n {
+            return None;
+        }
+        self.k += 1;
+        let a = self.k as f64 / (self.n + 1) as f64;
+        Some(Sample {
+            time_s: lerp(self.from.time_s, self.to.time_s, a),
+            gyro_dps: lerp(self.from.gyro_dps, self.to.gyro_dps, a),
+            temp_c: lerp(self.from.temp_c, self.to.temp_c, a),
+            table_dps: self.from.table_dps,
+        })
+    }
+}
+
+/// What to do with a gap of `dt` seconds at nominal period `period`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum GapVerdict {
+    /// Fill it with this many samples.
+    Fill(usize),
+    /// Longer than the fill limit (s).
+    TooLong(f64),
+    /// No filling asked for.
+    NotAllowed,
+}
+
+/// A gap of `dt` s gets `round(dt / period) − 1` samples when filling is on, `dt` is within
+/// the limit and the count within [`MAX_FILL_SAMPLES_PER_GAP`].
+pub(super) fn gap_verdict(dt: f64, period: f64, fill_max_s: Option<f64>) -> GapVerdict {
+    let n_f = (dt / period).round() - 1.0;
+    match fill_max_s {
+        // dt > 1.5 period, so n_f >= 1.
+        Some(max) if dt <= max && n_f <= MAX_FILL_SAMPLES_PER_GAP as f64 => {
+            GapVerdict::Fill((n_f as usize).max(1))
+        }
+        Some(max) => GapVerdict::TooLong(max),
+        None => GapVerdict::NotAllowed,
+    }
+}
+
+#[inline]
+fn lerp(a: f64, b: f64, t: f64) -> f64 {
+    a + (b - a) * t
+}

@@ -1,0 +1,514 @@
+//! The full report of a held-out comparison (`gyrotherm report`): the eight figures
+//! ([`FIGURE_STEMS`]) computed from the logs and the [`Comparison`], the comparison table, the model
+//! metadata and the warnings, written as `DIR/index.html` beside one PNG and SVG per figure.
+//!
+//! Figures that cannot apply to the data given (no rate-table held-out log, no LSTM fitted,
+//! ...) are left out with a note on the page, never an error.
+//!
+//! Which log each figure shows: figures 1, 2 and 7 the first static held-out log (else the
+//! first held-out log), figures 4 and 8 the first static held-out log, figures 5 and 6 the
+//! first rate-table held-out log. "Compensated" means the LSTM model's output through the
+//! flight compensator (`MethodResult::compensated`).
+
+mod allan_figure;
+mod rate_table;
+mod tables;
+
+pub use allan_figure::{allan_curve, noise_lines};
+pub use rate_table::{scale_factor_points, ScalePoints};
+pub use tables::{comparison_table, metadata};
+
+use allan_figure::allan_report_figure;
+use rate_table::rate_table_figures;
+
+use std::path::{Path, PathBuf};
+
+use super::figures::{
+    bias_figure, compensation_figure, loss_figure, raw_output_figure, temperature_figure, BiasData,
+    CompensationData, LossCurve, NamedSeries, RawOutputData, TemperatureData,
+};
+use super::html::{write_report, ReportContent, ReportFigure};
+use super::plot::FigureFiles;
+use super::ReportError;
+use crate::compare::{CompareConfig, Comparison, MethodResult, TestResult};
+use crate::fit::NamedLog;
+use crate::metrics::DPS_TO_DPH;
+use crate::model::Method;
+use crate::moving_average::{centred_moving_average, windowed_mean};
+use crate::sim::CHAMBER_TEMP_COL;
+
+/// Averaging window of the raw-output and compensation figures, s (He et al. 2024 use 100 s).
+pub const FIGURE_WINDOW_S: f64 = 100.0;
+/// Smoothing of the gyro temperature before differentiating it for figure 1, s.
+const TEMP_RATE_SMOOTHING_S: f64 = 100.0;
+/// Half-span of the central difference of the smoothed temperature, s.
+const TEMP_RATE_HALF_SPAN_S: f64 = 5.0;
+
+/// File stems of the figures, in report order.
+pub const FIGURE_STEMS: [&str; 8] = [
+    "fig1_temperature",
+    "fig2_raw_output",
+    "fig3_training_loss",
+    "fig4_bias",
+    "fig5_scale_factor",
+    "fig6_rate_table",
+    "fig7_compensation",
+    "fig8_allan",
+];
+
+/// [`write_full_report_with`] without extra warnings.
+pub fn write_full_report(
+    dir: &Path,
+    train: &[NamedLog],
+    test: &[NamedLog],
+    cmp: &Comparison,
+    cfg: &CompareConfig,
+) -> Result<PathBuf, ReportError> {
+    write_full_report_with(dir, train, test, cmp, cfg, &[])
+}
+
+/// Write the figures, then `dir/index.html` (creating `dir`), and return the page's path.
+/// `test` must be the held-out logs `cmp` was computed on, in the same order; `train` the
+/// training logs (named on the page). `extra_warnings` (e.g. gaps filled on reading) are
+/// listed after the extrapolation warnings of `cmp`.
+pub fn write_full_report_with(
+    dir: &Path,
+    train: &[NamedLog],
+    test: &[NamedLog],
+    cmp: &Comparison,
+    cfg: &CompareConfig,
+    extra_warnings: &[String],
+) -> Result<PathBuf, ReportError> {
+    if test.len() != cmp.tests.len() {
+        return Err(ReportError::Data {
+            what: format!(
+                "{} held-out logs given but the comparison has {}; pass the logs it was run on",
+                test.len(),
+                cmp.tests.len()
+            ),
+        });
+    }
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let pairs: Vec<(&NamedLog, &TestResult)> = test.iter().zip(&cmp.tests).collect();
+    let static_pair = pairs.iter().copied().find(|(_, r)| r.is_static);
+    let table_pair = pairs.iter().copied().find(|(_, r)| !r.is_static);
+    let main_pair = static_pair.or(pairs.first().copied());
+
+    let mut b = Builder {
+        dir,
+        figures: Vec::new(),
+        notes: Vec::new(),
+    };
+
+    fig_temperature_cycle(&mut b, main_pair)?;
+    fig_raw_output(&mut b, main_pair)?;
+    fig_training_loss(&mut b, cmp)?;
+    fig_bias(&mut b, static_pair, cfg)?;
+    fig_rate_table(&mut b, table_pair, cfg)?;
+    fig_before_after(&mut b, main_pair)?;
+    fig_allan(&mut b, static_pair)?;
+
+    let mut warnings: Vec<String> = cmp
+        .tests
+        .iter()
+        .flat_map(|t| t.warnings.iter().cloned())
+        .collect();
+    warnings.extend(extra_warnings.iter().cloned());
+
+    let content = ReportContent {
+        title: "gyrotherm report: thermal compensation of held-out logs".to_owned(),
+        table: Some(comparison_table(cmp, cfg)),
+        metadata: metadata(train, cmp, cfg),
+        warnings,
+        figures: b.figures,
+        notes: b.notes,
+    };
+    write_report(dir, &content)
+}
+
+/// Figure 1: the temperature cycle of the main held-out log.
+fn fig_temperature_cycle(
+    b: &mut Builder,
+    main_pair: Option<(&NamedLog, &TestResult)>,
+) -> Result<(), ReportError> {
+    match main_pair {
+        Some((l, _)) => {
+            let rate = temperature_rate_c_per_min(&l.log.time_s, &l.log.temp_c);
+            let chamber = l.log.extra_f64(CHAMBER_TEMP_COL);
+            let files = temperature_figure(
+                &b.path(0),
+                &TemperatureData {
+                    time_s: &l.log.time_s,
+                    gyro_temp_c: &l.log.temp_c,
+                    chamber_temp_c: chamber.as_deref(),
+                    temp_rate_c_per_min: &rate,
+                },
+            )?;
+            let chamber_note = if chamber.is_some() {
+                "chamber and gyro temperature"
+            } else {
+                "gyro temperature (the log has no chamber_temp_c column)"
+            };
+            b.add(
+                &files,
+                format!(
+                    "Temperature cycle of {}: {chamber_note} (°C) and the gyro temperature rate \
+                     (°C/min, central difference of the {} s moving average).",
+                    l.name,
+                    fmt_num(TEMP_RATE_SMOOTHING_S)
+                ),
+            );
+        }
+        None => b.note(1, "no held-out log given"),
+    }
+    Ok(())
+}
+
+/// Figure 2: the raw output of the main held-out log.
+fn fig_raw_output(
+    b: &mut Builder,
+    main_pair: Option<(&NamedLog, &TestResult)>,
+) -> Result<(), ReportError> {
+    if let Some((l, _)) = main_pair {
+        let dph = to_dph(&l.log.gyro_dps);
+        let files = raw_output_figure(
+            &b.path(1),
+            &RawOutputData {
+                time_s: &l.log.time_s,
+                gyro_dph: &dph,
+                window_s: FIGURE_WINDOW_S,
+            },
+        )?;
+        b.add(
+            &files,
+            format!(
+                "Raw gyro output of {} (°/h) and its centred {} s moving average.",
+                l.name,
+                fmt_num(FIGURE_WINDOW_S)
+            ),
+        );
+    } else {
+        b.note(2, "no held-out log given");
+    }
+    Ok(())
+}
+
+/// Figure 3: the LSTM training loss.
+fn fig_training_loss(b: &mut Builder, cmp: &Comparison) -> Result<(), ReportError> {
+    let lstm_fit = cmp.fits.iter().find(|f| f.model.method == Method::Lstm);
+    match lstm_fit {
+        None => b.note(
+            3,
+            "no LSTM model was fitted, so there is no training loss to show",
+        ),
+        Some(fit) => {
+            let mut curves = Vec::new();
+            if let Some(t) = fit
+                .bias_training
+                .as_ref()
+                .filter(|t| !t.loss_history.is_empty())
+            {
+                curves.push(LossCurve {
+                    label: "bias network",
+                    loss: &t.loss_history,
+                });
+            }
+            if let Some(t) = fit
+                .scale_training
+                .as_ref()
+                .filter(|t| !t.loss_history.is_empty())
+            {
+                curves.push(LossCurve {
+                    label: "scale-factor network",
+                    loss: &t.loss_history,
+                });
+            }
+            if curves.is_empty() {
+                b.note(3, "the LSTM fit recorded no loss history");
+            } else {
+                let files = loss_figure(&b.path(2), &curves)?;
+                let which: Vec<&str> = curves.iter().map(|c| c.label).collect();
+                b.add(
+                    &files,
+                    format!(
+                        "LSTM training loss (normalised mean squared error) against epoch: {}.",
+                        which.join(" and ")
+                    ),
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Figure 4: predicted against measured bias on the static held-out log.
+fn fig_bias(
+    b: &mut Builder,
+    static_pair: Option<(&NamedLog, &TestResult)>,
+    cfg: &CompareConfig,
+) -> Result<(), ReportError> {
+    match (static_pair, static_pair.and_then(|(_, r)| lstm_result(r))) {
+        (None, _) => b.note(4, "no static held-out log given"),
+        (Some(_), None) => b.note(4, "no LSTM model was fitted"),
+        (Some((l, _)), Some(m)) => {
+            match centred_moving_average(&l.log.time_s, &l.log.gyro_dps, cfg.fit.bias_window_s) {
+                Err(e) => b.note(4, &format!("cannot smooth {}: {e}", l.name)),
+                Ok(s) => {
+                    let measured = to_dph(&s.values);
+                    let predicted = to_dph(&m.compensated.bias_dps);
+                    let files = bias_figure(
+                        &b.path(3),
+                        &BiasData {
+                            time_s: &l.log.time_s,
+                            measured_dph: &measured,
+                            predicted_dph: &predicted,
+                        },
+                    )?;
+                    b.add(
+                        &files,
+                        format!(
+                            "Bias of {} (°/h): measured (centred {} s moving average of the raw \
+                             output) against predicted (LSTM bias network through the flight \
+                             compensator), and the residual.",
+                            l.name,
+                            fmt_num(cfg.fit.bias_window_s)
+                        ),
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Figures 5 and 6 on the rate-table held-out log.
+fn fig_rate_table(
+    b: &mut Builder,
+    table_pair: Option<(&NamedLog, &TestResult)>,
+    cfg: &CompareConfig,
+) -> Result<(), ReportError> {
+    match (
+        table_pair,
+        table_pair.and_then(|(_, r)| compensated_result(r)),
+    ) {
+        (None, _) => {
+            b.note(5, "no rate-table held-out log given");
+            b.note(6, "no rate-table held-out log given");
+        }
+        (Some(_), None) => {
+            b.note(5, "no compensation method was fitted");
+            b.note(6, "no compensation method was fitted");
+        }
+        (Some((l, _)), Some(m)) => {
+            rate_table_figures(b, l, m, cfg)?;
+        }
+    }
+    Ok(())
+}
+
+/// Figure 7: the output before and after compensation.
+fn fig_before_after(
+    b: &mut Builder,
+    main_pair: Option<(&NamedLog, &TestResult)>,
+) -> Result<(), ReportError> {
+    if let Some((l, r)) = main_pair {
+        // Each series minus its mean: a constant offset (Earth rate, turn-on bias) of many
+        // °/h would otherwise flatten the thermal drift the figure is about.
+        let (raw, raw_mean) = minus_mean(&to_dph(&l.log.gyro_dps));
+        let mut means = vec![format!("raw {}", sig(raw_mean))];
+        let comp: Vec<(String, Vec<f64>)> = r
+            .methods
+            .iter()
+            .map(|m| {
+                let label = method_label(m.method);
+                let (v, mean) = minus_mean(&to_dph(&m.compensated.gyro_comp_dps));
+                means.push(format!("{label} {}", sig(mean)));
+                (label.to_owned(), v)
+            })
+            .collect();
+        let mut series = vec![NamedSeries {
+            label: "raw",
+            values_dph: &raw,
+        }];
+        series.extend(comp.iter().map(|(label, v)| NamedSeries {
+            label,
+            values_dph: v,
+        }));
+        let files = compensation_figure(
+            &b.path(6),
+            &CompensationData {
+                time_s: &l.log.time_s,
+                series: &series,
+                window_s: FIGURE_WINDOW_S,
+            },
+        )?;
+        let names: Vec<&str> = series.iter().map(|s| s.label).collect();
+        b.add(
+            &files,
+            format!(
+                "Output of {} before and after compensation ({}), means over {} s, each \
+                 series minus its mean over the run (°/h; means removed: {} °/h).",
+                l.name,
+                names.join(" / "),
+                fmt_num(FIGURE_WINDOW_S),
+                means.join(", ")
+            ),
+        );
+    } else {
+        b.note(7, "no held-out log given");
+    }
+    Ok(())
+}
+
+/// Figure 8: the Allan deviation of the static held-out log.
+fn fig_allan(
+    b: &mut Builder,
+    static_pair: Option<(&NamedLog, &TestResult)>,
+) -> Result<(), ReportError> {
+    match static_pair {
+        None => b.note(8, "no static held-out log given"),
+        Some((l, r)) => allan_report_figure(b, l, r)?,
+    }
+    Ok(())
+}
+
+/// Collects the figures written and the notes for those left out.
+pub(super) struct Builder<'a> {
+    dir: &'a Path,
+    figures: Vec<ReportFigure>,
+    notes: Vec<String>,
+}
+
+impl Builder<'_> {
+    pub(super) fn path(&self, index: usize) -> PathBuf {
+        self.dir.join(FIGURE_STEMS[index])
+    }
+    pub(super) fn add(&mut self, files: &FigureFiles, caption: String) {
+        self.figures.push(ReportFigure::from_files(files, caption));
+    }
+    /// Figure `number` (1-based) was not drawn, because of `why`.
+    pub(super) fn note(&mut self, number: usize, why: &str) {
+        let name = [
+            "temperature cycle",
+            "raw output",
+            "training loss",
+            "predicted against measured bias",
+            "predicted against measured scale factor",
+            "output at the table rates",
+            "output before and after compensation",
+            "Allan deviation",
+        ];
+        self.notes.push(format!(
+            "Figure {number} ({}) not drawn: {why}.",
+            name[number - 1]
+        ));
+    }
+}
+
+pub(super) fn to_dph(dps: &[f64]) -> Vec<f64> {
+    dps.iter().map(|v| v * DPS_TO_DPH).collect()
+}
+
+/// `v` minus the mean of its finite values, and that mean (0 when there are none).
+fn minus_mean(v: &[f64]) -> (Vec<f64>, f64) {
+    let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    let mean = if finite.is_empty() {
+        0.0
+    } else {
+        finite.iter().sum::<f64>() / finite.len() as f64
+    };
+    (v.iter().map(|x| x - mean).collect(), mean)
+}
+
+pub(super) fn lstm_result(r: &TestResult) -> Option<&MethodResult> {
+    r.methods.iter().find(|m| m.method == Method::Lstm)
+}
+
+/// The LSTM result, else the last method's (the most capable fitted).
+pub(super) fn compensated_result(r: &TestResult) -> Option<&MethodResult> {
+    lstm_result(r).or(r.methods.last())
+}
+
+pub(super) fn method_label(m: Method) -> &'static str {
+    match m {
+        Method::Lstm => "LSTM",
+        Method::Linear => "linear",
+        Method::Poly => "polynomial",
+    }
+}
+
+/// Gyro temperature rate, °C/min: the `TEMP_RATE_SMOOTHING_S` centred moving average
+/// ([`centred_moving_average`]) differentiated
+/// by a central difference over ±`TEMP_RATE_HALF_SPAN_S` (one-sided at the ends).
+pub fn temperature_rate_c_per_min(time_s: &[f64], temp_c: &[f64]) -> Vec<f64> {
+    let n = time_s.len().min(temp_c.len());
+    // The symmetric shrinking window keeps a ramp unbiased up to the ends; a log it refuses
+    // (non-finite or non-increasing samples) gets the plain windowed mean.
+    let smooth = centred_moving_average(&time_s[..n], &temp_c[..n], TEMP_RATE_SMOOTHING_S)
+        .map(|s| s.values)
+        .unwrap_or_else(|_| windowed_mean(&time_s[..n], &temp_c[..n], TEMP_RATE_SMOOTHING_S));
+    let dt = if n >= 2 {
+        (time_s[n - 1] - time_s[0]) / (n - 1) as f64
+    } else {
+        1.0
+    };
+    let k = if dt.is_finite() && dt > 0.0 {
+        ((TEMP_RATE_HALF_SPAN_S / dt).round() as usize).max(1)
+    } else {
+        1
+    };
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(k), (i + k).min(n.saturating_sub(1)));
+            let span = time_s[b] - time_s[a];
+            if b > a && span > 0.0 {
+                (smooth[b] - smooth[a]) / span * 60.0
+            } else {
+                f64::NAN
+            }
+        })
+        .collect()
+}
+
+/// Three significant digits.
+pub(super) fn sig(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && (v.abs() < 1e-3 || v.abs() >= 1e5) {
+        format!("{v:.2e}")
+    } else {
+        let digits = if v == 0.0 || !v.is_finite() {
+            3
+        } else {
+            (2 - v.abs().log10().floor() as i32).max(0) as usize
+        };
+        format!("{v:.digits$}")
+    }
+}
+
+/// `100` rather than `100.0`.
+pub(super) fn fmt_num(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{}", v as i64)
+    } else {
+        format!("{v}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temperature_rate_of_a_ramp() {
+        // T = 20 + 0.05·t (°C, t in s) is 3 °C/min everywhere
+        // (a linear trend passes the symmetric centred average unchanged, ends included).
+        let t: Vec<f64> = (0..2000).map(|i| i as f64).collect();
+        let temp: Vec<f64> = t.iter().map(|x| 20.0 + 0.05 * x).collect();
+        let rate = temperature_rate_c_per_min(&t, &temp);
+        for (i, r) in rate.iter().enumerate() {
+            assert!((r - 3.0).abs() < 1e-9, "sample {i}: want 3 °C/min got {r}");
+        }
+    }
+}

@@ -1,0 +1,121 @@
+//! The report's tables: the comparison table and the model metadata.
+
+use super::{fmt_num, method_label};
+use crate::compare::{CompareConfig, Comparison};
+use crate::features::feature_names;
+use crate::fit::NamedLog;
+use crate::model::{Method, ModelFile};
+use crate::report::html::Table;
+
+/// The comparison table of `gyrotherm compare` ([`Comparison::table`]) as the report's HTML
+/// table: one row per figure, the held-out log named on its first row, a noise-floor column.
+pub fn comparison_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
+    let t = cmp.table(cfg);
+    let mut headers = vec!["held-out log".to_owned(), "figure".to_owned()];
+    headers.extend(t.columns.iter().cloned());
+    headers.push("noise floor".to_owned());
+    let mut rows = Vec::new();
+    for block in &t.blocks {
+        for (k, r) in block.rows.iter().enumerate() {
+            let mut row = vec![
+                if k == 0 { block.title() } else { String::new() },
+                r.figure.label(),
+            ];
+            row.extend(r.cells.iter().cloned());
+            row.push(r.floor.clone().unwrap_or_default());
+            rows.push(row);
+        }
+    }
+    Table { headers, rows }
+}
+
+/// Key-value facts of the models: method, recipe and epochs, seed, training ranges, data
+/// digest, inputs.
+pub fn metadata(
+    train: &[NamedLog],
+    cmp: &Comparison,
+    cfg: &CompareConfig,
+) -> Vec<(String, String)> {
+    let mut md = vec![
+        (
+            "training logs".to_owned(),
+            train.iter().map(|l| l.name).collect::<Vec<_>>().join(", "),
+        ),
+        (
+            "bias-stability smoothing τ".to_owned(),
+            format!("{} s", fmt_num(cfg.tau_s)),
+        ),
+        (
+            "bias target window".to_owned(),
+            format!("{} s", fmt_num(cfg.fit.bias_window_s)),
+        ),
+        (
+            "settle time per table segment".to_owned(),
+            format!("{} s", fmt_num(cfg.settle_s)),
+        ),
+    ];
+    for f in &cmp.fits {
+        model_metadata(&mut md, &f.model, cfg);
+        for (name, t) in [
+            ("bias network", &f.bias_training),
+            ("scale-factor network", &f.scale_training),
+        ] {
+            if let Some(t) = t {
+                md.push((
+                    format!("{} {name}", f.model.method.as_str()),
+                    format!("{} epochs, final loss {:.4e}", t.epochs, t.final_loss),
+                ));
+            }
+        }
+    }
+    md
+}
+
+fn model_metadata(md: &mut Vec<(String, String)>, m: &ModelFile, cfg: &CompareConfig) {
+    let p = m.method.as_str();
+    let ti = &m.training;
+    let targets = match (m.bias.is_some(), m.scale.is_some()) {
+        (true, true) => "bias and scale factor",
+        (true, false) => "bias only (no static training log)",
+        (false, true) => "scale factor only (no rate-table training log)",
+        (false, false) => "none",
+    };
+    md.push((
+        format!("{p} model"),
+        format!("{} — {targets}", method_label(m.method)),
+    ));
+    if m.method == Method::Lstm {
+        md.push((
+            format!("{p} recipe"),
+            format!(
+                "{:?}, {} epochs",
+                cfg.fit.recipe.kind, cfg.fit.recipe.epochs
+            ),
+        ));
+    }
+    if let Ok(spec) = m.feature_spec() {
+        md.push((format!("{p} inputs"), feature_names(&spec).0.join(", ")));
+    }
+    md.push((
+        format!("{p} training range"),
+        format!(
+            "temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min",
+            ti.temp_range_c.min,
+            ti.temp_range_c.max,
+            ti.rate_range_c_per_s.min * 60.0,
+            ti.rate_range_c_per_s.max * 60.0
+        ),
+    ));
+    if let Some(e) = ti.epochs {
+        md.push((format!("{p} epochs"), e.to_string()));
+    }
+    if let Some(s) = ti.seed {
+        md.push((format!("{p} seed"), s.to_string()));
+    }
+    md.push((
+        format!("{p} data digest (SHA-256)"),
+        ti.data_digest_sha256.clone(),
+    ));
+    md.push((format!("{p} training inputs"), ti.inputs.join(", ")));
+    md.push((format!("{p} written by"), ti.created_by.clone()));
+}
