@@ -145,10 +145,38 @@ pub fn builtin_profile() -> clap::builder::PossibleValuesParser {
     )
 }
 
-fn positive_seconds(s: &str) -> Result<f64, String> {
+pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(format!("{s:?} is not a positive number of seconds")),
+    }
+}
+
+/// A time that may be zero: finite and ≥ 0 s.
+pub(crate) fn non_negative_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not zero or a positive number of seconds")),
+    }
+}
+
+/// A scale factor (gyro output over input rate, nominally 1): finite and > 0.
+pub(crate) fn positive_scale_factor(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "{s:?} is not a scale factor: give a positive number (gyro output over table rate, about 1)"
+        )),
+    }
+}
+
+/// A power-law noise exponent α (S(f) ∝ f^α): an integer from -4 to 2.
+pub(crate) fn noise_alpha(s: &str) -> Result<i32, String> {
+    let what = "the noise exponent α is an integer from -4 to 2 (2 white PM, 1 flicker PM, \
+                0 white FM, -1 flicker FM, -2 random-walk FM, -3 and -4 for Hadamard only)";
+    match s.trim().parse::<i32>() {
+        Ok(a) if (-4..=2).contains(&a) => Ok(a),
+        _ => Err(format!("{s:?}: {what}")),
     }
 }
 

@@ -500,7 +500,7 @@ const RESCALE_BELOW: f64 = 1e-100;
 /// A power of two to divide the samples by when their magnitude is out of the safe range
 /// (None otherwise: the usual case, computed as is). Dividing by a power of two only moves
 /// exponents, so the rescaled deviation times the scale is the deviation of the samples.
-fn rescale_for_range(samples: &[f64]) -> Option<f64> {
+pub(crate) fn rescale_for_range(samples: &[f64]) -> Option<f64> {
     let max = samples.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if (max > 0.0 && max < RESCALE_BELOW) || max > RESCALE_ABOVE {
         // 2^⌊log2 max⌋ from the exponent bits (max is normal in both cases).
