@@ -166,3 +166,22 @@ fn huge_sample_period_is_refused_and_noise_terms_terminate() {
         .expect("noise_terms did not return");
     assert!(terms.arw_deg_rt_h.is_some_and(|t| t.value.is_finite()));
 }
+
+/// Found by the `allan` fuzz target: subnormal samples (below 2.2e-308) were divided by a
+/// scale of 0 and reported as "sample 0 is NaN or infinite".
+#[test]
+fn subnormal_samples_give_a_finite_deviation() {
+    let tiny = f64::MIN_POSITIVE / 1024.0;
+    let y: Vec<f64> = nbs_data()
+        .iter()
+        .map(|v| (v * 1000.0).round() * tiny)
+        .collect();
+    for kind in KINDS {
+        let pts = deviation(&y, 1.0, kind, &TauSet::Octave, NoiseModel::Alpha(0))
+            .unwrap_or_else(|e| panic!("{kind:?}: {e}"));
+        assert!(
+            pts.iter().all(|p| p.dev.is_finite() && p.dev > 0.0),
+            "{kind:?}"
+        );
+    }
+}

@@ -503,8 +503,9 @@ const RESCALE_BELOW: f64 = 1e-100;
 pub(crate) fn rescale_for_range(samples: &[f64]) -> Option<f64> {
     let max = samples.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if (max > 0.0 && max < RESCALE_BELOW) || max > RESCALE_ABOVE {
-        // 2^⌊log2 max⌋ from the exponent bits (max is normal in both cases).
-        Some(f64::from_bits(max.to_bits() & 0x7ff0_0000_0000_0000))
+        // 2^⌊log2 max⌋ from the exponent bits; the smallest normal power of two for a
+        // subnormal max (whose exponent bits are 0).
+        Some(f64::from_bits(max.to_bits() & 0x7ff0_0000_0000_0000).max(f64::MIN_POSITIVE))
     } else {
         None
     }
