@@ -96,6 +96,9 @@ pub fn read_log_noting_gaps(
     if let Some(w) = &warning {
         eprintln!("gyrotherm: {w}");
     }
+    if let Some(w) = report.jitter_warning(path) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
     Ok((log, warning))
 }
 

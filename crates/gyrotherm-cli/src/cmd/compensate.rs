@@ -84,10 +84,9 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
                     &opts,
                     &mut *w,
                     false,
-                )
-                .map_err(std::io::Error::other)?;
+                )?;
                 w.flush()?;
-                Ok::<_, std::io::Error>(s)
+                Ok::<_, anyhow::Error>(s)
             })
             .with_context(|| format!("cannot compensate into {}", out.display()))?;
         eprintln!(

@@ -24,7 +24,10 @@ mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
-pub use reader::{LogReader, Sample, GAP_FACTOR, MAX_FILL_SAMPLES_PER_GAP, PERIOD_ESTIMATE_STEPS};
+pub use reader::{
+    LogReader, Sample, GAP_FACTOR, MAX_FILLED_SAMPLES, MAX_FILL_SAMPLES_PER_GAP,
+    PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
+};
 pub use writer::{format_f64, LogWriter};
 
 use std::fs::File;
@@ -248,6 +251,33 @@ pub struct ReadReport {
     pub sample_period_s: Option<f64>,
     /// Whether that period was estimated from the data (false: given in the options).
     pub sample_period_estimated: bool,
+    /// Largest |step / period − 1| over the steps that are not gaps: 0 for an evenly sampled
+    /// log, 0.4 for steps 40 % off the period.
+    pub max_step_jitter: f64,
+    /// Line of the step with that jitter.
+    pub max_jitter_line: Option<u64>,
+}
+
+impl ReadReport {
+    /// Jitter above which a log is reported as irregularly sampled (the figures assume
+    /// even sampling).
+    pub const JITTER_WARNING: f64 = 0.05;
+
+    /// A warning about irregular steps, with the measured jitter, if above
+    /// [`JITTER_WARNING`](Self::JITTER_WARNING).
+    pub fn jitter_warning(&self, source: &Path) -> Option<String> {
+        let period = self.sample_period_s?;
+        (self.max_step_jitter > Self::JITTER_WARNING).then(|| {
+            format!(
+                "{}{}: time steps are irregular: up to {:.0} % off the {period} s period; the \
+                 figures assume even sampling (resample the log if that matters)",
+                source.display(),
+                self.max_jitter_line
+                    .map_or(String::new(), |l| format!(":{l}")),
+                100.0 * self.max_step_jitter
+            )
+        })
+    }
 }
 
 /// Read and validate a whole log. The file is read once, streaming; the columns are sized

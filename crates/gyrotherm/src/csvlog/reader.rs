@@ -35,6 +35,16 @@ pub const GAP_FACTOR: f64 = 1.5;
 /// that a tiny period and a large limit cannot exhaust memory.
 pub const MAX_FILL_SAMPLES_PER_GAP: usize = 10_000_000;
 
+/// Most samples gap filling may make in one log, all gaps together.
+pub const MAX_FILLED_SAMPLES: usize = 10_000_000;
+
+/// A given sample period is checked against this many leading time steps of the log.
+pub const PERIOD_CHECK_STEPS: usize = 10;
+
+/// That many of those steps more than [`GAP_FACTOR`] times longer or shorter than the given
+/// period mean the period is wrong (one or two may be real gaps).
+const PERIOD_CHECK_MISMATCHES: usize = 3;
+
 /// One validated row: finite numbers, gyro converted to °/s.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
@@ -98,6 +108,10 @@ pub struct LogReader<R> {
     line: u64,
     filled: bool,
     report: ReadReport,
+    /// Leading steps kept to check a given period (emptied once checked).
+    given_period_steps: Vec<f64>,
+    /// Steps checked against a given period so far.
+    period_checked: usize,
 }
 
 impl<R: Read> LogReader<R> {
@@ -191,6 +205,12 @@ impl<R: Read> LogReader<R> {
             line: header_line,
             filled: false,
             report: ReadReport::default(),
+            given_period_steps: Vec::with_capacity(if opts.sample_period_s.is_some() {
+                PERIOD_CHECK_STEPS
+            } else {
+                0
+            }),
+            period_checked: 0,
         })
     }
 
@@ -213,8 +233,16 @@ impl<R: Read> LogReader<R> {
         };
         if let (Some(p), Some(period)) = (self.prev, self.period_s) {
             let dt = s.time_s - p.time_s;
+            if !self.report.sample_period_estimated && self.period_checked < PERIOD_CHECK_STEPS {
+                self.check_given_period(dt, period, line)?;
+            }
             if dt > GAP_FACTOR * period {
                 return self.gap(p, s, line, dt, period);
+            }
+            let jitter = (dt / period - 1.0).abs();
+            if jitter > self.report.max_step_jitter {
+                self.report.max_step_jitter = jitter;
+                self.report.max_jitter_line = Some(line);
             }
         }
         Ok(Some(self.accept(s, line)))
@@ -250,6 +278,19 @@ impl<R: Read> LogReader<R> {
             p.time_s, s.time_s
         );
         match gap_verdict(dt, period, self.fill_max_s) {
+            GapVerdict::Fill(n) if self.report.filled_samples + n > MAX_FILLED_SAMPLES => {
+                Err(LogError::new(
+                    Kind::GapTooLong,
+                    &self.src.path,
+                    Some(line),
+                    Some(t_col),
+                    format!(
+                        "{what}: filling it would bring the samples made by gap filling to \
+                         more than {MAX_FILLED_SAMPLES}; check the sample period and the time \
+                         column, or split the log"
+                    ),
+                ))
+            }
             GapVerdict::Fill(n) => {
                 self.report.filled_gaps += 1;
                 self.report.filled_samples += n;
@@ -283,6 +324,38 @@ impl<R: Read> LogReader<R> {
                 ),
             )),
         }
+    }
+
+    /// A given period must match the log's own steps: a period far off would make every
+    /// step a gap (runaway gap filling) or hide real gaps.
+    #[cold]
+    fn check_given_period(&mut self, dt: f64, period: f64, line: u64) -> Result<(), LogError> {
+        self.period_checked += 1;
+        self.given_period_steps.push(dt);
+        let off = |d: &f64| *d > GAP_FACTOR * period || *d < period / GAP_FACTOR;
+        let mismatches = self.given_period_steps.iter().filter(|d| off(d)).count();
+        if mismatches >= PERIOD_CHECK_MISMATCHES {
+            let mut steps = self.given_period_steps.clone();
+            steps.sort_by(f64::total_cmp);
+            let median = steps[(steps.len() - 1) / 2];
+            return Err(LogError::new(
+                Kind::BadOptions,
+                &self.src.path,
+                Some(line),
+                Some(&self.src.headers[self.src.cols.time]),
+                format!(
+                    "the given sample period {period} s disagrees with the log's time steps: \
+                     {mismatches} of its first {} steps are more than {GAP_FACTOR} times longer \
+                     or shorter (median step {median} s); give the log's own period or leave \
+                     --sample-period out",
+                    steps.len()
+                ),
+            ));
+        }
+        if self.given_period_steps.len() >= PERIOD_CHECK_STEPS {
+            self.given_period_steps = Vec::new();
+        }
+        Ok(())
     }
 
     fn period_s_estimated(&self) -> bool {
