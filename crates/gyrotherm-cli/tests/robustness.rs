@@ -257,3 +257,80 @@ fn a_closed_output_pipe_ends_quietly_with_0() {
         "{err}"
     );
 }
+
+#[test]
+fn a_wrong_sample_period_cannot_make_runaway_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = log_of(dir.path(), "base.csv", noise);
+    let model = dir.path().join("m.json");
+    std::fs::write(
+        &model,
+        linear_model([0.001, 1e-6, 0.0], [1.0001, 1e-7, 0.0]).to_string(),
+    )
+    .unwrap();
+    let out = dir.path().join("out.csv");
+    for (period, fill) in [("0.001", "10"), ("1e-6", "1e6")] {
+        let (code, _, err) = gyrotherm(&[
+            "compensate",
+            "--model",
+            p(&model),
+            "--input",
+            p(&log),
+            "--out",
+            p(&out),
+            "--sample-period",
+            period,
+            "--fill-gaps",
+            fill,
+        ]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("base.csv:5: column time_s"), "{err}");
+        assert!(err.contains("disagrees with the log's time steps"), "{err}");
+        assert!(!out.exists());
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            2,
+            "no temporary file left"
+        );
+    }
+}
+
+#[test]
+fn delimiters_and_irregular_steps() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut semi = String::from("time_s;gyro_dps;temp_c\n");
+    let mut comma = String::from("time_s,gyro_dps,temp_c\n");
+    for i in 0..1000 {
+        let g = format!("{}", 0.001 + 1e-4 * noise(i));
+        semi.push_str(&format!("{i};{};25,5\n", g.replace('.', ",")));
+        comma.push_str(&format!("{i},{g},25.5\n"));
+    }
+    let s = dir.path().join("s.csv");
+    let c = dir.path().join("c.csv");
+    std::fs::write(&s, semi).unwrap();
+    std::fs::write(&c, comma).unwrap();
+    let (code, _, err) = gyrotherm(&["evaluate", "--input", p(&s)]);
+    assert_eq!(code, 2);
+    assert!(err.contains("give --delimiter ;"), "{err}");
+    let (code, out_s, err) =
+        gyrotherm(&["evaluate", "--input", p(&s), "--delimiter", ";", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let (_, out_c, _) = gyrotherm(&["evaluate", "--input", p(&c), "--json"]);
+    assert_eq!(out_s, out_c);
+
+    // ±25 % steps: accepted, with the measured jitter on stderr.
+    let mut j = String::from("time_s,gyro_dps,temp_c\n");
+    let mut t = 0.0;
+    for i in 0..1000 {
+        j.push_str(&format!("{t},0.001,25\n"));
+        t += [1.25, 0.75, 1.0][i % 3];
+    }
+    let jl = dir.path().join("j.csv");
+    std::fs::write(&jl, j).unwrap();
+    let (code, _, err) = gyrotherm(&["evaluate", "--input", p(&jl)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("j.csv:3: time steps are irregular: up to 25 % off"),
+        "{err}"
+    );
+}

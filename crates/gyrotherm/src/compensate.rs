@@ -299,7 +299,9 @@ pub fn compensate_stream<R: std::io::Read, W: std::io::Write>(
     if temp_seen.0 <= temp_seen.1 {
         summary.warnings = range_warnings(model, temp_seen, rate_seen);
     }
-    summary.warnings.extend(reader.report().jitter_warning(source));
+    summary
+        .warnings
+        .extend(reader.report().jitter_warning(source));
     Ok(summary)
 }
 

@@ -34,6 +34,10 @@ pub struct LogArgs {
     /// Nominal sample period in seconds (default: median of the first 100 time steps).
     #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
     pub sample_period: Option<f64>,
+    /// Field separator of the log: `,` (default), `;` or `tab`. With `;` or `tab`, numbers
+    /// may use a decimal comma (`0,5`).
+    #[arg(long, value_name = "SEP", default_value = ",", value_parser = delimiter)]
+    pub delimiter: u8,
 }
 
 /// `--gyro-unit` values.
@@ -69,6 +73,7 @@ impl LogArgs {
             gyro_unit: self.gyro_unit.into(),
             fill_gaps_max_s: self.fill_gaps,
             sample_period_s: self.sample_period,
+            delimiter: self.delimiter,
         }
     }
 }
@@ -152,6 +157,16 @@ pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(format!("{s:?} is not a positive number of seconds")),
+    }
+}
+
+/// `--delimiter`: `,`, `;` or `tab` (also a literal tab or `\t`).
+fn delimiter(s: &str) -> Result<u8, String> {
+    match s {
+        "," | "comma" => Ok(b','),
+        ";" | "semicolon" => Ok(b';'),
+        "tab" | "\t" | "\\t" => Ok(b'\t'),
+        _ => Err(format!("{s:?}: the separator is `,`, `;` or `tab`")),
     }
 }
 

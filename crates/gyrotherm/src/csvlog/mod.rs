@@ -222,6 +222,9 @@ pub struct ReadOptions {
     /// Nominal sample period, s (None: median of the first [`PERIOD_ESTIMATE_STEPS`] steps,
     /// which the streaming reader reads ahead before its first sample).
     pub sample_period_s: Option<f64>,
+    /// Field separator: `b','` (default), `b';'` or `b'\t'`. With any separator but the
+    /// comma, numbers may use a decimal comma (`0,5`), as European loggers write them.
+    pub delimiter: u8,
 }
 
 impl Default for ReadOptions {
@@ -234,6 +237,7 @@ impl Default for ReadOptions {
             gyro_unit: GyroUnit::Dps,
             fill_gaps_max_s: None,
             sample_period_s: None,
+            delimiter: b',',
         }
     }
 }

@@ -21,7 +21,7 @@ use csv::ByteRecord;
 use super::columns::{check_options, map_columns, Columns};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::gaps::{gap_verdict, Fill, GapVerdict};
-use super::number::parse_f64;
+use super::number::{parse_f64, parse_f64_decimal_comma};
 use super::{GyroUnit, ReadOptions, ReadReport};
 
 /// Number of leading time steps whose median is the nominal sample period.
@@ -67,6 +67,8 @@ struct Source<R> {
     header_end_byte: u64,
     cols: Columns,
     gyro_scale: f64,
+    /// Numbers may use a decimal comma (the separator is not a comma).
+    decimal_comma: bool,
     /// Time and line of the last row read, for the order checks.
     last: Option<(f64, u64)>,
     rows: u64,
@@ -125,6 +127,7 @@ impl<R: Read> LogReader<R> {
         let path: PathBuf = source.into();
         check_options(&path, opts)?;
         let mut csv = csv::ReaderBuilder::new()
+            .delimiter(opts.delimiter)
             .has_headers(false)
             .flexible(true)
             .comment(Some(b'#'))
@@ -191,6 +194,7 @@ impl<R: Read> LogReader<R> {
                 header_end_byte,
                 cols,
                 gyro_scale,
+                decimal_comma: opts.delimiter != b',',
                 last: None,
                 rows: 0,
                 peek: ByteRecord::new(),
@@ -562,7 +566,11 @@ impl<R: Read> Source<R> {
 
     #[inline(always)]
     fn number(&self, rec: &ByteRecord, i: usize, line: u64) -> Result<f64, Box<LogError>> {
-        match parse_f64(&rec[i]) {
+        let parsed = match parse_f64(&rec[i]) {
+            None if self.decimal_comma => parse_f64_decimal_comma(&rec[i]),
+            v => v,
+        };
+        match parsed {
             Some(v) if v.is_finite() => Ok(v),
             _ => Err(Box::new(self.number_error(&rec[i], i, line))),
         }
@@ -571,7 +579,9 @@ impl<R: Read> Source<R> {
     #[cold]
     fn number_error(&self, raw: &[u8], i: usize, line: u64) -> LogError {
         let text = String::from_utf8_lossy(raw);
-        let (kind, message) = if parse_f64(raw).is_some() {
+        let parses = parse_f64(raw).is_some()
+            || (self.decimal_comma && parse_f64_decimal_comma(raw).is_some());
+        let (kind, message) = if parses {
             (
                 Kind::NonFinite,
                 format!(
@@ -587,7 +597,7 @@ impl<R: Read> Source<R> {
                     .to_owned(),
             )
         } else {
-            let hint = if text.contains(',') {
+            let hint = if text.contains(',') && !self.decimal_comma {
                 " (use '.' as the decimal point)"
             } else {
                 ""
