@@ -731,7 +731,7 @@ impl ModelFile {
                     format!("at T = {temp:.3} °C, dT = {rate:.3e} °C/s, inside the training range ({t_lo} to {t_hi} °C, {r_lo:.3e} to {r_hi:.3e} °C/s)")
                 };
                 let b = bias.eval(&step.features).unwrap_or(f64::NAN);
-                if !(b.abs() <= MAX_PLAUSIBLE_BIAS_DPS) {
+                if !(b.is_finite() && b.abs() <= MAX_PLAUSIBLE_BIAS_DPS) {
                     return Err(ModelFileError::invalid(
                         "bias",
                         format!(
