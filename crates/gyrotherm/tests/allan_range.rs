@@ -185,3 +185,32 @@ fn subnormal_samples_give_a_finite_deviation() {
         );
     }
 }
+
+/// Found by the `allan` fuzz target: a curve near f64's top read off at τ = 1 s along its
+/// −½ slope gave an angle random walk of ∞. Such a term is not reported.
+#[test]
+fn noise_terms_beyond_f64_are_not_reported() {
+    use gyrotherm::allan::noise_terms;
+    let y: Vec<f64> = nbs_data().iter().map(|v| (v - 0.5) * 1e305).collect();
+    let pts = deviation(
+        &y,
+        5.26,
+        DevKind::Oadev,
+        &TauSet::Octave,
+        NoiseModel::Alpha(0),
+    )
+    .unwrap();
+    let t = noise_terms(&pts, 3600.0);
+    for term in [
+        t.arw_deg_rt_h,
+        t.bias_instability_dph,
+        t.rrw_deg_h_rt_h,
+        t.quantization_arcsec,
+        t.rate_ramp_deg_h2,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        assert!(term.value.is_finite(), "{term:?}");
+    }
+}

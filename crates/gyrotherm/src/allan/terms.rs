@@ -141,13 +141,16 @@ pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
         return NoiseTerms::default();
     }
     let local = local_slopes(&pts);
+    // A term read off so far along its line that it is beyond f64 is not reported.
     let term = |slope: f64, tau: f64, scale: f64| {
-        fixed_slope_read(&pts, &local, slope, tau).map(|(s, lo, hi)| NoiseTerm {
-            value: s * scale,
-            tau_read_s: tau,
-            fit_tau_min_s: lo,
-            fit_tau_max_s: hi,
-        })
+        fixed_slope_read(&pts, &local, slope, tau)
+            .map(|(s, lo, hi)| NoiseTerm {
+                value: s * scale,
+                tau_read_s: tau,
+                fit_tau_min_s: lo,
+                fit_tau_max_s: hi,
+            })
+            .filter(|t| t.value.is_finite())
     };
     // σ in °/h throughout.
     let arw = term(-0.5, 1.0, 1.0 / 60.0);
@@ -167,6 +170,7 @@ pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
             fit_tau_min_s: sel[0].ln_tau.exp(),
             fit_tau_max_s: sel[sel.len() - 1].ln_tau.exp(),
         })
+        .filter(|t| t.value.is_finite())
     });
     NoiseTerms {
         arw_deg_rt_h: arw,
