@@ -2,8 +2,9 @@
 //! either plausible (small steps around a chamber test) or any bit pattern, on a trained
 //! model (linear, polynomial, LSTM) or on a polynomial with arbitrary coefficients.
 //!
-//! Holds: no panic; for every finite gyro sample the compensator gives a finite bias, a
-//! finite positive scale factor and a finite rate, or one of its documented errors.
+//! Holds: no panic; every sample gets a status; a sample with a rate has a finite gyro, a
+//! finite rate, a finite bias and a finite positive scale factor; one without is
+//! `Status::Invalid` (documented: gyro not finite, or its corrected rate beyond f64).
 
 #![no_main]
 
@@ -13,7 +14,7 @@ use arbitrary::{Result, Unstructured};
 use gyrotherm::compensate::compensator;
 use gyrotherm::model::ModelFile;
 use gyrotherm_core::baseline::BaselineModel;
-use gyrotherm_core::compensator::{Compensator, TargetModel};
+use gyrotherm_core::compensator::{Compensator, Status, TargetModel};
 use gyrotherm_core::features::FeatureSpec;
 use libfuzzer_sys::fuzz_target;
 
@@ -89,24 +90,20 @@ fn run(data: &[u8]) -> Result<()> {
         if u.ratio(1, 64)? {
             comp.reset();
         }
-        match comp.step(t, gyro, temp) {
-            Ok(c) => {
-                assert!(gyro.is_finite(), "accepted gyro {gyro}");
-                assert!(
-                    c.bias_dps.is_finite(),
-                    "{c:?} at t={t} T={temp} gyro={gyro}"
-                );
+        let c = comp.step(t, gyro, temp);
+        match c.rate() {
+            Some(rate) => {
+                assert!(gyro.is_finite(), "a rate for gyro {gyro}: {c:?}");
+                assert!(rate.is_finite(), "{c:?} at t={t} T={temp} gyro={gyro}");
+                assert!(c.bias_dps.is_finite(), "{c:?} at t={t} T={temp} gyro={gyro}");
                 assert!(
                     c.scale.is_finite() && c.scale > 0.0,
                     "{c:?} at t={t} T={temp} gyro={gyro}"
                 );
-                assert!(
-                    c.rate_dps.is_finite(),
-                    "{c:?} at t={t} T={temp} gyro={gyro}"
-                );
             }
-            // Every error is an `InputError`: a refused input, state untouched.
-            Err(_) => {}
+            // `Status::Invalid`: no rate, for a gyro sample that is not finite or whose
+            // corrected rate would overflow.
+            None => assert_eq!(c.status, Status::Invalid),
         }
     }
     Ok(())

@@ -43,6 +43,8 @@ enum Command {
     Report(cmd::report::ReportArgs),
     /// Check a model file, or re-seal one after a deliberate hand edit.
     Model(cmd::model::ModelArgs),
+    /// Write a model as flight code: C99 or a Rust module for gyrotherm-core.
+    Export(cmd::export::ExportArgs),
 }
 
 fn main() -> ExitCode {
@@ -58,6 +60,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => cmd::compare::run(a),
         Command::Report(a) => cmd::report::run(a),
         Command::Model(a) => cmd::model::run(a),
+        Command::Export(a) => cmd::export::run(a),
     };
     match result {
         Ok(code) => code,

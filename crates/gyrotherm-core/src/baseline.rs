@@ -129,20 +129,25 @@ impl BaselineModel {
                 got: powers.len(),
             });
         }
-        if let Some(i) = powers.iter().position(|&p| p > MAX_POWER) {
+        if let Some((i, &power)) = powers.iter().enumerate().find(|(_, &p)| p > MAX_POWER) {
             return Err(BaselineError::PowerTooHigh {
                 term: j as u8,
                 feature: i as u8,
-                power: powers[i],
+                power,
             });
         }
         if !coefficient.is_finite() {
             return Err(BaselineError::NonFiniteCoefficient { term: j as u8 });
         }
         let mut row = [0u8; MAX_FEATURES];
-        row[..powers.len()].copy_from_slice(powers);
-        self.powers[j] = row;
-        self.coefficients[j] = coefficient;
+        for (dst, src) in row.iter_mut().zip(powers) {
+            *dst = *src;
+        }
+        let (Some(p), Some(c)) = (self.powers.get_mut(j), self.coefficients.get_mut(j)) else {
+            return Err(BaselineError::TooManyTerms);
+        };
+        *p = row;
+        *c = coefficient;
         self.n_terms += 1;
         Ok(())
     }
@@ -159,14 +164,11 @@ impl BaselineModel {
 
     /// Powers of term `j` (over all MAX_FEATURES slots) and its coefficient.
     pub fn term(&self, j: usize) -> Option<(&[u8], f64)> {
-        if j < self.n_terms as usize {
-            Some((
-                &self.powers[j][..self.n_features as usize],
-                self.coefficients[j],
-            ))
-        } else {
-            None
+        if j >= self.n_terms as usize {
+            return None;
         }
+        let powers = self.powers.get(j)?.get(..self.n_features as usize)?;
+        Some((powers, *self.coefficients.get(j)?))
     }
 
     /// `Σ_j c_j Π_i x_i^p_ji` over the first `n_features` values of `x`.
@@ -178,15 +180,17 @@ impl BaselineModel {
                 got: x.len(),
             });
         }
-        if let Some(i) = x[..nf].iter().position(|v| !v.is_finite()) {
+        let x = x.get(..nf).unwrap_or(&[]);
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
             return Err(InputError::NonFinite(Channel::Feature(i as u8)).into());
         }
         let mut y = 0.0;
-        for j in 0..self.n_terms as usize {
-            let mut m = self.coefficients[j];
-            for (i, &p) in self.powers[j][..nf].iter().enumerate() {
+        let terms = self.coefficients.iter().zip(&self.powers);
+        for (&c, powers) in terms.take(self.n_terms as usize) {
+            let mut m = c;
+            for (&xi, &p) in x.iter().zip(powers) {
                 for _ in 0..p {
-                    m *= x[i];
+                    m *= xi;
                 }
             }
             y += m;

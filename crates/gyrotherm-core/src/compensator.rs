@@ -7,12 +7,49 @@
 //! 1 Hz and at 100 Hz see the same model.
 //!
 //! [`Compensator`] is the one value flight code holds. Its [`Compensator::step`] is
-//! panic-free and allocation-free for every input.
+//! panic-free and allocation-free for every input, and gives a corrected rate for every
+//! finite gyro sample, whatever the temperature sensor does.
+//!
+//! # Temperature-sensor faults
+//! Every sample gets a [`Status`]:
+//! - [`Status::Ok`]: the temperature was accepted and B and K are current (from the latest
+//!   feature step).
+//! - [`Status::Held`]: this temperature sample was rejected (see below). The feature pipeline
+//!   (thermal state, rate window, lags) and the LSTM states are not advanced, and B and K keep
+//!   their last good values. Also given when the models produced no usable B or K at a step
+//!   (non-finite, or K ≤ 0): the last good values are kept.
+//! - [`Status::Degraded`]: as held, but no good temperature has been seen for longer than
+//!   [`TempLimits::degraded_after_s`] (60 s by default), or never since the start: before the
+//!   first accepted temperature there is no model output, so B = 0 and K = 1 (the rate is the
+//!   raw gyro output).
+//! - [`Status::Invalid`]: the gyro sample itself is not finite, or so large that
+//!   (Ĝ − B) / K is beyond f64; there is no rate
+//!   ([`Corrected::rate`] is `None`, `rate_dps` is 0). The temperature is still judged and used.
+//!
+//! A temperature sample is rejected when it is not finite; when it lies outside
+//! [`TempLimits::min_c`]..=[`TempLimits::max_c`]; when it implies a rate of change no chamber or
+//! aircraft bay produces: `|T − T_good| > max_rate_c_per_s · (t − t_good) + step_allowance_c`
+//! against the last accepted sample (`T_good` at `t_good`); or when its time stamp is not
+//! finite or not after the previous finite time stamp (the sample cannot be placed). The
+//! allowance absorbs sensor noise and resolution at high sample rates (a one-LSB flip of a
+//! DS18B20 at 100 Hz is 6 °C/s); because the allowed change grows with the time since the last
+//! good reading, a real temperature that moved during a long outage is accepted again after
+//! at most `|ΔT| / max_rate_c_per_s` seconds. The first sample's temperature is judged by the
+//! range alone.
+//!
+//! # Recovery without a transient
+//! Rejected samples never enter the pipeline, so nothing stale or spiky reaches the 20 s rate
+//! window. The first accepted sample after a gap is one step of the pipeline, which bridges
+//! the gap as it bridges a gap in the log: the rate's earlier value is the last good step at
+//! or before `t − L`, divided by the true elapsed time, which is the slope of the straight line
+//! across the gap (linear interpolation of the missing steps); the lags advance exactly over
+//! the elapsed time. The LSTM resumes from its held state at the new step.
 
 use crate::baseline::BaselineModel;
 use crate::error::{Channel, InputError};
 use crate::features::{FeaturePipeline, FeatureSpec, Features, SpecError, MAX_FEATURES};
 use crate::lstm::{Lstm, LstmWeights};
+use core::fmt;
 
 /// Hidden units of the flight LSTM: 8, as published (He et al. 2024, §2).
 pub const HIDDEN: usize = 8;
@@ -42,6 +79,12 @@ pub enum ModelError {
     BadNormalisation,
     /// More inputs than [`MAX_FEATURES`], or a model's input count differs from the spec's.
     FeatureCount { expected: usize, got: usize },
+    /// The temperature-sensor limits are unusable.
+    Limits(LimitsError),
+    /// A baseline model cannot be built.
+    Baseline(crate::baseline::BaselineError),
+    /// LSTM weights refused (wrong shape or not finite).
+    Weights(crate::lstm::WeightError),
 }
 
 impl core::fmt::Display for ModelError {
@@ -54,6 +97,9 @@ impl core::fmt::Display for ModelError {
             ModelError::FeatureCount { expected, got } => {
                 write!(f, "model takes {got} features, the spec gives {expected}")
             }
+            ModelError::Limits(e) => write!(f, "temperature-sensor limits: {e}"),
+            ModelError::Baseline(e) => write!(f, "baseline: {e}"),
+            ModelError::Weights(e) => write!(f, "lstm weights: {e}"),
         }
     }
 }
@@ -82,8 +128,12 @@ impl NormalisedLstm {
         }
         let mut mean = [0.0; MAX_FEATURES];
         let mut std = [1.0; MAX_FEATURES];
-        mean[..n].copy_from_slice(input_mean);
-        std[..n].copy_from_slice(input_std);
+        for (dst, src) in mean.iter_mut().zip(input_mean) {
+            *dst = *src;
+        }
+        for (dst, src) in std.iter_mut().zip(input_std) {
+            *dst = *src;
+        }
         Ok(NormalisedLstm {
             lstm: Lstm::new(weights),
             input_mean: mean,
@@ -103,9 +153,10 @@ impl NormalisedLstm {
     /// with the LSTM state untouched.
     pub fn step(&mut self, features: &[f64]) -> Result<f64, InputError> {
         let mut x = [0.0f32; LSTM_INPUTS];
-        for (k, slot) in x.iter_mut().enumerate().take(self.n_inputs) {
+        let norm = self.input_mean.iter().zip(&self.input_std);
+        for (k, (slot, (mean, std))) in x.iter_mut().zip(norm).enumerate().take(self.n_inputs) {
             let v = features.get(k).copied().unwrap_or(f64::NAN);
-            let z = (v - self.input_mean[k]) / self.input_std[k];
+            let z = (v - mean) / std;
             if !z.is_finite() {
                 return Err(InputError::NonFinite(Channel::Feature(k as u8)));
             }
@@ -193,9 +244,13 @@ impl TargetModel {
                 // Features, then the base value (checked: n_features + 1 ≤ MAX_FEATURES).
                 let mut x = [0.0f64; MAX_FEATURES];
                 let n = feats.len().min(MAX_FEATURES - 1);
-                x[..n].copy_from_slice(&feats[..n]);
-                x[n] = base;
-                l.step(&x[..n + 1])?
+                for (dst, src) in x.iter_mut().zip(feats) {
+                    *dst = *src;
+                }
+                if let Some(slot) = x.get_mut(n) {
+                    *slot = base;
+                }
+                l.step(x.get(..n + 1).unwrap_or(&x))?
             } else {
                 l.step(feats)?
             };
@@ -214,15 +269,146 @@ impl TargetModel {
     }
 }
 
+/// What a sample's output is worth; see the module doc for each case.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Status {
+    /// Temperature accepted; B and K current.
+    Ok = 0,
+    /// Temperature rejected: features, thermal state and LSTM states held; B and K held.
+    Held = 1,
+    /// No good temperature for longer than [`TempLimits::degraded_after_s`] (or none yet).
+    Degraded = 2,
+    /// The gyro sample is not finite (or its corrected rate would overflow): no rate.
+    Invalid = 3,
+}
+
+impl Status {
+    /// Lower-case name, as in the `status` column of `gyrotherm compensate`.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Held => "held",
+            Status::Degraded => "degraded",
+            Status::Invalid => "invalid",
+        }
+    }
+
+    /// The status from its name (`as_str`).
+    pub fn parse(s: &str) -> Option<Status> {
+        [Status::Ok, Status::Held, Status::Degraded, Status::Invalid]
+            .into_iter()
+            .find(|v| v.as_str() == s)
+    }
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// When a temperature sample is believed (see the module doc). Stored in the model file.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TempLimits {
+    /// Lowest plausible reading, °C.
+    pub min_c: f64,
+    /// Highest plausible reading, °C.
+    pub max_c: f64,
+    /// Fastest plausible temperature change, °C/s.
+    pub max_rate_c_per_s: f64,
+    /// Change always allowed between readings, °C (sensor noise and resolution).
+    pub step_allowance_c: f64,
+    /// Held for longer than this (s since the last good temperature) is degraded.
+    pub degraded_after_s: f64,
+}
+
+impl TempLimits {
+    /// −60…+100 °C (beyond an aircraft bay's −50…+50 °C, inside a DS18B20's −55…+125 °C but
+    /// excluding its −127 °C bus-error value), 2 °C/s, 1 °C allowance (16 DS18B20 LSBs, 100 σ of
+    /// the simulated sensor noise), degraded after 60 s.
+    pub const DEFAULT: TempLimits = TempLimits {
+        min_c: -60.0,
+        max_c: 100.0,
+        max_rate_c_per_s: 2.0,
+        step_allowance_c: 1.0,
+        degraded_after_s: 60.0,
+    };
+
+    /// Check the limits: finite, `min_c < max_c`, rate and degraded time > 0, allowance ≥ 0.
+    pub fn validate(&self) -> Result<(), LimitsError> {
+        let fin = |v: f64| v.is_finite();
+        if !(fin(self.min_c) && fin(self.max_c) && self.min_c < self.max_c) {
+            return Err(LimitsError::Range);
+        }
+        if !(fin(self.max_rate_c_per_s) && self.max_rate_c_per_s > 0.0) {
+            return Err(LimitsError::Rate);
+        }
+        if !(fin(self.step_allowance_c) && self.step_allowance_c >= 0.0) {
+            return Err(LimitsError::Allowance);
+        }
+        if !(fin(self.degraded_after_s) && self.degraded_after_s > 0.0) {
+            return Err(LimitsError::DegradedAfter);
+        }
+        Ok(())
+    }
+}
+
+impl Default for TempLimits {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// A [`TempLimits`] field that cannot be used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum LimitsError {
+    /// `min_c`/`max_c` not finite or not `min_c < max_c`.
+    Range,
+    /// `max_rate_c_per_s` not finite and > 0.
+    Rate,
+    /// `step_allowance_c` not finite and ≥ 0.
+    Allowance,
+    /// `degraded_after_s` not finite and > 0.
+    DegradedAfter,
+}
+
+impl fmt::Display for LimitsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            LimitsError::Range => "temperature range: min and max must be finite with min < max",
+            LimitsError::Rate => "temperature rate limit must be finite and > 0 °C/s",
+            LimitsError::Allowance => "temperature step allowance must be finite and >= 0 °C",
+            LimitsError::DegradedAfter => "degraded-after time must be finite and > 0 s",
+        })
+    }
+}
+
+impl core::error::Error for LimitsError {}
+
 /// A corrected sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Corrected {
-    /// Predicted bias B, °/s (held since the last feature step).
+    /// What this output is worth.
+    pub status: Status,
+    /// Predicted bias B, °/s (held since the last feature step; 0 before the first).
     pub bias_dps: f64,
-    /// Predicted scale factor K, dimensionless (held since the last feature step).
+    /// Predicted scale factor K, dimensionless (held since the last feature step; 1 before
+    /// the first).
     pub scale: f64,
-    /// Compensated rate G = (Ĝ - B) / K, °/s.
+    /// Compensated rate G = (Ĝ - B) / K, °/s; 0 when the status is [`Status::Invalid`].
     pub rate_dps: f64,
+}
+
+impl Corrected {
+    /// The compensated rate, `None` when the gyro sample was not finite.
+    pub fn rate(&self) -> Option<f64> {
+        match self.status {
+            Status::Invalid => None,
+            _ => Some(self.rate_dps),
+        }
+    }
 }
 
 /// Bias and scale-factor models on one streaming feature pipeline (see the module doc).
@@ -231,17 +417,39 @@ pub struct Compensator {
     pipeline: FeaturePipeline,
     bias: TargetModel,
     scale: TargetModel,
+    limits: TempLimits,
+    /// B and K of the latest good step.
     held: Option<(f64, f64)>,
+    /// `held` came from the latest step (false after a step whose models failed).
+    current: bool,
+    /// Latest finite time stamp, s (time order is judged against it).
+    last_time_s: Option<f64>,
+    /// Time and value of the latest accepted temperature.
+    last_good: Option<(f64, f64)>,
+    /// Time of the latest sample with status `Ok` (or its temperature accepted).
+    last_ok_s: Option<f64>,
 }
 
 impl Compensator {
-    /// Checked constructor: both models must read the spec's feature count.
+    /// Checked constructor with the default [`TempLimits`]: both models must read the spec's
+    /// feature count.
     pub fn new(
         spec: FeatureSpec,
         bias: TargetModel,
         scale: TargetModel,
     ) -> Result<Self, ModelError> {
+        Self::with_limits(spec, bias, scale, TempLimits::DEFAULT)
+    }
+
+    /// Checked constructor with temperature-sensor limits.
+    pub fn with_limits(
+        spec: FeatureSpec,
+        bias: TargetModel,
+        scale: TargetModel,
+        limits: TempLimits,
+    ) -> Result<Self, ModelError> {
         let pipeline = FeaturePipeline::new(spec).map_err(ModelError::Spec)?;
+        limits.validate().map_err(ModelError::Limits)?;
         let n = spec.n_features();
         bias.check(n)?;
         scale.check(n)?;
@@ -249,7 +457,12 @@ impl Compensator {
             pipeline,
             bias,
             scale,
+            limits,
             held: None,
+            current: false,
+            last_time_s: None,
+            last_good: None,
+            last_ok_s: None,
         })
     }
 
@@ -258,57 +471,106 @@ impl Compensator {
         self.pipeline.spec()
     }
 
-    /// One sample: time (s, increasing), gyro output Ĝ (°/s), temperature (°C).
-    ///
-    /// Errors, each leaving the feature pipeline and the models untouched where the input is
-    /// at fault: non-finite time, gyro or temperature, time not increasing. A model that gives a
-    /// non-finite or non-positive scale factor is reported as
-    /// `NonFinite(Channel::Temperature)` (the temperature drove it out of range). A finite
-    /// gyro sample whose corrected rate is not finite (|Ĝ − B| / K beyond f64) is reported as
-    /// `NonFinite(Channel::Gyro)`: every `Ok` rate is finite.
-    pub fn step(
-        &mut self,
-        time_s: f64,
-        gyro_dps: f64,
-        temp_c: f64,
-    ) -> Result<Corrected, InputError> {
-        if !gyro_dps.is_finite() {
-            return Err(InputError::NonFinite(Channel::Gyro));
+    /// The temperature-sensor limits.
+    pub fn limits(&self) -> &TempLimits {
+        &self.limits
+    }
+
+    /// Whether a temperature reading at `time_s` (already known finite and after every
+    /// earlier time stamp) is believed.
+    fn plausible(&self, time_s: f64, temp_c: f64) -> bool {
+        let l = &self.limits;
+        if !(temp_c >= l.min_c && temp_c <= l.max_c) {
+            return false;
         }
-        if let Some(step) = self.pipeline.push(time_s, temp_c)? {
-            let b = self.bias.eval(&step.features)?;
-            let k = self.scale.eval(&step.features)?;
-            if k <= 0.0 {
-                return Err(InputError::NonFinite(Channel::Temperature));
+        match self.last_good {
+            None => true,
+            Some((t, v)) => {
+                let allowed = l.max_rate_c_per_s * (time_s - t) + l.step_allowance_c;
+                libm::fabs(temp_c - v) <= allowed
             }
-            self.held = Some((b, k));
         }
-        // After the first accepted sample there is always a held value (step 0).
-        let (bias_dps, scale) = match self.held {
-            Some(v) => v,
-            None => return Err(InputError::NonFinite(Channel::Temperature)),
+    }
+
+    /// One sample: time (s, increasing), gyro output Ĝ (°/s), temperature (°C). Never fails:
+    /// the [`Status`] says what the output is worth (see the module doc).
+    pub fn step(&mut self, time_s: f64, gyro_dps: f64, temp_c: f64) -> Corrected {
+        let time_ok = time_s.is_finite() && self.last_time_s.is_none_or(|t| time_s > t);
+        let mut fresh = false;
+        if time_ok {
+            self.last_time_s = Some(time_s);
+            if self.plausible(time_s, temp_c) {
+                match self.pipeline.push(time_s, temp_c) {
+                    Ok(Some(step)) => {
+                        self.last_good = Some((time_s, temp_c));
+                        fresh = self.eval(&step.features);
+                    }
+                    Ok(None) => {
+                        self.last_good = Some((time_s, temp_c));
+                        fresh = self.current;
+                    }
+                    // Unreachable: time and temperature were checked above.
+                    Err(_) => {}
+                }
+            }
+        }
+        if fresh {
+            self.last_ok_s = self.last_time_s;
+        }
+        let (bias_dps, scale) = self.held.unwrap_or((0.0, 1.0));
+        // A finite sample so large that (Ĝ − B) / K overflows has no rate either.
+        let status = if !(gyro_dps.is_finite() && ((gyro_dps - bias_dps) / scale).is_finite()) {
+            Status::Invalid
+        } else if fresh {
+            Status::Ok
+        } else {
+            match (self.last_ok_s, self.last_time_s) {
+                (Some(ok), Some(now)) if now - ok <= self.limits.degraded_after_s => Status::Held,
+                _ => Status::Degraded,
+            }
         };
-        let rate_dps = (gyro_dps - bias_dps) / scale;
-        if !rate_dps.is_finite() {
-            return Err(InputError::NonFinite(Channel::Gyro));
-        }
-        Ok(Corrected {
+        let rate_dps = match status {
+            Status::Invalid => 0.0,
+            _ => (gyro_dps - bias_dps) / scale,
+        };
+        Corrected {
+            status,
             bias_dps,
             scale,
             rate_dps,
-        })
+        }
     }
 
-    /// The feature vector of the latest step (None before the first sample).
+    /// Evaluate both models on a new step; keep B and K only if both are usable.
+    fn eval(&mut self, f: &Features) -> bool {
+        self.current = false;
+        let (Ok(b), Ok(k)) = (self.bias.eval(f), self.scale.eval(f)) else {
+            return false;
+        };
+        // K > 0 also refuses NaN; a finite rate needs a finite quotient.
+        if !(k > 0.0 && b.is_finite() && k.is_finite()) {
+            return false;
+        }
+        self.held = Some((b, k));
+        self.current = true;
+        true
+    }
+
+    /// The feature vector of the latest step (None before the first accepted sample).
     pub fn features(&self) -> Option<&Features> {
         self.pipeline.current()
     }
 
-    /// Start over: clear the feature history, the LSTM states and the held values.
+    /// Start over: clear the feature history, the LSTM states, the held values and the
+    /// sensor-fault history.
     pub fn reset(&mut self) {
         self.pipeline.reset();
         self.bias.reset();
         self.scale.reset();
         self.held = None;
+        self.current = false;
+        self.last_time_s = None;
+        self.last_good = None;
+        self.last_ok_s = None;
     }
 }

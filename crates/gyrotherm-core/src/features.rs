@@ -189,7 +189,9 @@ impl FeatureSpec {
             return Err(SpecError::TooManyLags(tau_s.len().min(255) as u8));
         }
         self.lag_tau_s = [0.0; MAX_LAGS];
-        self.lag_tau_s[..tau_s.len()].copy_from_slice(tau_s);
+        for (dst, src) in self.lag_tau_s.iter_mut().zip(tau_s) {
+            *dst = *src;
+        }
         self.n_lags = tau_s.len() as u8;
         self.lag_outputs = outputs;
         self.validate()?;
@@ -198,7 +200,8 @@ impl FeatureSpec {
 
     /// The lag time constants in use, s.
     pub fn lags(&self) -> &[f64] {
-        &self.lag_tau_s[..(self.n_lags as usize).min(MAX_LAGS)]
+        let n = (self.n_lags as usize).min(MAX_LAGS);
+        self.lag_tau_s.get(..n).unwrap_or(&[])
     }
 
     /// Check every field; the error names the one at fault.
@@ -254,8 +257,8 @@ impl FeatureSpec {
         let mut at = 0usize;
         let mut order = [None; MAX_FEATURES];
         let mut put = |k: FeatureKind| {
-            if at < MAX_FEATURES {
-                order[at] = Some(k);
+            if let Some(slot) = order.get_mut(at) {
+                *slot = Some(k);
                 at += 1;
             }
         };
@@ -288,7 +291,7 @@ pub struct Features {
 impl Features {
     /// The features in use.
     pub fn as_slice(&self) -> &[f64] {
-        &self.values[..self.len as usize]
+        self.values.get(..self.len as usize).unwrap_or(&[])
     }
     /// Number of features.
     pub fn len(&self) -> usize {
@@ -399,7 +402,7 @@ impl FeaturePipeline {
         } else {
             back
         };
-        self.hist[idx]
+        self.hist.get(idx).copied().unwrap_or((0, 0.0))
     }
 
     /// Feed one sample. Returns `Ok(Some(step))` when the sample reaches a step boundary (the
@@ -444,18 +447,21 @@ impl FeaturePipeline {
         let p = self.spec.step_period_s;
         // Lags first (they need the elapsed time only).
         let n_lags = (self.spec.n_lags as usize).min(MAX_LAGS);
-        for j in 0..n_lags {
+        let lags = self.lag_c.iter_mut().zip(&self.lag_gain);
+        for ((c, &g1), &tau) in lags.zip(&self.spec.lag_tau_s).take(n_lags) {
             let gain = if n == 1 {
-                self.lag_gain[j]
+                g1
             } else if n == 0 {
                 0.0
             } else {
-                -libm::expm1(-(n as f64) * p / self.spec.lag_tau_s[j])
+                -libm::expm1(-(n as f64) * p / tau)
             };
-            self.lag_c[j] += gain * (t - self.lag_c[j]);
+            *c += gain * (t - *c);
         }
         // History ring.
-        self.hist[self.hist_head] = (k, t);
+        if let Some(slot) = self.hist.get_mut(self.hist_head) {
+            *slot = (k, t);
+        }
         self.hist_head = if self.hist_head + 1 == HISTORY_STEPS {
             0
         } else {
@@ -492,8 +498,8 @@ impl FeaturePipeline {
         let mut v = [0.0; MAX_FEATURES];
         let mut at = 0usize;
         let mut put = |x: f64| {
-            if at < MAX_FEATURES {
-                v[at] = x;
+            if let Some(slot) = v.get_mut(at) {
+                *slot = x;
                 at += 1;
             }
         };
@@ -513,13 +519,13 @@ impl FeaturePipeline {
             put(sum / f64::from(count.max(1)));
         }
         if self.spec.lag_levels() {
-            for j in 0..n_lags {
-                put(self.lag_c[j]);
+            for &c in self.lag_c.iter().take(n_lags) {
+                put(c);
             }
         }
         if self.spec.lag_diffs() {
-            for j in 0..n_lags {
-                put(t - self.lag_c[j]);
+            for &c in self.lag_c.iter().take(n_lags) {
+                put(t - c);
             }
         }
         self.current = Features {

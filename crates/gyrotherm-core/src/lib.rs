@@ -11,17 +11,29 @@
 //!   per step (1 s), so the cost does not matter.
 //! - [`baseline`]: evaluation of fitted linear/polynomial baseline models (f64).
 //! - [`compensator`]: bias and scale factor to corrected rate, G = (Ĝ − B)/K (eq. 4 of the
-//!   paper).
+//!   paper), riding through temperature-sensor faults with a [`Status`] per sample.
+//! - [`static_model`]: a model as plain static data (`gyrotherm export --lang rust`).
 //! - [`error`]: what the core refuses instead of panicking.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code)]
+// Panic-freedom, checked: no indexing that can fail, no unwrap/expect/panic (tests may).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::indexing_slicing,
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic
+    )
+)]
 
 pub mod baseline;
 pub mod compensator;
 pub mod error;
 pub mod features;
 pub mod lstm;
+pub mod static_model;
 
-pub use compensator::{Compensator, Corrected, TargetModel};
+pub use compensator::{Compensator, Corrected, Status, TargetModel, TempLimits};
 pub use error::{Channel, InputError};
 pub use features::FeatureSpec;

@@ -111,13 +111,16 @@ pub struct LstmWeights<const I: usize, const H: usize = 8> {
     b_out: f32,
 }
 
-/// First non-finite value of `v`, as its index.
+/// First non-finite value of `v`, as its index. Slice patterns, not indexing: `const` and
+/// panic-free.
 const fn first_non_finite(v: &[f32]) -> Option<usize> {
+    let mut rest = v;
     let mut k = 0;
-    while k < v.len() {
-        if !v[k].is_finite() {
+    while let [head, tail @ ..] = rest {
+        if !head.is_finite() {
             return Some(k);
         }
+        rest = tail;
         k += 1;
     }
     None
@@ -150,37 +153,45 @@ impl<const I: usize, const H: usize> LstmWeights<I, H> {
         w_out: [f32; H],
         b_out: f32,
     ) -> Result<Self, WeightError> {
+        // Gate by gate, row by row, walking the arrays as slices (no indexing in a const fn).
+        let (mut gi, mut gh, mut gbi, mut gbh): (&[_], &[_], &[_], &[_]) =
+            (&w_ih, &w_hh, &b_ih, &b_hh);
         let mut g = 0;
-        while g < GATES {
+        while let ([wi, ti @ ..], [wh, th @ ..], [bi, tbi @ ..], [bh, tbh @ ..]) =
+            (gi, gh, gbi, gbh)
+        {
+            let (mut ri, mut rh): (&[[f32; I]], &[[f32; H]]) = (wi, wh);
             let mut j = 0;
-            while j < H {
+            while let ([row_i, tri @ ..], [row_h, trh @ ..]) = (ri, rh) {
                 let row = g * H + j;
-                if let Some(k) = first_non_finite(&w_ih[g][j]) {
+                if let Some(k) = first_non_finite(row_i) {
                     return Err(WeightError::NonFinite {
                         tensor: Tensor::WIh,
                         index: row * I + k,
                     });
                 }
-                if let Some(k) = first_non_finite(&w_hh[g][j]) {
+                if let Some(k) = first_non_finite(row_h) {
                     return Err(WeightError::NonFinite {
                         tensor: Tensor::WHh,
                         index: row * H + k,
                     });
                 }
+                (ri, rh) = (tri, trh);
                 j += 1;
             }
-            if let Some(j) = first_non_finite(&b_ih[g]) {
+            if let Some(j) = first_non_finite(bi) {
                 return Err(WeightError::NonFinite {
                     tensor: Tensor::BIh,
                     index: g * H + j,
                 });
             }
-            if let Some(j) = first_non_finite(&b_hh[g]) {
+            if let Some(j) = first_non_finite(bh) {
                 return Err(WeightError::NonFinite {
                     tensor: Tensor::BHh,
                     index: g * H + j,
                 });
             }
+            (gi, gh, gbi, gbh) = (ti, th, tbi, tbh);
             g += 1;
         }
         if let Some(j) = first_non_finite(&w_out) {
@@ -322,38 +333,49 @@ pub fn tanh(z: f32) -> f32 {
 
 /// A running LSTM: weights repacked for the step loop, plus the state (h, c), zero at start.
 ///
-/// Size: 4H·(I + H + 1) + 3H + 1 floats (1.5 KiB for I = 2, H = 8).
+/// Size: 4H·(I + H + 1) + 3H + 1 floats (1.5 KiB for I = 2, H = 8), on 64-byte boundaries:
+/// `repr(C)` keeps the field order, and every column of 4H floats is 16H bytes, so each
+/// column starts 16-byte aligned and SIMD loads of the weights fold into the multiplies.
 #[derive(Debug, Clone, PartialEq)]
+#[repr(C, align(64))]
 pub struct Lstm<const I: usize, const H: usize = 8> {
-    /// `w_x[k][gate][j]` = `w_ih[gate][j][k]`: column-major, so a step is a sum of scaled
-    /// columns that the compiler vectorises over (gate, j).
+    /// `w_x[k][gate][j]` = `w_ih[gate][j][k]`: column-major, so the 4H gate sums are a sum of
+    /// scaled columns, each column 4H contiguous floats (8 SSE vectors for H = 8).
     w_x: [[[f32; H]; GATES]; I],
     /// `w_h[m][gate][j]` = `w_hh[gate][j][m]`.
     w_h: [[[f32; H]; GATES]; H],
     /// `b_ih + b_hh`.
     b: [[f32; H]; GATES],
-    w_out: [f32; H],
-    b_out: f32,
     h: [f32; H],
     c: [f32; H],
+    w_out: [f32; H],
+    b_out: f32,
 }
 
 impl<const I: usize, const H: usize> Lstm<I, H> {
     /// A network with zero state. The weights were checked by their constructor.
-    #[allow(clippy::needless_range_loop)] // a transpose reads clearest with indices
     pub fn new(weights: &LstmWeights<I, H>) -> Self {
+        // Transpose [gate][j][k] into [k][gate][j]: column k of each row lands in w_x[k].
         let mut w_x = [[[0.0; H]; GATES]; I];
+        for (k, col) in w_x.iter_mut().enumerate() {
+            for (col_g, w_g) in col.iter_mut().zip(&weights.w_ih) {
+                for (dst, row) in col_g.iter_mut().zip(w_g) {
+                    *dst = row.get(k).copied().unwrap_or(0.0);
+                }
+            }
+        }
         let mut w_h = [[[0.0; H]; GATES]; H];
-        let mut b = [[0.0; H]; GATES];
-        for g in 0..GATES {
-            for j in 0..H {
-                for k in 0..I {
-                    w_x[k][g][j] = weights.w_ih[g][j][k];
+        for (m, col) in w_h.iter_mut().enumerate() {
+            for (col_g, w_g) in col.iter_mut().zip(&weights.w_hh) {
+                for (dst, row) in col_g.iter_mut().zip(w_g) {
+                    *dst = row.get(m).copied().unwrap_or(0.0);
                 }
-                for m in 0..H {
-                    w_h[m][g][j] = weights.w_hh[g][j][m];
-                }
-                b[g][j] = weights.b_ih[g][j] + weights.b_hh[g][j];
+            }
+        }
+        let mut b = weights.b_ih;
+        for (b_g, bh_g) in b.iter_mut().zip(&weights.b_hh) {
+            for (bj, bh) in b_g.iter_mut().zip(bh_g) {
+                *bj += bh;
             }
         }
         Lstm {
@@ -376,8 +398,17 @@ impl<const I: usize, const H: usize> Lstm<I, H> {
     ///   `InputError::NonFinite(Channel::Feature(k))` with k the input of largest magnitude.
     ///
     /// With finite weights, the state stays finite: |h| ≤ 1 and |c| grows by at most 1 a step.
+    ///
+    /// Arithmetic, element by element (the order a C port must keep to match bit for bit;
+    /// every operation rounds to f32, no FMA):
+    /// `z = b; z += W_ih[:,k]·x[k] for k = 0..I; z += W_hh[:,m]·h[m] for m = 0..H`;
+    /// `i, f, o = σ(z)`, `g' = σ(2·z_g)`; `c = f·c + i·(2g' - 1)`; `t = σ(2c)`;
+    /// `h = o·(2t - 1)`; `y = b_out; y += w_out[j]·h[j] for j = 0..H`.
+    /// Each loop runs across the 4H gates or the H units (SIMD lanes), never across the
+    /// terms of one sum, so vectorising does not re-associate anything. The recurrence
+    /// (h → gate sums → σ → c → σ → h) is a chain of about 75 dependent operations, two of
+    /// them divisions: that chain, not the arithmetic, bounds the time of a step.
     #[inline]
-    #[allow(clippy::needless_range_loop)] // const bounds: no checks, and the loops vectorise
     pub fn step(&mut self, x: &[f32; I]) -> Result<f32, InputError> {
         if let Some(k) = x.iter().position(|v| !v.is_finite()) {
             return Err(InputError::NonFinite(Channel::Feature(feature_index(k))));
@@ -408,20 +439,23 @@ impl<const I: usize, const H: usize> Lstm<I, H> {
             }
         }
         let [zi, zf, zg, zo] = &z;
-        let mut c = [0.0f32; H];
-        let mut tc = [0.0f32; H];
-        for j in 0..H {
-            c[j] = zf[j] * self.c[j] + zi[j] * (2.0 * zg[j] - 1.0);
-            tc[j] = 2.0 * c[j];
-        }
+        // Lane j of each row; j < H always, so the fallback is never taken (and is compiled
+        // out), but no index can panic.
+        let lane = |row: &[f32; H], j: usize| row.get(j).copied().unwrap_or(0.0);
+        let c: [f32; H] = core::array::from_fn(|j| {
+            lane(zf, j) * lane(&self.c, j) + lane(zi, j) * (2.0 * lane(zg, j) - 1.0)
+        });
+        let mut tc: [f32; H] = core::array::from_fn(|j| 2.0 * lane(&c, j));
         for v in tc.iter_mut() {
             *v = sigmoid(*v);
         }
-        let mut h = [0.0f32; H];
+        let mut h = *zo;
+        for (hj, tj) in h.iter_mut().zip(&tc) {
+            *hj *= 2.0 * tj - 1.0;
+        }
         let mut y = self.b_out;
-        for j in 0..H {
-            h[j] = zo[j] * (2.0 * tc[j] - 1.0);
-            y += self.w_out[j] * h[j];
+        for (wj, hj) in self.w_out.iter().zip(&h) {
+            y += wj * hj;
         }
         // A NaN anywhere in h (only from an overflowing gate sum) reaches y, since the
         // read-out weights are finite and 0·NaN is NaN; |h| ≤ 1 so y cannot overflow.
@@ -477,8 +511,174 @@ fn feature_index(k: usize) -> u8 {
 }
 
 #[cfg(test)]
+#[allow(
+    clippy::indexing_slicing,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic
+)]
 mod tests {
     use super::*;
+
+    impl<const I: usize, const H: usize> Lstm<I, H> {
+        /// The step as first written (indexed loops over the units): the reference that
+        /// [`Lstm::step`] must equal bit for bit.
+        #[allow(clippy::needless_range_loop)]
+        fn step_reference(&mut self, x: &[f32; I]) -> Result<f32, InputError> {
+            if let Some(k) = x.iter().position(|v| !v.is_finite()) {
+                return Err(InputError::NonFinite(Channel::Feature(feature_index(k))));
+            }
+            let mut z = self.b;
+            for (col, xk) in self.w_x.iter().zip(x) {
+                for (zg, cg) in z.iter_mut().zip(col) {
+                    for (zj, w) in zg.iter_mut().zip(cg) {
+                        *zj += w * xk;
+                    }
+                }
+            }
+            for (col, hm) in self.w_h.iter().zip(&self.h) {
+                for (zg, cg) in z.iter_mut().zip(col) {
+                    for (zj, w) in zg.iter_mut().zip(cg) {
+                        *zj += w * hm;
+                    }
+                }
+            }
+            for v in z[2].iter_mut() {
+                *v *= 2.0;
+            }
+            for zg in z.iter_mut() {
+                for v in zg.iter_mut() {
+                    *v = sigmoid(*v);
+                }
+            }
+            let [zi, zf, zg, zo] = &z;
+            let mut c = [0.0f32; H];
+            let mut tc = [0.0f32; H];
+            for j in 0..H {
+                c[j] = zf[j] * self.c[j] + zi[j] * (2.0 * zg[j] - 1.0);
+                tc[j] = 2.0 * c[j];
+            }
+            for v in tc.iter_mut() {
+                *v = sigmoid(*v);
+            }
+            let mut h = [0.0f32; H];
+            let mut y = self.b_out;
+            for j in 0..H {
+                h[j] = zo[j] * (2.0 * tc[j] - 1.0);
+                y += self.w_out[j] * h[j];
+            }
+            if !y.is_finite() {
+                let mut k_max = (0, 0.0f32);
+                for (k, v) in x.iter().enumerate() {
+                    if v.abs() > k_max.1 {
+                        k_max = (k, v.abs());
+                    }
+                }
+                return Err(InputError::NonFinite(Channel::Feature(feature_index(
+                    k_max.0,
+                ))));
+            }
+            self.h = h;
+            self.c = c;
+            Ok(y)
+        }
+    }
+
+    /// xorshift64*: a deterministic stream for the equality sweep (no dependency).
+    struct Rng(u64);
+    impl Rng {
+        fn next_u64(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+        /// Uniform in [-1, 1).
+        fn unit(&mut self) -> f32 {
+            (self.next_u64() >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        }
+        /// Uniform in [-scale, scale), with scale drawn from 1e-3 to 1e3 per call
+        /// site when `wide`, so both saturated gates and tiny sums occur.
+        fn value(&mut self, scale: f32) -> f32 {
+            self.unit() * scale
+        }
+        fn scale(&mut self) -> f32 {
+            let e = (self.next_u64() % 7) as i32 - 3;
+            10f32.powi(e)
+        }
+    }
+
+    /// Random weights, each tensor at its own scale (1e-3 … 1e3).
+    fn random_weights<const I: usize, const H: usize>(rng: &mut Rng) -> LstmWeights<I, H> {
+        let s = [
+            rng.scale(),
+            rng.scale(),
+            rng.scale(),
+            rng.scale(),
+            rng.scale(),
+        ];
+        let w_ih: Vec<f32> = (0..GATES * H * I).map(|_| rng.value(s[0])).collect();
+        let w_hh: Vec<f32> = (0..GATES * H * H).map(|_| rng.value(s[1])).collect();
+        let b_ih: Vec<f32> = (0..GATES * H).map(|_| rng.value(s[2])).collect();
+        let b_hh: Vec<f32> = (0..GATES * H).map(|_| rng.value(s[2])).collect();
+        let w_out: Vec<f32> = (0..H).map(|_| rng.value(s[3])).collect();
+        let b_out = rng.value(s[4]);
+        LstmWeights::from_slices(&w_ih, &w_hh, &b_ih, &b_hh, &w_out, b_out).unwrap()
+    }
+
+    /// `Lstm::step` against `step_reference` over random weights, states and inputs: the
+    /// outputs, errors and states must agree bit for bit (compared as bit patterns, so a
+    /// differing NaN payload or signed zero would fail too). Inputs include values large
+    /// enough to overflow the gate sums (the error path) and non-finite ones.
+    fn step_equals_reference<const I: usize, const H: usize>(seed: u64, nets: usize, steps: usize) {
+        let mut rng = Rng(seed);
+        let (mut n_ok, mut n_err) = (0usize, 0usize);
+        for _ in 0..nets {
+            let w = random_weights::<I, H>(&mut rng);
+            let mut fast = Lstm::new(&w);
+            let (hs, cs) = (rng.scale().min(1.0), rng.scale() * 10.0);
+            let h0: [f32; H] = core::array::from_fn(|_| rng.value(hs));
+            let c0: [f32; H] = core::array::from_fn(|_| rng.value(cs));
+            fast.set_state(&h0, &c0).unwrap();
+            let mut slow = fast.clone();
+            let xs = rng.scale();
+            for _ in 0..steps {
+                let mut x: [f32; I] = core::array::from_fn(|_| rng.value(xs));
+                match rng.next_u64() % 64 {
+                    0 => x[0] = f32::MAX * rng.unit(),
+                    1 => x[I - 1] = f32::NAN,
+                    2 => x[0] = 1e30 * rng.unit(),
+                    _ => {}
+                }
+                let (a, b) = (fast.step(&x), slow.step_reference(&x));
+                match (a, b) {
+                    (Ok(a), Ok(b)) => {
+                        assert_eq!(a.to_bits(), b.to_bits(), "y: {a} vs {b}, x {x:?}");
+                        n_ok += 1;
+                    }
+                    (a, b) => {
+                        assert_eq!(a, b, "x {x:?}");
+                        n_err += 1;
+                    }
+                }
+                let bits = |v: &[f32; H]| v.map(f32::to_bits);
+                assert_eq!(bits(fast.hidden()), bits(slow.hidden()));
+                assert_eq!(bits(fast.cell()), bits(slow.cell()));
+            }
+        }
+        assert!(
+            n_ok > nets * steps / 2 && n_err > 0,
+            "{n_ok} ok, {n_err} errors"
+        );
+    }
+
+    #[test]
+    fn step_equals_reference_bit_for_bit() {
+        step_equals_reference::<2, 8>(0x9e37_79b9_7f4a_7c15, 400, 250);
+        step_equals_reference::<1, 1>(7, 200, 100);
+        step_equals_reference::<3, 5>(11, 200, 100);
+        step_equals_reference::<12, 8>(13, 100, 100);
+    }
 
     /// Sweep e^x, σ and tanh against std f64 over [-30, 30] in steps of 1/1024 (e^x over
     /// [-87, 88]) plus extremes. Tolerances: e^x and σ 4 f32 ulps relative (4·2^-23 ≈ 4.8e-7;

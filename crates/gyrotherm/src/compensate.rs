@@ -5,7 +5,6 @@
 
 use gyrotherm_core::compensator::{Compensator, NormalisedLstm, TargetModel, HIDDEN, LSTM_INPUTS};
 
-use crate::csvlog::LogError;
 use crate::csvlog::TestLog;
 use crate::model::{ModelFile, SubModel};
 use crate::model::{ModelFileError, Target};
@@ -13,8 +12,6 @@ use crate::nn::params::{LstmParams, ParamsError};
 use crate::nn::zscore::ZScore;
 use gyrotherm_core::baseline::BaselineError;
 use gyrotherm_core::compensator::ModelError as FlightModelError;
-use gyrotherm_core::error::InputError;
-use std::path::PathBuf;
 
 /// Compensated series of one log, one value per sample.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -28,7 +25,7 @@ pub struct Compensated {
 }
 
 /// Widen an LSTM to the flight input count: input columns beyond `input_size` get weight 0.
-fn padded_core_lstm(
+pub fn padded_core_lstm(
     params: &LstmParams,
 ) -> Result<gyrotherm_core::lstm::LstmWeights<LSTM_INPUTS, HIDDEN>, CompensateError> {
     let i = params.input_size;
@@ -75,27 +72,13 @@ pub fn target_model(sub: Option<&SubModel>, absent: f64) -> Result<TargetModel, 
         .baseline_core()
         .transpose()
         .map_err(CompensateError::Baseline)?;
-    let lstm = match sub {
-        SubModel::Lstm {
-            params,
-            input_norm,
-            target_norm,
+    let lstm = match sub.lstm() {
+        Some((params, input_norm, target_norm)) => {
+            Some(core_lstm(params, input_norm, target_norm)?)
         }
-        | SubModel::Residual {
-            params,
-            input_norm,
-            target_norm,
-            ..
-        } => Some(core_lstm(params, input_norm, target_norm)?),
-        SubModel::Baseline { .. } => None,
+        None => None,
     };
-    let lstm_reads_base = matches!(
-        sub,
-        SubModel::Residual {
-            lstm_reads_base: true,
-            ..
-        }
-    );
+    let lstm_reads_base = sub.reads_base();
     Ok(TargetModel {
         offset: 0.0,
         baseline,
@@ -115,7 +98,12 @@ pub fn compensator(model: &ModelFile) -> Result<Compensator, CompensateError> {
     };
     let bias = target_model(model.bias.as_ref(), 0.0).map_err(in_target(Target::Bias))?;
     let scale = target_model(model.scale.as_ref(), 1.0).map_err(in_target(Target::Scale))?;
-    Compensator::new(spec, bias, scale).map_err(CompensateError::Flight)
+    let limits = model
+        .features
+        .temp_sensor
+        .to_core()
+        .map_err(CompensateError::Model)?;
+    Compensator::with_limits(spec, bias, scale, limits).map_err(CompensateError::Flight)
 }
 
 /// Compensate a whole log with the flight compensator. The error names the sample.
@@ -128,13 +116,7 @@ pub fn compensate_log(model: &ModelFile, log: &TestLog) -> Result<Compensated, C
         gyro_comp_dps: Vec::with_capacity(n),
     };
     for i in 0..n {
-        let c = comp
-            .step(log.time_s[i], log.gyro_dps[i], log.temp_c[i])
-            .map_err(|source| CompensateError::Sample {
-                sample: i + 1,
-                time_s: log.time_s[i],
-                source,
-            })?;
+        let c = comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
         out.bias_dps.push(c.bias_dps);
         out.scale.push(c.scale);
         out.gyro_comp_dps.push(c.rate_dps);
@@ -191,119 +173,9 @@ pub(crate) fn range_warnings(
     out
 }
 
-/// Columns appended by [`compensate_stream`].
+/// Columns appended by [`compensate_lines`](crate::compensate_lines::compensate_lines) before
+/// its `status` column.
 pub const OUTPUT_COLUMNS: [&str; 3] = ["bias_dps", "scale", "gyro_comp_dps"];
-
-/// What a streaming compensation saw.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct StreamSummary {
-    /// Rows written.
-    pub rows: u64,
-    /// Rows made by gap filling.
-    pub filled_rows: u64,
-    /// Extrapolation warnings (temperature or its rate outside the training range).
-    pub warnings: Vec<String>,
-}
-
-/// Compensate a CSV log from `input` to `output`, one output row per input row: every input
-/// column as it was, then `bias_dps`, `scale` and `gyro_comp_dps` (°/s). Runs the flight
-/// [`Compensator`] sample by sample, so batch files and `--stream` give identical numbers.
-/// With `flush_each_row` every row is flushed as soon as it is written.
-pub fn compensate_stream<R: std::io::Read, W: std::io::Write>(
-    model: &ModelFile,
-    input: R,
-    source: &std::path::Path,
-    opts: &crate::csvlog::ReadOptions,
-    output: W,
-    flush_each_row: bool,
-) -> Result<StreamSummary, CompensateError> {
-    use crate::csvlog::{LogReader, LogWriter};
-    let mut comp = compensator(model)?;
-    let mut reader = LogReader::new(input, source, opts).map_err(CompensateError::Log)?;
-    let headers: Vec<String> = reader.headers().to_vec();
-    let mut writer = LogWriter::new(
-        output,
-        headers.iter().map(String::as_str).chain(OUTPUT_COLUMNS),
-    )
-    .map_err(|e| CompensateError::Write {
-        what: "the header",
-        source: e,
-    })?;
-    writer.set_flush_each_row(flush_each_row);
-    let col = |name: &str| headers.iter().position(|h| h.trim() == name);
-    let (ti, gi, ci, tabi) = (
-        col(&opts.time_col),
-        col(&opts.gyro_col),
-        col(&opts.temp_col),
-        col(&opts.table_col),
-    );
-    let mut summary = StreamSummary::default();
-    let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
-    while let Some(s) = reader.next_sample().map_err(CompensateError::Log)? {
-        let c = comp
-            .step(s.time_s, s.gyro_dps, s.temp_c)
-            .map_err(|e| CompensateError::Line {
-                path: source.to_path_buf(),
-                line: reader.line(),
-                source: e,
-            })?;
-        if let Some(f) = comp.features() {
-            let f = f.as_slice();
-            if let [t, r, ..] = f {
-                temp_seen = (temp_seen.0.min(*t), temp_seen.1.max(*t));
-                rate_seen = (rate_seen.0.min(*r), rate_seen.1.max(*r));
-            }
-        }
-        match reader.record() {
-            Some(rec) if !reader.is_filled() => {
-                for field in rec.iter() {
-                    writer.push_raw(field);
-                }
-            }
-            _ => {
-                summary.filled_rows += 1;
-                for k in 0..headers.len() {
-                    let v = if Some(k) == ti {
-                        Some(s.time_s)
-                    } else if Some(k) == gi {
-                        // The filled value in the file's own unit is not kept; write °/s.
-                        Some(s.gyro_dps)
-                    } else if Some(k) == ci {
-                        Some(s.temp_c)
-                    } else if Some(k) == tabi {
-                        s.table_dps
-                    } else {
-                        None
-                    };
-                    match v {
-                        Some(v) => writer.push_f64(v),
-                        None => writer.push_raw(b""),
-                    }
-                }
-            }
-        }
-        writer.push_f64(c.bias_dps);
-        writer.push_f64(c.scale);
-        writer.push_f64(c.rate_dps);
-        writer.end_row().map_err(|e| CompensateError::Write {
-            what: "output",
-            source: e,
-        })?;
-        summary.rows += 1;
-    }
-    writer.flush().map_err(|e| CompensateError::Write {
-        what: "output",
-        source: e,
-    })?;
-    if temp_seen.0 <= temp_seen.1 {
-        summary.warnings = range_warnings(model, temp_seen, rate_seen);
-    }
-    summary
-        .warnings
-        .extend(reader.report().jitter_warning(source));
-    Ok(summary)
-}
 
 /// Why a model could not be turned into the flight compensator, or a log not compensated: the
 /// target, sample, line or value at fault.
@@ -325,25 +197,6 @@ pub enum CompensateError {
         target: Target,
         source: Box<CompensateError>,
     },
-    /// The compensator refused sample `sample` (counted from 1) of a log.
-    Sample {
-        sample: usize,
-        time_s: f64,
-        source: InputError,
-    },
-    /// The compensator refused the sample on line `line` of file `path`.
-    Line {
-        path: PathBuf,
-        line: u64,
-        source: InputError,
-    },
-    /// The input log cannot be read.
-    Log(LogError),
-    /// Writing `what` failed.
-    Write {
-        what: &'static str,
-        source: std::io::Error,
-    },
 }
 
 impl std::fmt::Display for CompensateError {
@@ -360,16 +213,6 @@ impl std::fmt::Display for CompensateError {
             CompensateError::InTarget { target, source } => {
                 write!(f, "{}: {source}", target.as_str())
             }
-            CompensateError::Sample {
-                sample,
-                time_s,
-                source,
-            } => write!(f, "sample {sample} (time {time_s} s): {source}"),
-            CompensateError::Line { path, line, source } => {
-                write!(f, "{}:{line}: {source}", path.display())
-            }
-            CompensateError::Log(e) => e.fmt(f),
-            CompensateError::Write { what, source } => write!(f, "writing {what}: {source}"),
         }
     }
 }
@@ -381,11 +224,6 @@ impl std::error::Error for CompensateError {
             CompensateError::Params(e) => Some(e),
             CompensateError::Baseline(e) => Some(e),
             CompensateError::InTarget { source, .. } => Some(source.as_ref()),
-            CompensateError::Sample { source, .. } | CompensateError::Line { source, .. } => {
-                Some(source)
-            }
-            CompensateError::Log(e) => Some(e),
-            CompensateError::Write { source, .. } => Some(source),
             CompensateError::LstmInputs { .. } | CompensateError::Flight(_) => None,
         }
     }

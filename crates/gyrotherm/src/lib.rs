@@ -20,7 +20,7 @@
 //!   [`nn`].
 //! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]).
 //! - [`compensate`]: run the flight compensator (`gyrotherm-core`) over a log or a CSV
-//!   stream ([`compensate_log`], [`compensate_stream`]).
+//!   stream with a status per line ([`compensate_log`], [`compensate_lines`]).
 //! - [`allan`], [`metrics`]: the standard gyro figures (IEEE Std 952 / GJB 2426A).
 //! - [`compare`]: held-out comparison of methods (the numbers); [`report`]: the pictures and
 //!   the HTML report.
@@ -48,7 +48,9 @@ pub mod atomic_file;
 pub mod baseline;
 pub mod compare;
 pub mod compensate;
+pub mod compensate_lines;
 pub mod csvlog;
+pub mod export;
 pub mod features;
 pub mod fit;
 pub mod metrics;
@@ -60,7 +62,8 @@ pub mod sim;
 pub mod table_segments;
 pub mod targets;
 
-pub use compensate::{compensate_log, compensate_stream, compensator, CompensateError};
+pub use compensate::{compensate_log, compensator, CompensateError};
+pub use compensate_lines::{compensate_lines, LinesError, LinesSummary};
 pub use csvlog::{read_log, write_log, LogError, ReadOptions, TestLog};
 pub use features::{FeatureSpec, FeatureTable};
 pub use fit::{fit_model, FitConfig, FitError, FitOutcome, LstmRecipe, NamedLog, RecipeKind};

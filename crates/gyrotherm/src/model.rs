@@ -5,7 +5,9 @@
 //!   "format_version": 1,
 //!   "method": "linear",
 //!   "features": {"step_period_s": 1.0, "rate_lag_s": 20.0, "smoothing_window_s": 0.0,
-//!                "lag_tau_s": [], "lag_outputs": "diff_from_t"},
+//!                "lag_tau_s": [], "lag_outputs": "diff_from_t",
+//!                "temp_sensor": {"min_c": -60.0, "max_c": 100.0, "max_rate_c_per_s": 2.0,
+//!                                "step_allowance_c": 1.0, "degraded_after_s": 60.0}},
 //!   "bias": {"baseline": {"terms": {"n_features": 2, "powers": [[0,0],[1,0],[0,1]]},
 //!                         "coefficients": [0.001, 2e-5, 0.01]}},
 //!   "scale": {"lstm": {"params": {…LstmParams…}, "input_norm": {…}, "target_norm": {…}}},
@@ -25,6 +27,7 @@ use crate::features::FeatureTable;
 use crate::nn::params::{LstmParams, ParamsError};
 use crate::nn::zscore::ZScore;
 use gyrotherm_core::baseline::{BaselineError, BaselineModel};
+use gyrotherm_core::compensator::TempLimits;
 use gyrotherm_core::features::{FeatureKind, FeatureSpec, LagOutputs, MAX_LAGS};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -98,6 +101,60 @@ pub struct FeatureDef {
     pub lag_tau_s: Vec<f64>,
     /// Which lag outputs are features.
     pub lag_outputs: LagOutputsDef,
+    /// Which temperature readings are believed (absent in older files: the defaults).
+    #[serde(default)]
+    pub temp_sensor: TempSensorDef,
+}
+
+/// Temperature-sensor fault limits in the file (the core's [`TempLimits`]): a reading outside
+/// `min_c..=max_c`, or changing faster than `max_rate_c_per_s` (plus `step_allowance_c`)
+/// since the last good one, is held; held longer than `degraded_after_s` is degraded.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TempSensorDef {
+    /// Lowest plausible reading, °C.
+    pub min_c: f64,
+    /// Highest plausible reading, °C.
+    pub max_c: f64,
+    /// Fastest plausible change, °C/s.
+    pub max_rate_c_per_s: f64,
+    /// Change always allowed between readings, °C.
+    pub step_allowance_c: f64,
+    /// Seconds without a good reading before the output is degraded.
+    pub degraded_after_s: f64,
+}
+
+impl Default for TempSensorDef {
+    fn default() -> Self {
+        Self::from_core(&TempLimits::DEFAULT)
+    }
+}
+
+impl TempSensorDef {
+    /// The file form of core limits.
+    pub fn from_core(l: &TempLimits) -> Self {
+        TempSensorDef {
+            min_c: l.min_c,
+            max_c: l.max_c,
+            max_rate_c_per_s: l.max_rate_c_per_s,
+            step_allowance_c: l.step_allowance_c,
+            degraded_after_s: l.degraded_after_s,
+        }
+    }
+
+    /// The core limits, checked (the error names `features.temp_sensor`).
+    pub fn to_core(&self) -> Result<TempLimits, ModelFileError> {
+        let l = TempLimits {
+            min_c: self.min_c,
+            max_c: self.max_c,
+            max_rate_c_per_s: self.max_rate_c_per_s,
+            step_allowance_c: self.step_allowance_c,
+            degraded_after_s: self.degraded_after_s,
+        };
+        l.validate()
+            .map_err(|e| ModelFileError::invalid("features.temp_sensor", e.to_string()))?;
+        Ok(l)
+    }
 }
 
 impl FeatureDef {
@@ -113,6 +170,7 @@ impl FeatureDef {
                 LagOutputs::DiffFromT => LagOutputsDef::DiffFromT,
                 LagOutputs::Both => LagOutputsDef::Both,
             },
+            temp_sensor: TempSensorDef::default(),
         }
     }
 
@@ -183,6 +241,35 @@ impl SubModel {
             SubModel::Baseline { .. } => "least squares",
             SubModel::Residual { .. } => "least squares + lstm",
         }
+    }
+
+    /// The LSTM part, if any: parameters, input and target normalisation.
+    pub fn lstm(&self) -> Option<(&LstmParams, &ZScore, &ZScore)> {
+        match self {
+            SubModel::Lstm {
+                params,
+                input_norm,
+                target_norm,
+            }
+            | SubModel::Residual {
+                params,
+                input_norm,
+                target_norm,
+                ..
+            } => Some((params, input_norm, target_norm)),
+            SubModel::Baseline { .. } => None,
+        }
+    }
+
+    /// Whether the residual LSTM reads the least-squares base value as one more input.
+    pub fn reads_base(&self) -> bool {
+        matches!(
+            self,
+            SubModel::Residual {
+                lstm_reads_base: true,
+                ..
+            }
+        )
     }
 
     /// A baseline sub-model from a fit.
@@ -620,6 +707,7 @@ impl ModelFile {
             });
         }
         let spec = self.features.to_spec()?;
+        self.features.temp_sensor.to_core()?;
         let nf = spec.n_features();
         if self.bias.is_none() && self.scale.is_none() {
             return Err(ModelFileError::invalid(

@@ -1,46 +1,10 @@
 //! Finite-difference check of the hand-written BPTT: every parameter of every tensor, central
 //! differences in f64, against `loss_and_grad`.
 
-use gyrotherm::nn::{init_params, loss_and_grad, LstmParams, Sequence};
+use gyrotherm::nn::{init_params, loss_and_grad, Sequence};
 
-/// Flat parameter vector in PyTorch order (w_ih, w_hh, b_ih, b_hh, w_out, b_out), written out
-/// here from the documented layout (`LstmParams`), independently of the library's own.
-fn flatten(p: &LstmParams) -> Vec<f64> {
-    let mut v = Vec::new();
-    for t in [&p.w_ih, &p.w_hh, &p.b_ih, &p.b_hh, &p.w_out] {
-        v.extend_from_slice(t);
-    }
-    v.push(p.b_out);
-    v
-}
-
-/// Inverse of [`flatten`].
-fn unflatten(theta: &[f64], input_size: usize, hidden_size: usize) -> LstmParams {
-    let (i, h) = (input_size, hidden_size);
-    let mut at = 0;
-    let mut take = |n: usize| {
-        let s = theta[at..at + n].to_vec();
-        at += n;
-        s
-    };
-    let (w_ih, w_hh, b_ih, b_hh, w_out) = (
-        take(4 * h * i),
-        take(4 * h * h),
-        take(4 * h),
-        take(4 * h),
-        take(h),
-    );
-    LstmParams {
-        input_size,
-        hidden_size,
-        w_ih,
-        w_hh,
-        b_ih,
-        b_hh,
-        w_out,
-        b_out: theta[at],
-    }
-}
+mod lstm_layout;
+use lstm_layout::{flatten, unflatten};
 
 /// Central-difference step. Truncation error ~h²·|L'''| ≈ 1e-10, rounding ~ε·L/h ≈ 1e-11.
 const FD_STEP: f64 = 1e-5;

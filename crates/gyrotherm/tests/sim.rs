@@ -292,6 +292,7 @@ fn fault_injection() {
         dropout_s: 5.0,
         stuck_temp_per_hour: 20.0,
         stuck_temp_s: 30.0,
+        ..Default::default()
     };
     let f = simulate_series(&cfg).unwrap();
     let gaps = f.time_s.windows(2).filter(|w| w[1] - w[0] > 1.5).count();

@@ -1,6 +1,6 @@
 //! `gyrotherm compensate`: apply a fitted model to a log (file to file, or `--stream` on
-//! stdin/stdout). Both run the flight compensator of `gyrotherm-core`, so their numbers are
-//! identical.
+//! stdin/stdout), with a status per line. Both run the flight compensator of `gyrotherm-core`,
+//! so their numbers are identical (see `gyrotherm::compensate_lines`).
 
 use std::cell::RefCell;
 use std::io::{BufWriter, Read, Write};
@@ -9,8 +9,9 @@ use std::process::ExitCode;
 use std::rc::Rc;
 
 use anyhow::Context as _;
-use gyrotherm::compensate::compensate_stream;
-use gyrotherm::model::ModelFile;
+use gyrotherm::compensate_lines::{compensate_lines, Mode};
+use gyrotherm::model::{ModelFile, TempSensorDef};
+use gyrotherm_core::TempLimits;
 
 use super::common::LogArgs;
 
@@ -22,12 +23,12 @@ pub struct CompensateArgs {
     /// Log to compensate (CSV). Not with --stream.
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub input: Option<PathBuf>,
-    /// Output CSV: every input column, then bias_dps, scale and gyro_comp_dps (°/s).
+    /// Output CSV: every input column, then bias_dps, scale, gyro_comp_dps (°/s) and status
+    /// (ok, held, degraded, invalid).
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub out: Option<PathBuf>,
     /// Read CSV on stdin and write one output line per input line on stdout, flushed as it
-    /// goes (the flight path). Give --sample-period to start output at once; otherwise the
-    /// first line comes after 100 input lines (the sample-period estimate).
+    /// goes (the flight path). A malformed line is written as `invalid` and the stream goes on.
     #[arg(long)]
     pub stream: bool,
     #[command(flatten)]
@@ -36,6 +37,17 @@ pub struct CompensateArgs {
 
 pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
     let model = ModelFile::load(&args.model)?;
+    anyhow::ensure!(
+        args.log.fill_gaps.is_none(),
+        "--fill-gaps does not apply to compensate: the compensator bridges time gaps itself and \
+         writes one output line per input line"
+    );
+    if args.log.sample_period.is_some() {
+        eprintln!(
+            "gyrotherm: note: --sample-period is not needed by compensate (output starts with \
+             the first line); ignored"
+        );
+    }
     let opts = args.log.read_options();
     let summary = if args.stream {
         // Rows are handed on as they are made and stdout is flushed whenever the input has
@@ -46,17 +58,18 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             std::io::stdout().lock(),
         )));
         let write_error = Rc::new(RefCell::new(None));
-        let input = FlushBeforeRead {
+        let input = std::io::BufReader::new(FlushBeforeRead {
             inner: std::io::stdin().lock(),
             out: Rc::clone(&out),
             write_error: Rc::clone(&write_error),
-        };
-        let result = compensate_stream(
+        });
+        let result = compensate_lines(
             &model,
             input,
             "<stdin>".as_ref(),
             &opts,
             DeferredFlush(Rc::clone(&out)),
+            Mode::Stream,
             true,
         );
         // A failed flush ends the input (see FlushBeforeRead): that error, not the input's
@@ -68,6 +81,7 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
         out.borrow_mut()
             .flush()
             .context("writing standard output")?;
+        eprintln!("gyrotherm: {}", summary.describe());
         summary
     } else {
         let (Some(input), Some(out)) = (&args.input, &args.out) else {
@@ -77,30 +91,44 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("cannot open {}", input.display()))?;
         let summary =
             gyrotherm::atomic_file::write_atomically(out, |w: &mut BufWriter<std::fs::File>| {
-                let s = compensate_stream(
+                let s = compensate_lines(
                     &model,
                     std::io::BufReader::new(&file),
                     input,
                     &opts,
                     &mut *w,
+                    Mode::Strict,
                     false,
                 )?;
                 w.flush()?;
-                Ok::<_, anyhow::Error>(s)
+                Ok::<_, gyrotherm::compensate_lines::LinesError>(s)
             })
-            .with_context(|| format!("cannot compensate into {}", out.display()))?;
+            .map_err(|e| match e {
+                gyrotherm::compensate_lines::LinesError::Io(io) => anyhow::Error::new(io)
+                    .context(format!("cannot compensate into {}", out.display())),
+                other => anyhow::Error::new(other),
+            })?;
         eprintln!(
-            "gyrotherm: wrote {} ({} rows{})",
+            "gyrotherm: wrote {} ({})",
             out.display(),
-            summary.rows,
-            if summary.filled_rows > 0 {
-                format!(", {} made by gap filling", summary.filled_rows)
-            } else {
-                String::new()
-            }
+            summary.describe()
         );
         summary
     };
+    if summary.held + summary.degraded + summary.invalid > 0 {
+        eprintln!(
+            "gyrotherm: temperature faults ridden through: {} held, {} degraded; {} invalid \
+             (no rate: gyro not finite{})",
+            summary.held,
+            summary.degraded,
+            summary.invalid,
+            if summary.malformed > 0 {
+                " or malformed line"
+            } else {
+                ""
+            }
+        );
+    }
     for w in &summary.warnings {
         eprintln!("gyrotherm: warning: {w}");
     }
@@ -141,5 +169,46 @@ impl Write for DeferredFlush<'_> {
     }
     fn flush(&mut self) -> std::io::Result<()> {
         Ok(())
+    }
+}
+
+/// Temperature-sensor fault limits stored in the model at `train` (see `gyrotherm compensate`:
+/// a reading outside the range or changing faster than the rate limit is held).
+#[derive(Debug, Clone, clap::Args)]
+pub struct TempSensorArgs {
+    /// Lowest plausible temperature reading, °C.
+    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.min_c)]
+    pub temp_min: f64,
+    /// Highest plausible temperature reading, °C.
+    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.max_c)]
+    pub temp_max: f64,
+    /// Fastest plausible temperature change, °C/s.
+    #[arg(long, value_name = "C_PER_S", default_value_t = TempLimits::DEFAULT.max_rate_c_per_s)]
+    pub temp_max_rate: f64,
+    /// Temperature change always allowed between two readings (noise, resolution), °C.
+    #[arg(long, value_name = "C", default_value_t = TempLimits::DEFAULT.step_allowance_c)]
+    pub temp_step_allowance: f64,
+    /// Seconds without a good temperature before the output is `degraded` instead of `held`.
+    #[arg(long, value_name = "S", default_value_t = TempLimits::DEFAULT.degraded_after_s)]
+    pub degraded_after: f64,
+}
+
+impl TempSensorArgs {
+    /// The model-file form, checked.
+    pub fn to_def(&self) -> anyhow::Result<TempSensorDef> {
+        let def = TempSensorDef {
+            min_c: self.temp_min,
+            max_c: self.temp_max,
+            max_rate_c_per_s: self.temp_max_rate,
+            step_allowance_c: self.temp_step_allowance,
+            degraded_after_s: self.degraded_after,
+        };
+        def.to_core().map_err(|e| {
+            anyhow::anyhow!(
+                "temperature-sensor limits (--temp-min, --temp-max, --temp-max-rate, \
+                 --temp-step-allowance, --degraded-after): {e}"
+            )
+        })?;
+        Ok(def)
     }
 }

@@ -49,6 +49,30 @@ pub struct SimulateArgs {
     /// Length of each stuck-temperature episode, s.
     #[arg(long, default_value_t = 60.0, value_name = "S")]
     stuck_temp_s: f64,
+    /// Fault injection: mean single-sample temperature spikes per hour (85.0, −127.0 and
+    /// ±10–40 °C jumps in turn).
+    #[arg(long, default_value_t = 0.0, value_name = "N")]
+    spikes_per_hour: f64,
+    /// Fault injection: mean NaN temperature bursts per hour.
+    #[arg(long, default_value_t = 0.0, value_name = "N")]
+    nan_bursts_per_hour: f64,
+    /// Length of each NaN burst, s.
+    #[arg(long, default_value_t = 30.0, value_name = "S")]
+    nan_burst_s: f64,
+    /// Fault injection: mean episodes per hour of the temperature stuck at --stuck-value.
+    #[arg(long, default_value_t = 0.0, value_name = "N")]
+    stuck_value_per_hour: f64,
+    /// Length of each stuck-value episode, s.
+    #[arg(long, default_value_t = 120.0, value_name = "S")]
+    stuck_value_s: f64,
+    /// The reading of a stuck-value episode, °C (DS18B20 power-on value).
+    #[arg(
+        long,
+        default_value_t = 85.0,
+        value_name = "C",
+        allow_negative_numbers = true
+    )]
+    stuck_value: f64,
     /// Output CSV file.
     #[arg(long, value_name = "FILE", required_unless_present_any = ["list_profiles", "print_unit"])]
     out: Option<PathBuf>,
@@ -96,16 +120,23 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
             dropout_s: args.dropout_s,
             stuck_temp_per_hour: args.stuck_temp_per_hour,
             stuck_temp_s: args.stuck_temp_s,
+            spikes_per_hour: args.spikes_per_hour,
+            nan_bursts_per_hour: args.nan_bursts_per_hour,
+            nan_burst_s: args.nan_burst_s,
+            stuck_value_per_hour: args.stuck_value_per_hour,
+            stuck_value_s: args.stuck_value_s,
+            stuck_value_c: Some(args.stuck_value),
         },
         ..SimConfig::new(profile)
     };
     let out = args.out.context("--out is required")?;
     let log = sim::simulate(&cfg)?;
-    gyrotherm::csvlog::write_log(&out, &log)?;
+    gyrotherm::sim::fault::write_log(&out, &log)?;
 
     let (tmin, tmax) = log
         .temp_c
         .iter()
+        .filter(|t| t.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
             (a.min(t), b.max(t))
         });

@@ -150,6 +150,8 @@ pub struct TrainArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub log: LogArgs,
+    #[command(flatten)]
+    pub sensor: super::compensate::TempSensorArgs,
 }
 
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
@@ -157,13 +159,15 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let named = named(&logs);
     let method: Method = args.method.into();
     let cfg = args.fit.fit_config(method)?;
+    let temp_sensor = args.sensor.to_def()?;
     let started = std::time::Instant::now();
     let bars = TrainingBars::new(method == Method::Lstm, cfg.recipe.epochs, &[""]);
     let outcome = fit_model(&named, &cfg, &|t: Target, e, l| bars.update("", t, e, l));
     bars.finish();
-    let outcome = outcome
+    let mut outcome = outcome
         .map_err(anyhow::Error::msg)
         .context("training failed")?;
+    outcome.model.features.temp_sensor = temp_sensor;
     outcome
         .model
         .save(&args.out)

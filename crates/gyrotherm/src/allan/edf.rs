@@ -116,7 +116,7 @@ fn table3(d: u32) -> (f64, f64) {
 /// exponent α (S_y(f) ∝ f^α, integer in −4..=2, α + 2d > 1). `overlapping`: OADEV, OHDEV,
 /// MDEV; `modified`: MDEV. None where the algorithm is undefined (α + 2d ≤ 1, too few points,
 /// or α = 2 with ⌈r⌉ ≤ d).
-pub(crate) fn edf_greenhall(
+pub fn edf_greenhall(
     alpha: i32,
     d: u32,
     m: usize,
@@ -303,7 +303,7 @@ pub(crate) fn regularized_gamma_p(a: f64, x: f64) -> f64 {
 
 /// Quantile of the chi-square distribution with `dof` (> 0, may be fractional) degrees of
 /// freedom: the x with P(dof/2, x/2) = p, 0 < p < 1. NaN for arguments out of range.
-pub(crate) fn chi2_inv(p: f64, dof: f64) -> f64 {
+pub fn chi2_inv(p: f64, dof: f64) -> f64 {
     if !(p > 0.0 && p < 1.0 && dof > 0.0 && dof.is_finite()) {
         return f64::NAN;
     }

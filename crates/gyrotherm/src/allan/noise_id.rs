@@ -133,7 +133,33 @@ pub const B1_MIN_AVERAGES: usize = 4;
 /// [`b1_theory`]; for α ≥ 1 the ratio R(n) = MVAR/AVAR separates flicker PM (α = 1) from
 /// white PM (α = 2) (R(n) = 1/m for white PM; IEEE Std 1139 table for flicker PM with
 /// f_h = 1/(2τ0)). `phase` as made by [`super::phase_from_rate`].
+///
+/// `deviation` runs the same steps, with the O(N) R(n) work of several τ in parallel; this
+/// one-τ form is its reference in the tests.
+#[cfg(test)]
 pub(crate) fn b1_noise_id_from_phase(phase: &[f64], m: usize) -> Option<i32> {
+    match b1_stage(phase, m)? {
+        B1::Alpha(alpha) => Some(alpha),
+        B1::NeedsRn => {
+            let mdev = super::deviation_from_phase(phase, super::DevKind::Mdev, m)?.0;
+            let adev = super::deviation_from_phase(phase, super::DevKind::Oadev, m)?.0;
+            Some(rn_alpha(m, mdev, adev))
+        }
+    }
+}
+
+/// What the B1 ratio alone decides.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum B1 {
+    /// α ∈ {−2, −1, 0}.
+    Alpha(i32),
+    /// α ≥ 1: flicker or white PM, to be told apart by R(n) = MVAR/AVAR ([`rn_alpha`]).
+    NeedsRn,
+}
+
+/// The B1 part of `b1_noise_id_from_phase`: O(N/m); None with fewer than
+/// [`B1_MIN_AVERAGES`] averages or a degenerate ratio.
+pub(crate) fn b1_stage(phase: &[f64], m: usize) -> Option<B1> {
     if m == 0 || phase.is_empty() {
         return None;
     }
@@ -153,27 +179,28 @@ pub(crate) fn b1_noise_id_from_phase(phase: &[f64], m: usize) -> Option<i32> {
     }
     let b1 = var / avar;
     let bound = |mu_hi: i32, mu_lo: i32| (b1_theory(n, mu_hi) * b1_theory(n, mu_lo)).sqrt();
-    let alpha = if b1 < bound(-2, -1) {
-        // α = 1 or 2: R(n) = MVAR/AVAR.
-        let mdev = super::deviation_from_phase(phase, super::DevKind::Mdev, m)?.0;
-        let adev = super::deviation_from_phase(phase, super::DevKind::Oadev, m)?.0;
-        let rn = (mdev / adev).powi(2);
-        let pi2 = std::f64::consts::PI.powi(2);
-        let rn_white_pm = 1.0 / m as f64;
-        let avar_fpm = (1.038 + 3.0 * (std::f64::consts::PI * m as f64).ln()) / (4.0 * pi2);
-        let mvar_fpm = 3.0 * (256.0f64 / 27.0).ln() / (8.0 * pi2);
-        let rn_flicker_pm = mvar_fpm / avar_fpm;
-        if rn < (rn_white_pm * rn_flicker_pm).sqrt() {
-            2
-        } else {
-            1
-        }
+    Some(if b1 < bound(-2, -1) {
+        B1::NeedsRn
     } else if b1 < bound(-1, 0) {
-        0
+        B1::Alpha(0)
     } else if b1 < bound(0, 1) {
-        -1
+        B1::Alpha(-1)
     } else {
-        -2
-    };
-    Some(alpha)
+        B1::Alpha(-2)
+    })
+}
+
+/// α = 1 or 2 from R(n) = (MDEV/ADEV)² at averaging factor m.
+pub(crate) fn rn_alpha(m: usize, mdev: f64, adev: f64) -> i32 {
+    let rn = (mdev / adev).powi(2);
+    let pi2 = std::f64::consts::PI.powi(2);
+    let rn_white_pm = 1.0 / m as f64;
+    let avar_fpm = (1.038 + 3.0 * (std::f64::consts::PI * m as f64).ln()) / (4.0 * pi2);
+    let mvar_fpm = 3.0 * (256.0f64 / 27.0).ln() / (8.0 * pi2);
+    let rn_flicker_pm = mvar_fpm / avar_fpm;
+    if rn < (rn_white_pm * rn_flicker_pm).sqrt() {
+        2
+    } else {
+        1
+    }
 }

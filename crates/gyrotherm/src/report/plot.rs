@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use plotters::coord::combinators::WithKeyPoints;
 use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -331,6 +332,73 @@ fn trim_zeros(s: &str) -> &str {
     }
 }
 
+/// Mantissa ladders for log-axis ticks, sparsest first: decades, 1-2-5, then every integer
+/// mantissa, then a finer set for ranges well under a decade.
+const LOG_TICK_LADDERS: [&[f64]; 4] = [
+    &[1.0],
+    &[1.0, 2.0, 5.0],
+    &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+    &[1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+];
+
+/// Fewest labelled ticks a log axis gets when its range allows: one label alone cannot be
+/// read as a scale.
+const MIN_LOG_TICKS: usize = 3;
+/// Most labelled ticks before the labels crowd each other.
+const MAX_LOG_TICKS: usize = 12;
+
+/// Labelled ticks of a log axis over `[lo, hi]` (`0 < lo < hi`): the sparsest ladder of
+/// [`LOG_TICK_LADDERS`] giving at least [`MIN_LOG_TICKS`] ticks; on a range of many decades,
+/// every k-th decade so there are at most [`MAX_LOG_TICKS`].
+pub(crate) fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return Vec::new();
+    }
+    let ticks_of = |ladder: &[f64]| -> Vec<f64> {
+        let first = lo.log10().floor() as i32;
+        let last = hi.log10().ceil() as i32;
+        let mut t = Vec::new();
+        for e in first..=last {
+            let p = 10f64.powi(e);
+            for m in ladder {
+                // The product is rounded through a decimal string so labels read "0.2", not
+                // "0.20000000000000004".
+                let v: f64 = format!("{:.12e}", m * p).parse().unwrap_or(m * p);
+                if v >= lo * (1.0 - 1e-12) && v <= hi * (1.0 + 1e-12) {
+                    t.push(v);
+                }
+            }
+        }
+        t
+    };
+    let decades = ticks_of(LOG_TICK_LADDERS[0]);
+    if decades.len() > MAX_LOG_TICKS {
+        let step = decades.len().div_ceil(MAX_LOG_TICKS);
+        return decades.into_iter().step_by(step).collect();
+    }
+    let mut best = decades;
+    for ladder in LOG_TICK_LADDERS {
+        if best.len() >= MIN_LOG_TICKS {
+            break;
+        }
+        let t = ticks_of(ladder);
+        if t.len() > MAX_LOG_TICKS && !best.is_empty() {
+            break;
+        }
+        best = t;
+    }
+    best
+}
+
+/// A log axis over `[lo, hi]` labelled at [`log_ticks`].
+fn log_axis(lo: f64, hi: f64) -> WithKeyPoints<LogCoord<f64>> {
+    let ticks = log_ticks(lo, hi);
+    (lo..hi)
+        .log_scale()
+        .with_key_points(ticks.clone())
+        .with_light_points(ticks)
+}
+
 fn draw_figure<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> DrawResult
 where
     DB::ErrorType: 'static,
@@ -378,7 +446,7 @@ where
             ),
             (false, true) => draw_panel(
                 builder
-                    .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                    .build_cartesian_2d(x0..x1, log_axis(y0, y1))
                     .map_err(|e| e.to_string())?,
                 fig,
                 panel,
@@ -386,7 +454,7 @@ where
             ),
             (true, false) => draw_panel(
                 builder
-                    .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+                    .build_cartesian_2d(log_axis(x0, x1), y0..y1)
                     .map_err(|e| e.to_string())?,
                 fig,
                 panel,
@@ -394,7 +462,7 @@ where
             ),
             (true, true) => draw_panel(
                 builder
-                    .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                    .build_cartesian_2d(log_axis(x0, x1), log_axis(y0, y1))
                     .map_err(|e| e.to_string())?,
                 fig,
                 panel,
@@ -593,6 +661,33 @@ mod tests {
         ] {
             assert_eq!(tick_label(v), want, "tick_label({v})");
         }
+    }
+
+    /// Ticks are checked against the 1-2-5 rule by hand: a range under a decade (the
+    /// training-loss figure's 0.8…3) gets more than one label, every tick lies in the range,
+    /// and a range of many decades gets at most a dozen.
+    #[test]
+    fn log_axes_get_readable_ticks() {
+        assert_eq!(log_ticks(0.8, 3.0), vec![0.8, 0.9, 1.0, 2.0, 3.0]);
+        assert_eq!(log_ticks(0.05, 3.0), vec![0.05, 0.1, 0.2, 0.5, 1.0, 2.0]);
+        assert_eq!(log_ticks(1.0, 1e3), vec![1.0, 10.0, 100.0, 1000.0]);
+        assert_eq!(log_ticks(3.0, 150.0), vec![5.0, 10.0, 20.0, 50.0, 100.0]);
+        assert_eq!(
+            log_ticks(1e-3, 1e4),
+            vec![1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0, 1e3, 1e4]
+        );
+        assert_eq!(log_ticks(1.1, 1.9), vec![1.2, 1.5]);
+        let many = log_ticks(1e-15, 1e15);
+        assert!(
+            many.len() <= MAX_LOG_TICKS && many.len() >= MIN_LOG_TICKS,
+            "{many:?}"
+        );
+        for (lo, hi) in [(0.3, 0.9), (2.0, 7.0), (1e-4, 3e-2), (123.0, 4567.0)] {
+            let t = log_ticks(lo, hi);
+            assert!(t.len() >= MIN_LOG_TICKS, "[{lo}, {hi}]: {t:?}");
+            assert!(t.iter().all(|&v| v >= lo && v <= hi), "[{lo}, {hi}]: {t:?}");
+        }
+        assert!(log_ticks(0.0, 1.0).is_empty());
     }
 
     #[test]

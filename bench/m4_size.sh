@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Flash and RAM of `gyrotherm export --lang c` models on a Cortex-M4F, with Debian's
+# gcc-arm-none-eabi (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi).
+# Usage: bench/m4_size.sh
+# Models: linear, poly and the default `lstm` recipe (residual on thermal-state inputs)
+# trained here on simulated fast-cycle runs, and the `published`-recipe LSTM of
+# crates/gyrotherm-core/examples/flight_loop/model.json (bias and scale-factor LSTMs).
+# Per model: the object file's text, data and bss; flash = text + data; RAM = data + bss +
+# sizeof(gt_state) (one gyro axis); stack: an upper bound for one gt_step call; and the flash a linked image grows by against an empty
+# main (--specs=nano.specs, -Wl,--gc-sections): the model plus the soft-float double
+# routines and libm's floor that it pulls in (the M4F FPU is single precision).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+command -v arm-none-eabi-gcc >/dev/null || {
+    echo "needs arm-none-eabi-gcc: apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi" >&2
+    exit 2
+}
+cargo build --release -q -p gyrotherm-cli
+bin=target/release/gyrotherm
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+CFLAGS=(-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os -std=c99
+    -ffp-contract=off -ffunction-sections -fdata-sections -fno-common -fstack-usage
+    -Wall -Wextra -Werror -pedantic)
+LDFLAGS=(--specs=nano.specs --specs=nosys.specs -Wl,--gc-sections)
+$bin simulate --profile fast-cycle --seed 1 --out "$work/s.csv" 2>/dev/null
+$bin simulate --profile fast-cycle --seed 2 --table-rate 20 --out "$work/t.csv" 2>/dev/null
+for m in linear poly lstm; do
+    $bin train --method $m --input "$work/s.csv" --input "$work/t.csv" --out "$work/$m.json" 2>/dev/null
+done
+cp crates/gyrotherm-core/examples/flight_loop/model.json "$work/published.json"
+arm-none-eabi-gcc "${CFLAGS[@]}" bench/m4/size_main.c "${LDFLAGS[@]}" -o "$work/empty.elf" -lm
+empty=$(arm-none-eabi-size "$work/empty.elf" | awk 'NR==2 {print $1 + $2}')
+echo "arm-none-eabi-gcc $(arm-none-eabi-gcc -dumpversion); flags: ${CFLAGS[*]}"
+printf '%-10s %-20s %6s %6s %6s %8s %8s %7s %14s\n' model parts text data bss flash RAM stack "linked +flash"
+for m in linear poly lstm published; do
+    dir="$work/$m"
+    $bin export --model "$work/$m.json" --lang c --out "$dir" 2>/dev/null
+    arm-none-eabi-gcc "${CFLAGS[@]}" -c "$dir/gyrotherm_model.c" -o "$dir/model.o"
+    # Upper bound on gt_step's stack: the sum of every function's frame in the file.
+    stack=$(awk '{s += $(NF-1)} END {print s}' "$dir/model.su")
+    read -r text data bss _ < <(arm-none-eabi-size "$dir/model.o" | awk 'NR==2')
+    printf '#include "gyrotherm_model.h"\ngt_state probe;\n' > "$dir/probe.c"
+    arm-none-eabi-gcc "${CFLAGS[@]}" -I "$dir" -c "$dir/probe.c" -o "$dir/probe.o"
+    state=$(arm-none-eabi-size "$dir/probe.o" | awk 'NR==2 {print $3}')
+    arm-none-eabi-gcc "${CFLAGS[@]}" -DWITH_MODEL -I "$dir" bench/m4/size_main.c \
+        "$dir/gyrotherm_model.c" "${LDFLAGS[@]}" -o "$dir/image.elf" -lm
+    image=$(arm-none-eabi-size "$dir/image.elf" | awk 'NR==2 {print $1 + $2}')
+    parts=$(python3 -c "import json,sys; m=json.load(open(sys.argv[1])); print('/'.join(next(iter(m[t])) if m.get(t) else 'none' for t in ('bias','scale')))" "$work/$m.json")
+    printf '%-10s %-20s %6d %6d %6d %8d %8d %7d %14d\n' "$m" "$parts" "$text" "$data" "$bss" \
+        $((text + data)) $((data + bss + state)) "$stack" $((image - empty))
+done
+echo "state: sizeof(gt_state) = $state bytes per axis (RAM includes it); stack: sum of the"
+echo "frames of every function in gyrotherm_model.c (-fstack-usage), an upper bound for gt_step"

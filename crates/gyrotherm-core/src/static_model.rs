@@ -1,0 +1,158 @@
+//! A compensation model as plain static data: what `gyrotherm export --lang rust` writes, so
+//! flight code builds its [`Compensator`] without parsing JSON.
+//!
+//! ```
+//! use gyrotherm_core::features::FeatureSpec;
+//! use gyrotherm_core::static_model::{StaticBaseline, StaticModel, StaticTarget};
+//! use gyrotherm_core::{Compensator, TempLimits};
+//!
+//! // bias = 1e-3 + 2e-5·T °/s; no scale-factor model (K = 1).
+//! const fn powers() -> [[u8; 12]; 16] {
+//!     let mut p = [[0u8; 12]; 16];
+//!     p[1][0] = 1; // term 1: T
+//!     p
+//! }
+//! static MODEL: StaticModel = StaticModel {
+//!     spec: FeatureSpec::PUBLISHED,
+//!     limits: TempLimits::DEFAULT,
+//!     bias: StaticTarget {
+//!         offset: 0.0,
+//!         baseline: Some(StaticBaseline {
+//!             n_features: 2,
+//!             n_terms: 2,
+//!             powers: powers(),
+//!             coefficients: [1e-3, 2e-5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+//!                            0.0, 0.0, 0.0],
+//!         }),
+//!         lstm: None,
+//!         lstm_reads_base: false,
+//!     },
+//!     scale: StaticTarget::constant(1.0),
+//! };
+//! let mut c = Compensator::from_static(&MODEL).unwrap();
+//! let out = c.step(0.0, 0.01, 20.0);
+//! assert!((out.bias_dps - (1e-3 + 2e-5 * 20.0)).abs() < 1e-15);
+//! ```
+
+use crate::baseline::{BaselineModel, MAX_TERMS};
+use crate::compensator::{
+    Compensator, ModelError, NormalisedLstm, TargetModel, TempLimits, HIDDEN, LSTM_INPUTS,
+};
+use crate::features::{FeatureSpec, MAX_FEATURES};
+use crate::lstm::LstmWeights;
+
+/// A whole model: feature definition, sensor limits, bias and scale-factor models.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticModel {
+    /// The model inputs.
+    pub spec: FeatureSpec,
+    /// Temperature-sensor fault limits.
+    pub limits: TempLimits,
+    /// Bias model, °/s.
+    pub bias: StaticTarget,
+    /// Scale-factor model (dimensionless, ≈ 1).
+    pub scale: StaticTarget,
+}
+
+/// One target: `offset + baseline(features) + lstm(features)` (see [`TargetModel`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticTarget {
+    /// Constant part.
+    pub offset: f64,
+    /// Polynomial part.
+    pub baseline: Option<StaticBaseline>,
+    /// LSTM part.
+    pub lstm: Option<StaticLstm>,
+    /// The LSTM reads the features followed by the baseline's value.
+    pub lstm_reads_base: bool,
+}
+
+impl StaticTarget {
+    /// A target that is always `value`.
+    pub const fn constant(value: f64) -> Self {
+        StaticTarget {
+            offset: value,
+            baseline: None,
+            lstm: None,
+            lstm_reads_base: false,
+        }
+    }
+}
+
+/// A polynomial in the features: term `j` is `coefficients[j] · Π_i x_i^powers[j][i]`, for
+/// the first `n_terms` terms over the first `n_features` features.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticBaseline {
+    pub n_features: u8,
+    pub n_terms: u8,
+    pub powers: [[u8; MAX_FEATURES]; MAX_TERMS],
+    pub coefficients: [f64; MAX_TERMS],
+}
+
+/// An LSTM (PyTorch layout, `LSTM_INPUTS` input slots of which the first `n_inputs` are used,
+/// the rest with zero weights) with its z-score normalisation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticLstm {
+    pub w_ih: [[[f32; LSTM_INPUTS]; HIDDEN]; 4],
+    pub w_hh: [[[f32; HIDDEN]; HIDDEN]; 4],
+    pub b_ih: [[f32; HIDDEN]; 4],
+    pub b_hh: [[f32; HIDDEN]; 4],
+    pub w_out: [f32; HIDDEN],
+    pub b_out: f32,
+    pub n_inputs: u8,
+    pub input_mean: [f64; MAX_FEATURES],
+    pub input_std: [f64; MAX_FEATURES],
+    pub target_mean: f64,
+    pub target_std: f64,
+}
+
+impl StaticTarget {
+    fn to_target(&self) -> Result<TargetModel, ModelError> {
+        let baseline = match &self.baseline {
+            None => None,
+            Some(b) => {
+                let mut m =
+                    BaselineModel::new(b.n_features as usize).map_err(ModelError::Baseline)?;
+                let terms = b.powers.iter().zip(&b.coefficients);
+                for (powers, &c) in terms.take(b.n_terms as usize) {
+                    let p = powers.get(..b.n_features as usize).unwrap_or(&[]);
+                    m.push_term(p, c).map_err(ModelError::Baseline)?;
+                }
+                Some(m)
+            }
+        };
+        let lstm = match &self.lstm {
+            None => None,
+            Some(l) => {
+                let w = LstmWeights::new(l.w_ih, l.w_hh, l.b_ih, l.b_hh, l.w_out, l.b_out)
+                    .map_err(ModelError::Weights)?;
+                let n = l.n_inputs as usize;
+                let mean = l.input_mean.get(..n).ok_or(ModelError::FeatureCount {
+                    expected: MAX_FEATURES,
+                    got: n,
+                })?;
+                let std = l.input_std.get(..n).unwrap_or(&[]);
+                Some(NormalisedLstm::new(
+                    &w,
+                    mean,
+                    std,
+                    l.target_mean,
+                    l.target_std,
+                )?)
+            }
+        };
+        Ok(TargetModel {
+            offset: self.offset,
+            baseline,
+            lstm,
+            lstm_reads_base: self.lstm_reads_base,
+        })
+    }
+}
+
+impl Compensator {
+    /// The compensator of a static model, checked like [`Compensator::with_limits`].
+    pub fn from_static(m: &StaticModel) -> Result<Compensator, ModelError> {
+        Compensator::with_limits(m.spec, m.bias.to_target()?, m.scale.to_target()?, m.limits)
+    }
+}

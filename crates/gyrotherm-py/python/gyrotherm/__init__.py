@@ -1,0 +1,70 @@
+"""gyrotherm: temperature compensation of fiber optic gyroscopes, from Python.
+
+- Allan family, a drop-in for allantools: ``adev``, ``oadev``, ``mdev``, ``hdev``, ``ohdev``,
+  ``tdev`` take ``(data, rate=1.0, data_type="phase", taus=None)`` and return
+  ``(taus, devs, errs, ns)`` on allantools' τ set; ``deviation`` adds Greenhall EDF
+  confidence bounds; ``edf_greenhall`` and ``confidence_interval`` as in allantools.
+- Gyro figures: ``bias_stability``, ``noise_terms``, ``scale_factor``.
+- Logs and models: ``read_log``, ``fit`` → ``Model`` (``save``, ``Model.load``,
+  ``compensate``, ``summary``); model files are the CLI's JSON.
+
+Errors derive from ``GyrothermError`` (a ``ValueError``) and carry the CLI's messages.
+"""
+
+from ._gyrotherm import (
+    AllanError,
+    CompensationError,
+    FitError,
+    GyrothermError,
+    LogError,
+    MetricsError,
+    ModelError,
+    __version__,
+)
+from ._allan import (
+    ONE_SIGMA_CI,
+    Deviation,
+    adev,
+    confidence_interval,
+    deviation,
+    edf_greenhall,
+    hdev,
+    mdev,
+    oadev,
+    ohdev,
+    tdev,
+)
+from ._figures import bias_stability, noise_terms, scale_factor
+from ._logs import read_log
+from ._model import STATUS_NAMES, Compensation, GyrothermWarning, Model, fit
+
+__all__ = [
+    "AllanError",
+    "Compensation",
+    "CompensationError",
+    "Deviation",
+    "FitError",
+    "GyrothermError",
+    "GyrothermWarning",
+    "LogError",
+    "MetricsError",
+    "Model",
+    "ModelError",
+    "ONE_SIGMA_CI",
+    "STATUS_NAMES",
+    "__version__",
+    "adev",
+    "bias_stability",
+    "confidence_interval",
+    "deviation",
+    "edf_greenhall",
+    "fit",
+    "hdev",
+    "mdev",
+    "noise_terms",
+    "oadev",
+    "ohdev",
+    "read_log",
+    "scale_factor",
+    "tdev",
+]

@@ -1,0 +1,137 @@
+"""Type stubs of the public gyrotherm API."""
+
+import os
+from typing import Any, Callable, Dict, Iterable, List, NamedTuple, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+__all__: List[str]
+
+PathLike = Union[str, os.PathLike[str]]
+ArrayLike = npt.ArrayLike
+FloatArray = npt.NDArray[np.float64]
+TauArg = Union[None, str, float, npt.ArrayLike]
+AllanResult = Tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+
+ONE_SIGMA_CI: float
+STATUS_NAMES: Dict[int, str]
+
+class GyrothermError(ValueError): ...
+class LogError(GyrothermError): ...
+class ModelError(GyrothermError): ...
+class AllanError(GyrothermError): ...
+class MetricsError(GyrothermError): ...
+class FitError(GyrothermError): ...
+class CompensationError(GyrothermError): ...
+class GyrothermWarning(UserWarning): ...
+
+# Allan family (allantools signatures and return tuples: taus, devs, errs, ns)
+def adev(data: ArrayLike, rate: float = 1.0, data_type: str = "phase", taus: TauArg = None) -> AllanResult: ...
+def oadev(data: ArrayLike, rate: float = 1.0, data_type: str = "phase", taus: TauArg = None) -> AllanResult: ...
+def mdev(data: ArrayLike, rate: float = 1.0, data_type: str = "phase", taus: TauArg = None) -> AllanResult: ...
+def hdev(data: ArrayLike, rate: float = 1.0, data_type: str = "phase", taus: TauArg = None) -> AllanResult: ...
+def ohdev(data: ArrayLike, rate: float = 1.0, data_type: str = "phase", taus: TauArg = None) -> AllanResult: ...
+def tdev(data: ArrayLike, rate: float = 1.0, data_type: str = "phase", taus: TauArg = None) -> AllanResult: ...
+
+class Deviation(NamedTuple):
+    taus: FloatArray
+    devs: FloatArray
+    lo: FloatArray
+    hi: FloatArray
+    edf: FloatArray
+    alpha: npt.NDArray[np.int64]
+    ns: FloatArray
+
+def deviation(
+    data: ArrayLike,
+    rate: float = 1.0,
+    data_type: str = "phase",
+    kind: str = "oadev",
+    taus: TauArg = None,
+    alpha: Optional[int] = None,
+) -> Deviation: ...
+def edf_greenhall(
+    alpha: int,
+    d: int,
+    m: int,
+    N: int,
+    overlapping: bool = False,
+    modified: bool = False,
+    verbose: bool = False,
+) -> float: ...
+def confidence_interval(dev: Any, edf: float, ci: float = ...) -> Tuple[Any, Any]: ...
+
+# Gyro figures
+def bias_stability(rate_dps: ArrayLike, rate_hz: float, tau_s: float = 100.0) -> float: ...
+def noise_terms(rate_dps: ArrayLike, rate_hz: float) -> Dict[str, Any]: ...
+def scale_factor(
+    log: Any = None,
+    *,
+    time_s: Optional[ArrayLike] = None,
+    gyro_dps: Optional[ArrayLike] = None,
+    table_dps: Optional[ArrayLike] = None,
+    settle_s: float = 10.0,
+    reference_scale: Optional[float] = None,
+    **read_options: Any,
+) -> Dict[str, Any]: ...
+
+# Logs
+def read_log(
+    path: PathLike,
+    *,
+    as_frame: Optional[bool] = None,
+    time_col: str = "time_s",
+    gyro_col: str = "gyro_dps",
+    temp_col: str = "temp_c",
+    table_col: str = "table_dps",
+    gyro_unit: str = "dps",
+    fill_gaps: Optional[float] = None,
+    sample_period: Optional[float] = None,
+) -> Any: ...
+
+# Models
+class Compensation(NamedTuple):
+    bias_dps: FloatArray
+    scale: FloatArray
+    rate_dps: FloatArray
+    status: npt.NDArray[np.uint8]
+
+class Model:
+    def __init__(self, raw: Any) -> None: ...
+    @classmethod
+    def load(cls, path: PathLike) -> Model: ...
+    @classmethod
+    def from_json(cls, text: str) -> Model: ...
+    def save(self, path: PathLike) -> None: ...
+    def to_json(self) -> str: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def bias_kind(self) -> Optional[str]: ...
+    @property
+    def scale_kind(self) -> Optional[str]: ...
+    @property
+    def training(self) -> Dict[str, Any]: ...
+    def compensate(self, time_s: ArrayLike, gyro_dps: ArrayLike, temp_c: ArrayLike) -> Compensation: ...
+    def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]: ...
+    def summary(self) -> str: ...
+
+def fit(
+    static: Union[PathLike, Iterable[PathLike], None] = (),
+    table: Union[PathLike, Iterable[PathLike], None] = (),
+    method: str = "lstm",
+    recipe: str = "residual",
+    *,
+    epochs: Optional[int] = None,
+    seed: int = 0,
+    bias_window: Optional[float] = None,
+    settle: Optional[float] = None,
+    poly_temp_degree: int = 3,
+    poly_rate_degree: int = 1,
+    cross: bool = True,
+    validate_on_runs: bool = False,
+    progress: Union[bool, Callable[[str, int, float], Any], None] = False,
+    **log_options: Any,
+) -> Model: ...

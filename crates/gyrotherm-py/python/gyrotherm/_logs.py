@@ -1,0 +1,89 @@
+"""Test logs: ``read_log`` with the CLI's column mapping, units and gap options."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, Optional, Union
+
+import numpy as np
+
+from . import _gyrotherm as _g
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+#: The CLI's defaults for reading a log (``--time-col`` … ``--sample-period``).
+READ_DEFAULTS: Dict[str, Any] = {
+    "time_col": "time_s",
+    "gyro_col": "gyro_dps",
+    "temp_col": "temp_c",
+    "table_col": "table_dps",
+    "gyro_unit": "dps",
+    "fill_gaps": None,
+    "sample_period": None,
+}
+
+
+def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
+    """The full option dict for the Rust side; unknown keys are an error."""
+    unknown = sorted(set(options) - set(READ_DEFAULTS))
+    if unknown:
+        raise TypeError(
+            f"unknown log option(s) {', '.join(unknown)}; "
+            f"use {', '.join(READ_DEFAULTS)}"
+        )
+    out = dict(READ_DEFAULTS)
+    out.update(options)
+    for k in ("time_col", "gyro_col", "temp_col", "table_col", "gyro_unit"):
+        out[k] = str(out[k])
+    for k in ("fill_gaps", "sample_period"):
+        if out[k] is not None:
+            out[k] = float(out[k])
+    return out
+
+
+def _pandas():
+    try:
+        import pandas  # noqa: F401
+    except ImportError:
+        return None
+    return pandas
+
+
+def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any):
+    """Read and validate a test log (CSV) as ``gyrotherm`` commands do.
+
+    Columns come back in °/s (``gyro_unit`` converts), s and °C under the standard names
+    ``time_s``, ``gyro_dps``, ``temp_c`` (and ``table_dps`` for a rate-table log), whatever
+    they are called in the file; pass-through columns keep their names (numeric ones as float
+    arrays). Options: ``time_col``, ``gyro_col``, ``temp_col``, ``table_col``,
+    ``gyro_unit`` (``"dps"``, ``"dph"``, ``"rad/s"``), ``fill_gaps`` (max gap in s to
+    interpolate), ``sample_period`` (s).
+
+    Returns a pandas DataFrame when pandas is installed (``as_frame=None``, the default) or
+    ``as_frame=True``, else a dict of numpy arrays. The DataFrame's ``attrs`` hold the read
+    report (rows, filled samples and gaps, sample period).
+    Raises ``gyrotherm.LogError`` naming file, line and column.
+    """
+    cols, report = _g.read_log(os.fspath(path), read_options(options))
+    pd = _pandas()
+    if as_frame is None:
+        as_frame = pd is not None
+    if not as_frame:
+        return cols
+    if pd is None:
+        raise ImportError("read_log(as_frame=True) needs pandas; pip install pandas")
+    df = pd.DataFrame({k: (v if isinstance(v, np.ndarray) else list(v)) for k, v in cols.items()})
+    df.attrs.update(report)
+    return df
+
+
+def columns(log, names):
+    """Arrays ``names`` from a dict or DataFrame returned by :func:`read_log`."""
+    out = []
+    for n in names:
+        try:
+            v = log[n]
+        except KeyError:
+            raise KeyError(f"the log has no column {n!r}") from None
+        out.append(np.ascontiguousarray(v, dtype=np.float64))
+    return out

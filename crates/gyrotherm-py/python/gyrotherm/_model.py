@@ -1,0 +1,218 @@
+"""Fitting, model files and compensation: the CLI's ``train`` and ``compensate``."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+import warnings
+from typing import Any, Callable, Dict, Iterable, NamedTuple, Optional, Union
+
+import numpy as np
+
+from . import _gyrotherm as _g
+from ._logs import read_options
+
+PathLike = Union[str, "os.PathLike[str]"]
+Progress = Union[bool, Callable[[str, int, float], Any], None]
+
+#: Per-sample status codes of :meth:`Model.compensate` (the flight compensator's): ok, held
+#: (temperature rejected, B and K held), degraded (no good temperature for too long),
+#: invalid (gyro sample not finite: no rate).
+STATUS_NAMES: Dict[int, str] = dict(_g.STATUS_NAMES)
+
+
+class GyrothermWarning(UserWarning):
+    """The model extrapolates: temperature or its rate leaves the training range."""
+
+
+class Compensation(NamedTuple):
+    """Compensated samples, one value per input sample."""
+
+    bias_dps: np.ndarray
+    """Predicted bias B, °/s."""
+    scale: np.ndarray
+    """Predicted scale factor K (output °/s per input °/s)."""
+    rate_dps: np.ndarray
+    """Compensated rate G = (Ĝ − B)/K, °/s."""
+    status: np.ndarray
+    """Status code per sample (uint8, see ``STATUS_NAMES``; 0 is ok)."""
+
+
+def _warn(messages: Iterable[str]) -> None:
+    for m in messages:
+        warnings.warn(m, GyrothermWarning, stacklevel=3)
+
+
+class Model:
+    """A fitted compensation model: the JSON file ``gyrotherm train`` writes and
+    ``gyrotherm compensate`` reads. Make one with :func:`fit` or :meth:`Model.load`."""
+
+    def __init__(self, raw: "_g.RawModel") -> None:
+        if not isinstance(raw, _g.RawModel):
+            raise TypeError("make a Model with gyrotherm.fit(...) or Model.load(path)")
+        self._raw = raw
+
+    @classmethod
+    def load(cls, path: PathLike) -> "Model":
+        """Read and check a model file (raises ``gyrotherm.ModelError``)."""
+        return cls(_g.RawModel.load(os.fspath(path)))
+
+    @classmethod
+    def from_json(cls, text: str) -> "Model":
+        """Parse and check model JSON text."""
+        return cls(_g.RawModel.from_json(text))
+
+    def save(self, path: PathLike) -> None:
+        """Write the model file (atomically; the same bytes as ``gyrotherm train``)."""
+        self._raw.save(os.fspath(path))
+
+    def to_json(self) -> str:
+        """The model file's text."""
+        return self._raw.to_json()
+
+    @property
+    def method(self) -> str:
+        """``"lstm"``, ``"linear"`` or ``"poly"``."""
+        return self._raw.method
+
+    @property
+    def bias_kind(self) -> Optional[str]:
+        """What the bias model is made of (None: no bias model)."""
+        return self._raw.bias_kind
+
+    @property
+    def scale_kind(self) -> Optional[str]:
+        """What the scale-factor model is made of (None: no scale-factor model)."""
+        return self._raw.scale_kind
+
+    @property
+    def training(self) -> Dict[str, Any]:
+        """Training facts from the file (ranges, digest, epochs, loss, seed, inputs)."""
+        return self._raw.training
+
+    def compensate(self, time_s, gyro_dps, temp_c) -> Compensation:
+        """Compensate samples (time s increasing, gyro output °/s, temperature °C) with the
+        flight compensator, sample by sample: the numbers ``gyrotherm compensate`` writes.
+        Warns (``GyrothermWarning``) where the temperature or its rate leaves the training
+        range. Every sample gets a status (``STATUS_NAMES``) instead of an exception."""
+        arrays = [np.ascontiguousarray(a, dtype=np.float64) for a in (time_s, gyro_dps, temp_c)]
+        for name, a in zip(("time_s", "gyro_dps", "temp_c"), arrays):
+            if a.ndim != 1:
+                raise _g.CompensationError(f"{name}: need a 1-D array, got shape {a.shape}")
+        bias, scale, rate, status, warns = self._raw.compensate(*arrays)
+        _warn(warns)
+        return Compensation(bias, scale, rate, status)
+
+    def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]:
+        """``gyrotherm compensate --input INPUT --out OUT`` with the same log options: every
+        input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps`` and ``status``. Returns
+        the rows written, the count per status and the extrapolation warnings (also issued as
+        warnings)."""
+        if options.get("fill_gaps") is not None:
+            raise _g.CompensationError(
+                "fill_gaps does not apply to compensate: the compensator bridges time gaps "
+                "itself and writes one output line per input line"
+            )
+        rows, ok, held, degraded, invalid, warns = self._raw.compensate_csv(
+            os.fspath(input), os.fspath(out), read_options(options)
+        )
+        _warn(warns)
+        return {"rows": rows, "ok": ok, "held": held, "degraded": degraded,
+                "invalid": invalid, "warnings": warns}
+
+    def summary(self) -> str:
+        """What the model is, what it was trained on, and (after :func:`fit`) how training
+        went."""
+        return self._raw.summary()
+
+    def __repr__(self) -> str:
+        return repr(self._raw)
+
+
+class _PrintProgress:
+    """``progress=True``: one line per target on stderr at most every 2 s, and the last."""
+
+    def __init__(self, epochs: Optional[int]) -> None:
+        self.epochs = epochs
+        self.last: Dict[str, float] = {}
+
+    def __call__(self, target: str, epoch: int, loss: float) -> None:
+        now = time.monotonic()
+        final = self.epochs is not None and epoch + 1 >= self.epochs
+        if not final and now - self.last.get(target, -1e9) < 2.0:
+            return
+        self.last[target] = now
+        total = f"/{self.epochs}" if self.epochs else ""
+        print(
+            f"gyrotherm: {target} epoch {epoch + 1}{total}, loss {loss:.4e}",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+def _paths(logs, what: str):
+    if logs is None:
+        return []
+    if isinstance(logs, (str, bytes)) or hasattr(logs, "__fspath__"):
+        logs = [logs]
+    out = []
+    for p in logs:
+        if not (isinstance(p, str) or hasattr(p, "__fspath__")):
+            raise TypeError(f"{what}: give paths of CSV logs, got {type(p).__name__}")
+        out.append(os.fspath(p))
+    return out
+
+
+def fit(
+    static: Union[PathLike, Iterable[PathLike], None] = (),
+    table: Union[PathLike, Iterable[PathLike], None] = (),
+    method: str = "lstm",
+    recipe: str = "residual",
+    *,
+    epochs: Optional[int] = None,
+    seed: int = 0,
+    bias_window: Optional[float] = None,
+    settle: Optional[float] = None,
+    poly_temp_degree: int = 3,
+    poly_rate_degree: int = 1,
+    cross: bool = True,
+    validate_on_runs: bool = False,
+    progress: Progress = False,
+    **log_options: Any,
+) -> Model:
+    """Fit a compensation model, as ``gyrotherm train --input S… --input T… --method …``.
+
+    ``static``: static logs (bias model); ``table``: rate-table logs (scale-factor model).
+    ``method``: ``"lstm"`` (recipe ``"residual"``, ``"generic"``, ``"direct"`` or
+    ``"published"``), ``"linear"`` or ``"poly"``. ``bias_window``/``settle`` default to the
+    CLI's (100 s / 10 s). ``progress``: True prints epochs and loss to stderr; a callable gets
+    ``(target, epoch, loss)``. Log options (``time_col``, ``gyro_unit``, ``fill_gaps`` …)
+    apply to every log. The GIL is released while reading and training.
+    """
+    static_paths = _paths(static, "static")
+    table_paths = _paths(table, "table")
+    if not static_paths and not table_paths:
+        raise _g.FitError("no training logs given; pass static=[...] and/or table=[...]")
+    settings = {
+        "method": str(method),
+        "recipe": str(recipe),
+        "epochs": None if epochs is None else int(epochs),
+        "seed": int(seed),
+        "bias_window": float(_g.BIAS_WINDOW_S if bias_window is None else bias_window),
+        "settle": float(_g.SETTLE_S if settle is None else settle),
+        "poly_temp_degree": int(poly_temp_degree),
+        "poly_rate_degree": int(poly_rate_degree),
+        "cross": bool(cross),
+        "validate_on_runs": bool(validate_on_runs),
+    }
+    if progress is True:
+        callback = _PrintProgress(epochs)
+    elif progress is False or progress is None:
+        callback = None
+    elif callable(progress):
+        callback = progress
+    else:
+        raise TypeError("progress: give True, False or a callable(target, epoch, loss)")
+    raw = _g.fit(static_paths, table_paths, settings, read_options(log_options), callback)
+    return Model(raw)

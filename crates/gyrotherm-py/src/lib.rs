@@ -1,0 +1,93 @@
+//! `gyrotherm._gyrotherm`: the compiled half of the Python package `gyrotherm`.
+//!
+//! Thin bindings over the ground library: every function here converts arguments, calls one
+//! library function with the GIL released, and converts the result or the error. The
+//! Python half (`python/gyrotherm/`) holds what is Python-specific: the allantools τ
+//! generator and tuple layout, pandas, warnings and progress printing.
+//!
+//! Errors become exceptions derived from `gyrotherm.GyrothermError` (a `ValueError`) with the
+//! library's message, the one the CLI prints.
+
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+mod allan;
+mod figures;
+mod logs;
+mod model;
+
+create_exception!(
+    gyrotherm,
+    GyrothermError,
+    PyValueError,
+    "Base of every gyrotherm error; the message names the file, line and column where one is at fault, and what to do."
+);
+create_exception!(
+    gyrotherm,
+    LogError,
+    GyrothermError,
+    "A test log that cannot be read (file, line, column and the fix in the message)."
+);
+create_exception!(
+    gyrotherm,
+    ModelError,
+    GyrothermError,
+    "A model file that cannot be read, written or used."
+);
+create_exception!(
+    gyrotherm,
+    AllanError,
+    GyrothermError,
+    "An Allan-family deviation that cannot be computed (data, rate or τ)."
+);
+create_exception!(
+    gyrotherm,
+    MetricsError,
+    GyrothermError,
+    "A gyro figure (bias stability, scale factor) that cannot be computed."
+);
+create_exception!(
+    gyrotherm,
+    FitError,
+    GyrothermError,
+    "A compensation model that cannot be fitted."
+);
+create_exception!(
+    gyrotherm,
+    CompensationError,
+    GyrothermError,
+    "A sample the compensator refuses (non-finite input, time not increasing)."
+);
+
+/// A Python exception of type `E` carrying a library error's message (what the CLI prints).
+pub(crate) fn py_err<E: pyo3::PyTypeInfo>(e: impl std::fmt::Display) -> PyErr {
+    PyErr::new::<E, _>(e.to_string())
+}
+
+#[pymodule]
+fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("GyrothermError", py.get_type::<GyrothermError>())?;
+    m.add("LogError", py.get_type::<LogError>())?;
+    m.add("ModelError", py.get_type::<ModelError>())?;
+    m.add("AllanError", py.get_type::<AllanError>())?;
+    m.add("MetricsError", py.get_type::<MetricsError>())?;
+    m.add("FitError", py.get_type::<FitError>())?;
+    m.add("CompensationError", py.get_type::<CompensationError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("ONE_SIGMA_CI", gyrotherm::allan::ONE_SIGMA_CI)?;
+    m.add("BIAS_WINDOW_S", gyrotherm::targets::BIAS_WINDOW_S)?;
+    m.add("SETTLE_S", gyrotherm::targets::SETTLE_S)?;
+    m.add(
+        "STATUS_NAMES",
+        model::status_names()
+            .into_iter()
+            .collect::<std::collections::BTreeMap<_, _>>(),
+    )?;
+    allan::register(m)?;
+    figures::register(m)?;
+    logs::register(m)?;
+    model::register(m)?;
+    Ok(())
+}

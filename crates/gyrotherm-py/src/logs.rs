@@ -1,0 +1,109 @@
+//! Test logs: reading with the CLI's column mapping, unit and gap options.
+
+use std::path::{Path, PathBuf};
+
+use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::LogError;
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read_log, m)?)?;
+    Ok(())
+}
+
+/// How to read a log; the Python side passes every key (its defaults are the CLI's).
+#[derive(Debug, Clone, FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct LogOptions {
+    pub time_col: String,
+    pub gyro_col: String,
+    pub temp_col: String,
+    pub table_col: String,
+    pub gyro_unit: String,
+    pub fill_gaps: Option<f64>,
+    pub sample_period: Option<f64>,
+}
+
+fn positive(name: &str, v: Option<f64>) -> PyResult<Option<f64>> {
+    match v {
+        Some(x) if !(x.is_finite() && x > 0.0) => Err(LogError::new_err(format!(
+            "{name} = {x} is not a positive number of seconds"
+        ))),
+        _ => Ok(v),
+    }
+}
+
+impl LogOptions {
+    /// The library's read options (the same mapping as the CLI's `--time-col` … flags).
+    pub fn read_options(&self) -> PyResult<ReadOptions> {
+        let gyro_unit: GyroUnit = self.gyro_unit.parse().map_err(LogError::new_err)?;
+        Ok(ReadOptions {
+            time_col: self.time_col.clone(),
+            gyro_col: self.gyro_col.clone(),
+            temp_col: self.temp_col.clone(),
+            table_col: self.table_col.clone(),
+            gyro_unit,
+            fill_gaps_max_s: positive("fill_gaps", self.fill_gaps)?,
+            sample_period_s: positive("sample_period", self.sample_period)?,
+        })
+    }
+}
+
+/// Read a whole log; the error is the library's message (file, line, column, the fix).
+pub fn read(path: &Path, opts: &ReadOptions) -> Result<(TestLog, csvlog::ReadReport), String> {
+    csvlog::read_log(path, opts).map_err(|e| e.to_string())
+}
+
+/// Read a log into a dict of numpy arrays (extra columns: float arrays when every value is a
+/// number, else lists of str) and a report dict.
+#[pyfunction]
+fn read_log<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    options: LogOptions,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+    let opts = options.read_options()?;
+    let (log, report) = py
+        .detach(|| read(&path, &opts))
+        .map_err(LogError::new_err)?;
+    let sample_period = log.sample_period_s();
+    let cols = PyDict::new(py);
+    let extras: Vec<(String, Option<Vec<f64>>, Vec<String>)> = log
+        .extra
+        .iter()
+        .map(|c| (c.name.clone(), log.extra_f64(&c.name), c.values.clone()))
+        .collect();
+    let TestLog {
+        time_s,
+        gyro_dps,
+        temp_c,
+        table_dps,
+        ..
+    } = log;
+    cols.set_item(csvlog::TIME_COL, time_s.into_pyarray(py))?;
+    cols.set_item(csvlog::GYRO_COL, gyro_dps.into_pyarray(py))?;
+    cols.set_item(csvlog::TEMP_COL, temp_c.into_pyarray(py))?;
+    if let Some(t) = table_dps {
+        cols.set_item(csvlog::DEFAULT_TABLE_COL, t.into_pyarray(py))?;
+    }
+    for (name, numeric, text) in extras {
+        match numeric {
+            Some(v) => cols.set_item(name, v.into_pyarray(py))?,
+            None => cols.set_item(name, text)?,
+        }
+    }
+    let rep = PyDict::new(py);
+    rep.set_item("rows", report.rows)?;
+    rep.set_item("filled_samples", report.filled_samples)?;
+    rep.set_item("filled_gaps", report.filled_gaps)?;
+    rep.set_item(
+        "sample_period_s",
+        sample_period.is_finite().then_some(sample_period),
+    )?;
+    rep.set_item("sample_period_estimated", report.sample_period_estimated)?;
+    rep.set_item("path", path.display().to_string())?;
+    Ok((cols, rep))
+}

@@ -1,0 +1,449 @@
+//! Fitting and model files: `fit` (the CLI's `train`), the model file (the CLI's JSON), and
+//! compensation with the flight compensator (the CLI's `compensate`).
+
+use std::io::{BufWriter, Write as _};
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
+use gyrotherm::compensate_lines::{compensate_lines, LinesError, Mode};
+use gyrotherm::csvlog::TestLog;
+use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, LstmVerdict, NamedLog, Target};
+use gyrotherm::model::{Method, ModelFile};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::allan::slice;
+use crate::logs::{read, LogOptions};
+use crate::{py_err, CompensationError, FitError, LogError, ModelError};
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<RawModel>()?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    Ok(())
+}
+
+/// A model file in memory, with what training said when it came from `fit`.
+#[pyclass(module = "gyrotherm._gyrotherm", name = "RawModel", frozen)]
+pub struct RawModel {
+    file: ModelFile,
+    /// One line per fitted target (LSTM epochs, loss and verdict), from `fit` only.
+    training_notes: Vec<String>,
+}
+
+fn model_err(e: impl std::fmt::Display) -> PyErr {
+    ModelError::new_err(e.to_string())
+}
+
+type Compensated<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<u8>>,
+    Vec<String>,
+);
+
+#[pymethods]
+impl RawModel {
+    /// Read and check a model file.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<RawModel> {
+        let file = py.detach(|| ModelFile::load(&path)).map_err(model_err)?;
+        Ok(RawModel {
+            file,
+            training_notes: Vec::new(),
+        })
+    }
+
+    /// Parse and check model JSON text.
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<RawModel> {
+        let file = ModelFile::from_json(text).map_err(py_err::<ModelError>)?;
+        Ok(RawModel {
+            file,
+            training_notes: Vec::new(),
+        })
+    }
+
+    /// Write the model file atomically (the bytes `gyrotherm train` writes).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| self.file.save(&path)).map_err(model_err)
+    }
+
+    fn to_json(&self) -> PyResult<String> {
+        let mut text = self.file.to_json().map_err(py_err::<ModelError>)?;
+        text.push('\n');
+        Ok(text)
+    }
+
+    #[getter]
+    fn method(&self) -> &'static str {
+        self.file.method.as_str()
+    }
+
+    #[getter]
+    fn bias_kind(&self) -> Option<&'static str> {
+        self.file.bias.as_ref().map(|s| s.kind())
+    }
+
+    #[getter]
+    fn scale_kind(&self) -> Option<&'static str> {
+        self.file.scale.as_ref().map(|s| s.kind())
+    }
+
+    #[getter]
+    fn training_notes(&self) -> Vec<String> {
+        self.training_notes.clone()
+    }
+
+    /// Training facts of the file as a dict.
+    #[getter]
+    fn training<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let t = &self.file.training;
+        let d = PyDict::new(py);
+        d.set_item("temp_range_c", (t.temp_range_c.min, t.temp_range_c.max))?;
+        d.set_item(
+            "rate_range_c_per_s",
+            (t.rate_range_c_per_s.min, t.rate_range_c_per_s.max),
+        )?;
+        d.set_item("data_digest_sha256", &t.data_digest_sha256)?;
+        d.set_item("epochs", t.epochs)?;
+        d.set_item("final_loss", t.final_loss)?;
+        d.set_item("seed", t.seed)?;
+        d.set_item("created_by", &t.created_by)?;
+        d.set_item("inputs", PyList::new(py, &t.inputs)?)?;
+        Ok(d)
+    }
+
+    /// Compensate arrays sample by sample with the flight compensator: (bias °/s, scale,
+    /// compensated rate °/s, status, extrapolation warnings).
+    fn compensate<'py>(
+        &self,
+        py: Python<'py>,
+        time_s: PyReadonlyArray1<'py, f64>,
+        gyro_dps: PyReadonlyArray1<'py, f64>,
+        temp_c: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Compensated<'py>> {
+        let (t, g, c) = (
+            slice(&time_s, "time_s")?,
+            slice(&gyro_dps, "gyro_dps")?,
+            slice(&temp_c, "temp_c")?,
+        );
+        if t.len() != g.len() || t.len() != c.len() {
+            return Err(CompensationError::new_err(format!(
+                "time_s, gyro_dps and temp_c differ in length ({}, {}, {}); give one value per sample in each",
+                t.len(),
+                g.len(),
+                c.len()
+            )));
+        }
+        let log = TestLog {
+            time_s: t.to_vec(),
+            gyro_dps: g.to_vec(),
+            temp_c: c.to_vec(),
+            ..Default::default()
+        };
+        let (out, warnings) = py
+            .detach(|| {
+                compensate_with_status(&self.file, &log)
+                    .map(|out| (out, extrapolation_warnings(&self.file, &log)))
+            })
+            .map_err(py_err::<CompensationError>)?;
+        let (bias, scale, rate, status) = out;
+        Ok((
+            bias.into_pyarray(py),
+            scale.into_pyarray(py),
+            rate.into_pyarray(py),
+            status.into_pyarray(py),
+            warnings,
+        ))
+    }
+
+    /// Compensate a CSV log into a CSV file exactly as `gyrotherm compensate --input --out`
+    /// does (same code, same bytes); returns (rows, ok, held, degraded, invalid, warnings).
+    fn compensate_csv(
+        &self,
+        py: Python<'_>,
+        input: PathBuf,
+        out: PathBuf,
+        options: LogOptions,
+    ) -> PyResult<(u64, u64, u64, u64, u64, Vec<String>)> {
+        let opts = options.read_options()?;
+        let summary = py.detach(|| -> Result<_, String> {
+            let file = std::fs::File::open(&input)
+                .map_err(|e| format!("cannot open {}: {e}", input.display()))?;
+            gyrotherm::atomic_file::write_atomically(&out, |w: &mut BufWriter<std::fs::File>| {
+                let s = compensate_lines(
+                    &self.file,
+                    std::io::BufReader::new(&file),
+                    &input,
+                    &opts,
+                    &mut *w,
+                    Mode::Strict,
+                    false,
+                )?;
+                w.flush()?;
+                Ok::<_, LinesError>(s)
+            })
+            .map_err(|e| match e {
+                LinesError::Io(io) => format!("cannot compensate into {}: {io}", out.display()),
+                other => other.to_string(),
+            })
+        });
+        let s = summary.map_err(CompensationError::new_err)?;
+        Ok((s.rows, s.ok, s.held, s.degraded, s.invalid, s.warnings))
+    }
+
+    /// A human-readable description of the model.
+    fn summary(&self) -> PyResult<String> {
+        let m = &self.file;
+        let t = &m.training;
+        let spec = m.feature_spec().map_err(py_err::<ModelError>)?;
+        let mut s = format!(
+            "gyrotherm model (format {}, method {})\n",
+            m.format_version,
+            m.method.as_str()
+        );
+        s += &format!(
+            "  bias model: {}\n  scale-factor model: {}\n",
+            m.bias.as_ref().map_or("none (no static log)", |b| b.kind()),
+            m.scale
+                .as_ref()
+                .map_or("none (no rate-table log)", |b| b.kind())
+        );
+        s += &format!(
+            "  inputs: {} features, stepped every {} s (rate lag {} s)\n",
+            spec.n_features(),
+            m.features.step_period_s,
+            m.features.rate_lag_s
+        );
+        s += &format!(
+            "  training range: temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min\n",
+            t.temp_range_c.min,
+            t.temp_range_c.max,
+            t.rate_range_c_per_s.min * 60.0,
+            t.rate_range_c_per_s.max * 60.0
+        );
+        if let Some(e) = t.epochs {
+            s += &format!("  epochs: {e}\n");
+        }
+        if let Some(l) = t.final_loss {
+            s += &format!("  final loss: {l:.4e}\n");
+        }
+        if let Some(seed) = t.seed {
+            s += &format!("  seed: {seed}\n");
+        }
+        s += &format!(
+            "  trained on: {}\n  written by: {}\n",
+            t.inputs.join(", "),
+            t.created_by
+        );
+        for n in &self.training_notes {
+            s += &format!("  {n}\n");
+        }
+        Ok(s)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Model(method={:?}, bias={:?}, scale={:?})",
+            self.file.method.as_str(),
+            self.file.bias.as_ref().map(|s| s.kind()),
+            self.file.scale.as_ref().map(|s| s.kind())
+        )
+    }
+}
+
+type Columns = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<u8>);
+
+/// `compensate_log` with each sample's status code (`Status as u8`): the same flight
+/// compensator stepped over the same samples.
+fn compensate_with_status(model: &ModelFile, log: &TestLog) -> Result<Columns, CompensateError> {
+    let mut comp = compensator(model)?;
+    let n = log.len();
+    let mut out: Columns = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    for i in 0..n {
+        let c = comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
+        out.0.push(c.bias_dps);
+        out.1.push(c.scale);
+        out.2.push(c.rate_dps);
+        out.3.push(c.status as u8);
+    }
+    Ok(out)
+}
+
+/// Status code → name, as in the `status` column of the CLI's streaming output.
+pub fn status_names() -> Vec<(u8, &'static str)> {
+    use gyrotherm_core::compensator::Status;
+    [Status::Ok, Status::Held, Status::Degraded, Status::Invalid]
+        .into_iter()
+        .map(|s| (s as u8, s.as_str()))
+        .collect()
+}
+
+fn parse_method(name: &str) -> PyResult<Method> {
+    match name {
+        "lstm" => Ok(Method::Lstm),
+        "linear" => Ok(Method::Linear),
+        "poly" => Ok(Method::Poly),
+        other => Err(FitError::new_err(format!(
+            "unknown method {other:?}; use lstm, linear or poly"
+        ))),
+    }
+}
+
+/// Fitting settings; the Python side passes every key (defaults are the CLI's).
+#[derive(Debug, Clone, FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct FitSettings {
+    method: String,
+    recipe: String,
+    epochs: Option<usize>,
+    seed: u64,
+    bias_window: f64,
+    settle: f64,
+    poly_temp_degree: u8,
+    poly_rate_degree: u8,
+    cross: bool,
+    validate_on_runs: bool,
+}
+
+impl FitSettings {
+    /// The same checks and mapping as the CLI's `FitArgs::fit_config`.
+    fn config(&self) -> PyResult<FitConfig> {
+        let mut cfg = FitConfig::new(parse_method(&self.method)?);
+        let kind = gyrotherm::RecipeKind::parse(&self.recipe).map_err(py_err::<FitError>)?;
+        cfg.recipe = LstmRecipe::of_kind(kind);
+        if let Some(e) = self.epochs {
+            if e == 0 {
+                return Err(FitError::new_err("epochs must be at least 1"));
+            }
+            cfg.recipe.epochs = e;
+        }
+        if !(self.bias_window.is_finite() && self.bias_window > 0.0) {
+            return Err(FitError::new_err(
+                "bias_window must be a positive number of seconds",
+            ));
+        }
+        if !(self.settle.is_finite() && self.settle >= 0.0) {
+            return Err(FitError::new_err(
+                "settle must be zero or a positive number of seconds",
+            ));
+        }
+        cfg.seed = self.seed;
+        cfg.bias_window_s = self.bias_window;
+        cfg.settle_s = self.settle;
+        cfg.poly.temp = self.poly_temp_degree;
+        cfg.poly.rate = self.poly_rate_degree;
+        cfg.poly.cross = self.cross;
+        cfg.recipe.validate_on_runs = self.validate_on_runs;
+        Ok(cfg)
+    }
+}
+
+fn verdict_text(v: LstmVerdict) -> &'static str {
+    match v {
+        LstmVerdict::Kept => "kept",
+        LstmVerdict::LeftOut {
+            validation_blocks: true,
+            left_out_runs: true,
+        } => "left out: it beat the least-squares base neither on the validation blocks nor on every left-out run",
+        LstmVerdict::LeftOut {
+            validation_blocks: true,
+            left_out_runs: false,
+        } => "left out: it did not beat the least-squares base on the validation blocks",
+        LstmVerdict::LeftOut {
+            validation_blocks: false,
+            left_out_runs: true,
+        } => "left out: it did not beat the least-squares base on every left-out run",
+        LstmVerdict::LeftOut {
+            validation_blocks: false,
+            left_out_runs: false,
+        } => "left out: its correction fitted none of the validation residual",
+    }
+}
+
+/// Fit a model to logs: `static_logs` train the bias model, `table_logs` the scale-factor
+/// model (in that order, as `train --input S… --input T…`). `progress(target, epoch, loss)`
+/// is called with the GIL taken, from the training threads.
+#[pyfunction]
+#[pyo3(signature = (static_logs, table_logs, settings, options, progress=None))]
+fn fit(
+    py: Python<'_>,
+    static_logs: Vec<PathBuf>,
+    table_logs: Vec<PathBuf>,
+    settings: FitSettings,
+    options: LogOptions,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<RawModel> {
+    let cfg = settings.config()?;
+    let opts = options.read_options()?;
+    let failed: Mutex<Option<PyErr>> = Mutex::new(None);
+    let result = py.detach(|| -> Result<_, PyErr> {
+        let mut logs: Vec<(String, TestLog)> = Vec::new();
+        for (paths, want_static) in [(&static_logs, true), (&table_logs, false)] {
+            for p in paths {
+                let (log, _) = read(p, &opts).map_err(LogError::new_err)?;
+                let name = p.display().to_string();
+                let is_static = gyrotherm::targets::is_static(&log);
+                if want_static && !is_static {
+                    return Err(FitError::new_err(format!(
+                        "{name}: given as a static log but its {} column has non-zero rates; pass it in table=[...]",
+                        opts.table_col
+                    )));
+                }
+                if !want_static && is_static {
+                    return Err(FitError::new_err(format!(
+                        "{name}: given as a rate-table log but it has no non-zero {} rate; pass it in static=[...]",
+                        opts.table_col
+                    )));
+                }
+                logs.push((name, log));
+            }
+        }
+        let named: Vec<NamedLog> = logs
+            .iter()
+            .map(|(n, l)| NamedLog { name: n, log: l })
+            .collect();
+        let report = |t: Target, epoch: usize, loss: f64| {
+            let Some(cb) = &progress else { return };
+            Python::attach(|py| {
+                if let Err(e) = cb.call1(py, (t.as_str(), epoch, loss)) {
+                    let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
+                    slot.get_or_insert(e);
+                }
+            });
+        };
+        let outcome = fit_model(&named, &cfg, &report)
+            .map_err(|e| FitError::new_err(format!("training failed: {e}")))?;
+        Ok(outcome)
+    })?;
+    if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
+    let mut notes = Vec::new();
+    for (name, sub, t) in [
+        ("bias", &result.model.bias, &result.bias_training),
+        ("scale factor", &result.model.scale, &result.scale_training),
+    ] {
+        let Some(sub) = sub else { continue };
+        let mut line = format!("{name} model: {}", sub.kind());
+        if let Some(t) = t {
+            line += &format!(", {} epochs, final loss {:.4e}", t.epochs, t.final_loss);
+            if let Some(v) = t.lstm_verdict {
+                line += &format!("; LSTM {}", verdict_text(v));
+            }
+        }
+        notes.push(line);
+    }
+    Ok(RawModel {
+        file: result.model,
+        training_notes: notes,
+    })
+}

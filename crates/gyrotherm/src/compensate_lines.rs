@@ -1,0 +1,415 @@
+//! Compensate a CSV log line by line, with a status per line: what `gyrotherm compensate`
+//! and `compensate --stream` run.
+//!
+//! One output line per input data line (comment lines starting with `#` and blank lines are
+//! not data lines and are dropped): every input field as it was, then `bias_dps`, `scale`,
+//! `gyro_comp_dps` (°/s) and `status` (`ok`, `held`, `degraded`, `invalid`; see
+//! [`gyrotherm_core::compensator`]). The flight [`Compensator`](gyrotherm_core::Compensator)
+//! runs sample by sample, so the numbers are those of flight code.
+//!
+//! Temperature faults never stop the run: an empty, non-numeric, NaN or implausible temperature
+//! is handed to the compensator as a fault and the line is `held` (or `degraded`). A gyro field
+//! that is NaN or infinite gives `invalid` with an empty `gyro_comp_dps`. Malformed lines
+//! (wrong field count, a time or gyro field that is not a number, time not increasing) depend
+//! on the [`Mode`]: [`Mode::Strict`] (batch files) stops with an error naming the file, line
+//! and column; [`Mode::Stream`] writes the line as `invalid` (its fields, or empty fields when
+//! their count is wrong, and empty outputs) and reads the next line, except a time that does
+//! not increase, which the compensator holds (`held`: the sample cannot be placed in time). Time gaps are bridged by
+//! the compensator (no gap filling, no period estimate: the first output line follows the first
+//! input line at once). Quoted fields may hold commas and quotes but not line breaks.
+
+use std::io::{BufRead, Write};
+use std::path::Path;
+
+use gyrotherm_core::compensator::{Corrected, Status};
+
+use crate::csvlog::{GyroUnit, LogError, LogErrorKind, LogReader, LogWriter, ReadOptions};
+use crate::model::ModelFile;
+
+/// Columns appended to every row, in order.
+pub const OUTPUT_COLUMNS: [&str; 4] = ["bias_dps", "scale", "gyro_comp_dps", "status"];
+
+/// What to do with a malformed line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Stop with an error (batch files: the file is to be fixed).
+    Strict,
+    /// Write it as `invalid` and go on (a live feed must never stop).
+    Stream,
+}
+
+/// Counts of a run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LinesSummary {
+    /// Data lines written (= data lines read).
+    pub rows: u64,
+    /// Lines per status: ok, held, degraded, invalid (malformed lines included).
+    pub ok: u64,
+    pub held: u64,
+    pub degraded: u64,
+    pub invalid: u64,
+    /// Malformed lines written as invalid ([`Mode::Stream`] only).
+    pub malformed: u64,
+    /// Extrapolation warnings (temperature or its rate outside the training range).
+    pub warnings: Vec<String>,
+}
+
+impl LinesSummary {
+    fn count(&mut self, s: Status) {
+        match s {
+            Status::Ok => self.ok += 1,
+            Status::Held => self.held += 1,
+            Status::Degraded => self.degraded += 1,
+            Status::Invalid => self.invalid += 1,
+        }
+    }
+
+    /// `N lines: ok a, held b, degraded c, invalid d (m malformed)`.
+    pub fn describe(&self) -> String {
+        let mut s = format!(
+            "{} lines: ok {}, held {}, degraded {}, invalid {}",
+            self.rows, self.ok, self.held, self.degraded, self.invalid
+        );
+        if self.malformed > 0 {
+            s.push_str(&format!(" ({} malformed)", self.malformed));
+        }
+        s
+    }
+}
+
+/// Why a run stopped.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum LinesError {
+    /// The model cannot be turned into a compensator.
+    Model(crate::compensate::CompensateError),
+    /// The input (header, or a malformed line in [`Mode::Strict`]): file, line, column, fix.
+    Log(LogError),
+    /// Reading the input or writing the output failed.
+    Io(std::io::Error),
+}
+
+impl std::fmt::Display for LinesError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LinesError::Model(m) => write!(f, "model: {m}"),
+            LinesError::Log(e) => write!(f, "{e}"),
+            LinesError::Io(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for LinesError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            LinesError::Io(e) => Some(e),
+            LinesError::Log(e) => Some(e),
+            LinesError::Model(e) => Some(e),
+        }
+    }
+}
+
+impl From<std::io::Error> for LinesError {
+    fn from(e: std::io::Error) -> Self {
+        LinesError::Io(e)
+    }
+}
+
+/// The fields of one CSV line, as byte ranges: into the line itself when it holds no quote
+/// (the usual log line: no copy), else into `buf`, which holds the unquoted fields. Reused
+/// from line to line, so a steady stream allocates nothing.
+#[derive(Default)]
+struct Fields {
+    ranges: Vec<std::ops::Range<usize>>,
+    buf: Vec<u8>,
+    quoted: bool,
+}
+
+impl Fields {
+    /// Split `line`; false on a broken quote.
+    fn split(&mut self, line: &[u8]) -> bool {
+        self.ranges.clear();
+        self.quoted = line.contains(&b'"');
+        if !self.quoted {
+            let mut start = 0;
+            for (i, &b) in line.iter().enumerate() {
+                if b == b',' {
+                    self.ranges.push(start..i);
+                    start = i + 1;
+                }
+            }
+            self.ranges.push(start..line.len());
+            return true;
+        }
+        self.buf.clear();
+        let mut start = 0;
+        let mut quoted = false;
+        let mut at_start = true;
+        let mut i = 0;
+        while i < line.len() {
+            let b = line[i];
+            if quoted {
+                if b == b'"' {
+                    if line.get(i + 1) == Some(&b'"') {
+                        self.buf.push(b'"');
+                        i += 1;
+                    } else {
+                        quoted = false;
+                    }
+                } else {
+                    self.buf.push(b);
+                }
+            } else if b == b',' {
+                self.ranges.push(start..self.buf.len());
+                start = self.buf.len();
+                at_start = true;
+                i += 1;
+                continue;
+            } else if b == b'"' && at_start {
+                quoted = true;
+            } else {
+                self.buf.push(b);
+            }
+            at_start = false;
+            i += 1;
+        }
+        self.ranges.push(start..self.buf.len());
+        !quoted
+    }
+
+    fn len(&self) -> usize {
+        self.ranges.len()
+    }
+
+    /// Field `k` of `line` (the line last split), empty past the end.
+    fn get<'a>(&'a self, line: &'a [u8], k: usize) -> &'a [u8] {
+        let src = if self.quoted { &self.buf[..] } else { line };
+        self.ranges
+            .get(k)
+            .and_then(|r| src.get(r.clone()))
+            .unwrap_or(&[])
+    }
+}
+
+/// A numeric field (ASCII spaces around it allowed), as the log reader parses it.
+fn parse_number(raw: &[u8]) -> Option<f64> {
+    std::str::from_utf8(raw.trim_ascii()).ok()?.parse().ok()
+}
+
+/// Compensate `input` (CSV with a header) into `output`; see the module doc. `source` names
+/// the input in errors. With `flush_each_row` every line is flushed as soon as it is written.
+pub fn compensate_lines<R: BufRead, W: Write>(
+    model: &ModelFile,
+    mut input: R,
+    source: &Path,
+    opts: &ReadOptions,
+    output: W,
+    mode: Mode,
+    flush_each_row: bool,
+) -> Result<LinesSummary, LinesError> {
+    let mut comp = crate::compensate::compensator(model).map_err(LinesError::Model)?;
+    // Header: everything up to the first line that is neither blank nor a comment, checked by
+    // the log reader (column mapping and its messages).
+    let mut head = Vec::new();
+    let mut line_no = 0u64;
+    let mut buf = Vec::new();
+    loop {
+        buf.clear();
+        if input.read_until(b'\n', &mut buf)? == 0 {
+            break;
+        }
+        line_no += 1;
+        head.extend_from_slice(&buf);
+        let t = buf.trim_ascii();
+        if !t.is_empty() && !t.starts_with(b"#") {
+            break;
+        }
+    }
+    let headers: Vec<String> = {
+        let r = LogReader::new(&head[..], source, opts).map_err(LinesError::Log)?;
+        r.headers().to_vec()
+    };
+    let col = |name: &str| headers.iter().position(|h| h == name);
+    let (Some(ti), Some(gi), Some(ci)) = (
+        col(&opts.time_col),
+        col(&opts.gyro_col),
+        col(&opts.temp_col),
+    ) else {
+        // The log reader checked the mapping above; this cannot happen.
+        return Err(LinesError::Log(LogError::new(
+            LogErrorKind::MissingColumn,
+            source,
+            Some(line_no),
+            None,
+            "a mapped column is missing from the header",
+        )));
+    };
+    let gyro_scale = match opts.gyro_unit {
+        GyroUnit::Dps => 1.0,
+        GyroUnit::Dph => 1.0 / 3600.0,
+        GyroUnit::RadPerS => 180.0 / std::f64::consts::PI,
+    };
+    let mut writer = LogWriter::new(
+        output,
+        headers.iter().map(String::as_str).chain(OUTPUT_COLUMNS),
+    )?;
+    writer.set_flush_each_row(flush_each_row);
+    let err = |kind, line, column: Option<&str>, message: String| {
+        LinesError::Log(LogError::new(kind, source, Some(line), column, message))
+    };
+    let mut summary = LinesSummary::default();
+    let mut fields = Fields::default();
+    let mut last_time: Option<(f64, u64)> = None;
+    let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
+    loop {
+        buf.clear();
+        if input.read_until(b'\n', &mut buf)? == 0 {
+            break;
+        }
+        line_no += 1;
+        let line = buf.strip_suffix(b"\n").unwrap_or(&buf);
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let trimmed = line.trim_ascii();
+        if trimmed.is_empty() || trimmed.starts_with(b"#") {
+            continue;
+        }
+        summary.rows += 1;
+        // Parse; `None` is a malformed line (with the reason for strict mode).
+        let parsed: Result<(f64, f64, f64), LinesError> = (|| {
+            if !fields.split(line) || fields.len() != headers.len() {
+                return Err(err(
+                    LogErrorKind::FieldCount,
+                    line_no,
+                    None,
+                    format!(
+                        "{} fields, but the header has {}; fix the line (a missing or extra \
+                         ',') or comment it out with '#'",
+                        fields.len(),
+                        headers.len()
+                    ),
+                ));
+            }
+            let time_s = match parse_number(fields.get(line, ti)) {
+                Some(t) if t.is_finite() => t,
+                _ => {
+                    return Err(err(
+                        LogErrorKind::NotANumber,
+                        line_no,
+                        Some(&headers[ti]),
+                        format!(
+                            "{:?} is not a finite time; fix the value or comment the line out \
+                             with '#'",
+                            String::from_utf8_lossy(fields.get(line, ti))
+                        ),
+                    ))
+                }
+            };
+            if let (Some((t0, line0)), Mode::Strict) = (last_time, mode) {
+                if time_s <= t0 {
+                    return Err(err(
+                        LogErrorKind::TimeNotIncreasing,
+                        line_no,
+                        Some(&headers[ti]),
+                        format!(
+                            "time is not strictly increasing: {time_s} s comes after {t0} s \
+                             (line {line0}); sort the log by time or remove the row"
+                        ),
+                    ));
+                }
+            }
+            let gyro = match parse_number(fields.get(line, gi)) {
+                Some(g) => g * gyro_scale,
+                None => {
+                    return Err(err(
+                        LogErrorKind::NotANumber,
+                        line_no,
+                        Some(&headers[gi]),
+                        format!(
+                            "{:?} is not a number; fix the value or comment the line out \
+                             with '#'",
+                            String::from_utf8_lossy(fields.get(line, gi))
+                        ),
+                    ))
+                }
+            };
+            // A temperature that is not a number is a sensor fault: NaN, held.
+            let temp = parse_number(fields.get(line, ci)).unwrap_or(f64::NAN);
+            Ok((time_s, gyro, temp))
+        })();
+        let c: Option<Corrected> = match parsed {
+            Ok((t, g, temp)) => {
+                last_time = Some((t, line_no));
+                Some(comp.step(t, g, temp))
+            }
+            Err(e) if mode == Mode::Strict => return Err(e),
+            Err(_) => None,
+        };
+        match c {
+            Some(c) => {
+                for k in 0..fields.len() {
+                    writer.push_raw(fields.get(line, k));
+                }
+                writer.push_f64(c.bias_dps);
+                writer.push_f64(c.scale);
+                match c.rate() {
+                    Some(r) => writer.push_f64(r),
+                    None => writer.push_raw(b""),
+                }
+                writer.push_raw(c.status.as_str().as_bytes());
+                summary.count(c.status);
+                if c.status == Status::Ok {
+                    if let Some([t, r, ..]) = comp.features().map(|f| f.as_slice()) {
+                        temp_seen = (temp_seen.0.min(*t), temp_seen.1.max(*t));
+                        rate_seen = (rate_seen.0.min(*r), rate_seen.1.max(*r));
+                    }
+                }
+            }
+            None => {
+                let keep = fields.len() == headers.len();
+                for k in 0..headers.len() {
+                    writer.push_raw(if keep { fields.get(line, k) } else { b"" });
+                }
+                for _ in 0..3 {
+                    writer.push_raw(b"");
+                }
+                writer.push_raw(Status::Invalid.as_str().as_bytes());
+                summary.count(Status::Invalid);
+                summary.malformed += 1;
+            }
+        }
+        writer.end_row()?;
+    }
+    writer.flush()?;
+    if summary.rows == 0 {
+        return Err(err(
+            LogErrorKind::NoData,
+            line_no,
+            None,
+            "no data rows after the header; the log is empty or holds only comments".into(),
+        ));
+    }
+    if temp_seen.0 <= temp_seen.1 {
+        summary.warnings = crate::compensate::range_warnings(model, temp_seen, rate_seen);
+    }
+    Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Fields;
+
+    #[test]
+    fn splits_plain_and_quoted_fields() {
+        let mut f = Fields::default();
+        let line = br#"1,"a,""b""",,x"#;
+        assert!(f.split(line));
+        let got: Vec<&[u8]> = (0..f.len()).map(|k| f.get(line, k)).collect();
+        assert_eq!(got, [&b"1"[..], b"a,\"b\"", b"", b"x"]);
+        let line = b"0.5,1e-3,,NaN";
+        assert!(f.split(line));
+        let got: Vec<&[u8]> = (0..f.len()).map(|k| f.get(line, k)).collect();
+        assert_eq!(got, [&b"0.5"[..], b"1e-3", b"", b"NaN"]);
+        assert!(!f.split(br#"1,"open"#));
+    }
+}

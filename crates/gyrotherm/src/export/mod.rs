@@ -1,0 +1,210 @@
+//! Export a model file for flight code: a C99 source pair ([`c`]) or a Rust module for
+//! `gyrotherm-core` ([`rust`]), both from the same static form of the model
+//! ([`static_model`]), so that no JSON is parsed in flight.
+//!
+//! The C code computes exactly what `gyrotherm-core` computes: the same operations in the same
+//! order, f64 for features, baselines and the compensator, f32 for the LSTM with the core's
+//! activation approximations, and a port of the `libm` crate's `expm1` (FreeBSD `s_expm1.c`)
+//! for lag filters across gaps. Compiled with `-std=c99 -ffp-contract=off` (no fused
+//! multiply-add, as Rust never contracts) on an IEEE 754 target with single-precision `float`
+//! arithmetic (`FLT_EVAL_METHOD == 0`: x86-64 SSE, Cortex-M4F), its outputs equal
+//! `gyrotherm compensate --stream` to the last bit.
+
+pub mod c;
+pub mod rust;
+
+use std::path::{Path, PathBuf};
+
+use gyrotherm_core::compensator::{HIDDEN, LSTM_INPUTS};
+use gyrotherm_core::features::MAX_FEATURES;
+use gyrotherm_core::static_model::{StaticBaseline, StaticLstm, StaticModel, StaticTarget};
+
+use crate::compensate::CompensateError;
+use crate::model::{ModelFile, ModelFileError, SubModel, Target};
+
+/// Why a model cannot be exported.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// The model file fails its checks.
+    Model(ModelFileError),
+    /// The model cannot be turned into flight form.
+    Flight(CompensateError),
+    /// Writing an output file failed.
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl std::fmt::Display for ExportError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ExportError::Model(e) => write!(f, "model cannot be exported: {e}"),
+            ExportError::Flight(e) => write!(f, "model cannot be exported: {e}"),
+            ExportError::Io { path, source } => {
+                write!(f, "cannot write {}: {source}", path.display())
+            }
+        }
+    }
+}
+
+impl std::error::Error for ExportError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ExportError::Io { source, .. } => Some(source),
+            ExportError::Model(e) => Some(e),
+            ExportError::Flight(e) => Some(e),
+        }
+    }
+}
+
+/// Target language.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lang {
+    /// `gyrotherm_model.h` + `gyrotherm_model.c`, C99.
+    C,
+    /// `gyrotherm_model.rs`, a module for `gyrotherm-core`.
+    Rust,
+}
+
+/// The static (flight) form of a model file: the numbers the core's compensator is built
+/// from, after the same conversions (`f64` LSTM weights to `f32`, inputs padded to
+/// `LSTM_INPUTS` slots).
+pub fn static_model(model: &ModelFile) -> Result<StaticModel, ExportError> {
+    let err = ExportError::Model;
+    model.validate().map_err(err)?;
+    let spec = model.feature_spec().map_err(err)?;
+    let limits = model.features.temp_sensor.to_core().map_err(err)?;
+    let target = |sub: Option<&SubModel>, absent: f64, target: Target| {
+        static_target(sub, absent).map_err(|e| {
+            ExportError::Flight(CompensateError::InTarget {
+                target,
+                source: Box::new(e),
+            })
+        })
+    };
+    Ok(StaticModel {
+        spec,
+        limits,
+        bias: target(model.bias.as_ref(), 0.0, Target::Bias)?,
+        scale: target(model.scale.as_ref(), 1.0, Target::Scale)?,
+    })
+}
+
+fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, CompensateError> {
+    let Some(sub) = sub else {
+        return Ok(StaticTarget::constant(absent));
+    };
+    let baseline = match sub
+        .baseline_core()
+        .transpose()
+        .map_err(CompensateError::Baseline)?
+    {
+        None => None,
+        Some(b) => {
+            let mut s = StaticBaseline {
+                n_features: b.n_features() as u8,
+                n_terms: b.n_terms() as u8,
+                powers: [[0; MAX_FEATURES]; gyrotherm_core::baseline::MAX_TERMS],
+                coefficients: [0.0; gyrotherm_core::baseline::MAX_TERMS],
+            };
+            for j in 0..b.n_terms() {
+                if let Some((p, c)) = b.term(j) {
+                    s.powers[j][..p.len()].copy_from_slice(p);
+                    s.coefficients[j] = c;
+                }
+            }
+            Some(s)
+        }
+    };
+    let lstm = match sub.lstm() {
+        Some((params, input_norm, target_norm)) => {
+            let w = crate::compensate::padded_core_lstm(params)?;
+            let n = input_norm.mean.len();
+            if n > MAX_FEATURES {
+                return Err(CompensateError::LstmInputs { inputs: n });
+            }
+            let mut mean = [0.0; MAX_FEATURES];
+            let mut std = [1.0; MAX_FEATURES];
+            mean[..n].copy_from_slice(&input_norm.mean);
+            std[..n].copy_from_slice(&input_norm.std);
+            Some(StaticLstm {
+                w_ih: *w.w_ih(),
+                w_hh: *w.w_hh(),
+                b_ih: *w.b_ih(),
+                b_hh: *w.b_hh(),
+                w_out: *w.w_out(),
+                b_out: w.b_out(),
+                n_inputs: n as u8,
+                input_mean: mean,
+                input_std: std,
+                target_mean: target_norm.mean[0],
+                target_std: target_norm.std[0],
+            })
+        }
+        None => None,
+    };
+    let lstm_reads_base = sub.reads_base();
+    Ok(StaticTarget {
+        offset: 0.0,
+        baseline,
+        lstm,
+        lstm_reads_base,
+    })
+}
+
+// The generators index the core's arrays by these sizes.
+const _: () = assert!(LSTM_INPUTS == MAX_FEATURES && HIDDEN == 8);
+
+/// Write the export of `model` for `lang` into `dir` (created if missing), each file
+/// atomically; returns the files written.
+pub fn export(model: &ModelFile, lang: Lang, dir: &Path) -> Result<Vec<PathBuf>, ExportError> {
+    let m = static_model(model)?;
+    let files: Vec<(&str, String)> = match lang {
+        Lang::C => {
+            let (h, c) = c::generate(&m, &describe(model));
+            vec![("gyrotherm_model.h", h), ("gyrotherm_model.c", c)]
+        }
+        Lang::Rust => vec![("gyrotherm_model.rs", rust::generate(&m, &describe(model)))],
+    };
+    std::fs::create_dir_all(dir).map_err(|source| ExportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut out = Vec::new();
+    for (name, text) in files {
+        let path = dir.join(name);
+        crate::atomic_file::write_bytes_atomically(&path, text.as_bytes()).map_err(|source| {
+            ExportError::Io {
+                path: path.clone(),
+                source,
+            }
+        })?;
+        out.push(path);
+    }
+    Ok(out)
+}
+
+/// One line saying what the model is, for the generated files' headers.
+fn describe(model: &ModelFile) -> String {
+    let kind = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
+    format!(
+        "method {}, bias: {}, scale factor: {}; trained by {} on {}",
+        model.method.as_str(),
+        kind(&model.bias),
+        kind(&model.scale),
+        model.training.created_by,
+        model.training.inputs.join(", ")
+    )
+}
+
+/// Shortest round-trip text of an f64, valid as a C and a Rust literal (`1e0`, `-2.5e-3`).
+pub(crate) fn f64_lit(v: f64) -> String {
+    format!("{v:e}")
+}
+
+/// Shortest round-trip text of an f32 (no suffix).
+pub(crate) fn f32_lit(v: f32) -> String {
+    format!("{v:e}")
+}
