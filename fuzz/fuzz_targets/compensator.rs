@@ -95,7 +95,10 @@ fn run(data: &[u8]) -> Result<()> {
             Some(rate) => {
                 assert!(gyro.is_finite(), "a rate for gyro {gyro}: {c:?}");
                 assert!(rate.is_finite(), "{c:?} at t={t} T={temp} gyro={gyro}");
-                assert!(c.bias_dps.is_finite(), "{c:?} at t={t} T={temp} gyro={gyro}");
+                assert!(
+                    c.bias_dps.is_finite(),
+                    "{c:?} at t={t} T={temp} gyro={gyro}"
+                );
                 assert!(
                     c.scale.is_finite() && c.scale > 0.0,
                     "{c:?} at t={t} T={temp} gyro={gyro}"

@@ -264,7 +264,13 @@ fn a_wrong_sample_period_cannot_make_runaway_output() {
     let log = log_of(dir.path(), "base.csv", noise);
     for (period, fill) in [("0.001", "10"), ("1e-6", "1e6")] {
         let (code, _, err) = gyrotherm(&[
-            "evaluate", "--input", p(&log), "--sample-period", period, "--fill-gaps", fill,
+            "evaluate",
+            "--input",
+            p(&log),
+            "--sample-period",
+            period,
+            "--fill-gaps",
+            fill,
         ]);
         assert_eq!(code, 2, "{err}");
         assert!(err.contains("base.csv:5: column time_s"), "{err}");
