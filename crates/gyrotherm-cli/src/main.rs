@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
+mod signals;
 
 /// Remove temperature-induced errors from fiber optic gyroscope (FOG) test logs.
 #[derive(Debug, Parser)]
@@ -40,12 +41,15 @@ enum Command {
     Compare(cmd::compare::CompareArgs),
     /// Write an HTML report with figures for a held-out comparison.
     Report(cmd::report::ReportArgs),
+    /// Check a model file, or re-seal one after a deliberate hand edit.
+    Model(cmd::model::ModelArgs),
     /// Write a model as flight code: C99 or a Rust module for gyrotherm-core.
     Export(cmd::export::ExportArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    signals::remove_temp_files_on_termination();
     let result = match cli.command {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Simulate(a) => cmd::simulate::run(a),
@@ -55,6 +59,7 @@ fn main() -> ExitCode {
         Command::Compensate(a) => cmd::compensate::run(a),
         Command::Compare(a) => cmd::compare::run(a),
         Command::Report(a) => cmd::report::run(a),
+        Command::Model(a) => cmd::model::run(a),
         Command::Export(a) => cmd::export::run(a),
     };
     match result {
@@ -73,5 +78,7 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
     err.chain().any(|e| {
         e.downcast_ref::<std::io::Error>()
             .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            || e.downcast_ref::<gyrotherm::csvlog::LogError>()
+                .is_some_and(|l| l.kind == gyrotherm::csvlog::LogErrorKind::OutputClosed)
     })
 }

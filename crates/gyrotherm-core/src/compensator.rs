@@ -22,7 +22,8 @@
 //!   [`TempLimits::degraded_after_s`] (60 s by default), or never since the start: before the
 //!   first accepted temperature there is no model output, so B = 0 and K = 1 (the rate is the
 //!   raw gyro output).
-//! - [`Status::Invalid`]: the gyro sample itself is not finite; there is no rate
+//! - [`Status::Invalid`]: the gyro sample itself is not finite, or so large that
+//!   (Ĝ − B) / K is beyond f64; there is no rate
 //!   ([`Corrected::rate`] is `None`, `rate_dps` is 0). The temperature is still judged and used.
 //!
 //! A temperature sample is rejected when it is not finite; when it lies outside
@@ -278,7 +279,7 @@ pub enum Status {
     Held = 1,
     /// No good temperature for longer than [`TempLimits::degraded_after_s`] (or none yet).
     Degraded = 2,
-    /// The gyro sample is not finite: no rate.
+    /// The gyro sample is not finite (or its corrected rate would overflow): no rate.
     Invalid = 3,
 }
 
@@ -517,7 +518,8 @@ impl Compensator {
             self.last_ok_s = self.last_time_s;
         }
         let (bias_dps, scale) = self.held.unwrap_or((0.0, 1.0));
-        let status = if !gyro_dps.is_finite() {
+        // A finite sample so large that (Ĝ − B) / K overflows has no rate either.
+        let status = if !(gyro_dps.is_finite() && ((gyro_dps - bias_dps) / scale).is_finite()) {
             Status::Invalid
         } else if fresh {
             Status::Ok

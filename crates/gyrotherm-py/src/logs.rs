@@ -48,6 +48,7 @@ impl LogOptions {
             gyro_unit,
             fill_gaps_max_s: positive("fill_gaps", self.fill_gaps)?,
             sample_period_s: positive("sample_period", self.sample_period)?,
+            ..ReadOptions::default()
         })
     }
 }

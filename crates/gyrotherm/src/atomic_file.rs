@@ -1,13 +1,124 @@
 //! Write outputs so that nothing is lost: into a temporary file in the target folder, then
 //! renamed into place. A crash or error mid-write leaves any previous file untouched.
+//!
+//! Where the output goes decides how it is written ([`destination`]):
+//! - a new path or a regular file: temporary file beside it, renamed over it;
+//! - a symbolic link: followed to its final target, which is written as above, so the link
+//!   stays a link (a dangling link creates its target);
+//! - a FIFO, a character or block device, a socket (or a link to one, such as
+//!   `/dev/null`): opened and written straight, nothing renamed or created beside it;
+//! - `-`, `/dev/stdout` (and `/dev/stderr`): the process's own standard output (error),
+//!   written straight, sharing its position with the shell's redirection;
+//! - a directory: refused.
+//!
+//! Temporary files being written are kept in a process-wide list, so that a signal handler
+//! (installed by the command-line program) can remove them before the process exits:
+//! [`remove_temp_files`].
 
-use std::fs::File;
+use std::fs::{File, OpenOptions};
 use std::io::{self, BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
 
-/// Write `path` atomically: `write` gets a buffered writer on a temporary file in the same
-/// folder; on success the file is flushed, synced and renamed over `path`. On error the
-/// temporary file is removed and `path` is left as it was.
+/// How an output path is written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Destination {
+    /// The process's standard output (`-`, `/dev/stdout`, `/dev/fd/1`).
+    Stdout,
+    /// The process's standard error (`/dev/stderr`, `/dev/fd/2`).
+    Stderr,
+    /// Opened and written in place: a FIFO, device or socket (possibly behind links).
+    Direct(PathBuf),
+    /// Written to a temporary file beside this path (a regular file or none yet; links
+    /// already followed) and renamed over it.
+    Replace(PathBuf),
+}
+
+/// Most symbolic links followed before giving up (as Linux's `ELOOP` limit).
+const MAX_LINKS: usize = 40;
+
+/// Decide how `path` is written (see the module documentation). Errors: a directory, a link
+/// loop, or a path whose kind cannot be read (permission).
+pub fn destination(path: &Path) -> io::Result<Destination> {
+    if let Some(stream) = standard_stream(path) {
+        return Ok(stream);
+    }
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_dir() => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("{} is a directory; give a file name", path.display()),
+        )),
+        Ok(meta) if meta.is_file() => {
+            if under_dev_or_proc(path) {
+                // e.g. /dev/fd/3 opened by the shell onto a file: writing in place keeps
+                // the shell's view of it; a rename would put a file into /dev.
+                return Ok(Destination::Direct(path.to_path_buf()));
+            }
+            let is_link = std::fs::symlink_metadata(path)?.file_type().is_symlink();
+            if is_link {
+                Ok(Destination::Replace(std::fs::canonicalize(path)?))
+            } else {
+                Ok(Destination::Replace(path.to_path_buf()))
+            }
+        }
+        Ok(_) => Ok(Destination::Direct(path.to_path_buf())),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            match std::fs::symlink_metadata(path) {
+                // A dangling link: create what it points at.
+                Ok(m) if m.file_type().is_symlink() => {
+                    Ok(Destination::Replace(final_link_target(path)?))
+                }
+                _ => Ok(Destination::Replace(path.to_path_buf())),
+            }
+        }
+        Err(e) => Err(io::Error::new(
+            e.kind(),
+            format!("cannot inspect {}: {e}", path.display()),
+        )),
+    }
+}
+
+/// `-` and the names of the standard streams.
+fn standard_stream(path: &Path) -> Option<Destination> {
+    match path.to_str()? {
+        "-" | "/dev/stdout" | "/dev/fd/1" | "/proc/self/fd/1" => Some(Destination::Stdout),
+        "/dev/stderr" | "/dev/fd/2" | "/proc/self/fd/2" => Some(Destination::Stderr),
+        _ => None,
+    }
+}
+
+fn under_dev_or_proc(path: &Path) -> bool {
+    let mut c = path.components();
+    c.next() == Some(Component::RootDir)
+        && matches!(c.next(), Some(Component::Normal(n)) if n == "dev" || n == "proc")
+}
+
+/// Follow a chain of links whose last target does not exist; that last target.
+fn final_link_target(path: &Path) -> io::Result<PathBuf> {
+    let mut p = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = std::fs::read_link(&p)?;
+                p = match p.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err(io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!("{}: too many levels of symbolic links", path.display()),
+    ))
+}
+
+/// Write `path` safely: `write` gets a buffered writer; on success it is flushed. For a file
+/// (see [`destination`]) the writer is on a temporary file in the same folder, which is
+/// synced and renamed over the file; on error (or a panic) the temporary file is removed
+/// and the file is left as it was. FIFOs, devices and standard output are written straight.
 pub fn write_atomically<T, E>(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> Result<T, E>,
@@ -15,60 +126,219 @@ pub fn write_atomically<T, E>(
 where
     E: From<io::Error>,
 {
-    let tmp = temp_path_for(path);
-    let file = File::create(&tmp).map_err(|e| {
-        io::Error::new(
-            e.kind(),
-            format!("cannot create temporary file {}: {e}", tmp.display()),
-        )
-    })?;
-    let mut out = BufWriter::new(file);
-    let result = write(&mut out).and_then(|v| {
-        out.flush()?;
-        out.get_ref().sync_all()?;
-        Ok(v)
-    });
-    match result {
-        Ok(v) => {
-            drop(out);
-            std::fs::rename(&tmp, path).map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                io::Error::new(
-                    e.kind(),
-                    format!("cannot rename {} to {}: {e}", tmp.display(), path.display()),
-                )
+    match destination(path)? {
+        Destination::Stdout => {
+            // Anything printed through `std::io::stdout` must come first.
+            io::stdout().flush()?;
+            write_straight(clone_stdout()?, write)
+        }
+        Destination::Stderr => write_straight(clone_stderr()?, write),
+        Destination::Direct(p) => {
+            let file = OpenOptions::new().write(true).open(&p).map_err(|e| {
+                io::Error::new(e.kind(), format!("cannot open {}: {e}", p.display()))
             })?;
-            Ok(v)
+            write_straight(file, write)
         }
-        Err(e) => {
-            drop(out);
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
+        Destination::Replace(target) => write_replacing(&target, write),
     }
 }
 
-/// Write bytes atomically (see [`write_atomically`]).
-pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    write_atomically(path, |w| w.write_all(bytes))
+fn write_straight<T, E>(
+    file: File,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<T, E>,
+) -> Result<T, E>
+where
+    E: From<io::Error>,
+{
+    let mut out = BufWriter::new(file);
+    let v = write(&mut out)?;
+    out.flush()?;
+    Ok(v)
 }
 
-/// `dir/.name.tmp.<pid>` beside `path`, so the final rename stays on one file system.
-fn temp_path_for(path: &Path) -> PathBuf {
+fn write_replacing<T, E>(
+    target: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<T, E>,
+) -> Result<T, E>
+where
+    E: From<io::Error>,
+{
+    let old_permissions = std::fs::metadata(target).ok().map(|m| m.permissions());
+    let (tmp, file) = create_temp_beside(target)?;
+    let guard = TempGuard::new(tmp);
+    let mut out = BufWriter::new(file);
+    let v = write(&mut out)?;
+    out.flush()?;
+    if let Some(perm) = old_permissions {
+        out.get_ref().set_permissions(perm)?;
+    }
+    out.get_ref().sync_all()?;
+    drop(out);
+    guard.rename_to(target)?;
+    Ok(v)
+}
+
+/// `dir/.name.tmp.<pid>.<n>` beside `path` (so the final rename stays on one file system),
+/// created new: never an existing file or a link planted under that name.
+fn create_temp_beside(path: &Path) -> io::Result<(PathBuf, File)> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "output".to_owned());
-    let tmp_name = format!(".{name}.tmp.{}", std::process::id());
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp_name),
-        _ => PathBuf::from(tmp_name),
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut last_err = None;
+    for _ in 0..100 {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.tmp.{}.{n}", std::process::id()));
+        // Registered before it exists, so a signal arriving in between still removes it.
+        register(&tmp);
+        match OpenOptions::new().write(true).create_new(true).open(&tmp) {
+            Ok(f) => return Ok((tmp, f)),
+            Err(e) => {
+                unregister(&tmp);
+                if e.kind() != io::ErrorKind::AlreadyExists {
+                    return Err(io::Error::new(
+                        e.kind(),
+                        format!("cannot create temporary file {}: {e}", tmp.display()),
+                    ));
+                }
+                last_err = Some(e);
+            }
+        }
+    }
+    Err(last_err.unwrap_or_else(|| io::Error::other("no free temporary name")))
+}
+
+fn clone_stdout() -> io::Result<File> {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        Ok(File::from(io::stdout().as_fd().try_clone_to_owned()?))
+    }
+    #[cfg(windows)]
+    {
+        use std::os::windows::io::AsHandle;
+        Ok(File::from(io::stdout().as_handle().try_clone_to_owned()?))
+    }
+}
+
+fn clone_stderr() -> io::Result<File> {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        Ok(File::from(io::stderr().as_fd().try_clone_to_owned()?))
+    }
+    #[cfg(windows)]
+    {
+        use std::os::windows::io::AsHandle;
+        Ok(File::from(io::stderr().as_handle().try_clone_to_owned()?))
+    }
+}
+
+/// Write bytes safely (see [`write_atomically`]).
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_atomically(path, |w| w.write_all(bytes))
+}
+
+/// Temporary files now being written by this process.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live() -> MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+fn register(tmp: &Path) {
+    live().push(tmp.to_path_buf());
+}
+
+fn unregister(tmp: &Path) {
+    live().retain(|p| p != tmp);
+}
+
+/// Remove every temporary file this process is writing and forget them; returns how many
+/// were removed. For a signal handler that is about to end the process: a write in progress
+/// then fails at its rename instead of leaving a hidden partial file.
+pub fn remove_temp_files() -> usize {
+    remove_temp_files_where(|_| true)
+}
+
+fn remove_temp_files_where(select: impl Fn(&Path) -> bool) -> usize {
+    let mut live = live();
+    let mut removed = 0;
+    live.retain(|p| {
+        if !select(p) {
+            return true;
+        }
+        removed += usize::from(std::fs::remove_file(p).is_ok());
+        false
+    });
+    removed
+}
+
+/// A registered temporary file, removed when dropped unless renamed into place.
+struct TempGuard {
+    tmp: Option<PathBuf>,
+}
+
+impl TempGuard {
+    fn new(tmp: PathBuf) -> Self {
+        TempGuard { tmp: Some(tmp) }
+    }
+
+    fn rename_to(mut self, target: &Path) -> io::Result<()> {
+        let Some(tmp) = self.tmp.take() else {
+            return Ok(());
+        };
+        // Under the list's lock, so that a concurrent remove_temp_files either removes the
+        // file before the rename (which then fails) or finds it already in place.
+        let mut live = live();
+        if !live.contains(&tmp) {
+            return Err(io::Error::new(
+                io::ErrorKind::Interrupted,
+                format!("{} was removed before it was complete", target.display()),
+            ));
+        }
+        let result = std::fs::rename(&tmp, target).map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            io::Error::new(
+                e.kind(),
+                format!(
+                    "cannot rename {} to {}: {e}",
+                    tmp.display(),
+                    target.display()
+                ),
+            )
+        });
+        live.retain(|p| p != &tmp);
+        result
+    }
+}
+
+impl Drop for TempGuard {
+    fn drop(&mut self) {
+        if let Some(tmp) = self.tmp.take() {
+            let _ = std::fs::remove_file(&tmp);
+            unregister(&tmp);
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
 
     #[test]
     fn failed_write_keeps_old_file_and_leaves_no_temp() {
@@ -81,7 +351,22 @@ mod tests {
         });
         assert!(r.is_err());
         assert_eq!(std::fs::read(&path).unwrap(), b"old");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert_eq!(entries(dir.path()), ["out.csv"]);
+    }
+
+    #[test]
+    fn panicking_write_leaves_no_temp() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.csv");
+        let r = std::panic::catch_unwind(|| {
+            let _ = write_atomically(&path, |w| -> io::Result<()> {
+                w.write_all(b"partial")?;
+                w.flush()?;
+                panic!("mid-write");
+            });
+        });
+        assert!(r.is_err());
+        assert!(entries(dir.path()).is_empty());
     }
 
     #[test]
@@ -91,5 +376,134 @@ mod tests {
         std::fs::write(&path, b"old").unwrap();
         write_bytes_atomically(&path, b"new").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert_eq!(entries(dir.path()), ["out.csv"]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn replacing_keeps_the_old_files_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.csv");
+        std::fs::write(&path, b"old").unwrap();
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_bytes_atomically(&path, b"new").unwrap();
+        let mode = std::fs::metadata(&path).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o640);
+    }
+
+    #[test]
+    fn a_directory_is_refused_and_left_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = write_bytes_atomically(dir.path(), b"x").unwrap_err();
+        assert!(err.to_string().contains("is a directory"), "{err}");
+        assert!(dir.path().is_dir());
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_is_written_through_to_its_target() {
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.csv");
+        let link = dir.path().join("link.csv");
+        std::fs::write(&real, b"old").unwrap();
+        std::os::unix::fs::symlink("real.csv", &link).unwrap();
+        write_bytes_atomically(&link, b"new").unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_link(&link).unwrap(), Path::new("real.csv"));
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        assert_eq!(entries(dir.path()), ["link.csv", "real.csv"]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_chain_of_links_to_a_missing_file_creates_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("sub")).unwrap();
+        let a = dir.path().join("a");
+        std::os::unix::fs::symlink("b", &a).unwrap();
+        std::os::unix::fs::symlink("sub/new.csv", dir.path().join("b")).unwrap();
+        assert_eq!(
+            destination(&a).unwrap(),
+            Destination::Replace(dir.path().join("sub/new.csv"))
+        );
+        write_bytes_atomically(&a, b"new").unwrap();
+        assert_eq!(
+            std::fs::read(dir.path().join("sub/new.csv")).unwrap(),
+            b"new"
+        );
+        assert!(std::fs::symlink_metadata(&a)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_loop_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a");
+        std::os::unix::fs::symlink("b", &a).unwrap();
+        std::os::unix::fs::symlink("a", dir.path().join("b")).unwrap();
+        assert!(write_bytes_atomically(&a, b"x").is_err());
+        assert_eq!(entries(dir.path()), ["a", "b"]);
+    }
+
+    #[test]
+    fn standard_streams_and_devices_are_written_straight() {
+        assert_eq!(destination(Path::new("-")).unwrap(), Destination::Stdout);
+        assert_eq!(
+            destination(Path::new("/dev/stdout")).unwrap(),
+            Destination::Stdout
+        );
+        assert_eq!(
+            destination(Path::new("/dev/stderr")).unwrap(),
+            Destination::Stderr
+        );
+        #[cfg(unix)]
+        assert_eq!(
+            destination(Path::new("/dev/null")).unwrap(),
+            Destination::Direct(PathBuf::from("/dev/null"))
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn dev_null_stays_a_device() {
+        use std::os::unix::fs::FileTypeExt;
+        // Guarded: were /dev/null to be taken for a file, writing would replace it.
+        assert!(matches!(
+            destination(Path::new("/dev/null")).unwrap(),
+            Destination::Direct(_)
+        ));
+        write_bytes_atomically(Path::new("/dev/null"), b"discarded").unwrap();
+        let ft = std::fs::metadata("/dev/null").unwrap().file_type();
+        assert!(ft.is_char_device());
+    }
+
+    #[test]
+    fn remove_temp_files_removes_a_write_in_progress() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.csv");
+        std::fs::write(&path, b"old").unwrap();
+        let r = write_atomically(&path, |w| -> io::Result<()> {
+            w.write_all(b"partial")?;
+            w.flush()?;
+            assert_eq!(entries(dir.path()).len(), 2);
+            // As the signal handler would, from another thread (limited to this test's
+            // folder: other tests write files at the same time).
+            let mine = |p: &Path| p.starts_with(dir.path());
+            let removed =
+                std::thread::scope(|s| s.spawn(|| remove_temp_files_where(mine)).join().unwrap());
+            assert_eq!(removed, 1);
+            Ok(())
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        assert_eq!(entries(dir.path()), ["out.csv"]);
     }
 }

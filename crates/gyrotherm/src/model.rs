@@ -28,7 +28,7 @@ use crate::nn::params::{LstmParams, ParamsError};
 use crate::nn::zscore::ZScore;
 use gyrotherm_core::baseline::{BaselineError, BaselineModel};
 use gyrotherm_core::compensator::TempLimits;
-use gyrotherm_core::features::{FeatureSpec, LagOutputs, MAX_LAGS};
+use gyrotherm_core::features::{FeatureKind, FeatureSpec, LagOutputs, MAX_LAGS};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -37,6 +37,20 @@ use std::path::{Path, PathBuf};
 pub const FORMAT_VERSION: u32 = 1;
 /// The format versions this build reads.
 pub const SUPPORTED_VERSIONS: &[u32] = &[1];
+
+/// Largest |coefficient| of a least-squares term: far beyond any fit of a gyro's drift in
+/// °C and °C/s, short of what makes f64 sums overflow.
+pub const MAX_PLAUSIBLE_COEFFICIENT: f64 = 1e15;
+/// Largest |bias| a model may predict inside its training range, °/s: beyond the measuring
+/// range of any fibre optic gyro.
+pub const MAX_PLAUSIBLE_BIAS_DPS: f64 = 1e3;
+/// Range of scale factor K (nominal 1) a model may predict inside its training range.
+pub const PLAUSIBLE_SCALE: (f64, f64) = (0.1, 10.0);
+/// Most feature steps of one probe run in the training-range check (a ramp at the slowest
+/// rate stops there).
+const MAX_PROBE_STEPS: usize = 20_000;
+/// Key of the content checksum in a model file.
+pub const CHECKSUM_KEY: &str = "content_sha256";
 
 /// How the model was fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -358,6 +372,16 @@ impl SubModel {
                         "coefficients[{k}] is not finite"
                     )));
                 }
+                if let Some(k) = coefficients
+                    .iter()
+                    .position(|c| c.abs() > MAX_PLAUSIBLE_COEFFICIENT)
+                {
+                    return Err(SubModelError::Invalid(format!(
+                        "coefficients[{k}] is {:e}: implausibly large (|c| ≤ {MAX_PLAUSIBLE_COEFFICIENT:e}); \
+                         re-train, or check a hand edit",
+                        coefficients[k]
+                    )));
+                }
                 Ok(())
             }
         }
@@ -538,6 +562,9 @@ pub enum ModelFileError {
     Fields(serde_json::Error),
     /// No `format_version` field.
     MissingVersion,
+    /// The `content_sha256` written with the model does not match its content (edited or
+    /// damaged since it was saved).
+    Checksum { found: String, computed: String },
     /// A `format_version` this build does not read (the value as written).
     UnsupportedVersion { found: String },
     /// The feature definition cannot be built.
@@ -583,6 +610,12 @@ impl std::fmt::Display for ModelFileError {
             ModelFileError::SubModel { target, source } => {
                 write!(f, "{}: {source}", target.as_str())
             }
+            ModelFileError::Checksum { found, computed } => write!(
+                f,
+                "{CHECKSUM_KEY} is {found} but the content gives {computed}: the file was edited \
+                 or damaged after it was saved; re-train, or if the edit is intended, check the \
+                 model and run `gyrotherm model seal FILE`"
+            ),
             ModelFileError::Invalid { field, problem } if field.is_empty() => f.write_str(problem),
             ModelFileError::Invalid { field, problem } => write!(f, "{field}: {problem}"),
         }
@@ -743,19 +776,118 @@ impl ModelFile {
                 });
             }
         }
+        self.check_outputs_in_training_range(&spec)
+    }
+
+    /// Runs the bias and scale models through the training range (holds at its lowest,
+    /// middle and highest temperature, ramps between them at its fastest rates, each long
+    /// enough for the slowest lag to settle) and refuses a model whose bias is not finite or
+    /// beyond [`MAX_PLAUSIBLE_BIAS_DPS`], or whose scale factor leaves [`PLAUSIBLE_SCALE`]
+    /// (K ≤ 0 included) anywhere on the way. The message names the target, T and dT.
+    fn check_outputs_in_training_range(&self, spec: &FeatureSpec) -> Result<(), ModelFileError> {
+        use crate::compensate::target_model;
+        use gyrotherm_core::features::FeaturePipeline;
+        let t = &self.training;
+        let (t_lo, t_hi) = (t.temp_range_c.min, t.temp_range_c.max);
+        let (r_lo, r_hi) = (t.rate_range_c_per_s.min, t.rate_range_c_per_s.max);
+        let dt = spec.step_period_s;
+        let slowest = spec.lags().iter().fold(spec.rate_lag_s, |a, &b| a.max(b));
+        let hold = ((3.0 * slowest / dt).ceil() as usize + 2).min(MAX_PROBE_STEPS);
+        let ramp = |from: f64, to: f64, rate: f64| -> Vec<f64> {
+            let n = ((to - from) / (rate * dt)).ceil();
+            let n = if n.is_finite() && n > 0.0 {
+                (n as usize).min(MAX_PROBE_STEPS)
+            } else {
+                0
+            };
+            (0..=n).map(|k| from + rate * dt * k as f64).collect()
+        };
+        let mut probes: Vec<Vec<f64>> = [t_lo, 0.5 * t_lo + 0.5 * t_hi, t_hi]
+            .iter()
+            .map(|&temp| vec![temp; hold])
+            .collect();
+        if r_hi > 0.0 {
+            probes.push(ramp(t_lo, t_hi, r_hi));
+        }
+        if r_lo < 0.0 {
+            probes.push(ramp(t_hi, t_lo, r_lo));
+        }
+        let build = |target: Target, sub: Option<&SubModel>, absent: f64| {
+            target_model(sub, absent)
+                .map_err(|e| ModelFileError::invalid(target.as_str(), e.to_string()))
+        };
+        let bias0 = build(Target::Bias, self.bias.as_ref(), 0.0)?;
+        let scale0 = build(Target::Scale, self.scale.as_ref(), 1.0)?;
+        for temps in probes {
+            let (mut bias, mut scale) = (bias0.clone(), scale0.clone());
+            let mut pipeline = FeaturePipeline::new(*spec).map_err(ModelFileError::Features)?;
+            for (k, &temp) in temps.iter().enumerate() {
+                let Ok(Some(step)) = pipeline.push(k as f64 * dt, temp) else {
+                    continue;
+                };
+                let rate = (0..spec.n_features())
+                    .find(|&i| spec.kind(i) == Some(FeatureKind::Rate))
+                    .and_then(|i| step.features.as_slice().get(i).copied())
+                    .unwrap_or(0.0);
+                let at = || {
+                    format!("at T = {temp:.3} °C, dT = {rate:.3e} °C/s, inside the training range ({t_lo} to {t_hi} °C, {r_lo:.3e} to {r_hi:.3e} °C/s)")
+                };
+                let b = bias.eval(&step.features).unwrap_or(f64::NAN);
+                if !(b.is_finite() && b.abs() <= MAX_PLAUSIBLE_BIAS_DPS) {
+                    return Err(ModelFileError::invalid(
+                        "bias",
+                        format!(
+                            "predicts B = {b:e} °/s {}: not a gyro bias (|B| ≤ {MAX_PLAUSIBLE_BIAS_DPS} °/s); re-train, or check a hand edit",
+                            at()
+                        ),
+                    ));
+                }
+                let k_sf = scale.eval(&step.features).unwrap_or(f64::NAN);
+                let (k_lo, k_hi) = PLAUSIBLE_SCALE;
+                if !(k_sf >= k_lo && k_sf <= k_hi) {
+                    return Err(ModelFileError::invalid(
+                        "scale",
+                        format!(
+                            "predicts K = {k_sf:e} {}: a scale factor must stay within {k_lo} to {k_hi} (nominal 1); re-train, or check a hand edit",
+                            at()
+                        ),
+                    ));
+                }
+            }
+        }
         Ok(())
     }
 
-    /// The JSON text (pretty, shortest round-trip floats), after [`validate`](Self::validate).
-    pub fn to_json(&self) -> Result<String, ModelFileError> {
-        self.validate()?;
-        serde_json::to_string_pretty(self).map_err(ModelFileError::Fields)
+    /// SHA-256 of the model's content (its compact JSON, fields in declaration order):
+    /// layout and key order of the file do not change it, any value does.
+    pub fn content_digest(&self) -> Result<String, ModelFileError> {
+        let compact = serde_json::to_string(self).map_err(ModelFileError::Fields)?;
+        Ok(sha256_hex(compact.as_bytes()))
     }
 
-    /// Parse and check JSON text.
+    /// The JSON text (pretty, shortest round-trip floats), after [`validate`](Self::validate),
+    /// sealed with `content_sha256` (see [`content_digest`](Self::content_digest)) as the
+    /// last key.
+    pub fn to_json(&self) -> Result<String, ModelFileError> {
+        self.validate()?;
+        let text = serde_json::to_string_pretty(self).map_err(ModelFileError::Fields)?;
+        let digest = self.content_digest()?;
+        let body = text.strip_suffix("\n}").unwrap_or(&text);
+        Ok(format!("{body},\n  \"{CHECKSUM_KEY}\": \"{digest}\"\n}}"))
+    }
+
+    /// Parse and check JSON text: a leading byte-order mark is skipped; a `content_sha256`
+    /// must match the content (a file without one, written before files were sealed or by
+    /// hand, is read on its other checks).
     pub fn from_json(text: &str) -> Result<ModelFile, ModelFileError> {
+        Self::parse(text, true)
+    }
+
+    fn parse(text: &str, verify: bool) -> Result<ModelFile, ModelFileError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         // Version first, so that a newer file gets "unsupported version", not a field error.
-        let v: serde_json::Value = serde_json::from_str(text).map_err(ModelFileError::NotJson)?;
+        let mut v: serde_json::Value =
+            serde_json::from_str(text).map_err(ModelFileError::NotJson)?;
         match v.get("format_version") {
             None => return Err(ModelFileError::MissingVersion),
             Some(fv) => match fv.as_u64() {
@@ -767,9 +899,42 @@ impl ModelFile {
                 }
             },
         }
-        let m: ModelFile = serde_json::from_str(text).map_err(ModelFileError::Fields)?;
+        let sealed = v.as_object_mut().and_then(|o| o.remove(CHECKSUM_KEY));
+        let m: ModelFile = match &sealed {
+            // Parsed from the text where possible: its errors give line and column.
+            None => serde_json::from_str(text).map_err(ModelFileError::Fields)?,
+            Some(_) => serde_json::from_value(v).map_err(ModelFileError::Fields)?,
+        };
+        if let (Some(found), true) = (sealed, verify) {
+            let computed = m.content_digest()?;
+            let found = match found {
+                serde_json::Value::String(s) => s,
+                other => other.to_string(),
+            };
+            if !found.eq_ignore_ascii_case(&computed) {
+                return Err(ModelFileError::Checksum { found, computed });
+            }
+        }
         m.validate()?;
         Ok(m)
+    }
+
+    /// Re-seal a model file after a deliberate hand edit: read it without checking its
+    /// `content_sha256`, check everything else, and write it back with a new one. Returns
+    /// the model and its new digest.
+    pub fn seal(path: &Path) -> Result<(ModelFile, String), ModelFileError> {
+        let in_file = |e| ModelFileError::InFile {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        };
+        let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let m = Self::parse(&text, false).map_err(in_file)?;
+        m.save(path)?;
+        let digest = m.content_digest().map_err(in_file)?;
+        Ok((m, digest))
     }
 
     /// Write to `path` atomically (temporary file + rename), after validating.

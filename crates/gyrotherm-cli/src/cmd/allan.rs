@@ -32,7 +32,7 @@ pub struct AllanArgs {
     pub taus: TauSet,
     /// Noise exponent α (S(f) ∝ f^α) for the confidence intervals at every τ instead of the
     /// lag-1 autocorrelation noise identification.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = super::common::noise_alpha)]
     pub alpha: Option<i32>,
     /// Print JSON instead of a table.
     #[arg(long)]

@@ -34,6 +34,10 @@ pub struct LogArgs {
     /// Nominal sample period in seconds (default: median of the first 100 time steps).
     #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
     pub sample_period: Option<f64>,
+    /// Field separator of the log: `,` (default), `;` or `tab`. With `;` or `tab`, numbers
+    /// may use a decimal comma (`0,5`).
+    #[arg(long, value_name = "SEP", default_value = ",", value_parser = delimiter)]
+    pub delimiter: u8,
 }
 
 /// `--gyro-unit` values.
@@ -69,6 +73,7 @@ impl LogArgs {
             gyro_unit: self.gyro_unit.into(),
             fill_gaps_max_s: self.fill_gaps,
             sample_period_s: self.sample_period,
+            delimiter: self.delimiter,
         }
     }
 }
@@ -95,6 +100,9 @@ pub fn read_log_noting_gaps(
     });
     if let Some(w) = &warning {
         eprintln!("gyrotherm: {w}");
+    }
+    if let Some(w) = report.jitter_warning(path) {
+        eprintln!("gyrotherm: warning: {w}");
     }
     Ok((log, warning))
 }
@@ -145,10 +153,48 @@ pub fn builtin_profile() -> clap::builder::PossibleValuesParser {
     )
 }
 
-fn positive_seconds(s: &str) -> Result<f64, String> {
+pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(format!("{s:?} is not a positive number of seconds")),
+    }
+}
+
+/// `--delimiter`: `,`, `;` or `tab` (also a literal tab or `\t`).
+fn delimiter(s: &str) -> Result<u8, String> {
+    match s {
+        "," | "comma" => Ok(b','),
+        ";" | "semicolon" => Ok(b';'),
+        "tab" | "\t" | "\\t" => Ok(b'\t'),
+        _ => Err(format!("{s:?}: the separator is `,`, `;` or `tab`")),
+    }
+}
+
+/// A time that may be zero: finite and ≥ 0 s.
+pub(crate) fn non_negative_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not zero or a positive number of seconds")),
+    }
+}
+
+/// A scale factor (gyro output over input rate, nominally 1): finite and > 0.
+pub(crate) fn positive_scale_factor(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "{s:?} is not a scale factor: give a positive number (gyro output over table rate, about 1)"
+        )),
+    }
+}
+
+/// A power-law noise exponent α (S(f) ∝ f^α): an integer from -4 to 2.
+pub(crate) fn noise_alpha(s: &str) -> Result<i32, String> {
+    let what = "the noise exponent α is an integer from -4 to 2 (2 white PM, 1 flicker PM, \
+                0 white FM, -1 flicker FM, -2 random-walk FM, -3 and -4 for Hadamard only)";
+    match s.trim().parse::<i32>() {
+        Ok(a) if (-4..=2).contains(&a) => Ok(a),
+        _ => Err(format!("{s:?}: {what}")),
     }
 }
 

@@ -36,7 +36,7 @@ pub struct CompensateArgs {
 }
 
 pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
-    let model = ModelFile::load(&args.model).map_err(anyhow::Error::msg)?;
+    let model = ModelFile::load(&args.model)?;
     anyhow::ensure!(
         args.log.fill_gaps.is_none(),
         "--fill-gaps does not apply to compensate: the compensator bridges time gaps itself and \
@@ -57,11 +57,13 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             64 * 1024,
             std::io::stdout().lock(),
         )));
+        let write_error = Rc::new(RefCell::new(None));
         let input = std::io::BufReader::new(FlushBeforeRead {
             inner: std::io::stdin().lock(),
             out: Rc::clone(&out),
+            write_error: Rc::clone(&write_error),
         });
-        let summary = compensate_lines(
+        let result = compensate_lines(
             &model,
             input,
             "<stdin>".as_ref(),
@@ -69,8 +71,16 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             DeferredFlush(Rc::clone(&out)),
             Mode::Stream,
             true,
-        )?;
-        out.borrow_mut().flush()?;
+        );
+        // A failed flush ends the input (see FlushBeforeRead): that error, not the input's
+        // state at that moment, is what went wrong.
+        if let Some(e) = write_error.borrow_mut().take() {
+            return Err(anyhow::Error::new(e).context("writing standard output"));
+        }
+        let summary = result?;
+        out.borrow_mut()
+            .flush()
+            .context("writing standard output")?;
         eprintln!("gyrotherm: {}", summary.describe());
         summary
     } else {
@@ -127,15 +137,24 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
 
 type SharedOut<'a> = Rc<RefCell<BufWriter<std::io::StdoutLock<'a>>>>;
 
-/// Stdin that flushes stdout before every read, so no output line waits on more input.
+/// Stdin that flushes stdout before every read, so no output line waits on more input. A
+/// flush that fails (e.g. the reader of a pipe went away) is kept for the caller and ends the
+/// input, so it is not reported as a read error of stdin.
 struct FlushBeforeRead<'a, R> {
     inner: R,
     out: SharedOut<'a>,
+    write_error: Rc<RefCell<Option<std::io::Error>>>,
 }
 
 impl<R: Read> Read for FlushBeforeRead<'_, R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        self.out.borrow_mut().flush()?;
+        if self.write_error.borrow().is_some() {
+            return Ok(0);
+        }
+        if let Err(e) = self.out.borrow_mut().flush() {
+            *self.write_error.borrow_mut() = Some(e);
+            return Ok(0);
+        }
         self.inner.read(buf)
     }
 }

@@ -23,13 +23,13 @@ pub struct EvaluateArgs {
     pub column: String,
     /// Smoothing time of the bias stability, s (default 100 s, or the multiple of the sample
     /// period nearest to it when 100 s is not one).
-    #[arg(long)]
+    #[arg(long, value_parser = super::common::positive_seconds)]
     pub tau: Option<f64>,
     /// Time dropped at the start of each rate-table segment, s.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = super::common::non_negative_seconds)]
     pub settle: f64,
     /// Room-temperature scale factor for the thermal error (default: first rate segment's).
-    #[arg(long)]
+    #[arg(long, value_parser = super::common::positive_scale_factor)]
     pub reference_scale: Option<f64>,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -45,7 +45,6 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
             args.column
         );
     };
-    let rate_dps: Vec<f64> = values.iter().map(|v| v * to_dph / 3600.0).collect();
     let tau_s = match args.tau {
         Some(t) => t,
         None => {
@@ -59,6 +58,19 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
             t
         }
     };
+    let duration_s = tau0_s * values.len() as f64;
+    if tau_s > duration_s / 2.0 {
+        bail!(
+            "--tau {:?} s is longer than half the log ({} samples of {tau0_s} s = {duration_s} s): \
+             the bias stability needs at least two means; give at most {} s",
+            tau_s,
+            values.len(),
+            duration_s / 2.0
+        );
+    }
+    // Factor first: v·to_dph could overflow where v·(to_dph/3600) does not.
+    let to_dps = to_dph / 3600.0;
+    let rate_dps: Vec<f64> = values.iter().map(|v| v * to_dps).collect();
     let opts = EvaluationOptions {
         tau_s,
         settle_s: args.settle,
@@ -82,11 +94,11 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         "{} ({} samples, τ0 = {} s)",
         e.column, e.samples, e.sample_period_s
     )?;
-    writeln!(w, "bias                 {:>14.6} °/h", e.bias_dph)?;
+    writeln!(w, "bias                 {:>14} °/h", num(e.bias_dph, 6))?;
     writeln!(
         w,
-        "bias stability       {:>14.6} °/h (1σ of {} means of {} s{})",
-        e.bias_stability_dph,
+        "bias stability       {:>14} °/h (1σ of {} means of {} s{})",
+        num(e.bias_stability_dph, 6),
         e.means,
         e.tau_s,
         if e.stop_segments_only {
@@ -96,16 +108,31 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         }
     )?;
     if let Some(r) = &e.scale {
-        let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.3}"));
-        writeln!(w, "scale factor         {:>14.9}", r.scale_factor)?;
-        writeln!(w, "nonlinearity         {:>14.3} ppm", r.nonlinearity_ppm)?;
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| num(x, 3));
+        writeln!(w, "scale factor         {:>14}", num(r.scale_factor, 9))?;
+        writeln!(
+            w,
+            "nonlinearity         {:>14} ppm",
+            num(r.nonlinearity_ppm, 3)
+        )?;
         writeln!(w, "asymmetry            {:>14} ppm", opt(r.asymmetry_ppm))?;
-        writeln!(w,
-            "SF thermal error     {:>14.3} ppm (max |K(t) − K_ref|, K_ref = {:.9}, {} rate segments)",
-            r.sf_thermal_error_ppm,
-            r.reference_scale,
+        writeln!(
+            w,
+            "SF thermal error     {:>14} ppm (max |K(t) − K_ref|, K_ref = {}, {} rate segments)",
+            num(r.sf_thermal_error_ppm, 3),
+            num(r.reference_scale, 9),
             r.scale_over_time.len()
         )?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Fixed-point with `prec` decimals for ordinary magnitudes, scientific beyond (a figure of
+/// 1e28 °/h is not printed as 29 digits).
+fn num(x: f64, prec: usize) -> String {
+    if x != 0.0 && !(1e-4..1e9).contains(&x.abs()) {
+        format!("{x:.prec$e}")
+    } else {
+        format!("{x:.prec$}")
+    }
 }

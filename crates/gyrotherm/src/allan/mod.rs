@@ -175,6 +175,9 @@ pub enum AllanError {
     TauOutOfRange { tau_s: f64, max_tau_s: f64 },
     /// Too few samples for any τ.
     TooShort { samples: usize, need: usize },
+    /// Finite samples so large that the deviation or its bounds exceed the range of f64;
+    /// `index` is the sample of largest magnitude (or, streaming, the one that overflowed).
+    TooLarge { index: usize, value: f64 },
 }
 
 impl fmt::Display for AllanError {
@@ -201,6 +204,11 @@ impl fmt::Display for AllanError {
             AllanError::TooShort { samples, need } => write!(
                 f,
                 "{samples} samples is too short for this deviation (need at least {need})"
+            ),
+            AllanError::TooLarge { index, value } => write!(
+                f,
+                "sample {index} is {value:e}: too large for its deviation to be represented; \
+                 check the column's unit or remove the outlier"
             ),
         }
     }
@@ -231,7 +239,8 @@ pub struct AllanPoint {
 
 /// Checks τ0 and the samples (finite).
 fn check_input(samples: &[f64], tau0_s: f64) -> Result<(), AllanError> {
-    if !(tau0_s.is_finite() && tau0_s > 0.0) {
+    // Every τ = m·τ0 (m ≤ N) must be finite too.
+    if !(tau0_s.is_finite() && tau0_s > 0.0 && (tau0_s * samples.len() as f64).is_finite()) {
         return Err(AllanError::BadSamplePeriod(tau0_s));
     }
     if let Some(index) = samples.iter().position(|v| !v.is_finite()) {
@@ -507,6 +516,61 @@ pub fn deviation_from_phase(x: &[f64], kind: DevKind, m: usize) -> Option<(f64, 
     Some((var.max(0.0).sqrt(), n))
 }
 
+/// Largest |sample| past which (or, non-zero, below which) [`deviation`] works on rescaled
+/// samples. Below it nothing can overflow: with N ≤ 1e9 samples of magnitude ≤ 1e100 the
+/// phase stays below 2e109 and the sums of squared differences below 1e230; nor underflow
+/// (the squares of differences of magnitude ≥ 1e-100 are ≥ 1e-200).
+const RESCALE_ABOVE: f64 = 1e100;
+const RESCALE_BELOW: f64 = 1e-100;
+
+/// A power of two to divide the samples by when their magnitude is out of the safe range
+/// (None otherwise: the usual case, computed as is). Dividing by a power of two only moves
+/// exponents, so the rescaled deviation times the scale is the deviation of the samples.
+pub(crate) fn rescale_for_range(samples: &[f64]) -> Option<f64> {
+    let max = samples.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if (max > 0.0 && max < RESCALE_BELOW) || max > RESCALE_ABOVE {
+        // 2^⌊log2 max⌋ from the exponent bits; the smallest normal power of two for a
+        // subnormal max (whose exponent bits are 0).
+        Some(f64::from_bits(max.to_bits() & 0x7ff0_0000_0000_0000).max(f64::MIN_POSITIVE))
+    } else {
+        None
+    }
+}
+
+/// Points of rescaled samples back in the samples' unit; refused when a deviation or bound
+/// is beyond f64 (the error names the largest sample).
+fn scale_points(
+    mut points: Vec<AllanPoint>,
+    scale: f64,
+    samples: &[f64],
+) -> Result<Vec<AllanPoint>, AllanError> {
+    for p in &mut points {
+        p.dev *= scale;
+        p.lo *= scale;
+        p.hi *= scale;
+        let bounds_ok = !p.edf.is_finite() || (p.lo.is_finite() && p.hi.is_finite());
+        if !(p.dev.is_finite() && bounds_ok) {
+            let (index, value) =
+                samples
+                    .iter()
+                    .copied()
+                    .enumerate()
+                    .fold(
+                        (0, 0.0f64),
+                        |(i, m), (j, v)| {
+                            if v.abs() > m.abs() {
+                                (j, v)
+                            } else {
+                                (i, m)
+                            }
+                        },
+                    );
+            return Err(AllanError::TooLarge { index, value });
+        }
+    }
+    Ok(points)
+}
+
 /// How to compute the confidence intervals.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum NoiseModel {
@@ -529,6 +593,11 @@ pub fn deviation(
     noise: NoiseModel,
 ) -> Result<Vec<AllanPoint>, AllanError> {
     check_input(samples, tau0_s)?;
+    if let Some(scale) = rescale_for_range(samples) {
+        let scaled: Vec<f64> = samples.iter().map(|v| v / scale).collect();
+        let points = deviation(&scaled, tau0_s, kind, taus, noise)?;
+        return scale_points(points, scale, samples);
+    }
     let ms = averaging_factors(taus, kind, samples.len(), tau0_s)?;
     let x = phase_from_rate(samples);
     Ok(deviation_of_phase(&x, tau0_s, kind, &ms, noise))

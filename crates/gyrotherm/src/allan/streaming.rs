@@ -3,6 +3,8 @@
 //!
 //! Same estimator as [`super::deviation`] with [`super::DevKind::Oadev`]; the phase is the
 //! running sum of (Ω − Ω_first) (an offset leaves OADEV unchanged and keeps the sum small).
+//! Samples are divided by a power of two near the first non-zero one (exact: only exponents
+//! move), so that logs in any unit, however large or small, neither overflow nor underflow.
 
 use super::{confidence, AllanError, AllanPoint, DevKind};
 
@@ -16,6 +18,8 @@ pub struct StreamingOadev {
     /// Phase points seen so far (N + 1 once N samples were pushed).
     phase_points: usize,
     offset: Option<f64>,
+    /// Power of two the samples are divided by (fixed by the first non-zero sample).
+    scale: Option<f64>,
     sum: f64,
     comp: f64,
     sums: Vec<f64>,
@@ -46,6 +50,7 @@ impl StreamingOadev {
             ring,
             phase_points: 1,
             offset: None,
+            scale: None,
             sum: 0.0,
             comp: 0.0,
         })
@@ -60,7 +65,8 @@ impl StreamingOadev {
     }
 
     /// Adds samples. A non-finite sample is an error naming its index in the whole stream;
-    /// the samples before it in this chunk are kept.
+    /// the samples before it in this chunk are kept. A finite sample so large that the sums
+    /// overflow is an error too ([`AllanError::TooLarge`]); the state is then spent.
     pub fn push(&mut self, samples: &[f64]) -> Result<(), AllanError> {
         let len = self.ring.len();
         for &v in samples {
@@ -69,6 +75,12 @@ impl StreamingOadev {
                     index: self.phase_points - 1,
                 });
             }
+            let raw = v;
+            if self.scale.is_none() && v != 0.0 {
+                self.scale = Some(power_of_two_below(v.abs()));
+            }
+            let scale = self.scale.unwrap_or(1.0);
+            let v = v / scale;
             let off = *self.offset.get_or_insert(v);
             let v = v - off;
             let t = self.sum + v;
@@ -90,6 +102,15 @@ impl StreamingOadev {
                 let x_old = self.ring[(k_new - 2 * m) % len];
                 let d = x_new - 2.0 * x_mid + x_old;
                 *s += d * d;
+            }
+            // A deviation is at most √sum and its upper bound a few times that: refuse
+            // before any of them would be beyond f64 in the samples' unit.
+            let fits = |s: &f64| (s.sqrt() * scale * 8.0).is_finite();
+            if !(x_new.is_finite() && self.sums.iter().all(fits)) {
+                return Err(AllanError::TooLarge {
+                    index: k_new - 1,
+                    value: raw,
+                });
             }
         }
         Ok(())
@@ -113,7 +134,8 @@ impl StreamingOadev {
                     return None;
                 }
                 let mf = m as f64;
-                let dev = (s / (2.0 * mf * mf * n as f64)).max(0.0).sqrt();
+                let dev =
+                    (s / (2.0 * mf * mf * n as f64)).max(0.0).sqrt() * self.scale.unwrap_or(1.0);
                 let (edf, lo, hi) = match alpha {
                     Some(a) => confidence(DevKind::Oadev, dev, a, m, n_samples),
                     None => (f64::NAN, f64::NAN, f64::NAN),
@@ -131,4 +153,9 @@ impl StreamingOadev {
             })
             .collect()
     }
+}
+
+/// 2^⌊log2 v⌋ for finite v > 0 (the smallest normal power of two for subnormal v).
+fn power_of_two_below(v: f64) -> f64 {
+    f64::from_bits(v.to_bits() & 0x7ff0_0000_0000_0000).max(f64::MIN_POSITIVE)
 }

@@ -79,13 +79,15 @@ struct LogPoint {
 fn best_run(pts: &[LogPoint], local: &[f64], slope: f64) -> Option<std::ops::Range<usize>> {
     let mut best: Option<(f64, std::ops::Range<usize>)> = None;
     let mut i = 0;
+    // A NaN local slope is near nothing (and must not stop the scan).
+    let near = |i: usize| (local[i] - slope).abs() <= SLOPE_TOL;
     while i < pts.len() {
-        if (local[i] - slope).abs() > SLOPE_TOL {
+        if !near(i) {
             i += 1;
             continue;
         }
         let start = i;
-        while i < pts.len() && (local[i] - slope).abs() <= SLOPE_TOL {
+        while i < pts.len() && near(i) {
             i += 1;
         }
         let w: f64 = pts[start..i].iter().map(|p| p.weight).sum();
@@ -122,7 +124,7 @@ fn fixed_slope_read(
 pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
     let mut pts: Vec<LogPoint> = points
         .iter()
-        .filter(|p| p.dev.is_finite() && p.dev > 0.0 && p.tau_s > 0.0)
+        .filter(|p| p.dev.is_finite() && p.dev > 0.0 && p.tau_s.is_finite() && p.tau_s > 0.0)
         .map(|p| LogPoint {
             ln_tau: p.tau_s.ln(),
             ln_sigma: (p.dev * to_dph).ln(),
@@ -139,13 +141,16 @@ pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
         return NoiseTerms::default();
     }
     let local = local_slopes(&pts);
+    // A term read off so far along its line that it is beyond f64 is not reported.
     let term = |slope: f64, tau: f64, scale: f64| {
-        fixed_slope_read(&pts, &local, slope, tau).map(|(s, lo, hi)| NoiseTerm {
-            value: s * scale,
-            tau_read_s: tau,
-            fit_tau_min_s: lo,
-            fit_tau_max_s: hi,
-        })
+        fixed_slope_read(&pts, &local, slope, tau)
+            .map(|(s, lo, hi)| NoiseTerm {
+                value: s * scale,
+                tau_read_s: tau,
+                fit_tau_min_s: lo,
+                fit_tau_max_s: hi,
+            })
+            .filter(|t| t.value.is_finite())
     };
     // σ in °/h throughout.
     let arw = term(-0.5, 1.0, 1.0 / 60.0);
@@ -165,6 +170,7 @@ pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
             fit_tau_min_s: sel[0].ln_tau.exp(),
             fit_tau_max_s: sel[sel.len() - 1].ln_tau.exp(),
         })
+        .filter(|t| t.value.is_finite())
     });
     NoiseTerms {
         arw_deg_rt_h: arw,

@@ -72,7 +72,8 @@ pub(super) fn map_columns(
         Ok(first)
     };
     let require = |name: &str, flag: &str, what: &str| -> Result<usize, LogError> {
-        find(name, flag, what)?.ok_or_else(|| missing_column(path, line, headers, name, flag, what))
+        find(name, flag, what)?
+            .ok_or_else(|| missing_column(path, line, headers, name, flag, what, opts.delimiter))
     };
     let time = require(&opts.time_col, "--time-col", "time")?;
     let gyro = require(&opts.gyro_col, "--gyro-col", "gyro")?;
@@ -87,6 +88,7 @@ pub(super) fn map_columns(
             &opts.table_col,
             "--table-col",
             "table-rate",
+            opts.delimiter,
         ));
     }
     let roles = [
@@ -130,6 +132,7 @@ fn missing_column(
     name: &str,
     flag: &str,
     what: &str,
+    opts_delimiter: u8,
 ) -> LogError {
     let found = headers
         .iter()
@@ -138,14 +141,18 @@ fn missing_column(
         .join(", ");
     let mut message =
         format!("required column not found; the header (line {line}) has: {found}; name the {what} column with {flag} NAME");
-    if headers.len() == 1 {
-        for (sep, sep_name) in [(';', "';'"), ('\t', "tabs")] {
-            if headers[0].contains(sep) {
-                message.push_str(&format!(
-                    " (the file seems to separate fields with {sep_name}; gyrotherm reads \
-                     comma-separated files)"
-                ));
-            }
+    // Which separator the header seems to use, when it is not the one being read with.
+    let header = headers.join(&*String::from(char::from(opts_delimiter)));
+    for (sep, sep_name, flag) in [
+        (',', "commas", ","),
+        (';', "';'", ";"),
+        ('\t', "tabs", "tab"),
+    ] {
+        if sep as u8 != opts_delimiter && header.contains(sep) {
+            message.push_str(&format!(
+                " (the header seems to separate fields with {sep_name}: give --delimiter {flag})"
+            ));
+            break;
         }
     }
     if !headers.is_empty() && headers.iter().all(|h| parse_f64(h.as_bytes()).is_some()) {

@@ -11,6 +11,9 @@ use std::path::PathBuf;
 pub enum LogErrorKind {
     /// The file could not be opened, read or written.
     Io,
+    /// The output's reader went away (a closed pipe, as `| head` leaves): not a fault of the
+    /// log; a command-line program ends quietly.
+    OutputClosed,
     /// The CSV syntax itself is broken (reported by the `csv` parser).
     Csv,
     /// No header row: the file is empty or holds only comments.

@@ -16,7 +16,6 @@
 //! duplicate timestamps, and gaps longer than [`GAP_FACTOR`] nominal sample periods (the
 //! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`LogReader`]).
 
-mod chunk;
 mod columns;
 mod error;
 mod gaps;
@@ -25,8 +24,10 @@ mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
-pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
-pub use reader::{LogReader, GAP_FACTOR, PERIOD_ESTIMATE_STEPS};
+pub use reader::{
+    LogReader, Sample, GAP_FACTOR, MAX_FILLED_SAMPLES, MAX_FILL_SAMPLES_PER_GAP,
+    PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
+};
 pub use writer::{format_f64, LogWriter};
 
 use std::fs::File;
@@ -221,6 +222,9 @@ pub struct ReadOptions {
     /// Nominal sample period, s (None: median of the first [`PERIOD_ESTIMATE_STEPS`] steps,
     /// which the streaming reader reads ahead before its first sample).
     pub sample_period_s: Option<f64>,
+    /// Field separator: `b','` (default), `b';'` or `b'\t'`. With any separator but the
+    /// comma, numbers may use a decimal comma (`0,5`), as European loggers write them.
+    pub delimiter: u8,
 }
 
 impl Default for ReadOptions {
@@ -233,6 +237,7 @@ impl Default for ReadOptions {
             gyro_unit: GyroUnit::Dps,
             fill_gaps_max_s: None,
             sample_period_s: None,
+            delimiter: b',',
         }
     }
 }
@@ -250,6 +255,33 @@ pub struct ReadReport {
     pub sample_period_s: Option<f64>,
     /// Whether that period was estimated from the data (false: given in the options).
     pub sample_period_estimated: bool,
+    /// Largest |step / period − 1| over the steps that are not gaps: 0 for an evenly sampled
+    /// log, 0.4 for steps 40 % off the period.
+    pub max_step_jitter: f64,
+    /// Line of the step with that jitter.
+    pub max_jitter_line: Option<u64>,
+}
+
+impl ReadReport {
+    /// Jitter above which a log is reported as irregularly sampled (the figures assume
+    /// even sampling).
+    pub const JITTER_WARNING: f64 = 0.05;
+
+    /// A warning about irregular steps, with the measured jitter, if above
+    /// [`JITTER_WARNING`](Self::JITTER_WARNING).
+    pub fn jitter_warning(&self, source: &Path) -> Option<String> {
+        let period = self.sample_period_s?;
+        (self.max_step_jitter > Self::JITTER_WARNING).then(|| {
+            format!(
+                "{}{}: time steps are irregular: up to {:.0} % off the {period} s period; the \
+                 figures assume even sampling (resample the log if that matters)",
+                source.display(),
+                self.max_jitter_line
+                    .map_or(String::new(), |l| format!(":{l}")),
+                100.0 * self.max_step_jitter
+            )
+        })
+    }
 }
 
 /// Read and validate a whole log. The file is read once, streaming; the columns are sized
@@ -342,13 +374,12 @@ pub fn write_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
         out.flush()
     })
     .map_err(|e| {
-        LogError::new(
-            LogErrorKind::Io,
-            path,
-            None,
-            None,
-            format!("cannot write: {e}"),
-        )
+        let kind = if e.kind() == std::io::ErrorKind::BrokenPipe {
+            LogErrorKind::OutputClosed
+        } else {
+            LogErrorKind::Io
+        };
+        LogError::new(kind, path, None, None, format!("cannot write: {e}"))
     })
 }
 

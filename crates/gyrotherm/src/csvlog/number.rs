@@ -11,6 +11,20 @@ pub(super) fn parse_f64(raw: &[u8]) -> Option<f64> {
     }
 }
 
+/// A number written with a decimal comma (`-0,25`, `1,5e-3`): one comma and no point.
+#[cold]
+pub(super) fn parse_f64_decimal_comma(raw: &[u8]) -> Option<f64> {
+    let t = raw.trim_ascii();
+    if t.iter().filter(|&&b| b == b',').count() != 1 || t.contains(&b'.') {
+        return None;
+    }
+    let dotted: Vec<u8> = t
+        .iter()
+        .map(|&b| if b == b',' { b'.' } else { b })
+        .collect();
+    parse_f64(&dotted)
+}
+
 #[cold]
 #[inline(never)]
 fn parse_f64_std(raw: &[u8]) -> Option<f64> {
@@ -31,21 +45,10 @@ const POW10: [f64; 23] = [
 /// Anything else (exponent, spaces, 20+ digits, NaN, inf) gives None.
 #[inline(always)]
 pub(super) fn parse_plain_decimal(s: &[u8]) -> Option<f64> {
-    match parse_decimal_prefix(s) {
-        Some((v, end)) if end == s.len() => Some(v),
-        _ => None,
-    }
-}
-
-/// [`parse_plain_decimal`] of the longest `[+-]digits[.digits]` at the start of `s`: the
-/// value and the index after it (None where the fast path does not apply). The caller
-/// checks that a delimiter or the end follows, so a row is scanned once.
-#[inline(always)]
-pub(super) fn parse_decimal_prefix(s0: &[u8]) -> Option<(f64, usize)> {
-    let (neg, sign, s) = match s0.first() {
-        Some(b'-') => (true, 1, &s0[1..]),
-        Some(b'+') => (false, 1, &s0[1..]),
-        _ => (false, 0, s0),
+    let (neg, s) = match s.first() {
+        Some(b'-') => (true, &s[1..]),
+        Some(b'+') => (false, &s[1..]),
+        _ => (false, s),
     };
     let mut m: u64 = 0;
     let mut i = digits(s, 0, &mut m);
@@ -58,11 +61,11 @@ pub(super) fn parse_decimal_prefix(s0: &[u8]) -> Option<(f64, usize)> {
     }
     let digits = int_digits + frac_digits;
     // 19 digits cannot overflow u64, so `m` is exact when digits <= 19.
-    if digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
+    if i != s.len() || digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
         return None;
     }
     let v = m as f64 / POW10[frac_digits];
-    Some((if neg { -v } else { v }, sign + i))
+    Some(if neg { -v } else { v })
 }
 
 /// Accumulate the decimal digits of `s` from `i` into `m` (wrapping; the caller bounds the

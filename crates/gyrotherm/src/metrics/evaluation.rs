@@ -134,6 +134,13 @@ pub enum EvaluationError {
     StopSegments(MetricsError),
     /// Scale factor from the table column.
     ScaleFactor(ScaleFactorError),
+    /// Finite rates so large that a figure is beyond f64 (e.g. °/h of a rate near f64::MAX);
+    /// the sample of largest magnitude (index from 0, its time and value in °/s).
+    TooLarge {
+        index: usize,
+        time_s: f64,
+        value_dps: f64,
+    },
 }
 
 impl fmt::Display for EvaluationError {
@@ -143,6 +150,16 @@ impl fmt::Display for EvaluationError {
             EvaluationError::BiasStability(_) => write!(f, "bias stability"),
             EvaluationError::StopSegments(_) => write!(f, "bias over the stop segments"),
             EvaluationError::ScaleFactor(_) => write!(f, "scale factor from table_dps"),
+            EvaluationError::TooLarge {
+                index,
+                time_s,
+                value_dps,
+            } => write!(
+                f,
+                "sample {} (time {time_s} s) is {value_dps:e} °/s: too large for the figures to \
+                 be represented; check the column's unit or remove the outlier",
+                index + 1
+            ),
         }
     }
 }
@@ -154,6 +171,7 @@ impl std::error::Error for EvaluationError {
             | EvaluationError::BiasStability(e)
             | EvaluationError::StopSegments(e) => Some(e),
             EvaluationError::ScaleFactor(e) => Some(e),
+            EvaluationError::TooLarge { .. } => None,
         }
     }
 }
@@ -168,6 +186,36 @@ pub fn evaluate(
     table_dps: Option<&[f64]>,
     opts: &EvaluationOptions,
 ) -> Result<Evaluation, EvaluationError> {
+    // Rates of extreme magnitude are judged divided by a power of two (exact: every figure
+    // is proportional to the rates or independent of their scale), so no sum overflows or
+    // underflows; a figure still beyond f64 once scaled back is refused.
+    if let Some(s) = crate::allan::rescale_for_range(rate_dps) {
+        let scaled: Vec<f64> = rate_dps.iter().map(|v| v / s).collect();
+        let scaled_opts = EvaluationOptions {
+            reference_scale: opts.reference_scale.map(|k| k / s),
+            ..*opts
+        };
+        let mut e = evaluate(
+            column,
+            time_s,
+            &scaled,
+            sample_period_s,
+            table_dps,
+            &scaled_opts,
+        )?;
+        e.scale_rates(s);
+        if !e.is_finite() {
+            let index = (0..rate_dps.len())
+                .max_by(|&a, &b| rate_dps[a].abs().total_cmp(&rate_dps[b].abs()))
+                .unwrap_or(0);
+            return Err(EvaluationError::TooLarge {
+                index,
+                time_s: time_s.get(index).copied().unwrap_or(f64::NAN),
+                value_dps: rate_dps[index],
+            });
+        }
+        return Ok(e);
+    }
     // A rate-table log's bias comes from its stop segments only.
     let stop_segments_only = table_dps.is_some_and(|t| t.iter().any(|w| *w != 0.0));
     let (bias, stab) = match table_dps {
@@ -205,4 +253,45 @@ pub fn evaluate(
         stop_segments_only: scale.is_some(),
         scale,
     })
+}
+
+impl Evaluation {
+    /// Multiply every figure in the unit of the rates by `s` (ratios and ppm stay).
+    fn scale_rates(&mut self, s: f64) {
+        self.bias_dph *= s;
+        self.bias_stability_dph *= s;
+        if let Some(f) = &mut self.scale {
+            f.scale_factor *= s;
+            f.intercept_dps *= s;
+            f.scale_positive = f.scale_positive.map(|k| k * s);
+            f.scale_negative = f.scale_negative.map(|k| k * s);
+            f.reference_scale *= s;
+            for p in &mut f.rate_points {
+                p.mean_output_dps *= s;
+            }
+            for p in &mut f.scale_over_time {
+                p.scale *= s;
+            }
+        }
+    }
+
+    /// Whether every figure that was computed is finite.
+    fn is_finite(&self) -> bool {
+        let mut v = vec![self.bias_dph, self.bias_stability_dph];
+        if let Some(f) = &self.scale {
+            v.extend([
+                f.scale_factor,
+                f.intercept_dps,
+                f.nonlinearity_ppm,
+                f.sf_thermal_error_ppm,
+                f.reference_scale,
+            ]);
+            v.extend(f.scale_positive);
+            v.extend(f.scale_negative);
+            v.extend(f.asymmetry_ppm);
+            v.extend(f.rate_points.iter().map(|p| p.mean_output_dps));
+            v.extend(f.scale_over_time.iter().map(|p| p.scale));
+        }
+        v.iter().all(|x| x.is_finite())
+    }
 }
