@@ -2,7 +2,22 @@
 //! gap; with a fill limit it is filled by linear interpolation (gyro, temperature; the table
 //! rate holds the earlier sample's value), else it is an error.
 
-use super::reader::{Sample, MAX_FILL_SAMPLES_PER_GAP};
+/// Most samples one gap may be filled with; beyond it the gap is reported as too long, so
+/// that a tiny period and a large limit cannot exhaust memory.
+pub const MAX_FILL_SAMPLES_PER_GAP: usize = 10_000_000;
+
+/// One validated row: finite numbers, gyro converted to °/s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Time, s (strictly increasing along the log).
+    pub time_s: f64,
+    /// Gyro output, °/s (converted from the file's unit).
+    pub gyro_dps: f64,
+    /// Temperature, °C.
+    pub temp_c: f64,
+    /// Rate-table input rate, °/s (None: the log has no table column).
+    pub table_dps: Option<f64>,
+}
 
 /// Gap filling in progress: `n` samples between `from` and `to`, `k` already handed out.
 #[derive(Debug, Clone, Copy)]

@@ -24,9 +24,9 @@ mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
+pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
 pub use reader::{
-    LogReader, Sample, GAP_FACTOR, MAX_FILLED_SAMPLES, MAX_FILL_SAMPLES_PER_GAP,
-    PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
+    LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
 };
 pub use writer::{format_f64, LogWriter};
 

@@ -20,7 +20,7 @@ use csv::ByteRecord;
 
 use super::columns::{check_options, map_columns, Columns};
 use super::error::{LogError, LogErrorKind as Kind};
-use super::gaps::{gap_verdict, Fill, GapVerdict};
+use super::gaps::{gap_verdict, Fill, GapVerdict, Sample};
 use super::number::{parse_f64, parse_f64_decimal_comma};
 use super::{GyroUnit, ReadOptions, ReadReport};
 
@@ -31,10 +31,6 @@ pub const PERIOD_ESTIMATE_STEPS: usize = 100;
 /// periods) must be caught, while jitter of half a period must not be.
 pub const GAP_FACTOR: f64 = 1.5;
 
-/// Most samples one gap may be filled with; beyond it the gap is reported as too long, so
-/// that a tiny period and a large limit cannot exhaust memory.
-pub const MAX_FILL_SAMPLES_PER_GAP: usize = 10_000_000;
-
 /// Most samples gap filling may make in one log, all gaps together.
 pub const MAX_FILLED_SAMPLES: usize = 10_000_000;
 
@@ -44,19 +40,6 @@ pub const PERIOD_CHECK_STEPS: usize = 10;
 /// That many of those steps more than [`GAP_FACTOR`] times longer or shorter than the given
 /// period mean the period is wrong (one or two may be real gaps).
 const PERIOD_CHECK_MISMATCHES: usize = 3;
-
-/// One validated row: finite numbers, gyro converted to °/s.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sample {
-    /// Time, s (strictly increasing along the log).
-    pub time_s: f64,
-    /// Gyro output, °/s (converted from the file's unit).
-    pub gyro_dps: f64,
-    /// Temperature, °C.
-    pub temp_c: f64,
-    /// Rate-table input rate, °/s (None: the log has no table column).
-    pub table_dps: Option<f64>,
-}
 
 /// The CSV side: parses and validates one record at a time (numbers, field count, time order).
 struct Source<R> {
