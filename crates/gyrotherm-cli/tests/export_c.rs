@@ -178,23 +178,7 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
     }
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let train_s = simulate(
-        d,
-        "train_s.csv",
-        &["--profile", "fast-cycle", "--seed", "1"],
-    );
-    let train_t = simulate(
-        d,
-        "train_t.csv",
-        &[
-            "--profile",
-            "fast-cycle",
-            "--seed",
-            "2",
-            "--table-rate",
-            "20",
-        ],
-    );
+    let (train_s, train_t) = cli::fast_cycle_training_pair(d);
     let base = ["--profile", "seed-shock", "--seed", "3"];
     let clean = simulate(d, "clean.csv", &base);
     let mut fault_args = base.to_vec();

@@ -36,23 +36,7 @@ fn bias_stability_dph(x: &[f64]) -> f64 {
 fn faulted_run_keeps_its_bias_stability() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let train_s = simulate(
-        d,
-        "train_s.csv",
-        &["--profile", "fast-cycle", "--seed", "1"],
-    );
-    let train_t = simulate(
-        d,
-        "train_t.csv",
-        &[
-            "--profile",
-            "fast-cycle",
-            "--seed",
-            "2",
-            "--table-rate",
-            "20",
-        ],
-    );
+    let (train_s, train_t) = cli::fast_cycle_training_pair(d);
     let model = d.join("model.json");
     run_ok(
         gyrotherm()

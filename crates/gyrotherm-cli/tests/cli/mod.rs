@@ -34,3 +34,25 @@ pub fn simulate_args(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
     );
     path
 }
+
+/// A static and a ±20 °/s rate-table training run on `fast-cycle` (seeds 1 and 2).
+pub fn fast_cycle_training_pair(dir: &Path) -> (PathBuf, PathBuf) {
+    let s = simulate_args(
+        dir,
+        "train_s.csv",
+        &["--profile", "fast-cycle", "--seed", "1"],
+    );
+    let t = simulate_args(
+        dir,
+        "train_t.csv",
+        &[
+            "--profile",
+            "fast-cycle",
+            "--seed",
+            "2",
+            "--table-rate",
+            "20",
+        ],
+    );
+    (s, t)
+}
