@@ -176,6 +176,14 @@ fn an_edited_model_is_refused_until_resealed() {
         linear_model([0.001, 1e-6, 0.0], [1.0001, 1e-7, 0.0]).to_string(),
     )
     .unwrap();
+    // An unsealed file is read on its other checks, with a warning that names it.
+    let (code, out_text, err) = gyrotherm(&["model", "check", p(&model)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out_text.contains("ok but not sealed"), "{out_text}");
+    assert!(
+        err.contains("warning: ") && err.contains("m.json: no content_sha256"),
+        "{err}"
+    );
     // Sealing an unsealed file adds the checksum.
     let (code, _, err) = gyrotherm(&["model", "seal", p(&model)]);
     assert_eq!(code, 0, "{err}");
@@ -204,8 +212,17 @@ fn an_edited_model_is_refused_until_resealed() {
     assert_eq!(gyrotherm(&["model", "seal", p(&model)]).0, 0);
     let (code, out_text, err) = gyrotherm(&["model", "check", p(&model)]);
     assert_eq!(code, 0, "{err}");
-    assert!(out_text.contains("ok, content_sha256"), "{out_text}");
-    assert_eq!(gyrotherm(&compensate).0, 0);
+    assert!(
+        out_text.contains("ok, sealed, content_sha256"),
+        "{out_text}"
+    );
+    assert!(!err.contains("warning"), "{err}");
+    let (code, _, err) = gyrotherm(&compensate);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        !err.contains("content_sha256"),
+        "a sealed model warns of nothing: {err}"
+    );
 }
 
 #[test]

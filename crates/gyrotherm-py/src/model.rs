@@ -30,6 +30,8 @@ pub struct RawModel {
     file: ModelFile,
     /// One line per fitted target (LSTM epochs, loss and verdict), from `fit` only.
     training_notes: Vec<String>,
+    /// What loading the file said (an unsealed file), from `load` only.
+    load_warnings: Vec<String>,
 }
 
 fn model_err(e: impl std::fmt::Display) -> PyErr {
@@ -46,13 +48,16 @@ type Compensated<'py> = (
 
 #[pymethods]
 impl RawModel {
-    /// Read and check a model file.
+    /// Read and check a model file (`load_warnings` says when it has no content checksum).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<RawModel> {
-        let file = py.detach(|| ModelFile::load(&path)).map_err(model_err)?;
+        let (file, seal) = py
+            .detach(|| ModelFile::load_sealed(&path))
+            .map_err(model_err)?;
         Ok(RawModel {
             file,
             training_notes: Vec::new(),
+            load_warnings: seal.warning(&path).into_iter().collect(),
         })
     }
 
@@ -63,6 +68,7 @@ impl RawModel {
         Ok(RawModel {
             file,
             training_notes: Vec::new(),
+            load_warnings: Vec::new(),
         })
     }
 
@@ -95,6 +101,11 @@ impl RawModel {
     #[getter]
     fn training_notes(&self) -> Vec<String> {
         self.training_notes.clone()
+    }
+
+    #[getter]
+    fn load_warnings(&self) -> Vec<String> {
+        self.load_warnings.clone()
     }
 
     /// Training facts of the file as a dict.
@@ -445,5 +456,6 @@ fn fit(
     Ok(RawModel {
         file: result.model,
         training_notes: notes,
+        load_warnings: Vec::new(),
     })
 }

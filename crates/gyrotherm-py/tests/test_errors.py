@@ -2,6 +2,7 @@
 do), never a crash of the interpreter."""
 
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -140,3 +141,19 @@ def test_compensate_gives_bad_samples_a_status(logs):
     assert set(gt.STATUS_NAMES.values()) == {"ok", "held", "degraded", "invalid"}
     with pytest.raises(TypeError):
         gt.Model("not a model")
+
+
+def test_unsealed_model_file_loads_with_a_warning_naming_it(cli, logs, tmp_path):
+    good = gt.fit(static=logs["static"], method="linear")
+    doc = json.loads(good.to_json())
+    del doc["content_sha256"]
+    path = tmp_path / "unsealed.json"
+    path.write_text(json.dumps(doc))
+    with pytest.warns(gt.GyrothermWarning, match="unsealed.json: no content_sha256"):
+        loaded = gt.Model.load(path)
+    assert loaded.to_json() == good.to_json()
+    sealed = tmp_path / "sealed.json"
+    good.save(sealed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", gt.GyrothermWarning)
+        gt.Model.load(sealed)

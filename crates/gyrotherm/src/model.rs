@@ -52,6 +52,16 @@ const MAX_PROBE_STEPS: usize = 20_000;
 /// Key of the content checksum in a model file.
 pub const CHECKSUM_KEY: &str = "content_sha256";
 
+/// Whether a loaded model file carried a content checksum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Seal {
+    /// The file's `content_sha256` matched its content.
+    Verified,
+    /// The file had no `content_sha256` (written before files were sealed, or by hand): its
+    /// other checks passed, but corruption of a value cannot be told from a deliberate one.
+    Absent,
+}
+
 /// How the model was fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -879,10 +889,17 @@ impl ModelFile {
     /// must match the content (a file without one, written before files were sealed or by
     /// hand, is read on its other checks).
     pub fn from_json(text: &str) -> Result<ModelFile, ModelFileError> {
-        Self::parse(text, true)
+        Self::from_json_sealed(text).map(|(m, _)| m)
     }
 
-    fn parse(text: &str, verify: bool) -> Result<ModelFile, ModelFileError> {
+    /// [`from_json`](Self::from_json), also saying whether the text was sealed.
+    pub fn from_json_sealed(text: &str) -> Result<(ModelFile, Seal), ModelFileError> {
+        let (m, sealed) = Self::parse(text, true)?;
+        Ok((m, if sealed { Seal::Verified } else { Seal::Absent }))
+    }
+
+    /// The model and whether the text held a checksum (checked only when `verify`).
+    fn parse(text: &str, verify: bool) -> Result<(ModelFile, bool), ModelFileError> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         // Version first, so that a newer file gets "unsupported version", not a field error.
         let mut v: serde_json::Value =
@@ -899,6 +916,7 @@ impl ModelFile {
             },
         }
         let sealed = v.as_object_mut().and_then(|o| o.remove(CHECKSUM_KEY));
+        let has_seal = sealed.is_some();
         let m: ModelFile = match &sealed {
             // Parsed from the text where possible: its errors give line and column.
             None => serde_json::from_str(text).map_err(ModelFileError::Fields)?,
@@ -915,7 +933,7 @@ impl ModelFile {
             }
         }
         m.validate()?;
-        Ok(m)
+        Ok((m, has_seal))
     }
 
     /// Re-seal a model file after a deliberate hand edit: read it without checking its
@@ -930,7 +948,7 @@ impl ModelFile {
             path: path.to_path_buf(),
             source,
         })?;
-        let m = Self::parse(&text, false).map_err(in_file)?;
+        let (m, _) = Self::parse(&text, false).map_err(in_file)?;
         m.save(path)?;
         let digest = m.content_digest().map_err(in_file)?;
         Ok((m, digest))
@@ -951,14 +969,36 @@ impl ModelFile {
 
     /// Read and check a model file.
     pub fn load(path: &Path) -> Result<ModelFile, ModelFileError> {
+        Self::load_sealed(path).map(|(m, _)| m)
+    }
+
+    /// [`load`](Self::load), also saying whether the file was sealed (a caller warns on
+    /// [`Seal::Absent`]; see [`Seal::warning`]).
+    pub fn load_sealed(path: &Path) -> Result<(ModelFile, Seal), ModelFileError> {
         let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Read {
             path: path.to_path_buf(),
             source,
         })?;
-        Self::from_json(&text).map_err(|e| ModelFileError::InFile {
+        Self::from_json_sealed(&text).map_err(|e| ModelFileError::InFile {
             path: path.to_path_buf(),
             source: Box::new(e),
         })
+    }
+}
+
+impl Seal {
+    /// What to tell the user about the model file `path`: nothing when sealed.
+    pub fn warning(self, path: &Path) -> Option<String> {
+        match self {
+            Seal::Verified => None,
+            Seal::Absent => Some(format!(
+                "{}: no {CHECKSUM_KEY}: the model passed its plausibility checks, but a \
+                 corrupted value cannot be told from an intended one; if the content is as \
+                 intended, run `gyrotherm model seal {}`",
+                path.display(),
+                path.display()
+            )),
+        }
     }
 }
 

@@ -36,7 +36,10 @@ pub struct CompensateArgs {
 }
 
 pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
-    let model = ModelFile::load(&args.model)?;
+    let (model, seal) = ModelFile::load_sealed(&args.model)?;
+    if let Some(w) = seal.warning(&args.model) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
     anyhow::ensure!(
         args.log.fill_gaps.is_none(),
         "--fill-gaps does not apply to compensate: the compensator bridges time gaps itself and \

@@ -31,7 +31,10 @@ pub struct ExportArgs {
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
-    let model = ModelFile::load(&args.model).map_err(anyhow::Error::msg)?;
+    let (model, seal) = ModelFile::load_sealed(&args.model).map_err(anyhow::Error::msg)?;
+    if let Some(w) = seal.warning(&args.model) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
     let lang = match args.lang {
         LangArg::C => Lang::C,
         LangArg::Rust => Lang::Rust,

@@ -38,9 +38,16 @@ pub fn run(args: ModelArgs) -> anyhow::Result<ExitCode> {
             );
         }
         ModelAction::Check { file } => {
-            let m = ModelFile::load(&file)?;
+            let (m, seal) = ModelFile::load_sealed(&file)?;
+            if let Some(w) = seal.warning(&file) {
+                eprintln!("gyrotherm: warning: {w}");
+            }
+            let state = match seal {
+                gyrotherm::model::Seal::Verified => "ok, sealed",
+                gyrotherm::model::Seal::Absent => "ok but not sealed",
+            };
             println!(
-                "{}: ok, content_sha256 {}",
+                "{}: {state}, content_sha256 {}",
                 file.display(),
                 m.content_digest()?
             );

@@ -23,7 +23,8 @@ STATUS_NAMES: Dict[int, str] = dict(_g.STATUS_NAMES)
 
 
 class GyrothermWarning(UserWarning):
-    """The model extrapolates: temperature or its rate leaves the training range."""
+    """The model extrapolates (temperature or its rate leaves the training range), or a
+    loaded model file has no content checksum."""
 
 
 class Compensation(NamedTuple):
@@ -55,8 +56,11 @@ class Model:
 
     @classmethod
     def load(cls, path: PathLike) -> "Model":
-        """Read and check a model file (raises ``gyrotherm.ModelError``)."""
-        return cls(_g.RawModel.load(os.fspath(path)))
+        """Read and check a model file (raises ``gyrotherm.ModelError``; warns,
+        ``GyrothermWarning``, when the file has no content checksum)."""
+        raw = _g.RawModel.load(os.fspath(path))
+        _warn(raw.load_warnings)
+        return cls(raw)
 
     @classmethod
     def from_json(cls, text: str) -> "Model":
