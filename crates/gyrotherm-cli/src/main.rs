@@ -68,7 +68,7 @@ fn main() -> ExitCode {
             if is_broken_pipe(&err) {
                 return ExitCode::SUCCESS;
             }
-            eprintln!("gyrotherm: {err:#}");
+            eprintln!("gyrotherm: {}", cmd::common::error_message(&err));
             ExitCode::from(2)
         }
     }

@@ -334,3 +334,25 @@ fn delimiters_and_irregular_steps() {
         "{err}"
     );
 }
+
+#[test]
+fn an_error_says_each_cause_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = log_of(dir.path(), "base.csv", noise);
+    let model = dir.path().join("junk.json");
+    std::fs::write(&model, "{not json").unwrap();
+    let out = dir.path().join("out.csv");
+    let (code, _, err) = gyrotherm(&[
+        "compensate",
+        "--model",
+        p(&model),
+        "--input",
+        p(&log),
+        "--out",
+        p(&out),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("junk.json: not valid JSON"), "{err}");
+    assert_eq!(err.matches("line 1 column 2").count(), 1, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+}

@@ -123,7 +123,7 @@ pub fn read_logs(
                 out.push((p.display().to_string(), log));
             }
             Err(e) => {
-                eprintln!("gyrotherm: {e:#}");
+                eprintln!("gyrotherm: {}", error_message(&e));
                 failed += 1;
             }
         }
@@ -198,6 +198,24 @@ pub(crate) fn noise_alpha(s: &str) -> Result<i32, String> {
     }
 }
 
+/// An error and its causes on one line, `: `-separated, each cause left out when the text so
+/// far already holds it (the library's errors put their source in their own message and
+/// also return it from `source()`, as a caller walking the chain expects).
+pub fn error_message(err: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in err.chain() {
+        let part = cause.to_string();
+        if text.contains(&part) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -260,7 +278,7 @@ mod tests {
         let log = read_log_reporting(&path, &cli.log).unwrap();
         assert_eq!(log.time_s, [0.0, 1.0, 2.0, 3.0]);
         let cli = Cli::try_parse_from(["t"]).unwrap();
-        let err = format!("{:#}", read_log_reporting(&path, &cli.log).unwrap_err());
+        let err = error_message(&read_log_reporting(&path, &cli.log).unwrap_err());
         assert!(
             err.contains("gap.csv:4: column time_s: gap of 2 s"),
             "{err}"
