@@ -45,27 +45,39 @@ const POW10: [f64; 23] = [
 /// Anything else (exponent, spaces, 20+ digits, NaN, inf) gives None.
 #[inline(always)]
 pub(super) fn parse_plain_decimal(s: &[u8]) -> Option<f64> {
-    let (neg, s) = match s.first() {
-        Some(b'-') => (true, &s[1..]),
-        Some(b'+') => (false, &s[1..]),
-        _ => (false, s),
+    match parse_decimal_prefix(s, b'.') {
+        Some((v, end)) if end == s.len() => Some(v),
+        _ => None,
+    }
+}
+
+/// [`parse_plain_decimal`] of the longest `[+-]digits[<point>digits]` at the start of `s`
+/// (`point` is `.`, or `,` for a decimal comma): the value and the index after it (None
+/// where the fast path does not apply). The caller checks that a delimiter or the end
+/// follows, so a row is scanned once.
+#[inline(always)]
+pub(super) fn parse_decimal_prefix(s0: &[u8], point: u8) -> Option<(f64, usize)> {
+    let (neg, sign, s) = match s0.first() {
+        Some(b'-') => (true, 1, &s0[1..]),
+        Some(b'+') => (false, 1, &s0[1..]),
+        _ => (false, 0, s0),
     };
     let mut m: u64 = 0;
     let mut i = digits(s, 0, &mut m);
     let int_digits = i;
     let mut frac_digits = 0;
-    if i < s.len() && s[i] == b'.' {
+    if i < s.len() && s[i] == point {
         let start = i + 1;
         i = digits(s, start, &mut m);
         frac_digits = i - start;
     }
     let digits = int_digits + frac_digits;
     // 19 digits cannot overflow u64, so `m` is exact when digits <= 19.
-    if i != s.len() || digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
+    if digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
         return None;
     }
     let v = m as f64 / POW10[frac_digits];
-    Some(if neg { -v } else { v })
+    Some((if neg { -v } else { v }, sign + i))
 }
 
 /// Accumulate the decimal digits of `s` from `i` into `m` (wrapping; the caller bounds the
