@@ -59,15 +59,36 @@ impl Layout {
     }
 }
 
-/// One accepted row: its sample, 1-based line and the byte range of its text (without the
-/// line terminator) in the block.
+/// One accepted row: its numbers (time, gyro in °/s, temperature, table rate or 0), 1-based
+/// line and the byte range of its text (without the line terminator) in the block. 48
+/// bytes: the rows of a block are written by two threads and read back by one.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Row {
-    pub(super) sample: Sample,
+    pub(super) vals: [f64; 4],
     pub(super) line: u64,
-    pub(super) start: usize,
-    pub(super) end: usize,
+    pub(super) start: u32,
+    pub(super) end: u32,
 }
+
+impl Row {
+    #[inline(always)]
+    pub(super) fn time_s(&self) -> f64 {
+        self.vals[0]
+    }
+
+    #[inline(always)]
+    pub(super) fn sample(&self, has_table: bool) -> Sample {
+        Sample {
+            time_s: self.vals[0],
+            gyro_dps: self.vals[1],
+            temp_c: self.vals[2],
+            table_dps: has_table.then_some(self.vals[3]),
+        }
+    }
+}
+
+/// Most bytes a block may hold: row offsets are `u32`.
+pub(super) const MAX_BLOCK_BYTES: usize = u32::MAX as usize;
 
 /// Outcome of parsing a run of complete lines.
 #[derive(Debug, Clone, Copy, Default)]
@@ -80,8 +101,9 @@ pub(super) struct Parsed {
     pub(super) stopped: bool,
 }
 
-/// Parse the complete lines in `block[from..to]` (`to` just after a `\n`) into `rows`;
-/// `line` is the line number at `from`, `prev_time` the time of the row before.
+/// Parse the complete lines in `block[from..to]` (`to` just after a `\n`, at most
+/// [`MAX_BLOCK_BYTES`]) into `rows`; `line` is the line number at `from`, `prev_time` the
+/// time of the row before.
 pub(super) fn parse_lines(
     block: &[u8],
     from: usize,
@@ -91,9 +113,31 @@ pub(super) fn parse_lines(
     lay: &Layout,
     rows: &mut Vec<Row>,
 ) -> Parsed {
+    let block = &block[..to];
     let mut pos = from;
-    let mut fields = [0.0f64; 4];
+    let mut vals = [0.0f64; 4];
     while pos < to {
+        let stop = Parsed {
+            stop: pos,
+            stop_line: line,
+            stopped: true,
+        };
+        // The usual row, parsed straight through to its newline.
+        if let Some(([t, g, c, r], end, next)) = direct_row(block, pos, lay) {
+            if prev_time.is_some_and(|t0| t <= t0) {
+                return stop;
+            }
+            prev_time = Some(t);
+            rows.push(Row {
+                vals: [t, g * lay.gyro_scale, c, r],
+                line,
+                start: pos as u32,
+                end: end as u32,
+            });
+            line += 1;
+            pos = next;
+            continue;
+        }
         let nl = match memchr(b'\n', &block[pos..to]) {
             Some(k) => pos + k,
             None => break,
@@ -103,18 +147,13 @@ pub(super) fn parse_lines(
             end -= 1;
         }
         let text = &block[pos..end];
-        let stop = Parsed {
-            stop: pos,
-            stop_line: line,
-            stopped: true,
-        };
         match text.first() {
             // Blank line: the CSV path skips it.
             None => {}
             // A comment runs to the newline whatever it holds.
             Some(b'#') => {}
             Some(_) => {
-                let Some(s) = parse_row(text, lay, &mut fields) else {
+                let Some(s) = parse_row(text, lay, &mut vals) else {
                     return stop;
                 };
                 if prev_time.is_some_and(|t0| s.time_s <= t0) {
@@ -122,10 +161,10 @@ pub(super) fn parse_lines(
                 }
                 prev_time = Some(s.time_s);
                 rows.push(Row {
-                    sample: s,
+                    vals: [s.time_s, s.gyro_dps, s.temp_c, s.table_dps.unwrap_or(0.0)],
                     line,
-                    start: pos,
-                    end,
+                    start: pos as u32,
+                    end: end as u32,
                 });
             }
         }
@@ -137,6 +176,61 @@ pub(super) fn parse_lines(
         stop_line: line,
         stopped: false,
     }
+}
+
+/// The row starting at `pos`, parsed in one pass when it is plain: every mapped field a
+/// plain decimal ([`parse_decimal_prefix`]) ended by the delimiter (the last field by the
+/// line's `\n` or `\r\n`), pass-through fields free of quotes, CR and newline (the last one
+/// also of delimiters), and no `#` at the start. Gives time, gyro (unscaled), temperature,
+/// table rate (0 without one), the end of the row's text and the start of the next line;
+/// None for anything else, which [`parse_row`] then judges.
+#[inline(always)]
+fn direct_row(block: &[u8], pos: usize, lay: &Layout) -> Option<([f64; 4], usize, usize)> {
+    if block.get(pos) == Some(&b'#') {
+        return None;
+    }
+    let d = lay.delimiter;
+    let last = lay.roles.len() - 1;
+    let mut p = pos;
+    // Scalars, not an array indexed by role: that would live on the stack, and the row's
+    // wide copy of it would stall on the narrow stores.
+    let (mut t, mut g, mut c, mut r) = (0.0, 0.0, 0.0, 0.0);
+    for (k, &role) in lay.roles.iter().enumerate() {
+        let sep = if k < last { d } else { b'\n' };
+        if role < 4 {
+            let rest = &block[p..];
+            let mut parsed = parse_decimal_prefix(rest, b'.');
+            if lay.decimal_comma && parsed.is_some_and(|(_, n)| rest.get(n) == Some(&b',')) {
+                parsed = parse_decimal_prefix(rest, b',');
+            }
+            let (v, n) = parsed?;
+            match role {
+                0 => t = v,
+                1 => g = v,
+                2 => c = v,
+                _ => r = v,
+            }
+            p += n;
+        } else {
+            while let Some(&b) = block.get(p) {
+                if b == sep || b == b'\r' && sep == b'\n' {
+                    break;
+                }
+                // (A delimiter here is one in the last field: too many fields.)
+                if b == b'"' || b == b'\r' || b == b'\n' || b == d {
+                    return None;
+                }
+                p += 1;
+            }
+        }
+        match block.get(p) {
+            Some(&b) if b == sep => p += 1,
+            Some(b'\r') if sep == b'\n' && block.get(p + 1) == Some(&b'\n') => p += 2,
+            _ => return None,
+        }
+    }
+    let end = if block[p - 2] == b'\r' { p - 2 } else { p - 1 };
+    Some(([t, g, c, r], end, p))
 }
 
 /// Split `text` (one line, no terminator) and parse its mapped fields; None for anything

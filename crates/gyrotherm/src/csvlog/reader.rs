@@ -24,7 +24,7 @@ use csv::ByteRecord;
 use std::cell::OnceCell;
 use std::time::Instant;
 
-use super::chunk::{self, parse_lines, Layout, Row, PARALLEL_MIN_BYTES};
+use super::chunk::{self, parse_lines, Layout, Row, MAX_BLOCK_BYTES, PARALLEL_MIN_BYTES};
 use super::columns::{check_options, map_columns, Columns};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::gaps::{gap_verdict, Fill, GapVerdict, Sample};
@@ -188,7 +188,7 @@ impl<R: Read> LogReader<R> {
         let mut eof = false;
         let header_end = loop {
             match find_header(&buf[..len]) {
-                HeaderScan::Found(end) if fast => break Some(end),
+                HeaderScan::Found(end) if fast && len <= MAX_BLOCK_BYTES / 2 => break Some(end),
                 HeaderScan::Found(_) => break None,
                 HeaderScan::Hard => break None,
                 HeaderScan::NeedMore if eof => break None,
@@ -328,17 +328,35 @@ impl<R: Read> LogReader<R> {
             self.fill = None;
             return Ok(Some(self.accept(to, to_line)));
         }
+        // The usual case: the next row of the fast path's block, handed straight on.
+        if self.warmed_up && self.pending.is_empty() {
+            if let Some(row) = self.src.fast_row() {
+                self.from_pending = false;
+                return self.real(row.sample(self.src.lay.has_table), row.line);
+            }
+        }
         let Some((s, line)) = self.next_row()? else {
             self.report.rows = self.src.rows;
             return Ok(None);
         };
-        if let (Some(p), Some(period)) = (self.prev, self.period_s) {
-            let dt = s.time_s - p.time_s;
+        self.real(s, line)
+    }
+
+    /// Check the step to a real sample (given period, gap, jitter) and hand it out.
+    #[inline(always)]
+    fn real(&mut self, s: Sample, line: u64) -> Result<Option<Sample>, LogError> {
+        // Only the time of the sample before is read here (not a copy of all of it: that
+        // stalls on the store that wrote it a moment ago).
+        let prev_time = self.prev.as_ref().map(|p| p.time_s);
+        if let (Some(prev_time), Some(period)) = (prev_time, self.period_s) {
+            let dt = s.time_s - prev_time;
             if !self.report.sample_period_estimated && self.period_checked < PERIOD_CHECK_STEPS {
                 self.check_given_period(dt, period, line)?;
             }
             if dt > GAP_FACTOR * period {
-                return self.gap(p, s, line, dt, period);
+                if let Some(p) = self.prev {
+                    return self.gap(p, s, line, dt, period);
+                }
             }
             let jitter = (dt / period - 1.0).abs();
             if jitter > self.report.max_step_jitter {
@@ -641,18 +659,28 @@ impl<R: Read> Source<R> {
     /// Read and check one data row; it becomes the current record.
     #[inline]
     fn read(&mut self) -> Result<Option<(Sample, u64)>, Box<LogError>> {
-        if let Mode::Fast(f) = &mut self.mode {
-            if let Some(row) = f.parts[f.part].get(f.next) {
-                let row = *row;
-                f.next += 1;
-                f.record = OnceCell::new();
-                self.last = Some((row.sample.time_s, row.line));
-                self.rows += 1;
-                return Ok(Some((row.sample, row.line)));
-            }
+        if let Some(row) = self.fast_row() {
+            return Ok(Some((row.sample(self.lay.has_table), row.line)));
+        }
+        if let Mode::Fast(_) = self.mode {
             return self.refill();
         }
         self.read_csv()
+    }
+
+    /// The next row already parsed by the fast path, if there is one; it becomes the
+    /// current record.
+    #[inline(always)]
+    fn fast_row(&mut self) -> Option<Row> {
+        let Mode::Fast(f) = &mut self.mode else {
+            return None;
+        };
+        let row = *f.parts[f.part].get(f.next)?;
+        f.next += 1;
+        f.record = OnceCell::new();
+        self.last = Some((row.time_s(), row.line));
+        self.rows += 1;
+        Some(row)
     }
 
     /// The fast path's rows are all out: go to the second half of the block, parse the
@@ -697,6 +725,12 @@ impl<R: Read> Source<R> {
             }
             if f.len == f.buf.len() {
                 let n = f.buf.len();
+                if 2 * n > MAX_BLOCK_BYTES {
+                    // A line of gigabytes: the CSV path judges it.
+                    let line = f.line;
+                    self.switch_to_csv(0, line);
+                    continue;
+                }
                 f.buf.resize(2 * n, 0);
             }
             let n = read_retry(&mut f.inner, &mut f.buf[f.len..])
@@ -740,7 +774,7 @@ impl<R: Read> Source<R> {
             Mode::Fast(f) => {
                 let at = f.parts[f.part]
                     .get(f.next)
-                    .map_or(f.parsed_end, |r| r.start);
+                    .map_or(f.parsed_end, |r| r.start as usize);
                 self.fast_bytes + at as u64
             }
             Mode::Csv(c) => self.fast_bytes + c.csv.position().byte() - self.csv_skip,
@@ -1066,11 +1100,11 @@ impl<R: Read> Fast<R> {
         for r in rows_b.iter_mut() {
             r.line += base;
         }
-        let before = rows_a.last().map(|r| r.sample.time_s).or(prev_time);
+        let before = rows_a.last().map(Row::time_s).or(prev_time);
         if let (Some(t0), Some(first)) = (before, rows_b.first()) {
-            if first.sample.time_s <= t0 {
-                self.switch_at = Some((first.start, first.line));
-                self.parsed_end = first.start;
+            if first.time_s() <= t0 {
+                self.switch_at = Some((first.start as usize, first.line));
+                self.parsed_end = first.start as usize;
                 rows_b.clear();
                 return;
             }
@@ -1089,7 +1123,7 @@ impl<R: Read> Fast<R> {
         match self.next.checked_sub(1) {
             Some(k) => {
                 let r = &self.parts[self.part][k];
-                &self.buf[r.start..r.end]
+                &self.buf[r.start as usize..r.end as usize]
             }
             // Before the first row.
             None => b"",
@@ -1372,7 +1406,7 @@ mod tests {
 
     /// `text` (written with commas and decimal points) read with `;` and tab separators,
     /// with decimal points and with decimal commas, and with a given sample period: the
-    /// fast path gives what the CSV path gives.
+    /// fast path gives what the CSV path gives; and with the gyro in °/h.
     fn same_in_every_layout(text: &str) {
         let semicolon = ReadOptions {
             delimiter: b';',
@@ -1394,6 +1428,11 @@ mod tests {
         );
         same_as_csv(text.replace(',', "\t").replace('.', ",").as_bytes(), &tab);
         same_as_csv(text.as_bytes(), &given);
+        let dph = ReadOptions {
+            gyro_unit: GyroUnit::Dph,
+            ..ReadOptions::default()
+        };
+        same_as_csv(text.as_bytes(), &dph);
     }
 
     #[test]
