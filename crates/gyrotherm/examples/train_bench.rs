@@ -47,8 +47,9 @@ fn main() {
     let dt = t0.elapsed().as_secs_f64();
     for (n, o) in losses.iter().enumerate() {
         println!(
-            "network {n}: loss {:.5} -> {:.5}",
+            "network {n}: loss {:.5} -> {:.5} (last bits: {:e})",
             o.loss_history[0],
+            o.loss_history.last().unwrap(),
             o.loss_history.last().unwrap()
         );
     }

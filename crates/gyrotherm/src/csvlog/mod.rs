@@ -16,6 +16,7 @@
 //! duplicate timestamps, and gaps longer than [`GAP_FACTOR`] nominal sample periods (the
 //! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`LogReader`]).
 
+mod chunk;
 mod columns;
 mod error;
 mod gaps;

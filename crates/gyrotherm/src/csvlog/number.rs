@@ -45,47 +45,70 @@ const POW10: [f64; 23] = [
 /// Anything else (exponent, spaces, 20+ digits, NaN, inf) gives None.
 #[inline(always)]
 pub(super) fn parse_plain_decimal(s: &[u8]) -> Option<f64> {
-    let (neg, s) = match s.first() {
-        Some(b'-') => (true, &s[1..]),
-        Some(b'+') => (false, &s[1..]),
-        _ => (false, s),
+    match parse_decimal_prefix(s, b'.') {
+        Some((v, end)) if end == s.len() => Some(v),
+        _ => None,
+    }
+}
+
+/// [`parse_plain_decimal`] of the longest `[+-]digits[<point>digits]` at the start of `s`
+/// (`point` is `.`, or `,` for a decimal comma): the value and the index after it (None
+/// where the fast path does not apply). The caller checks that a delimiter or the end
+/// follows, so a row is scanned once.
+#[inline(always)]
+pub(super) fn parse_decimal_prefix(s0: &[u8], point: u8) -> Option<(f64, usize)> {
+    let (neg, sign, s) = match s0.first() {
+        Some(b'-') => (true, 1, &s0[1..]),
+        Some(b'+') => (false, 1, &s0[1..]),
+        _ => (false, 0, s0),
     };
     let mut m: u64 = 0;
     let mut i = digits(s, 0, &mut m);
     let int_digits = i;
     let mut frac_digits = 0;
-    if i < s.len() && s[i] == b'.' {
+    if i < s.len() && s[i] == point {
         let start = i + 1;
         i = digits(s, start, &mut m);
         frac_digits = i - start;
     }
     let digits = int_digits + frac_digits;
     // 19 digits cannot overflow u64, so `m` is exact when digits <= 19.
-    if i != s.len() || digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
+    if digits == 0 || digits > 19 || m > (1 << 53) || frac_digits > 22 {
         return None;
     }
     let v = m as f64 / POW10[frac_digits];
-    Some(if neg { -v } else { v })
+    Some((if neg { -v } else { v }, sign + i))
 }
 
 /// Accumulate the decimal digits of `s` from `i` into `m` (wrapping; the caller bounds the
-/// count), eight at a time where it can; returns the index after the last digit.
+/// count), eight bytes at a time where eight are left; returns the index after the last
+/// digit.
 #[inline(always)]
 fn digits(s: &[u8], mut i: usize, m: &mut u64) -> usize {
     while let Some(chunk) = s.get(i..i + 8) {
         let mut word = [0u8; 8];
         word.copy_from_slice(chunk);
         let v = u64::from_le_bytes(word);
-        // All eight bytes in b'0'..=b'9' (SWAR test as in simdjson / fast_float).
-        let all_digits = (v.wrapping_add(0x4646_4646_4646_4646)
+        // High bit of each byte not in b'0'..=b'9' (SWAR test as in simdjson / fast_float).
+        // Digits below a byte carry or borrow nothing into it, so the lowest flagged byte
+        // is exactly the first non-digit.
+        let non_digit = (v.wrapping_add(0x4646_4646_4646_4646)
             | v.wrapping_sub(0x3030_3030_3030_3030))
-            & 0x8080_8080_8080_8080
-            == 0;
-        if !all_digits {
-            break;
+            & 0x8080_8080_8080_8080;
+        if non_digit == 0 {
+            *m = m.wrapping_mul(100_000_000).wrapping_add(eight_digits(v));
+            i += 8;
+            continue;
         }
-        *m = m.wrapping_mul(100_000_000).wrapping_add(eight_digits(v));
-        i += 8;
+        let n = (non_digit.trailing_zeros() / 8) as usize;
+        if n > 0 {
+            // The n digits moved to the top bytes, b'0' below them: the same value.
+            let shift = 8 * (8 - n as u32);
+            let v = (v << shift) | (0x3030_3030_3030_3030 >> (64 - shift));
+            *m = m.wrapping_mul(POW10_U64[n]).wrapping_add(eight_digits(v));
+            i += n;
+        }
+        return i;
     }
     while i < s.len() && s[i].is_ascii_digit() {
         *m = m.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
@@ -93,6 +116,9 @@ fn digits(s: &[u8], mut i: usize, m: &mut u64) -> usize {
     }
     i
 }
+
+/// 10^n for n < 8.
+const POW10_U64: [u64; 8] = [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000];
 
 /// Value of eight ASCII digits packed little-endian in `v` (first digit in the low byte).
 #[inline(always)]
@@ -160,6 +186,35 @@ mod tests {
         #[test]
         fn decimal_parse_matches_std(s in "[+-]?[0-9]{0,20}(\\.[0-9]{0,25})?") {
             same_as_std(&s);
+        }
+
+        /// A number followed by a delimiter and more of the row: the prefix parser gives the
+        /// number's value (as `str::parse` of the number alone) and where it ends.
+        #[test]
+        fn decimal_prefix_matches_std(
+            s in "[+-]?[0-9]{0,20}(\\.[0-9]{0,25})?",
+            rest in "[,;\t.a-z0-9]{0,12}",
+        ) {
+            let want: Option<f64> = s.parse().ok();
+            let text = format!("{s}{rest}");
+            match parse_decimal_prefix(text.as_bytes(), b'.') {
+                Some((v, n)) if n == s.len() => prop_assert_eq!(Some(v.to_bits()), want.map(f64::to_bits)),
+                // The prefix ran on into `rest` (digits or a point there): judge that prefix.
+                Some((v, n)) => {
+                    let longer: Option<f64> = text[..n].parse().ok();
+                    prop_assert!(n > s.len());
+                    prop_assert_eq!(Some(v.to_bits()), longer.map(f64::to_bits));
+                }
+                // The fast path declines: too many digits, or no digits at all.
+                None => {}
+            }
+            // With a decimal comma: the same.
+            let dotted = format!("{s};1");
+            let comma = format!("{};1", s.replace('.', ","));
+            prop_assert_eq!(
+                parse_decimal_prefix(comma.as_bytes(), b','),
+                parse_decimal_prefix(dotted.as_bytes(), b'.')
+            );
         }
 
         #[test]

@@ -1,7 +1,10 @@
 //! Streaming, validating reader: one CSV record in, one checked [`Sample`] out.
 //!
-//! The reader keeps a single reused [`csv::ByteRecord`] for the current row, so reading a log
-//! costs no allocation per row; pass-through fields are handed out as raw bytes of that record.
+//! Rows are read in newline-aligned blocks of plain rows parsed on two threads (the fast
+//! path, [`super::chunk`]); at the first line the fast path cannot judge (a quote, a lone
+//! CR, an error) the csv crate takes over from that line, so errors keep their exact line,
+//! column and text. Either way reading costs no allocation per row; pass-through fields are
+//! handed out as raw bytes of the row.
 //!
 //! # Nominal sample period and gaps
 //! The nominal period is the median (the lower middle value for an even count) of the first
@@ -18,6 +21,10 @@ use std::path::{Path, PathBuf};
 
 use csv::ByteRecord;
 
+use std::cell::OnceCell;
+use std::time::Instant;
+
+use super::chunk::{self, parse_lines, Layout, Row, MAX_BLOCK_BYTES, PARALLEL_MIN_BYTES};
 use super::columns::{check_options, map_columns, Columns};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::gaps::{gap_verdict, Fill, GapVerdict, Sample};
@@ -41,23 +48,76 @@ pub const PERIOD_CHECK_STEPS: usize = 10;
 /// period mean the period is wrong (one or two may be real gaps).
 const PERIOD_CHECK_MISMATCHES: usize = 3;
 
-/// The CSV side: parses and validates one record at a time (numbers, field count, time order).
+/// Where rows come from: the fast path (plain rows in newline-aligned blocks, parsed on two
+/// threads, see [`super::chunk`]) until it meets a line it cannot judge, then the CSV path
+/// from that line on. Both check numbers, field count and time order.
 struct Source<R> {
-    csv: csv::Reader<Tail<R>>,
     path: PathBuf,
     headers: Vec<String>,
     header_line: u64,
-    header_end_byte: u64,
     cols: Columns,
-    gyro_scale: f64,
+    lay: Layout,
     /// Numbers may use a decimal comma (the separator is not a comma).
     decimal_comma: bool,
     /// Time and line of the last row read, for the order checks.
     last: Option<(f64, u64)>,
     rows: u64,
+    /// Whether lines end in CRLF (judged by the first line; None: not known yet).
+    crlf: Option<bool>,
+    mode: Mode<R>,
+    /// Bytes of the log consumed by the fast path, and where the CSV path's byte count
+    /// starts (for [`LogReader::bytes_per_row`]).
+    fast_bytes: u64,
+    csv_skip: u64,
     /// Scratch record for looking one row ahead after a short row.
     peek: ByteRecord,
 }
+
+/// The input with the bytes already read in front of it.
+type Resume<R> = std::io::Chain<std::io::Cursor<Vec<u8>>, R>;
+
+enum Mode<R> {
+    Fast(Box<Fast<R>>),
+    Csv(Box<CsvPart<R>>),
+    /// Only while switching.
+    Gone,
+}
+
+/// The CSV path: the csv crate over the rest of the input; its line numbers are offset by
+/// the lines before the point where it took over.
+struct CsvPart<R> {
+    csv: csv::Reader<Tail<Resume<R>>>,
+    line_offset: u64,
+    /// The current record.
+    rec: ByteRecord,
+}
+
+/// The fast path's block and the rows parsed from it.
+struct Fast<R> {
+    inner: R,
+    /// The block (its length is its capacity; `len` bytes are valid).
+    buf: Vec<u8>,
+    len: usize,
+    /// Offset after the last complete line parsed, and its line number.
+    parsed_end: usize,
+    line: u64,
+    eof: bool,
+    /// Rows of the two halves of the block, and the next one to hand out.
+    parts: [Vec<Row>; 2],
+    part: usize,
+    next: usize,
+    /// Where the CSV path takes over once the parsed rows are out (offset, line).
+    switch_at: Option<(usize, u64)>,
+    /// The current row's record, built on demand.
+    record: OnceCell<ByteRecord>,
+    threads: bool,
+    /// Share of a block this thread parses, and when its last parse ended.
+    share: f64,
+    cycle: Option<Instant>,
+}
+
+/// Block size of the fast path.
+const BLOCK_BYTES: usize = 2 << 20;
 
 /// Streaming reader of a test log.
 ///
@@ -81,8 +141,9 @@ struct Source<R> {
 /// After an error the reader's state is unspecified: stop reading.
 pub struct LogReader<R> {
     src: Source<R>,
-    /// The raw record of the current (real) sample.
+    /// The raw record of the current sample when it came from the read-ahead queue.
     record: ByteRecord,
+    from_pending: bool,
     period_s: Option<f64>,
     warmed_up: bool,
     /// Rows read ahead during warm-up: record, sample, line.
@@ -107,37 +168,79 @@ impl<R: Read> LogReader<R> {
         source: impl Into<PathBuf>,
         opts: &ReadOptions,
     ) -> Result<Self, LogError> {
-        let path: PathBuf = source.into();
+        Self::with_path(reader, source.into(), opts, true)
+    }
+
+    /// `fast: false` reads everything down the CSV path (the reference for the fast path).
+    fn with_path(
+        reader: R,
+        path: PathBuf,
+        opts: &ReadOptions,
+        fast: bool,
+    ) -> Result<Self, LogError> {
         check_options(&path, opts)?;
-        let mut csv = csv::ReaderBuilder::new()
-            .delimiter(opts.delimiter)
-            .has_headers(false)
-            .flexible(true)
-            .comment(Some(b'#'))
-            .buffer_capacity(64 * 1024)
-            .from_reader(Tail {
-                inner: reader,
-                total: 0,
-                last: b'\n',
-                crlf: false,
-                crlf_known: false,
-            });
-        let mut header = ByteRecord::new();
-        let got = csv
-            .read_byte_record(&mut header)
-            .map_err(|e| csv_error(&path, e))?;
-        if !got {
-            return Err(LogError::new(
-                Kind::NoHeader,
-                &path,
-                None,
-                None,
-                "empty file: no header row; the first line that is not a '#' comment must name \
-                 the columns, e.g. time_s,gyro_dps,temp_c",
-            ));
-        }
-        let header_line = record_line(&csv, &header);
-        let header_end_byte = csv.position().byte();
+        let mut inner = reader;
+        // Read until the header line is complete, then parse it with the csv crate; a
+        // header the fast path cannot judge (quotes, lone CR) sends the whole input
+        // down the CSV path.
+        let mut buf = vec![0u8; BLOCK_BYTES];
+        let mut len = 0;
+        let mut eof = false;
+        let header_end = loop {
+            match find_header(&buf[..len]) {
+                HeaderScan::Found(end) if fast && len <= MAX_BLOCK_BYTES / 2 => break Some(end),
+                HeaderScan::Found(_) => break None,
+                HeaderScan::Hard => break None,
+                HeaderScan::NeedMore if eof => break None,
+                HeaderScan::NeedMore => {
+                    if len == buf.len() {
+                        buf.resize(2 * buf.len(), 0);
+                    }
+                    let n =
+                        read_retry(&mut inner, &mut buf[len..]).map_err(|e| io_error(&path, e))?;
+                    eof = n == 0;
+                    len += n;
+                }
+            }
+        };
+        let crlf = memchr::memchr(b'\n', &buf[..len]).map(|k| k > 0 && buf[k - 1] == b'\r');
+        let (mode, header, header_line, csv_skip) = match header_end {
+            Some(end) => {
+                let mut csv = csv_reader(&buf[..end], crlf, opts.delimiter);
+                let (header, header_line) = read_header(&mut csv, &path)?;
+                let line = buf[..end].iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+                let fast = Fast {
+                    inner,
+                    buf,
+                    len,
+                    parsed_end: end,
+                    line,
+                    eof,
+                    parts: [Vec::new(), Vec::new()],
+                    part: 0,
+                    next: 0,
+                    switch_at: None,
+                    record: OnceCell::new(),
+                    threads: std::thread::available_parallelism().is_ok_and(|n| n.get() > 1),
+                    share: 0.3,
+                    cycle: None,
+                };
+                (Mode::Fast(Box::new(fast)), header, header_line, 0)
+            }
+            None => {
+                buf.truncate(len);
+                let mut csv =
+                    csv_reader(std::io::Cursor::new(buf).chain(inner), crlf, opts.delimiter);
+                let (header, header_line) = read_header(&mut csv, &path)?;
+                let skip = csv.position().byte();
+                let part = CsvPart {
+                    csv,
+                    line_offset: 0,
+                    rec: ByteRecord::new(),
+                };
+                (Mode::Csv(Box::new(part)), header, header_line, skip)
+            }
+        };
         let mut headers = Vec::with_capacity(header.len());
         for (i, raw) in header.iter().enumerate() {
             let raw = if i == 0 {
@@ -168,21 +271,32 @@ impl<R: Read> LogReader<R> {
             GyroUnit::RadPerS => 180.0 / std::f64::consts::PI,
         };
         let ncols = headers.len();
+        let lay = Layout {
+            delimiter: opts.delimiter,
+            decimal_comma: opts.delimiter != b',',
+            ncols,
+            has_table: cols.table.is_some(),
+            gyro_scale,
+            roles: Layout::roles(ncols, cols.time, cols.gyro, cols.temp, cols.table),
+        };
         Ok(LogReader {
             src: Source {
-                csv,
                 path,
                 headers,
                 header_line,
-                header_end_byte,
                 cols,
-                gyro_scale,
+                lay,
                 decimal_comma: opts.delimiter != b',',
                 last: None,
                 rows: 0,
+                crlf,
+                mode,
+                fast_bytes: 0,
+                csv_skip,
                 peek: ByteRecord::new(),
             },
             record: ByteRecord::with_capacity(64, ncols),
+            from_pending: false,
             period_s: opts.sample_period_s,
             warmed_up: false,
             pending: VecDeque::new(),
@@ -214,17 +328,35 @@ impl<R: Read> LogReader<R> {
             self.fill = None;
             return Ok(Some(self.accept(to, to_line)));
         }
+        // The usual case: the next row of the fast path's block, handed straight on.
+        if self.warmed_up && self.pending.is_empty() {
+            if let Some(row) = self.src.fast_row() {
+                self.from_pending = false;
+                return self.real(row.sample(self.src.lay.has_table), row.line);
+            }
+        }
         let Some((s, line)) = self.next_row()? else {
             self.report.rows = self.src.rows;
             return Ok(None);
         };
-        if let (Some(p), Some(period)) = (self.prev, self.period_s) {
-            let dt = s.time_s - p.time_s;
+        self.real(s, line)
+    }
+
+    /// Check the step to a real sample (given period, gap, jitter) and hand it out.
+    #[inline(always)]
+    fn real(&mut self, s: Sample, line: u64) -> Result<Option<Sample>, LogError> {
+        // Only the time of the sample before is read here (not a copy of all of it: that
+        // stalls on the store that wrote it a moment ago).
+        let prev_time = self.prev.as_ref().map(|p| p.time_s);
+        if let (Some(prev_time), Some(period)) = (prev_time, self.period_s) {
+            let dt = s.time_s - prev_time;
             if !self.report.sample_period_estimated && self.period_checked < PERIOD_CHECK_STEPS {
                 self.check_given_period(dt, period, line)?;
             }
             if dt > GAP_FACTOR * period {
-                return self.gap(p, s, line, dt, period);
+                if let Some(p) = self.prev {
+                    return self.gap(p, s, line, dt, period);
+                }
             }
             let jitter = (dt / period - 1.0).abs();
             if jitter > self.report.max_step_jitter {
@@ -357,9 +489,11 @@ impl<R: Read> LogReader<R> {
         }
         if let Some((mut rec, s, line)) = self.pending.pop_front() {
             std::mem::swap(&mut self.record, &mut rec);
+            self.from_pending = true;
             return Ok(Some((s, line)));
         }
-        self.src.read(&mut self.record).map_err(|e| *e)
+        self.from_pending = false;
+        self.src.read().map_err(|e| *e)
     }
 
     /// Read ahead to estimate the period (unless given) and check there is data at all.
@@ -372,9 +506,11 @@ impl<R: Read> LogReader<R> {
             PERIOD_ESTIMATE_STEPS + 1
         };
         while self.pending.len() < want {
-            let mut rec = ByteRecord::with_capacity(64, self.src.headers.len());
-            match self.src.read(&mut rec).map_err(|e| *e)? {
-                Some((s, line)) => self.pending.push_back((rec, s, line)),
+            match self.src.read().map_err(|e| *e)? {
+                Some((s, line)) => {
+                    let rec = self.src.record().clone();
+                    self.pending.push_back((rec, s, line));
+                }
                 None => break,
             }
         }
@@ -443,12 +579,27 @@ impl<R: Read> LogReader<R> {
             .cols
             .extra
             .iter()
-            .map(move |&i| if filled { &b""[..] } else { &self.record[i] })
+            .map(move |&i| if filled { &b""[..] } else { self.field(i) })
     }
 
     /// The raw record of the current sample (None for a gap-filled sample).
     pub fn record(&self) -> Option<&ByteRecord> {
-        (!self.filled).then_some(&self.record)
+        if self.filled {
+            None
+        } else if self.from_pending {
+            Some(&self.record)
+        } else {
+            Some(self.src.record())
+        }
+    }
+
+    /// Field `i` of the current real sample's record.
+    fn field(&self, i: usize) -> &[u8] {
+        if self.from_pending {
+            &self.record[i]
+        } else {
+            self.src.field(i)
+        }
     }
 
     /// Whether the current sample was made by gap filling.
@@ -482,9 +633,7 @@ impl<R: Read> LogReader<R> {
     /// sizing buffers; None before any row).
     pub fn bytes_per_row(&self) -> Option<f64> {
         let rows = self.src.rows;
-        (rows > 0).then(|| {
-            (self.src.csv.position().byte() - self.src.header_end_byte) as f64 / rows as f64
-        })
+        (rows > 0).then(|| self.src.bytes_consumed() as f64 / rows as f64)
     }
 
     /// Convert the current sample's `k`-th pass-through field to text, with a located error
@@ -494,7 +643,7 @@ impl<R: Read> LogReader<R> {
             return Ok("");
         }
         let i = self.src.cols.extra[k];
-        std::str::from_utf8(&self.record[i]).map_err(|_| {
+        std::str::from_utf8(self.field(i)).map_err(|_| {
             LogError::new(
                 Kind::NotUtf8,
                 &self.src.path,
@@ -507,22 +656,180 @@ impl<R: Read> LogReader<R> {
 }
 
 impl<R: Read> Source<R> {
-    /// Read and check one data row into `rec`.
+    /// Read and check one data row; it becomes the current record.
     #[inline]
-    fn read(&mut self, rec: &mut ByteRecord) -> Result<Option<(Sample, u64)>, Box<LogError>> {
-        let more = self
+    fn read(&mut self) -> Result<Option<(Sample, u64)>, Box<LogError>> {
+        if let Some(row) = self.fast_row() {
+            return Ok(Some((row.sample(self.lay.has_table), row.line)));
+        }
+        if let Mode::Fast(_) = self.mode {
+            return self.refill();
+        }
+        self.read_csv()
+    }
+
+    /// The next row already parsed by the fast path, if there is one; it becomes the
+    /// current record.
+    #[inline(always)]
+    fn fast_row(&mut self) -> Option<Row> {
+        let Mode::Fast(f) = &mut self.mode else {
+            return None;
+        };
+        let row = *f.parts[f.part].get(f.next)?;
+        f.next += 1;
+        f.record = OnceCell::new();
+        self.last = Some((row.time_s(), row.line));
+        self.rows += 1;
+        Some(row)
+    }
+
+    /// The fast path's rows are all out: go to the second half of the block, parse the
+    /// next block, or hand over to the CSV path.
+    #[cold]
+    fn refill(&mut self) -> Result<Option<(Sample, u64)>, Box<LogError>> {
+        loop {
+            let Mode::Fast(f) = &mut self.mode else {
+                return self.read_csv();
+            };
+            if f.next < f.parts[f.part].len() {
+                return self.read();
+            }
+            if f.part == 0 && !f.parts[1].is_empty() {
+                f.part = 1;
+                f.next = 0;
+                continue;
+            }
+            if let Some((at, line)) = f.switch_at {
+                self.switch_to_csv(at, line);
+                continue;
+            }
+            // Keep the unparsed tail (a partial line), read more behind it.
+            f.buf.copy_within(f.parsed_end..f.len, 0);
+            f.len -= f.parsed_end;
+            self.fast_bytes += f.parsed_end as u64;
+            f.parsed_end = 0;
+            f.parts[0].clear();
+            f.parts[1].clear();
+            f.part = 0;
+            f.next = 0;
+            let end = memchr::memrchr(b'\n', &f.buf[..f.len]).map_or(0, |k| k + 1);
+            if end > 0 {
+                f.parse(end, self.last.map(|l| l.0), &self.lay);
+                continue;
+            }
+            if f.eof {
+                // An unterminated last line (or nothing): the CSV path judges it.
+                let line = f.line;
+                self.switch_to_csv(0, line);
+                continue;
+            }
+            if f.len == f.buf.len() {
+                let n = f.buf.len();
+                if 2 * n > MAX_BLOCK_BYTES {
+                    // A line of gigabytes: the CSV path judges it.
+                    let line = f.line;
+                    self.switch_to_csv(0, line);
+                    continue;
+                }
+                f.buf.resize(2 * n, 0);
+            }
+            let n = read_retry(&mut f.inner, &mut f.buf[f.len..])
+                .map_err(|e| Box::new(io_error(&self.path, e)))?;
+            f.eof = n == 0;
+            f.len += n;
+        }
+    }
+
+    /// Hand the input from `at` in the block (line `line`) on to the CSV path.
+    #[cold]
+    fn switch_to_csv(&mut self, at: usize, line: u64) {
+        let Mode::Fast(f) = std::mem::replace(&mut self.mode, Mode::Gone) else {
+            unreachable!("switch_to_csv is only called in fast mode")
+        };
+        let Fast {
+            inner,
+            mut buf,
+            len,
+            ..
+        } = *f;
+        self.fast_bytes += at as u64;
+        buf.truncate(len);
+        buf.drain(..at);
+        let csv = csv_reader(
+            std::io::Cursor::new(buf).chain(inner),
+            self.crlf,
+            self.lay.delimiter,
+        );
+        self.csv_skip = 0;
+        self.mode = Mode::Csv(Box::new(CsvPart {
+            csv,
+            line_offset: line - 1,
+            rec: ByteRecord::with_capacity(64, self.headers.len()),
+        }));
+    }
+
+    /// Bytes of data rows consumed so far (after the header).
+    fn bytes_consumed(&self) -> u64 {
+        match &self.mode {
+            Mode::Fast(f) => {
+                let at = f.parts[f.part]
+                    .get(f.next)
+                    .map_or(f.parsed_end, |r| r.start as usize);
+                self.fast_bytes + at as u64
+            }
+            Mode::Csv(c) => self.fast_bytes + c.csv.position().byte() - self.csv_skip,
+            Mode::Gone => self.fast_bytes,
+        }
+    }
+
+    /// The current record.
+    fn record(&self) -> &ByteRecord {
+        match &self.mode {
+            Mode::Fast(f) => f.record.get_or_init(|| {
+                let text = f.current_text();
+                let mut rec = ByteRecord::with_capacity(text.len(), self.lay.ncols);
+                for field in text.split(|&b| b == self.lay.delimiter) {
+                    rec.push_field(field);
+                }
+                rec
+            }),
+            Mode::Csv(c) => &c.rec,
+            Mode::Gone => unreachable!("no record while switching"),
+        }
+    }
+
+    /// Field `i` of the current record.
+    fn field(&self, i: usize) -> &[u8] {
+        match &self.mode {
+            Mode::Fast(f) => chunk::field(f.current_text(), self.lay.delimiter, i),
+            Mode::Csv(c) => &c.rec[i],
+            Mode::Gone => unreachable!("no record while switching"),
+        }
+    }
+
+    /// The CSV path: read and check one row into the current record.
+    fn read_csv(&mut self) -> Result<Option<(Sample, u64)>, Box<LogError>> {
+        let Mode::Csv(c) = &mut self.mode else {
+            unreachable!("read_csv is only called in CSV mode")
+        };
+        let more = c
             .csv
-            .read_byte_record(rec)
-            .map_err(|e| Box::new(csv_error(&self.path, e)))?;
+            .read_byte_record(&mut c.rec)
+            .map_err(|e| Box::new(csv_error(&self.path, e, c.line_offset)))?;
         if !more {
             return Ok(None);
         }
-        let line = record_line(&self.csv, rec);
+        let line = record_line(&c.csv, &c.rec) + c.line_offset;
+        // Taken out while the checks borrow `self`; put back below (after an error the
+        // reader's state does not matter).
+        let taken = std::mem::take(&mut c.rec);
+        let rec = &taken;
         if rec.len() != self.headers.len() {
-            return Err(Box::new(self.field_count_error(rec.len(), line)));
+            let found = rec.len();
+            return Err(Box::new(self.field_count_error(found, line)));
         }
         let time_s = self.number(rec, self.cols.time, line)?;
-        let gyro_dps = self.number(rec, self.cols.gyro, line)? * self.gyro_scale;
+        let gyro_dps = self.number(rec, self.cols.gyro, line)? * self.lay.gyro_scale;
         let temp_c = self.number(rec, self.cols.temp, line)?;
         let table_dps = match self.cols.table {
             Some(i) => Some(self.number(rec, i, line)?),
@@ -536,6 +843,9 @@ impl<R: Read> Source<R> {
         }
         self.last = Some((time_s, line));
         self.rows += 1;
+        if let Mode::Csv(c) = &mut self.mode {
+            c.rec = taken;
+        }
         Ok(Some((
             Sample {
                 time_s,
@@ -606,8 +916,11 @@ impl<R: Read> Source<R> {
     fn field_count_error(&mut self, found: usize, line: u64) -> LogError {
         let want = self.headers.len();
         // A short row followed by nothing is a file cut mid-write.
-        let is_last =
-            found < want && matches!(self.csv.read_byte_record(&mut self.peek), Ok(false));
+        let is_last = found < want
+            && match &mut self.mode {
+                Mode::Csv(c) => matches!(c.csv.read_byte_record(&mut self.peek), Ok(false)),
+                _ => false,
+            };
         if is_last {
             LogError::new(
                 Kind::TruncatedLine,
@@ -714,11 +1027,487 @@ impl<R: Read> Read for Tail<R> {
     }
 }
 
-fn csv_error(path: &Path, e: csv::Error) -> LogError {
-    let line = e.position().map(|p| p.line());
+fn csv_error(path: &Path, e: csv::Error, line_offset: u64) -> LogError {
+    let line = e.position().map(|p| p.line() + line_offset);
     if let csv::ErrorKind::Io(io) = e.kind() {
         LogError::new(Kind::Io, path, line, None, format!("cannot read: {io}"))
     } else {
         LogError::new(Kind::Csv, path, line, None, format!("malformed CSV: {e}"))
+    }
+}
+
+impl<R: Read> Fast<R> {
+    /// Parse the complete lines `buf[..end]` (`end` just after a newline), in two parts
+    /// on two threads when the block is long; `prev_time` is the time of the row before.
+    fn parse(&mut self, end: usize, prev_time: Option<f64>, lay: &Layout) {
+        self.parse_split(end, prev_time, lay);
+        self.cycle = Some(Instant::now());
+    }
+
+    fn parse_split(&mut self, end: usize, prev_time: Option<f64>, lay: &Layout) {
+        let buf = &self.buf[..end];
+        let split = if self.threads && end >= PARALLEL_MIN_BYTES {
+            // This thread also reads the input and hands the rows out: it parses the
+            // share that balances the two (see below).
+            let mid = (end as f64 * self.share) as usize;
+            memchr::memchr(b'\n', &buf[mid..end]).map_or(end, |k| mid + k + 1)
+        } else {
+            end
+        };
+        let [rows_a, rows_b] = &mut self.parts;
+        let (a, b) = if split < end {
+            let serial = self.cycle.map(|t| t.elapsed());
+            let t0 = Instant::now();
+            let (a, b, busy_b) = std::thread::scope(|s| {
+                let hb = s.spawn(|| {
+                    let t = Instant::now();
+                    let b = parse_lines(buf, split, end, 0, None, lay, rows_b);
+                    (b, t.elapsed())
+                });
+                let a = parse_lines(buf, 0, split, self.line, prev_time, lay, rows_a);
+                let (b, busy_b) = hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+                (a, b, busy_b)
+            });
+            // Balance: this thread's cycle (handing out the last block's rows, reading,
+            // parsing its share) against the other thread's share. Only the split point
+            // moves; the rows are the same wherever it falls.
+            if let Some(serial) = serial {
+                let busy_a = serial + t0.elapsed();
+                let step = if busy_b < busy_a { -0.02 } else { 0.02 };
+                self.share = (self.share + step).clamp(0.02, 0.5);
+            }
+            (a, Some(b))
+        } else {
+            (
+                parse_lines(buf, 0, end, self.line, prev_time, lay, rows_a),
+                None,
+            )
+        };
+        if a.stopped {
+            rows_b.clear();
+            self.switch_at = Some((a.stop, a.stop_line));
+            self.parsed_end = a.stop;
+            return;
+        }
+        let Some(b) = b else {
+            self.parsed_end = end;
+            self.line = a.stop_line;
+            return;
+        };
+        // The second half counted lines from 0: shift them, and check the order across
+        // the split (the first half's last row, or the row before the block).
+        let base = a.stop_line;
+        for r in rows_b.iter_mut() {
+            r.line += base;
+        }
+        let before = rows_a.last().map(Row::time_s).or(prev_time);
+        if let (Some(t0), Some(first)) = (before, rows_b.first()) {
+            if first.time_s() <= t0 {
+                self.switch_at = Some((first.start as usize, first.line));
+                self.parsed_end = first.start as usize;
+                rows_b.clear();
+                return;
+            }
+        }
+        if b.stopped {
+            self.switch_at = Some((b.stop, b.stop_line + base));
+            self.parsed_end = b.stop;
+            return;
+        }
+        self.parsed_end = end;
+        self.line = b.stop_line + base;
+    }
+
+    /// Text of the current row (the last one handed out).
+    fn current_text(&self) -> &[u8] {
+        match self.next.checked_sub(1) {
+            Some(k) => {
+                let r = &self.parts[self.part][k];
+                &self.buf[r.start as usize..r.end as usize]
+            }
+            // Before the first row.
+            None => b"",
+        }
+    }
+}
+
+/// What the start of the input says about the header line.
+enum HeaderScan {
+    /// The header line ends just before this offset (after its newline).
+    Found(usize),
+    /// Not all of it read yet.
+    NeedMore,
+    /// Something only the CSV path judges (quote, lone CR).
+    Hard,
+}
+
+/// Skip comment and blank lines to the header line, as the CSV path does.
+fn find_header(bytes: &[u8]) -> HeaderScan {
+    // A byte-order mark is skipped, as the csv crate does when it reads the header from the
+    // block (which holds the mark and at least the newline after it).
+    let mut pos = if bytes.starts_with(b"\xEF\xBB\xBF") {
+        3
+    } else {
+        0
+    };
+    while let Some(k) = memchr::memchr(b'\n', &bytes[pos..]) {
+        let nl = pos + k;
+        let mut text = &bytes[pos..nl];
+        if let [rest @ .., b'\r'] = text {
+            text = rest;
+        }
+        match text.first() {
+            None | Some(b'#') => {}
+            Some(_) => {
+                return if text.iter().any(|&b| b == b'"' || b == b'\r') {
+                    HeaderScan::Hard
+                } else {
+                    HeaderScan::Found(nl + 1)
+                };
+            }
+        }
+        pos = nl + 1;
+    }
+    HeaderScan::NeedMore
+}
+
+/// `read`, retried on `Interrupted`.
+fn read_retry<R: Read>(r: &mut R, buf: &mut [u8]) -> std::io::Result<usize> {
+    loop {
+        match r.read(buf) {
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            other => return other,
+        }
+    }
+}
+
+fn io_error(path: &Path, e: std::io::Error) -> LogError {
+    LogError::new(Kind::Io, path, None, None, format!("cannot read: {e}"))
+}
+
+/// The csv crate set up as the CSV path reads: no header handling, any field count, `#`
+/// comments.
+fn csv_reader<S: Read>(input: S, crlf: Option<bool>, delimiter: u8) -> csv::Reader<Tail<S>> {
+    csv::ReaderBuilder::new()
+        .delimiter(delimiter)
+        .has_headers(false)
+        .flexible(true)
+        .comment(Some(b'#'))
+        .buffer_capacity(64 * 1024)
+        .from_reader(Tail {
+            inner: input,
+            total: 0,
+            last: b'\n',
+            crlf: crlf.unwrap_or(false),
+            crlf_known: crlf.is_some(),
+        })
+}
+
+/// Read the header record and its line.
+fn read_header<S: Read>(
+    csv: &mut csv::Reader<Tail<S>>,
+    path: &Path,
+) -> Result<(ByteRecord, u64), LogError> {
+    let mut header = ByteRecord::new();
+    let got = csv
+        .read_byte_record(&mut header)
+        .map_err(|e| csv_error(path, e, 0))?;
+    if !got {
+        return Err(LogError::new(
+            Kind::NoHeader,
+            path,
+            None,
+            None,
+            "empty file: no header row; the first line that is not a '#' comment must name \
+             the columns, e.g. time_s,gyro_dps,temp_c",
+        ));
+    }
+    let line = record_line(csv, &header);
+    Ok((header, line))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// One sample as handed out: the bits of time, gyro, temperature, table rate; line;
+    /// whether filled; the raw record.
+    type Out = (u64, u64, u64, Option<u64>, u64, bool, Vec<Vec<u8>>);
+
+    /// The report at the end: rows, period bits, filled samples and gaps, jitter bits and
+    /// line.
+    type End = (u64, Option<u64>, usize, usize, u64, Option<u64>);
+
+    /// Everything a reader hands out, and how it ends.
+    #[derive(Debug, PartialEq)]
+    struct Run {
+        samples: Vec<Out>,
+        end: Result<End, String>,
+    }
+
+    fn run<R: Read>(input: R, opts: &ReadOptions, fast: bool) -> Run {
+        let mut samples = Vec::new();
+        let mut rdr = match LogReader::with_path(input, "<t>".into(), opts, fast) {
+            Ok(r) => r,
+            Err(e) => {
+                return Run {
+                    samples,
+                    end: Err(e.to_string()),
+                }
+            }
+        };
+        let end = loop {
+            match rdr.next_sample() {
+                Ok(Some(s)) => samples.push((
+                    s.time_s.to_bits(),
+                    s.gyro_dps.to_bits(),
+                    s.temp_c.to_bits(),
+                    s.table_dps.map(f64::to_bits),
+                    rdr.line(),
+                    rdr.is_filled(),
+                    rdr.record()
+                        .map(|r| r.iter().map(<[u8]>::to_vec).collect())
+                        .unwrap_or_default(),
+                )),
+                Ok(None) => {
+                    let r = rdr.report();
+                    break Ok((
+                        r.rows,
+                        r.sample_period_s.map(f64::to_bits),
+                        r.filled_samples,
+                        r.filled_gaps,
+                        r.max_step_jitter.to_bits(),
+                        r.max_jitter_line,
+                    ));
+                }
+                Err(e) => break Err(e.to_string()),
+            }
+        };
+        Run { samples, end }
+    }
+
+    /// A reader that hands out at most `step` bytes per call (block edges everywhere).
+    struct Dribble<'a> {
+        data: &'a [u8],
+        step: usize,
+    }
+
+    impl Read for Dribble<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            let n = self.step.min(buf.len()).min(self.data.len());
+            buf[..n].copy_from_slice(&self.data[..n]);
+            self.data = &self.data[n..];
+            Ok(n)
+        }
+    }
+
+    /// Whether the last record of `text` runs inside an open quote to the end of the input
+    /// (csv-core's quoting: a quote opens only at a field's start, `""` inside is a quote,
+    /// `#` at a record's start is a comment line). There the CSV path's line number is
+    /// approximate (`record_line` cannot tell the file's last newline, inside the quote,
+    /// from a terminator); from a later starting point, as after the fast path hands over,
+    /// it comes out right. The comparisons close such a quote first.
+    fn ends_in_open_quote(text: &[u8], d: u8) -> bool {
+        let (mut i, mut record_start, mut field_start, mut quoted) = (0, true, true, false);
+        while i < text.len() {
+            let b = text[i];
+            i += 1;
+            if quoted {
+                if b == b'"' {
+                    if text.get(i) == Some(&b'"') {
+                        i += 1;
+                    } else {
+                        quoted = false;
+                    }
+                }
+            } else if record_start && b == b'#' {
+                i = memchr::memchr(b'\n', &text[i..]).map_or(text.len(), |k| i + k + 1);
+            } else if b == b'\n' || b == b'\r' {
+                (record_start, field_start) = (true, true);
+            } else {
+                record_start = false;
+                quoted = field_start && b == b'"';
+                field_start = b == d;
+            }
+        }
+        quoted
+    }
+
+    /// The fast path (whole input, and in small pieces) gives what the CSV path gives.
+    fn same_as_csv(text: &[u8], opts: &ReadOptions) {
+        let want = run(text, opts, false);
+        assert_eq!(
+            run(text, opts, true),
+            want,
+            "fast path, {:?}",
+            String::from_utf8_lossy(text)
+        );
+        for step in [1, 7] {
+            let got = run(Dribble { data: text, step }, opts, true);
+            assert_eq!(
+                got,
+                want,
+                "fast path in {step}-byte reads, {:?}",
+                String::from_utf8_lossy(text)
+            );
+        }
+    }
+
+    fn log(rows: usize, table: bool) -> String {
+        let mut s = String::from("# bench\ntime_s,gyro_dps,temp_c");
+        s += if table { ",table_dps,id\n" } else { ",id\n" };
+        for i in 0..rows {
+            let gyro = 0.0012 + 1e-7 * ((i * 7919) % 1000) as f64;
+            s += &format!(
+                "{:.3},{gyro:.13},{}",
+                i as f64 * 0.01,
+                20.0 + (i % 16) as f64 * 0.0625
+            );
+            if table {
+                s += ",20";
+            }
+            s += &format!(",r{i}\n");
+        }
+        s
+    }
+
+    #[test]
+    fn fast_path_matches_csv_path_on_edge_cases() {
+        let opts = ReadOptions::default();
+        let gaps = ReadOptions {
+            fill_gaps_max_s: Some(10.0),
+            ..ReadOptions::default()
+        };
+        for text in [
+            "time_s,gyro_dps,temp_c\n0,1,2\n1,1,2\n",
+            "time_s,gyro_dps,temp_c\r\n0,1,2\r\n\r\n# c\r\n1,1,2\r\n2,1,2",
+            "time_s,gyro_dps,temp_c\n0,1,2\n1,1\n",
+            "time_s,gyro_dps,temp_c\n0,1,2\n1,1,2,3\n2,1,2\n",
+            "time_s,gyro_dps,temp_c\n0,1,2\n\"1\",1,2\n2,\"1\n\",2\n3,x,2\n",
+            "time_s,gyro_dps,temp_c\n0,1,2\n1\r,1,2\n",
+            "time_s,gyro_dps,temp_c\n0,1,2\n0,1,2\n",
+            "time_s,gyro_dps,temp_c\n0,1,2\n 1 , 1e0 ,2\n2,nan,2\n",
+            "time_s,gyro_dps,temp_c\n0,1,2\n1,1,2\n5,1,2\n6,1,2\n",
+            "\u{feff}time_s,gyro_dps,temp_c\n0,1,2\n",
+            "\u{feff}# c\ntime_s,gyro_dps,temp_c\n0,1,2\n1,1,2\n",
+            "\u{feff}\r\n\r\ntime_s,gyro_dps,temp_c\r\n0,1,2\r\n",
+            "time_s,gyro_dps,temp_c\n0,1.5,2\n1,-.5,2.\n2,+1.25,2\n3,1.2.3,2\n",
+            "time_s,gyro_dps,temp_c\n0,1,2\n1.25,1,2\n2,1,2\n3,1,2\n3.5,1,2\n",
+            "# only\n",
+            "time_s,gyro_dps,temp_c\n",
+            "time_s,gyro_dps,temp_c\n#0,1,2\n 1,1,2\n",
+        ] {
+            same_as_csv(text.as_bytes(), &opts);
+            same_as_csv(text.as_bytes(), &gaps);
+            same_in_every_layout(text);
+        }
+    }
+
+    /// `text` (written with commas and decimal points) read with `;` and tab separators,
+    /// with decimal points and with decimal commas, and with a given sample period: the
+    /// fast path gives what the CSV path gives; and with the gyro in °/h.
+    fn same_in_every_layout(text: &str) {
+        let semicolon = ReadOptions {
+            delimiter: b';',
+            ..ReadOptions::default()
+        };
+        let tab = ReadOptions {
+            delimiter: b'\t',
+            ..ReadOptions::default()
+        };
+        let given = ReadOptions {
+            sample_period_s: Some(1.0),
+            fill_gaps_max_s: Some(10.0),
+            ..ReadOptions::default()
+        };
+        same_as_csv(text.replace(',', ";").as_bytes(), &semicolon);
+        same_as_csv(
+            text.replace(',', ";").replace('.', ",").as_bytes(),
+            &semicolon,
+        );
+        same_as_csv(text.replace(',', "\t").replace('.', ",").as_bytes(), &tab);
+        same_as_csv(text.as_bytes(), &given);
+        let dph = ReadOptions {
+            gyro_unit: GyroUnit::Dph,
+            ..ReadOptions::default()
+        };
+        same_as_csv(text.as_bytes(), &dph);
+    }
+
+    #[test]
+    fn fast_path_matches_csv_path_across_the_parallel_split() {
+        let opts = ReadOptions::default();
+        let text = log(20_000, true);
+        assert!(text.len() > PARALLEL_MIN_BYTES, "the log must be split");
+        let want = run(text.as_bytes(), &opts, false);
+        assert_eq!(want.samples.len(), 20_000);
+        assert_eq!(run(text.as_bytes(), &opts, true), want);
+        // An error in each half, near the split, and an order break across it.
+        let lines: Vec<&str> = text.lines().collect();
+        for (at, bad) in [
+            (3_000, "x"),
+            (10_000, "1,2"),
+            (10_003, "\"5\",1,2,3,4"),
+            (15_000, "1e9,1,2,3,4"),
+            (19_999, "1,1,1,1,1"),
+        ] {
+            let mut l = lines.clone();
+            l[at] = bad;
+            let t = l.join("\n") + "\n";
+            let want = run(t.as_bytes(), &opts, false);
+            assert_eq!(run(t.as_bytes(), &opts, true), want, "bad line {at}");
+        }
+        for k in 9_990..10_010 {
+            let mut l = lines.clone();
+            l.swap(k, k + 1);
+            let t = l.join("\n") + "\n";
+            assert_eq!(
+                run(t.as_bytes(), &opts, true),
+                run(t.as_bytes(), &opts, false)
+            );
+        }
+    }
+
+    proptest! {
+        // No lone CR here: the CSV path's line numbers are approximate in a file that mixes
+        // line endings (see `Tail`), the fast path's count newlines.
+        #[test]
+        fn fast_path_matches_csv_path_on_any_input(
+            body in prop::collection::vec(
+                prop::sample::select(b"0123456789.,-e#\n\" ".to_vec()), 0..200),
+        ) {
+            let mut text = b"time_s,gyro_dps,temp_c\n".to_vec();
+            text.extend(body);
+            if ends_in_open_quote(&text, b',') {
+                text.push(b'"');
+            }
+            same_as_csv(&text, &ReadOptions::default());
+        }
+
+        #[test]
+        fn fast_path_matches_csv_path_on_any_input_with_decimal_commas(
+            body in prop::collection::vec(
+                prop::sample::select(b"0123456789.,;-+e#\n\" ".to_vec()), 0..200),
+        ) {
+            let mut text = b"time_s;gyro_dps;temp_c\n".to_vec();
+            text.extend(body);
+            if ends_in_open_quote(&text, b';') {
+                text.push(b'"');
+            }
+            let opts = ReadOptions { delimiter: b';', ..ReadOptions::default() };
+            same_as_csv(&text, &opts);
+        }
+
+        #[test]
+        fn fast_path_matches_csv_path_on_logs_with_a_fault(
+            at in 0usize..60,
+            fault in prop::sample::select(vec!["", "x", ",", "\r", "\"", "#", "\n", "1e999", "-"]),
+        ) {
+            let mut text = log(60, false).into_bytes();
+            let pos = (at * text.len() / 60).min(text.len());
+            text.splice(pos..pos, fault.bytes());
+            same_as_csv(&text, &ReadOptions::default());
+        }
     }
 }
