@@ -177,8 +177,10 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
     let test_s = simulate(dir.path(), "test_static.csv", "slow-ramp", 3, false);
     let out = run_ok(
         gyrotherm()
-            // The residual recipe: this test reads its LSTM gate.
-            .args(["compare", "--json", "--recipe", "residual", "--train"])
+            // The residual recipe: this test reads its LSTM gate. The published column is
+            // left out (its own test below).
+            .args(["compare", "--json", "--recipe", "residual"])
+            .args(["--methods", "linear,poly,lstm", "--train"])
             .arg(&train_s)
             .arg("--train")
             .arg(&train_t)
@@ -211,7 +213,7 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
         fig("linear")
     );
     let models = v["models"].as_array().unwrap();
-    let model = |m: &str| models.iter().find(|x| x["method"] == m).unwrap();
+    let model = |m: &str| models.iter().find(|x| x["key"] == m).unwrap();
     assert!(model("lstm")["bias_lstm_validation_improvement"].is_number());
     assert!(
         model("lstm")["bias_lstm_run_gate"].is_null(),
@@ -236,6 +238,79 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
         model("lstm")
     );
     assert_eq!(model("linear")["label"], "linear");
+    assert_eq!(models.len(), 3, "--methods linear,poly,lstm: three columns");
+}
+
+/// By default the published recipe (He et al. 2024) has its own column beside the default
+/// `lstm`-method model, named "LSTM, He et al." in the table and in `--json`; `--methods`
+/// chooses the columns and their order, and a column asked for twice is refused.
+#[test]
+fn compare_shows_the_published_recipe_beside_the_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let train_s = simulate(dir.path(), "train_static.csv", "seed-shock", 1, false);
+    let train_t = simulate(dir.path(), "train_table.csv", "seed-shock", 2, true);
+    let test_s = simulate(dir.path(), "test_static.csv", "slow-ramp", 3, false);
+    let compare = |extra: &[&str]| {
+        let mut c = gyrotherm();
+        c.args(["compare", "--epochs", "5", "--train"])
+            .arg(&train_s)
+            .arg("--train")
+            .arg(&train_t)
+            .arg("--test")
+            .arg(&test_s)
+            .args(extra);
+        c
+    };
+    let out = run_ok(&mut compare(&["--json"]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let keys: Vec<&str> = v["models"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["key"].as_str().unwrap())
+        .collect();
+    assert_eq!(keys, ["linear", "poly", "lstm", "published"]);
+    let published = &v["models"][3];
+    assert_eq!(published["label"], "LSTM, He et al.");
+    assert_eq!(published["method"], "lstm");
+    assert_eq!(published["recipe"], "published");
+    assert_eq!(published["bias_model"], "lstm");
+    assert_eq!(published["bias_epochs"], 5);
+    // The default recipe holds no LSTM: its column is not called one.
+    assert_eq!(v["models"][2]["recipe"], "thermal");
+    assert_eq!(v["models"][2]["label"], "thermal-state LS");
+    let methods = v["tests"][0]["methods"].as_object().unwrap();
+    for k in keys {
+        assert!(methods[k]["bias_stability_dph"].is_number(), "{k}");
+    }
+    // The table: one column per model, the published one named after its authors.
+    let out = run_ok(&mut compare(&["--methods", "published,linear"]));
+    let table = String::from_utf8_lossy(&out.stdout);
+    let header = table
+        .lines()
+        .find(|l| l.trim_start().starts_with("figure"))
+        .unwrap_or_else(|| panic!("no header in:\n{table}"));
+    let cols: Vec<&str> = header
+        .split("  ")
+        .map(str::trim)
+        .filter(|c| !c.is_empty())
+        .collect();
+    assert_eq!(
+        cols,
+        ["figure", "raw", "LSTM, He et al.", "linear", "noise floor"]
+    );
+    // `--recipe published` makes the lstm column the published one: asking for both is
+    // refused, and the default columns hold it once.
+    let out = compare(&["--recipe", "published", "--methods", "lstm,published"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("published column is asked for twice"), "{err}");
+    let out = run_ok(&mut compare(&["--recipe", "published", "--json"]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["models"].as_array().unwrap().len(), 3);
+    assert_eq!(v["models"][2]["label"], "LSTM, He et al.");
 }
 
 /// `--validate-on-runs` with two static logs: the output names each log with its figure for
@@ -402,4 +477,68 @@ fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["tau_s"].as_f64(), Some(150.0));
+}
+
+/// `compare` and `report` on logs at one sample per 15 s: the default τ is the multiple of
+/// the period nearest 100 s, 105 s = 7 × 15 s (as `evaluate` takes it), said on stderr, and
+/// every column gets its figure; `--tau` still chooses.
+#[test]
+fn compare_and_report_take_the_nearest_multiple_of_a_coarse_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = |name: &str, profile: &str, seed: &str, extra: &[&str]| {
+        let path = dir.path().join(name);
+        run_ok(
+            gyrotherm()
+                .args(["simulate", "--profile", profile, "--seed", seed])
+                .args(["--rate-hz", "0.06666666666666667"])
+                .args(extra)
+                .arg("--out")
+                .arg(&path),
+        );
+        path
+    };
+    let train_s = sim("train_static.csv", "seed-shock", "1", &[]);
+    let train_t = sim(
+        "train_table.csv",
+        "seed-shock",
+        "2",
+        &["--table-rate", "20", "--table-segment", "600"],
+    );
+    let test_s = sim("test_static.csv", "slow-ramp", "3", &["--truth"]);
+    let args = |cmd: &str| {
+        let mut c = gyrotherm();
+        c.args([cmd, "--epochs", "3", "--train"])
+            .arg(&train_s)
+            .arg("--train")
+            .arg(&train_t)
+            .arg("--test")
+            .arg(&test_s);
+        c
+    };
+    let out = run_ok(args("compare").arg("--json"));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["tau_s"].as_f64(), Some(105.0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("τ = 105 s") && err.contains("15 s sample period nearest 100 s"),
+        "{err}"
+    );
+    let methods = v["tests"][0]["methods"].as_object().unwrap();
+    assert_eq!(methods.len(), 4, "{methods:?}");
+    for (k, m) in methods {
+        assert!(
+            m["bias_stability_dph"].as_f64().is_some_and(f64::is_finite),
+            "{k}"
+        );
+    }
+    let out = run_ok(args("compare").args(["--json", "--tau", "150"]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["tau_s"].as_f64(), Some(150.0));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("nearest 100 s"));
+    let report = dir.path().join("report");
+    let out = run_ok(args("report").arg("--out").arg(&report));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("τ = 105 s"));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("τ = 105 s"));
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(html.contains("τ = 105 s"), "the report's table says τ");
 }

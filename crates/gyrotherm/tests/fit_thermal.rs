@@ -3,7 +3,9 @@
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, FitOutcome, LstmRecipe, NamedLog, RecipeKind};
+use gyrotherm::fit::{
+    fit_model, FitConfig, FitOutcome, LstmRecipe, LstmVerdict, NamedLog, RecipeKind,
+};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::model::{Method, SubModel};
 use gyrotherm::sim::{random_unit, simulate, FogUnit, Profile, SensorNode, SimConfig};
@@ -144,4 +146,73 @@ fn beats_linear_held_out_on_a_family_unit() {
         b_th <= 0.7 * b_lin,
         "thermal {b_th} °/h, linear {b_lin} °/h on slow-ramp"
     );
+}
+
+/// The thermal model with a residual LSTM on top (`ThermalConfig::residual_lstm`, reading the
+/// model's prediction; docs/experiments/lstm-on-thermal-base.md). The gate decides alone: with
+/// a least validation improvement below what the LSTM achieved on the held-out blocks it is
+/// kept (the model holds it, is named `LS + LSTM`, and runs through the flight compensator);
+/// with one just above, the model is the thermal model, coefficient for coefficient.
+#[test]
+fn residual_lstm_on_the_thermal_model_is_kept_only_by_its_gate() {
+    let unit = random_unit(1016);
+    let sim = |profile: &str, seed: u64, table: bool| {
+        let mut c = SimConfig::builtin(profile).unwrap();
+        c.unit = unit.clone();
+        c.seed = seed;
+        c.table_rate_dps = table.then_some(20.0);
+        run(c)
+    };
+    let (train_s, train_t) = (
+        sim("seed-shock", 101_601, false),
+        sim("seed-shock", 101_602, true),
+    );
+    let test = sim("slow-ramp", 101_651, false);
+    let logs = [("s.csv", &train_s), ("t.csv", &train_t)];
+    let with_gate = |min: f64| {
+        let mut c = thermal();
+        c.seed = 1;
+        c.thermal.residual_lstm = true;
+        c.recipe.base_input = true;
+        c.recipe.min_val_improvement = min;
+        fit(&logs, &c)
+    };
+    let plain = fit(&logs, &thermal());
+    assert_eq!(plain.model.label(), "thermal-state LS");
+    let kept = with_gate(0.0);
+    let t = kept.bias_training.as_ref().unwrap();
+    assert!(t.thermal.is_some(), "the thermal report is kept");
+    let improvement = t.val_improvement.expect("validated on held-out blocks");
+    assert!(
+        improvement > 0.0,
+        "the LSTM learnt something: {improvement}"
+    );
+    assert_eq!(
+        t.lstm_verdict,
+        Some(LstmVerdict::Kept),
+        "gain {:?}",
+        t.lstm_gain
+    );
+    assert!(matches!(
+        kept.model.bias,
+        Some(SubModel::Residual {
+            lstm_reads_base: true,
+            ..
+        })
+    ));
+    assert_eq!(kept.model.label(), "LS + LSTM");
+    // The scale factor keeps the thermal model alone.
+    assert_eq!(kept.model.scale, plain.model.scale);
+    let c = compensate_log(&kept.model, &test).unwrap();
+    assert!(c.gyro_comp_dps.iter().all(|v| v.is_finite()));
+    let left_out = with_gate(improvement + 0.01);
+    assert!(matches!(
+        left_out.bias_training.as_ref().unwrap().lstm_verdict,
+        Some(LstmVerdict::LeftOut {
+            validation_blocks: true,
+            ..
+        })
+    ));
+    assert_eq!(left_out.model.bias, plain.model.bias);
+    assert_eq!(left_out.model.label(), "thermal-state LS");
 }

@@ -9,10 +9,9 @@ use html_refs::references;
 use std::collections::HashSet;
 use std::path::Path;
 
-use gyrotherm::compare::{compare, CompareConfig, Comparison};
+use gyrotherm::compare::{compare, Candidate, CompareConfig, Comparison};
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::NamedLog;
-use gyrotherm::model::Method;
 use gyrotherm::report::write_full_report;
 use gyrotherm::report::FIGURE_STEMS;
 use gyrotherm::sim::{simulate, Profile, Segment, SimConfig};
@@ -124,6 +123,12 @@ fn full_report_over_simulated_logs_draws_every_figure() {
     // none), and a few epochs: the figures, not the fit quality, are under test.
     cfg.fit.recipe = gyrotherm::fit::LstmRecipe::residual();
     cfg.fit.recipe.epochs = 3;
+    cfg.candidates = vec![
+        Candidate::linear(),
+        Candidate::poly(),
+        Candidate::lstm(),
+        Candidate::published(Some(3)),
+    ];
     let cmp = run_compare(&train_n, &test_n, &cfg);
 
     let dir = tempfile::tempdir().unwrap();
@@ -174,8 +179,8 @@ fn full_report_over_simulated_logs_draws_every_figure() {
         let v = m.performance.bias_stability_dph.unwrap();
         assert!(
             html.contains(&format!("<td>{v:.5}</td>")),
-            "{:?} {v:.5} missing",
-            m.method
+            "{} {v:.5} missing",
+            m.label
         );
     }
     let floor = s.floor_dph.expect("simulated with truth: noise floor");
@@ -191,6 +196,15 @@ fn full_report_over_simulated_logs_draws_every_figure() {
         assert!(html.contains(&f.model.training.data_digest_sha256));
     }
     assert!(html.contains("3 epochs"), "LSTM recipe epochs missing");
+    // The published recipe has its own column, named after its authors.
+    assert!(
+        html.contains("<th>LSTM, He et al.</th>"),
+        "no published column"
+    );
+    assert!(
+        html.contains("published recipe"),
+        "published recipe missing"
+    );
     // Only the figures and the page: no temporary files left.
     let names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
@@ -215,7 +229,7 @@ fn figures_that_cannot_apply_are_noted_not_errors() {
     let test = vec![("test.csv".to_owned(), sim(6, false))];
     let (train_n, test_n) = (named(&train), named(&test));
     let cfg = CompareConfig {
-        methods: vec![Method::Linear, Method::Poly],
+        candidates: vec![Candidate::linear(), Candidate::poly()],
         ..CompareConfig::default()
     };
     let cmp = run_compare(&train_n, &test_n, &cfg);
@@ -236,7 +250,7 @@ fn figures_that_cannot_apply_are_noted_not_errors() {
             );
         }
     }
-    assert!(html.contains("no LSTM model was fitted"));
+    assert!(html.contains("no model in this comparison trained an LSTM"));
     assert!(html.contains("no rate-table held-out log given"));
     for r in references(&html) {
         assert!(
@@ -251,7 +265,7 @@ fn mismatched_logs_are_refused() {
     let train = vec![("train.csv".to_owned(), sim(7, false))];
     let (train_n, test_n) = (named(&train), named(&train));
     let cfg = CompareConfig {
-        methods: vec![Method::Linear],
+        candidates: vec![Candidate::linear()],
         ..CompareConfig::default()
     };
     let cmp = run_compare(&train_n, &test_n, &cfg);

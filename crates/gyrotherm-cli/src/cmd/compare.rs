@@ -1,14 +1,14 @@
-//! `gyrotherm compare`: fit linear, polynomial and LSTM models on training logs and judge them
-//! on held-out logs — the results table of He et al. 2024, for the user's own data.
+//! `gyrotherm compare`: fit linear, polynomial, the default `lstm`-method model and the
+//! published recipe of He et al. 2024 on training logs and judge them on held-out logs — the
+//! paper's results table, for the user's own data, one column per model.
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::compare::{compare, CompareConfig, Comparison};
-use gyrotherm::fit::NamedLog;
-use gyrotherm::model::Method;
+use gyrotherm::compare::{compare, Candidate, CompareConfig, Comparison};
+use gyrotherm::fit::{NamedLog, RecipeKind};
 
 use super::common::LogArgs;
 use super::common::{named, read_logs};
@@ -23,34 +23,115 @@ pub struct CompareArgs {
     /// Held-out log to judge on (CSV); repeat for several.
     #[arg(long, required = true)]
     pub test: Vec<PathBuf>,
-    /// Bias-stability smoothing time, s.
-    #[arg(long, default_value_t = 100.0)]
-    pub tau: f64,
+    /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
+    /// sample period nearest to it when 100 s is not one; said on stderr).
+    #[arg(long, value_parser = super::common::positive_seconds)]
+    pub tau: Option<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub columns: ColumnArgs,
     #[command(flatten)]
     pub fit: FitArgs,
     #[command(flatten)]
     pub log: LogArgs,
 }
 
-/// Run the comparison with progress bars for the LSTM.
+/// Which models the comparison fits, one column each (`compare`, `demo`, `report`).
+#[derive(Debug, clap::Args)]
+pub struct ColumnArgs {
+    /// Columns to compare, comma-separated, in table order: `linear`, `poly`, `lstm` (the
+    /// `--recipe`, default `thermal`; its column is named by what the model holds) and
+    /// `published` (He et al. 2024 as published, column "LSTM, He et al."; `--epochs`
+    /// applies to it too). Default: all four (`published` only once when `--recipe
+    /// published`).
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "LIST")]
+    pub methods: Option<Vec<ColumnArg>>,
+}
+
+/// A `--methods` entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ColumnArg {
+    /// Linear least squares in T and dT (the paper's comparison).
+    Linear,
+    /// Polynomial least squares in T and dT.
+    Poly,
+    /// The `lstm` method with `--recipe` (default `thermal`).
+    Lstm,
+    /// The `lstm` method with the published recipe (He et al. 2024).
+    Published,
+}
+
+impl ColumnArgs {
+    /// The comparison's columns; `fit` gives the `--epochs` the published column also takes.
+    pub fn candidates(&self, fit: &FitArgs) -> Vec<Candidate> {
+        let recipe_is_published = RecipeKind::from(fit.recipe) == RecipeKind::Published;
+        let wanted = match &self.methods {
+            Some(m) => m.clone(),
+            None => {
+                let mut all = vec![ColumnArg::Linear, ColumnArg::Poly, ColumnArg::Lstm];
+                if !recipe_is_published {
+                    all.push(ColumnArg::Published);
+                }
+                all
+            }
+        };
+        wanted
+            .into_iter()
+            .map(|c| match c {
+                ColumnArg::Linear => Candidate::linear(),
+                ColumnArg::Poly => Candidate::poly(),
+                ColumnArg::Lstm => Candidate::lstm(),
+                ColumnArg::Published => Candidate::published(fit.epochs),
+            })
+            .collect()
+    }
+
+    /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`.
+    pub fn compare_config(&self, fit: &FitArgs, tau_s: f64) -> anyhow::Result<CompareConfig> {
+        Ok(CompareConfig {
+            candidates: self.candidates(fit),
+            ..fit.compare_config(tau_s)?
+        })
+    }
+}
+
+/// `--tau` if given, else the default for the held-out logs
+/// ([`gyrotherm::compare::default_tau_s`]), said on stderr when it is not 100 s.
+pub fn resolve_tau(tau: Option<f64>, test: &[NamedLog]) -> f64 {
+    if let Some(t) = tau {
+        return t;
+    }
+    let (t, adjusted_to) = gyrotherm::compare::default_tau_s(test);
+    if let Some(period) = adjusted_to {
+        eprintln!(
+            "gyrotherm: τ = {t} s, the multiple of the {period} s sample period nearest 100 s \
+             (100 s is not one; give --tau to choose)"
+        );
+    }
+    t
+}
+
+/// Run the comparison with progress bars for every column that trains an LSTM.
 pub fn run_comparison(
     train: &[NamedLog],
     test: &[NamedLog],
     cfg: &CompareConfig,
 ) -> anyhow::Result<Comparison> {
-    let bars = TrainingBars::new(
-        cfg.methods.contains(&Method::Lstm),
-        cfg.fit.recipe.epochs,
-        &["lstm"],
-    );
-    let result = compare(train, test, cfg, &|m, t, e, l| {
-        if m == Method::Lstm {
-            bars.update("lstm", t, e, l)
-        }
-    });
+    let training: Vec<&Candidate> = cfg
+        .candidates
+        .iter()
+        .filter(|c| c.trains_lstm(&cfg.fit))
+        .collect();
+    let keys: Vec<&str> = training.iter().map(|c| c.key(&cfg.fit)).collect();
+    let epochs = training
+        .iter()
+        .map(|c| c.fit_config(&cfg.fit).recipe.epochs)
+        .max()
+        .unwrap_or(0);
+    let bars = TrainingBars::new(!keys.is_empty(), epochs, &keys);
+    let result = compare(train, test, cfg, &|key, t, e, l| bars.update(key, t, e, l));
     bars.finish();
     result.context("comparison failed")
 }
@@ -61,7 +142,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let test = read_logs(&args.test, &args.log, &mut warnings)?;
     let train_named = named(&train);
     let test_named = named(&test);
-    let cfg = args.fit.compare_config(args.tau)?;
+    let tau_s = resolve_tau(args.tau, &test_named);
+    let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let mut out = std::io::stdout().lock();
     if args.json {

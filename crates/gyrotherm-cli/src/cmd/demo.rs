@@ -1,6 +1,7 @@
 //! `gyrotherm demo`: the main job on built-in defaults. Simulates a training pair (static and
 //! rate-table runs of the default unit on one chamber profile) and a held-out pair on another
-//! profile, fits linear, polynomial and LSTM models, and prints the held-out results table.
+//! profile, fits linear, polynomial, the default `lstm`-method model and the published recipe
+//! (He et al. 2024), and prints the held-out results table, one column per model.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,7 +11,7 @@ use gyrotherm::csvlog::{write_log, TestLog};
 use gyrotherm::sim::{simulate, SimConfig};
 
 use super::common::{builtin_profile, named};
-use super::compare::{print_table, run_comparison};
+use super::compare::{print_table, run_comparison, ColumnArgs};
 use super::train::FitArgs;
 
 #[derive(Debug, clap::Args)]
@@ -27,6 +28,8 @@ pub struct DemoArgs {
     /// Rate-table rate of the rate-table runs, °/s.
     #[arg(long, default_value_t = 20.0)]
     pub table_rate: f64,
+    #[command(flatten)]
+    pub columns: ColumnArgs,
     #[command(flatten)]
     pub fit: FitArgs,
 }
@@ -85,14 +88,16 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     }
     let named = named(&logs);
     let cfg = args
-        .fit
-        .compare_config(gyrotherm::compare::BIAS_STABILITY_TAU_S)?;
-    eprintln!("gyrotherm: fitting linear, poly and lstm models on the training runs ...");
+        .columns
+        .compare_config(&args.fit, gyrotherm::compare::BIAS_STABILITY_TAU_S)?;
+    let keys: Vec<&str> = cfg.candidates.iter().map(|c| c.key(&cfg.fit)).collect();
+    eprintln!(
+        "gyrotherm: fitting the {} models on the training runs ...",
+        keys.join(", ")
+    );
     let cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
-    for fit in &cmp.fits {
-        let path = args
-            .dir
-            .join(format!("model_{}.json", fit.model.method.as_str()));
+    for (fit, col) in cmp.fits.iter().zip(&cmp.columns) {
+        let path = args.dir.join(format!("model_{}.json", col.key));
         fit.model.save(&path).map_err(anyhow::Error::msg)?;
     }
     let mut out = std::io::stdout().lock();

@@ -11,7 +11,7 @@ use anyhow::Context as _;
 use gyrotherm::report::write_full_report_with;
 
 use super::common::{named, read_logs, LogArgs};
-use super::compare::{print_table, run_comparison};
+use super::compare::{print_table, resolve_tau, run_comparison, ColumnArgs};
 use super::train::FitArgs;
 
 #[derive(Debug, clap::Args)]
@@ -25,9 +25,12 @@ pub struct ReportArgs {
     /// Report folder (created if missing): index.html and a PNG and SVG per figure.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Bias-stability smoothing time, s.
-    #[arg(long, default_value_t = 100.0)]
-    pub tau: f64,
+    /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
+    /// sample period nearest to it when 100 s is not one; said on stderr).
+    #[arg(long, value_parser = super::common::positive_seconds)]
+    pub tau: Option<f64>,
+    #[command(flatten)]
+    pub columns: ColumnArgs,
     #[command(flatten)]
     pub fit: FitArgs,
     #[command(flatten)]
@@ -40,7 +43,8 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let test = read_logs(&args.test, &args.log, &mut gap_warnings)?;
     let train_named = named(&train);
     let test_named = named(&test);
-    let cfg = args.fit.compare_config(args.tau)?;
+    let tau_s = resolve_tau(args.tau, &test_named);
+    let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let index = write_full_report_with(
         &args.out,

@@ -58,6 +58,26 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         "published" => lstm(LstmRecipe::published()),
         "direct" => lstm(LstmRecipe::of_kind(RecipeKind::Direct)),
         "thermal" => lstm(LstmRecipe::of_kind(RecipeKind::Thermal)),
+        v if v.starts_with("thermal-lstm") => {
+            // thermal-lstm[:<base input 0|1>[:<runs gate 0|1>[:<epochs>[:<min improvement>
+            // [:<residual smoothing steps>]]]]]: the thermal model with a residual LSTM on
+            // top, for the design-family sweep.
+            let mut c = lstm(LstmRecipe::of_kind(RecipeKind::Thermal));
+            c.thermal.residual_lstm = true;
+            let parts: Vec<&str> = v.split(':').collect();
+            c.recipe.base_input = parts.get(1) == Some(&"1");
+            c.recipe.validate_on_runs = parts.get(2) == Some(&"1");
+            if let Some(e) = parts.get(3) {
+                c.recipe.epochs = e.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            if let Some(f) = parts.get(4) {
+                c.recipe.min_val_improvement = f.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            if let Some(f) = parts.get(5) {
+                c.recipe.residual_smooth_steps = f.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            c
+        }
         v if v.starts_with("thermal:") => {
             // thermal:<lags>:<basis>[:<folds>] for the design-family sweep.
             let mut c = lstm(LstmRecipe::of_kind(RecipeKind::Thermal));
@@ -90,7 +110,7 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         other => {
             return Err(format!(
                 "unknown method {other:?}: linear, poly, residual, residual-ls, generic, \
-                 published, direct"
+                 published, direct, thermal, thermal:..., thermal-lstm:..."
             ))
         }
     })

@@ -1,7 +1,8 @@
 //! Held-out comparison of compensation methods: the paper's results table for the user's logs.
 //!
-//! Fits linear, polynomial and LSTM models on the training logs, compensates each held-out log
-//! with the flight compensator, and judges it with the standard figures: bias stability
+//! Fits one model per [`Candidate`] on the training logs (by default linear, polynomial, the
+//! default `lstm` recipe and the published recipe of He et al. 2024, each its own column),
+//! compensates each held-out log with the flight compensator, and judges it with the standard figures: bias stability
 //! (1σ of τ-means, °/h) for static logs; for rate-table logs the scale factor K(t) per segment
 //! against the ideal K = 1 (ppm) and the compensated output range at each table rate. When a
 //! held-out log carries simulator truth (`noise_dps`), the bias stability of the noise alone is
@@ -24,7 +25,7 @@ use serde::Serialize;
 
 use crate::compensate::{compensate_log, extrapolation_warnings, Compensated};
 use crate::csvlog::{TestLog, NOISE_COL};
-use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, Target};
+use crate::fit::{fit_model, FitConfig, FitOutcome, LstmRecipe, NamedLog, RecipeKind, Target};
 use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
 use crate::model::Method;
 use crate::targets;
@@ -32,12 +33,117 @@ use crate::targets;
 /// Bias-stability smoothing time of the comparison, s (100 s: METHOD.md, He et al. 2024).
 pub const BIAS_STABILITY_TAU_S: f64 = 100.0;
 
+/// The column name of the published recipe: the seed's method, named after its authors.
+pub const PUBLISHED_LABEL: &str = "LSTM, He et al.";
+
+/// One column of the comparison: a method and, for `lstm`, the recipe it trains.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    pub method: Method,
+    /// The LSTM recipe (method `lstm` only; None: the comparison's [`FitConfig::recipe`]).
+    pub recipe: Option<LstmRecipe>,
+}
+
+impl Candidate {
+    /// The `linear` fit.
+    pub fn linear() -> Self {
+        Candidate {
+            method: Method::Linear,
+            recipe: None,
+        }
+    }
+
+    /// The `poly` fit.
+    pub fn poly() -> Self {
+        Candidate {
+            method: Method::Poly,
+            recipe: None,
+        }
+    }
+
+    /// The `lstm` method with the comparison's recipe (the default: `thermal`).
+    pub fn lstm() -> Self {
+        Candidate {
+            method: Method::Lstm,
+            recipe: None,
+        }
+    }
+
+    /// The `lstm` method with the recipe as published (He et al. 2024), `epochs` Adam steps
+    /// (None: the published 1000).
+    pub fn published(epochs: Option<usize>) -> Self {
+        let mut recipe = LstmRecipe::published();
+        if let Some(e) = epochs {
+            recipe.epochs = e;
+        }
+        Candidate {
+            method: Method::Lstm,
+            recipe: Some(recipe),
+        }
+    }
+
+    /// The fit settings of this column: `base` with its method and recipe.
+    pub fn fit_config(&self, base: &FitConfig) -> FitConfig {
+        FitConfig {
+            method: self.method,
+            recipe: self.recipe.clone().unwrap_or_else(|| base.recipe.clone()),
+            ..base.clone()
+        }
+    }
+
+    /// Whether this column trains the published recipe.
+    pub fn is_published(&self, base: &FitConfig) -> bool {
+        self.method == Method::Lstm && self.fit_config(base).recipe.kind == RecipeKind::Published
+    }
+
+    /// The column's key in `gyrotherm compare --json` and `--methods`: `linear`, `poly`,
+    /// `lstm`, or `published` for the published recipe.
+    pub fn key(&self, base: &FitConfig) -> &'static str {
+        if self.is_published(base) {
+            "published"
+        } else {
+            self.method.as_str()
+        }
+    }
+
+    /// Whether fitting this column trains an LSTM (and reports its epochs).
+    pub fn trains_lstm(&self, base: &FitConfig) -> bool {
+        let c = self.fit_config(base);
+        c.method == Method::Lstm
+            && c.recipe.epochs > 0
+            && (c.recipe.kind != RecipeKind::Thermal || c.thermal.residual_lstm)
+    }
+}
+
+/// The bias-stability smoothing time for held-out logs when none was asked for:
+/// [`BIAS_STABILITY_TAU_S`] when it is a whole number of sample periods of every static log
+/// in `test`, otherwise the multiple of the longest such period nearest to it
+/// ([`metrics::default_tau_s`]). Returns τ and, when it is not [`BIAS_STABILITY_TAU_S`], the
+/// sample period it is a multiple of; a caller should say so (one sample per 15 s gives
+/// τ = 105 s). Rate-table logs count only when no log is static.
+pub fn default_tau_s(test: &[NamedLog]) -> (f64, Option<f64>) {
+    let periods = |static_only: bool| {
+        test.iter()
+            .filter(move |t| !static_only || t.log.is_static())
+            .map(|t| t.log.sample_period_s())
+            .filter(|p| p.is_finite() && *p > 0.0)
+            .fold(None, |a: Option<f64>, p| Some(a.map_or(p, |a| a.max(p))))
+    };
+    match periods(true).or_else(|| periods(false)) {
+        Some(p) => match metrics::default_tau_s(p, BIAS_STABILITY_TAU_S) {
+            (t, true) => (t, Some(p)),
+            (t, false) => (t, None),
+        },
+        None => (BIAS_STABILITY_TAU_S, None),
+    }
+}
+
 /// What to compare and how to judge.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompareConfig {
-    /// Methods to fit, in table order.
-    pub methods: Vec<Method>,
-    /// Fit settings shared by all methods (the method field is overridden per method).
+    /// The columns to fit, in table order; no two with the same [`Candidate::key`].
+    pub candidates: Vec<Candidate>,
+    /// Fit settings shared by all columns (method and recipe set per [`Candidate`]).
     pub fit: FitConfig,
     /// Bias-stability smoothing time, s (100 s as in He et al. 2024).
     pub tau_s: f64,
@@ -48,7 +154,12 @@ pub struct CompareConfig {
 impl Default for CompareConfig {
     fn default() -> Self {
         CompareConfig {
-            methods: vec![Method::Linear, Method::Poly, Method::Lstm],
+            candidates: vec![
+                Candidate::linear(),
+                Candidate::poly(),
+                Candidate::lstm(),
+                Candidate::published(None),
+            ],
             fit: FitConfig::new(Method::Lstm),
             tau_s: BIAS_STABILITY_TAU_S,
             settle_s: targets::SETTLE_S,
@@ -79,10 +190,15 @@ pub struct Performance {
     pub rate_ranges: Vec<RateRange>,
 }
 
-/// One method's result on one held-out log.
+/// One column's result on one held-out log.
 #[derive(Debug, Clone)]
 pub struct MethodResult {
     pub method: Method,
+    /// The column's key ([`Candidate::key`]).
+    pub key: &'static str,
+    /// The column's name: what the model holds ([`ModelFile::label`](crate::model::ModelFile::label)),
+    /// or [`PUBLISHED_LABEL`].
+    pub label: &'static str,
     pub performance: Performance,
     pub compensated: Compensated,
 }
@@ -103,17 +219,33 @@ pub struct TestResult {
 /// The whole comparison.
 #[derive(Debug, Clone)]
 pub struct Comparison {
+    /// One fitted model per column, in table order.
     pub fits: Vec<FitOutcome>,
+    /// Key and name of each column, beside [`Comparison::fits`].
+    pub columns: Vec<Column>,
     pub tests: Vec<TestResult>,
+}
+
+/// A column of a finished comparison: its key and its name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Column {
+    /// [`Candidate::key`]: `linear`, `poly`, `lstm` or `published`.
+    pub key: &'static str,
+    /// What the model holds, or [`PUBLISHED_LABEL`].
+    pub label: &'static str,
 }
 
 /// Why a comparison could not be made.
 #[derive(Debug)]
 #[non_exhaustive]
 pub enum CompareError {
-    /// Fitting `method` on the training logs failed.
+    /// No column to fit.
+    NoCandidates,
+    /// Two columns would fit the same thing (`key`).
+    DuplicateColumn { key: &'static str },
+    /// Fitting the column `key` on the training logs failed.
     Fit {
-        method: Method,
+        key: &'static str,
         source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// Compensating the held-out log `log` failed.
@@ -131,7 +263,14 @@ pub enum CompareError {
 impl fmt::Display for CompareError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CompareError::Fit { method, source } => write!(f, "{} fit: {source}", method.as_str()),
+            CompareError::NoCandidates => write!(f, "no method to compare: name at least one"),
+            CompareError::DuplicateColumn { key } => {
+                write!(
+                    f,
+                    "the {key} column is asked for twice; name each method once"
+                )
+            }
+            CompareError::Fit { key, source } => write!(f, "{key} fit: {source}"),
             CompareError::Compensate { log, source } => write!(f, "{log}: {source}"),
             CompareError::Performance { log, source } => write!(f, "{log}: {source}"),
         }
@@ -145,6 +284,7 @@ impl std::error::Error for CompareError {
                 Some(source.as_ref())
             }
             CompareError::Performance { source, .. } => Some(source),
+            CompareError::NoCandidates | CompareError::DuplicateColumn { .. } => None,
         }
     }
 }
@@ -237,26 +377,39 @@ pub fn performance(
     Ok(f)
 }
 
-/// Fit every configured method on `train` and judge each on every log of `test`.
-/// `progress(method, target, epoch, loss)` reports LSTM training.
+/// Fit every configured column on `train` and judge each on every log of `test`.
+/// `progress(key, target, epoch, loss)` reports LSTM training ([`Candidate::key`]).
 pub fn compare(
     train: &[NamedLog],
     test: &[NamedLog],
     cfg: &CompareConfig,
-    progress: &(dyn Fn(Method, Target, usize, f64) + Sync),
+    progress: &(dyn Fn(&'static str, Target, usize, f64) + Sync),
 ) -> Result<Comparison, CompareError> {
+    if cfg.candidates.is_empty() {
+        return Err(CompareError::NoCandidates);
+    }
+    let keys: Vec<&'static str> = cfg.candidates.iter().map(|c| c.key(&cfg.fit)).collect();
+    for (i, &key) in keys.iter().enumerate() {
+        if keys[..i].contains(&key) {
+            return Err(CompareError::DuplicateColumn { key });
+        }
+    }
     let mut fits = Vec::new();
-    for &m in &cfg.methods {
-        let fc = FitConfig {
-            method: m,
-            ..cfg.fit.clone()
-        };
-        let fit = fit_model(train, &fc, &|t, e, l| progress(m, t, e, l)).map_err(|e| {
+    let mut columns = Vec::new();
+    for (c, &key) in cfg.candidates.iter().zip(&keys) {
+        let fc = c.fit_config(&cfg.fit);
+        let fit = fit_model(train, &fc, &|t, e, l| progress(key, t, e, l)).map_err(|e| {
             CompareError::Fit {
-                method: m,
+                key,
                 source: e.into(),
             }
         })?;
+        let label = if c.is_published(&cfg.fit) {
+            PUBLISHED_LABEL
+        } else {
+            fit.model.label()
+        };
+        columns.push(Column { key, label });
         fits.push(fit);
     }
     let mut tests = Vec::new();
@@ -276,7 +429,7 @@ pub fn compare(
         };
         let mut methods = Vec::new();
         let mut warnings = Vec::new();
-        for fit in &fits {
+        for (fit, col) in fits.iter().zip(&columns) {
             let comp = compensate_log(&fit.model, t.log).map_err(|e| CompareError::Compensate {
                 log: t.name.to_owned(),
                 source: e.into(),
@@ -284,13 +437,15 @@ pub fn compare(
             let performance = performance(t.log, &comp.gyro_comp_dps, cfg.tau_s, cfg.settle_s)
                 .map_err(perf_err)?;
             for w in extrapolation_warnings(&fit.model, t.log) {
-                let w = format!("{} ({} model): {w}", t.name, fit.model.method.as_str());
+                let w = format!("{} ({} model): {w}", t.name, col.label);
                 if !warnings.contains(&w) {
                     warnings.push(w);
                 }
             }
             methods.push(MethodResult {
                 method: fit.model.method,
+                key: col.key,
+                label: col.label,
                 performance,
                 compensated: comp,
             });
@@ -304,5 +459,9 @@ pub fn compare(
             warnings,
         });
     }
-    Ok(Comparison { fits, tests })
+    Ok(Comparison {
+        fits,
+        columns,
+        tests,
+    })
 }

@@ -24,7 +24,8 @@ pub struct TestSummary {
     pub is_static: bool,
     pub floor_dph: Option<f64>,
     pub raw: Performance,
-    /// Keyed by method name (`"lstm"`, `"linear"`, `"poly"`).
+    /// Keyed by column ([`Candidate::key`](super::Candidate::key): `"linear"`, `"poly"`,
+    /// `"lstm"`, `"published"`).
     pub methods: BTreeMap<&'static str, Performance>,
     pub warnings: Vec<String>,
 }
@@ -32,9 +33,14 @@ pub struct TestSummary {
 /// One fitted model in a [`ComparisonSummary`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelSummary {
+    /// The column's key, as in [`TestSummary::methods`].
+    pub key: &'static str,
     pub method: &'static str,
-    /// What the model holds ([`ModelFile::label`](crate::model::ModelFile::label)): the
-    /// name its column has in the table.
+    /// The LSTM recipe (method `lstm` only).
+    pub recipe: Option<&'static str>,
+    /// The name its column has in the table: what the model holds
+    /// ([`ModelFile::label`](crate::model::ModelFile::label)), or `LSTM, He et al.` for the
+    /// published recipe.
     pub label: &'static str,
     /// Kind of the bias and scale-factor sub-models (None: not fitted).
     pub bias_model: Option<&'static str>,
@@ -68,7 +74,7 @@ impl Comparison {
                     methods: t
                         .methods
                         .iter()
-                        .map(|m| (m.method.as_str(), m.performance.clone()))
+                        .map(|m| (m.key, m.performance.clone()))
                         .collect(),
                     warnings: t.warnings.clone(),
                 })
@@ -76,11 +82,16 @@ impl Comparison {
             models: self
                 .fits
                 .iter()
-                .map(|f| {
+                .zip(&self.columns)
+                .zip(&cfg.candidates)
+                .map(|((f, col), cand)| {
                     let (b, s) = (f.bias_training.as_ref(), f.scale_training.as_ref());
                     ModelSummary {
+                        key: col.key,
                         method: f.model.method.as_str(),
-                        label: f.model.label(),
+                        recipe: (f.model.method == crate::model::Method::Lstm)
+                            .then(|| cand.fit_config(&cfg.fit).recipe.kind.as_str()),
+                        label: col.label,
                         bias_model: f.model.bias.as_ref().map(|b| b.kind()),
                         scale_model: f.model.scale.as_ref().map(|b| b.kind()),
                         bias_epochs: b.map(|t| t.epochs),

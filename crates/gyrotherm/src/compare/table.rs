@@ -10,11 +10,12 @@ impl Comparison {
     pub fn model_lines(&self) -> Vec<String> {
         self.fits
             .iter()
-            .map(|f| {
+            .zip(&self.columns)
+            .map(|(f, col)| {
                 let part = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
                 let mut line = format!(
                     "{:>16}: bias model {}, scale-factor model {}",
-                    f.model.label(),
+                    col.label,
                     part(&f.model.bias),
                     part(&f.model.scale)
                 );
@@ -31,19 +32,18 @@ impl Comparison {
 
     /// The results table, built once for every rendering.
     pub fn table(&self, cfg: &CompareConfig) -> ComparisonTable {
-        let methods: Vec<Method> = self.fits.iter().map(|f| f.model.method).collect();
         let mut columns = vec!["raw".to_owned()];
-        columns.extend(self.fits.iter().map(|f| f.model.label().to_owned()));
+        columns.extend(self.columns.iter().map(|c| c.label.to_owned()));
         let empty = Performance::default();
         let blocks = self
             .tests
             .iter()
             .map(|t| {
                 let all: Vec<&Performance> = std::iter::once(&t.raw)
-                    .chain(methods.iter().map(|m| {
+                    .chain(self.columns.iter().map(|c| {
                         t.methods
                             .iter()
-                            .find(|r| r.method == *m)
+                            .find(|r| r.key == c.key)
                             .map_or(&empty, |r| &r.performance)
                     }))
                     .collect();
@@ -111,7 +111,7 @@ fn cell(v: Option<f64>, digits: usize) -> String {
 /// (raw, then each method), cells already formatted.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ComparisonTable {
-    /// Output columns: `raw`, then the method names.
+    /// Output columns: `raw`, then each column's name ([`Column::label`](super::Column)).
     pub columns: Vec<String>,
     pub blocks: Vec<TableBlock>,
 }

@@ -147,6 +147,28 @@ fn fit_one(
 ) -> Result<(SubModel, Option<TrainSummary>), FitError> {
     if let Some(id) = identified {
         let (sub, report) = thermal::fit_target(sets, &cfg.thermal, id, target == Target::Scale)?;
+        let want_lstm = cfg.thermal.residual_lstm
+            && cfg.recipe.epochs > 0
+            && (target == Target::Bias || cfg.recipe.scale_lstm);
+        if let (
+            true,
+            SubModel::Baseline {
+                terms,
+                coefficients,
+            },
+        ) = (want_lstm, &sub)
+        {
+            let base = thermal_base(sets, terms, coefficients);
+            let seed = cfg.seed.wrapping_add(match target {
+                Target::Bias => 0,
+                Target::Scale => 1,
+            });
+            let n_in = sets[0].table.n_features;
+            let (sub, mut summary) =
+                residual::fit_lstm_on_base(sets, base, &cfg.recipe, n_in, seed, progress)?;
+            summary.thermal = Some(report);
+            return Ok((sub, Some(summary)));
+        }
         let summary = TrainSummary {
             thermal: Some(report),
             ..TrainSummary::default()
@@ -166,6 +188,37 @@ fn fit_one(
             let (sub, summary) = fit_target(sets, &cfg.recipe, target, seed, progress)?;
             Ok((sub, Some(summary)))
         }
+    }
+}
+
+/// The thermal recipe's fitted model as a base for a residual LSTM: each run's offset is its
+/// mean residual against the model (the model's constant is their labelled-step mean).
+fn thermal_base(
+    sets: &[TargetSet],
+    terms: &Terms,
+    coefficients: &[f64],
+) -> baseline::FixedEffectsFit {
+    let mut run_offset = Vec::with_capacity(sets.len());
+    let (mut ss, mut n) = (0.0, 0usize);
+    for s in sets {
+        let resid: Vec<f64> = (0..s.table.n_rows())
+            .filter(|r| s.mask[*r] && s.target[*r].is_finite())
+            .map(|r| s.target[r] - baseline::evaluate(terms, coefficients, s.table.row(r)))
+            .collect();
+        let off = if resid.is_empty() {
+            0.0
+        } else {
+            resid.iter().sum::<f64>() / resid.len() as f64
+        };
+        ss += resid.iter().map(|e| (e - off) * (e - off)).sum::<f64>();
+        n += resid.len();
+        run_offset.push(off);
+    }
+    baseline::FixedEffectsFit {
+        terms: terms.clone(),
+        coefficients: coefficients.to_vec(),
+        run_offset,
+        rms: (ss / n.max(1) as f64).sqrt(),
     }
 }
 

@@ -62,7 +62,7 @@ impl std::fmt::Display for UnknownRecipe {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "unknown LSTM recipe {:?}: use `residual` (default), `thermal`, `generic`, `direct` or \
+            "unknown LSTM recipe {:?}: use `thermal` (default), `residual`, `generic`, `direct` or \
              `published`",
             self.name
         )

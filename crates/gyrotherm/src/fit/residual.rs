@@ -159,7 +159,11 @@ fn leave_one_run_out(
             .filter(|(j, _)| *j != k)
             .map(|(_, s)| s.clone())
             .collect();
-        let base_k = fit_fixed_effects(&others, terms)?;
+        // A base that cannot be refitted without run `k` cannot vouch for the LSTM there.
+        let Ok(base_k) = fit_fixed_effects(&others, terms) else {
+            out.push(0.0);
+            continue;
+        };
         let tr_blocks: Vec<Block> = others
             .iter()
             .enumerate()
@@ -255,6 +259,23 @@ pub(crate) fn fit(
         };
         return Ok((base_sub_model(&base), summary));
     }
+    let (sub, mut summary) = fit_lstm_on_base(train, base, recipe, n_in, seed, progress)?;
+    summary.selection = selection;
+    Ok((sub, summary))
+}
+
+/// Steps 2 and 3 of the recipe on a fitted least-squares `base` (its run offsets included):
+/// an LSTM trained on the base's residual, kept only where the validation blocks (and, with
+/// [`LstmRecipe::validate_on_runs`] and two or more runs, each left-out run) say it helps.
+/// Shared by the residual recipes and the thermal recipe's optional residual LSTM.
+pub(crate) fn fit_lstm_on_base(
+    train: &[TargetSet],
+    base: FixedEffectsFit,
+    recipe: &LstmRecipe,
+    n_in: usize,
+    seed: u64,
+    progress: &mut dyn FnMut(usize, f64),
+) -> Result<(SubModel, TrainSummary), FitError> {
     // 2. Residual per run, cut into blocks; every `validation_every`-th block validates.
     let n_lstm = n_in + usize::from(recipe.base_input);
     let mut train_blocks = Vec::new();
@@ -338,7 +359,7 @@ pub(crate) fn fit(
         baseline_rms: Some(base.rms),
         lstm_gain: Some(gain),
         val_improvement,
-        selection,
+        selection: None,
         run_gate,
         lstm_verdict: Some(verdict),
         thermal: None,

@@ -72,6 +72,11 @@ pub struct ThermalConfig {
     /// The strongest ridge whose cross-validated score is within this relative margin of the
     /// best is taken (prefer the smoother fit when the data cannot tell them apart).
     pub ridge_tolerance: f64,
+    /// Train an LSTM on the fitted model's residual (the residual recipe's knobs and gates:
+    /// validation blocks, and each left-out run with `validate_on_runs`), reading the
+    /// identified thermal states and, with [`LstmRecipe::base_input`](super::LstmRecipe),
+    /// the model's prediction. Off by default (`docs/experiments/lstm-on-thermal-base.md`).
+    pub residual_lstm: bool,
 }
 
 impl Default for ThermalConfig {
@@ -90,6 +95,7 @@ impl Default for ThermalConfig {
             min_lag_ratio: 3.0,
             joint: true,
             ridge_tolerance: 0.0,
+            residual_lstm: false,
         }
     }
 }

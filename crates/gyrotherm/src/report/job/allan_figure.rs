@@ -1,6 +1,6 @@
 //! Figure 8 and the Allan curve and noise-term lines that `gyrotherm allan --plot` reuses.
 
-use super::{compensated_result, method_label, sig, Builder};
+use super::{compensated_result, sig, Builder};
 use crate::allan::{self, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
 use crate::compare::TestResult;
 use crate::fit::NamedLog;
@@ -37,7 +37,7 @@ pub(super) fn allan_report_figure(
     if let Some(m) = compensated_result(r) {
         match oadev(&m.compensated.gyro_comp_dps) {
             Ok(p) => {
-                let label = method_label(m.method);
+                let label = m.label;
                 curves.push(allan_curve(&format!("{label} compensated"), &p, DPS_TO_DPH));
                 lines = noise_lines(&allan::noise_terms(&p, DPS_TO_DPH), label);
                 terms_from = label;

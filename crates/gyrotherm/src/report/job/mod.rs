@@ -33,7 +33,6 @@ use super::ReportError;
 use crate::compare::{CompareConfig, Comparison, MethodResult, TestResult};
 use crate::fit::NamedLog;
 use crate::metrics::DPS_TO_DPH;
-use crate::model::Method;
 use crate::moving_average::{centred_moving_average, windowed_mean};
 use crate::sim::CHAMBER_TEMP_COL;
 
@@ -196,15 +195,22 @@ fn fig_raw_output(
     Ok(())
 }
 
-/// Figure 3: the LSTM training loss.
+/// Figure 3: the LSTM training loss of the first column that trained one.
 fn fig_training_loss(b: &mut Builder, cmp: &Comparison) -> Result<(), ReportError> {
-    let lstm_fit = cmp.fits.iter().find(|f| f.model.method == Method::Lstm);
+    let trained = |t: &Option<crate::fit::TrainSummary>| {
+        t.as_ref().is_some_and(|t| !t.loss_history.is_empty())
+    };
+    let lstm_fit = cmp
+        .fits
+        .iter()
+        .zip(&cmp.columns)
+        .find(|(f, _)| trained(&f.bias_training) || trained(&f.scale_training));
     match lstm_fit {
         None => b.note(
             3,
-            "no LSTM model was fitted, so there is no training loss to show",
+            "no model in this comparison trained an LSTM, so there is no training loss to show",
         ),
-        Some(fit) => {
+        Some((fit, col)) => {
             let mut curves = Vec::new();
             if let Some(t) = fit
                 .bias_training
@@ -234,7 +240,9 @@ fn fig_training_loss(b: &mut Builder, cmp: &Comparison) -> Result<(), ReportErro
                 b.add(
                     &files,
                     format!(
-                        "LSTM training loss (normalised mean squared error) against epoch: {}.",
+                        "LSTM training loss of the {} model (normalised mean squared error) \
+                         against epoch: {}.",
+                        col.label,
                         which.join(" and ")
                     ),
                 );
@@ -323,7 +331,7 @@ fn fig_before_after(
             .methods
             .iter()
             .map(|m| {
-                let label = method_label(m.method);
+                let label = m.label;
                 let (v, mean) = minus_mean(&to_dph(&m.compensated.gyro_comp_dps));
                 means.push(format!("{label} {}", sig(mean)));
                 (label.to_owned(), v)
@@ -423,21 +431,14 @@ fn minus_mean(v: &[f64]) -> (Vec<f64>, f64) {
     (v.iter().map(|x| x - mean).collect(), mean)
 }
 
+/// The result of the `lstm` column (the default recipe).
 pub(super) fn lstm_result(r: &TestResult) -> Option<&MethodResult> {
-    r.methods.iter().find(|m| m.method == Method::Lstm)
+    r.methods.iter().find(|m| m.key == "lstm")
 }
 
-/// The LSTM result, else the last method's (the most capable fitted).
+/// The `lstm` column's result, else the last column's.
 pub(super) fn compensated_result(r: &TestResult) -> Option<&MethodResult> {
     lstm_result(r).or(r.methods.last())
-}
-
-pub(super) fn method_label(m: Method) -> &'static str {
-    match m {
-        Method::Lstm => "LSTM",
-        Method::Linear => "linear",
-        Method::Poly => "polynomial",
-    }
 }
 
 /// Gyro temperature rate, °C/min: the `TEMP_RATE_SMOOTHING_S` centred moving average

@@ -1,6 +1,6 @@
 //! Figures 5 and 6: the scale factor per rate segment and the output at the table rates.
 
-use super::{fmt_num, method_label, Builder};
+use super::{fmt_num, Builder};
 use crate::compare::{CompareConfig, MethodResult};
 use crate::csvlog::TestLog;
 use crate::fit::NamedLog;
@@ -78,7 +78,7 @@ pub(super) fn rate_table_figures(
         b.note(6, "the rate-table log has no table_dps column");
         return Ok(());
     };
-    let label = method_label(m.method);
+    let label = m.label;
     match scale_factor_points(log, &m.compensated.scale, cfg.settle_s) {
         Err(e) => b.note(5, &format!("{}: {e}", l.name)),
         Ok(ScalePoints {

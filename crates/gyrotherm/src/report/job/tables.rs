@@ -1,7 +1,7 @@
 //! The report's tables: the comparison table and the model metadata.
 
-use super::{fmt_num, method_label};
-use crate::compare::{CompareConfig, Comparison};
+use super::fmt_num;
+use crate::compare::{Candidate, Column, CompareConfig, Comparison};
 use crate::features::feature_names;
 use crate::fit::NamedLog;
 use crate::model::{Method, ModelFile};
@@ -54,15 +54,15 @@ pub fn metadata(
             format!("{} s", fmt_num(cfg.settle_s)),
         ),
     ];
-    for f in &cmp.fits {
-        model_metadata(&mut md, &f.model, cfg);
+    for ((f, col), cand) in cmp.fits.iter().zip(&cmp.columns).zip(&cfg.candidates) {
+        model_metadata(&mut md, &f.model, col, cand, cfg);
         for (name, t) in [
             ("bias network", &f.bias_training),
             ("scale-factor network", &f.scale_training),
         ] {
             if let Some(t) = t {
                 md.push((
-                    format!("{} {name}", f.model.method.as_str()),
+                    format!("{} {name}", col.key),
                     format!("{} epochs, final loss {:.4e}", t.epochs, t.final_loss),
                 ));
             }
@@ -71,8 +71,14 @@ pub fn metadata(
     md
 }
 
-fn model_metadata(md: &mut Vec<(String, String)>, m: &ModelFile, cfg: &CompareConfig) {
-    let p = m.method.as_str();
+fn model_metadata(
+    md: &mut Vec<(String, String)>,
+    m: &ModelFile,
+    col: &Column,
+    cand: &Candidate,
+    cfg: &CompareConfig,
+) {
+    let p = col.key;
     let ti = &m.training;
     let targets = match (m.bias.is_some(), m.scale.is_some()) {
         (true, true) => "bias and scale factor",
@@ -82,15 +88,13 @@ fn model_metadata(md: &mut Vec<(String, String)>, m: &ModelFile, cfg: &CompareCo
     };
     md.push((
         format!("{p} model"),
-        format!("{} — {targets}", method_label(m.method)),
+        format!("{} ({} method) — {targets}", col.label, m.method.as_str()),
     ));
     if m.method == Method::Lstm {
+        let recipe = cand.fit_config(&cfg.fit).recipe;
         md.push((
             format!("{p} recipe"),
-            format!(
-                "{:?}, {} epochs",
-                cfg.fit.recipe.kind, cfg.fit.recipe.epochs
-            ),
+            format!("{}, at most {} epochs", recipe.kind.as_str(), recipe.epochs),
         ));
     }
     if let Ok(spec) = m.feature_spec() {
