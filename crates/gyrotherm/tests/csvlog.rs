@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use gyrotherm::csvlog::{
-    read_log, write_log, ExtraColumn, GyroUnit, LogError, LogErrorKind, LogReader, LogWriter,
-    ReadOptions, ReadReport, TestLog,
+    read_log, write_log, write_log_with, ExtraColumn, GyroUnit, LogError, LogErrorKind, LogReader,
+    LogWriter, ReadOptions, ReadReport, TestLog, WriteOptions,
 };
 use proptest::prelude::*;
 
@@ -115,6 +115,31 @@ fn write_log_refuses_bad_logs() {
     let e = write_log(&path, &log).unwrap_err();
     assert_eq!(e.kind, LogErrorKind::BadLog, "{e}");
     assert!(!path.exists(), "nothing may be written for a bad log");
+}
+
+#[test]
+fn a_nan_temperature_is_written_only_when_allowed_and_only_there() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("faulty.csv");
+    let mut log = TestLog {
+        time_s: vec![0.0, 1.0],
+        gyro_dps: vec![0.0, 0.1],
+        temp_c: vec![20.0, f64::NAN],
+        ..TestLog::default()
+    };
+    let e = write_log(&path, &log).unwrap_err();
+    assert!(e.message.contains("row 2"), "{e}");
+    let allow = WriteOptions {
+        allow_nan_temperature: true,
+    };
+    write_log_with(&path, &log, allow).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(text.lines().nth(2), Some("1,0.1,NaN"), "{text}");
+    log.gyro_dps[1] = f64::NAN;
+    std::fs::remove_file(&path).unwrap();
+    let e = write_log_with(&path, &log, allow).unwrap_err();
+    assert!(e.column.as_deref() == Some("gyro_dps"), "{e}");
+    assert!(!path.exists());
 }
 
 #[test]

@@ -352,7 +352,20 @@ pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport)
 /// increasing without gaps). Refuses columns of unequal length, non-finite values and
 /// extra columns named like a standard one.
 pub fn write_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
-    check_log(path, log)?;
+    write_log_with(path, log, WriteOptions::default())
+}
+
+/// What [`write_log_with`] lets through that [`write_log`] refuses.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// Write a non-finite temperature as `NaN` (a simulated temperature-sensor fault; the
+    /// flight compensator rides through it, the strict reader refuses it).
+    pub allow_nan_temperature: bool,
+}
+
+/// [`write_log`] with [`WriteOptions`].
+pub fn write_log_with(path: &Path, log: &TestLog, opts: WriteOptions) -> Result<(), LogError> {
+    check_log(path, log, opts)?;
     crate::atomic_file::write_atomically(path, |w| -> std::io::Result<()> {
         let mut header = vec![TIME_COL, GYRO_COL, TEMP_COL];
         if log.table_dps.is_some() {
@@ -384,7 +397,7 @@ pub fn write_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
     })
 }
 
-fn check_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
+fn check_log(path: &Path, log: &TestLog, opts: WriteOptions) -> Result<(), LogError> {
     let bad = |column: Option<&str>, message: String| {
         LogError::new(LogErrorKind::BadLog, path, None, column, message)
     };
@@ -404,7 +417,8 @@ fn check_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
                 format!("{} values but {n} timestamps; not written", v.len()),
             ));
         }
-        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        let may_be_nan = name == TEMP_COL && opts.allow_nan_temperature;
+        if let Some(i) = v.iter().position(|x| !x.is_finite() && !may_be_nan) {
             return Err(bad(
                 Some(name),
                 format!(

@@ -19,7 +19,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::csvlog::{LogError, LogErrorKind};
+use crate::csvlog::LogError;
 
 use super::noise::Gauss;
 use super::SimSeries;
@@ -195,68 +195,12 @@ fn sensor_faults(temp_c: &mut [f64], f: &FaultParams, dt_s: f64, seed: u64) {
     }
 }
 
-/// Write a simulated log as CSV like [`crate::csvlog::write_log`] (same bytes when every
-/// value is finite), but with non-finite temperatures allowed and written as `NaN`: the
-/// temperature-sensor faults above. The other columns must be finite.
+/// Write a simulated log as CSV like [`crate::csvlog::write_log`], but with non-finite
+/// temperatures allowed and written as `NaN`: the temperature-sensor faults above. The other
+/// columns must be finite.
 pub fn write_log(path: &std::path::Path, log: &crate::csvlog::TestLog) -> Result<(), LogError> {
-    use crate::csvlog::{LogWriter, DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
-    if log.temp_c.iter().all(|v| v.is_finite()) {
-        return crate::csvlog::write_log(path, log);
-    }
-    let n = log.len();
-    let mut numeric = vec![(TIME_COL, &log.time_s), (GYRO_COL, &log.gyro_dps)];
-    if let Some(t) = &log.table_dps {
-        numeric.push((DEFAULT_TABLE_COL, t));
-    }
-    let bad = |col: &str, message: String| {
-        LogError::new(LogErrorKind::BadLog, path, None, Some(col), message)
+    let opts = crate::csvlog::WriteOptions {
+        allow_nan_temperature: true,
     };
-    for (name, v) in numeric {
-        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-            return Err(bad(
-                name,
-                format!("row {} holds {}; not written", i + 1, v[i]),
-            ));
-        }
-    }
-    let lengths = [log.gyro_dps.len(), log.temp_c.len()]
-        .into_iter()
-        .chain(log.table_dps.as_ref().map(Vec::len))
-        .chain(log.extra.iter().map(|c| c.values.len()));
-    if let Some(m) = lengths.into_iter().find(|&m| m != n) {
-        return Err(bad(
-            TIME_COL,
-            format!("{m} values in a column but {n} timestamps; not written"),
-        ));
-    }
-    crate::atomic_file::write_atomically(path, |w| -> std::io::Result<()> {
-        let mut header = vec![TIME_COL, GYRO_COL, TEMP_COL];
-        if log.table_dps.is_some() {
-            header.push(DEFAULT_TABLE_COL);
-        }
-        header.extend(log.extra.iter().map(|c| c.name.as_str()));
-        let mut out = LogWriter::new(w, header)?;
-        for i in 0..log.len() {
-            out.push_f64(log.time_s[i]);
-            out.push_f64(log.gyro_dps[i]);
-            out.push_f64(log.temp_c[i]);
-            if let Some(t) = &log.table_dps {
-                out.push_f64(t[i]);
-            }
-            for c in &log.extra {
-                out.push_raw(c.values[i].as_bytes());
-            }
-            out.end_row()?;
-        }
-        out.flush()
-    })
-    .map_err(|e| {
-        LogError::new(
-            LogErrorKind::Io,
-            path,
-            None,
-            None,
-            format!("cannot write: {e}"),
-        )
-    })
+    crate::csvlog::write_log_with(path, log, opts)
 }
