@@ -22,7 +22,6 @@ use std::path::{Path, PathBuf};
 use csv::ByteRecord;
 
 use std::cell::OnceCell;
-use std::time::Instant;
 
 use super::chunk::{self, parse_lines, Layout, Row, MAX_BLOCK_BYTES, PARALLEL_MIN_BYTES};
 use super::columns::{check_options, map_columns, Columns};
@@ -111,9 +110,6 @@ struct Fast<R> {
     /// The current row's record, built on demand.
     record: OnceCell<ByteRecord>,
     threads: bool,
-    /// Share of a block this thread parses, and when its last parse ended.
-    share: f64,
-    cycle: Option<Instant>,
 }
 
 /// Block size of the fast path.
@@ -222,8 +218,6 @@ impl<R: Read> LogReader<R> {
                     switch_at: None,
                     record: OnceCell::new(),
                     threads: std::thread::available_parallelism().is_ok_and(|n| n.get() > 1),
-                    share: 0.3,
-                    cycle: None,
                 };
                 (Mode::Fast(Box::new(fast)), header, header_line, 0)
             }
@@ -1040,42 +1034,27 @@ impl<R: Read> Fast<R> {
     /// Parse the complete lines `buf[..end]` (`end` just after a newline), in two parts
     /// on two threads when the block is long; `prev_time` is the time of the row before.
     fn parse(&mut self, end: usize, prev_time: Option<f64>, lay: &Layout) {
-        self.parse_split(end, prev_time, lay);
-        self.cycle = Some(Instant::now());
-    }
-
-    fn parse_split(&mut self, end: usize, prev_time: Option<f64>, lay: &Layout) {
         let buf = &self.buf[..end];
         let split = if self.threads && end >= PARALLEL_MIN_BYTES {
-            // This thread also reads the input and hands the rows out: it parses the
-            // share that balances the two (see below).
-            let mid = (end as f64 * self.share) as usize;
+            // Halves: the other thread runs only while this one parses its half (reading
+            // and handing rows out happen between blocks, on this thread alone), so equal
+            // halves finish together. (Shifting work to the other thread to cover this
+            // thread's reading measured slower: that work does not overlap.)
+            let mid = end / 2;
             memchr::memchr(b'\n', &buf[mid..end]).map_or(end, |k| mid + k + 1)
         } else {
             end
         };
         let [rows_a, rows_b] = &mut self.parts;
         let (a, b) = if split < end {
-            let serial = self.cycle.map(|t| t.elapsed());
-            let t0 = Instant::now();
-            let (a, b, busy_b) = std::thread::scope(|s| {
-                let hb = s.spawn(|| {
-                    let t = Instant::now();
-                    let b = parse_lines(buf, split, end, 0, None, lay, rows_b);
-                    (b, t.elapsed())
-                });
+            let (a, b) = std::thread::scope(|s| {
+                let hb = s.spawn(|| parse_lines(buf, split, end, 0, None, lay, rows_b));
                 let a = parse_lines(buf, 0, split, self.line, prev_time, lay, rows_a);
-                let (b, busy_b) = hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
-                (a, b, busy_b)
+                (
+                    a,
+                    hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p)),
+                )
             });
-            // Balance: this thread's cycle (handing out the last block's rows, reading,
-            // parsing its share) against the other thread's share. Only the split point
-            // moves; the rows are the same wherever it falls.
-            if let Some(serial) = serial {
-                let busy_a = serial + t0.elapsed();
-                let step = if busy_b < busy_a { -0.02 } else { 0.02 };
-                self.share = (self.share + step).clamp(0.02, 0.5);
-            }
             (a, Some(b))
         } else {
             (
