@@ -155,11 +155,21 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
     let mut w = std::io::stdout().lock();
     let (_log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
     let noise_model = args.alpha.map_or(NoiseModel::Identify, NoiseModel::Alpha);
-    let points = allan::deviation(&values, tau0_s, kind, &args.taus, noise_model)
-        .with_context(|| format!("{} of column {}", kind.name(), args.column))?;
+    let n_samples = values.len();
+    let to_dph = rate_column_to_dph(&args.column);
+    // The samples are handed over (the phase is built in their buffer) unless an OADEV curve
+    // for the noise terms still needs them.
+    let needs_oadev = to_dph.is_some() && !matches!(kind, DevKind::Adev | DevKind::Oadev);
+    let (points, values) = if needs_oadev {
+        let p = allan::deviation(&values, tau0_s, kind, &args.taus, noise_model);
+        (p, values)
+    } else {
+        let p = allan::deviation_owned(values, tau0_s, kind, &args.taus, noise_model);
+        (p, Vec::new())
+    };
+    let points = points.with_context(|| format!("{} of column {}", kind.name(), args.column))?;
     // Noise terms are defined on the Allan deviation: from this curve for adev/oadev, else
     // from an OADEV curve at the same τ.
-    let to_dph = rate_column_to_dph(&args.column);
     let (noise, noise_from) = match to_dph {
         None => (None, None),
         Some(f) => {
@@ -185,7 +195,7 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
         let out = AllanJson {
             kind: kind.name(),
             column: &args.column,
-            samples: values.len(),
+            samples: n_samples,
             tau0_s,
             confidence: allan::ONE_SIGMA_CI,
             points: &points,
@@ -200,7 +210,7 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
         "{} of {} ({} samples, τ0 = {} s; 68.3 % bounds from Greenhall EDF)",
         kind.name().to_uppercase(),
         args.column,
-        values.len(),
+        n_samples,
         tau0_s
     )?;
     writeln!(
