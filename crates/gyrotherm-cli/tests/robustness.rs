@@ -119,6 +119,19 @@ fn numeric_options_are_checked_in_their_own_terms() {
 }
 
 /// A linear model (as `train --method linear` writes one) over -30..70 °C.
+/// `gyrotherm compensate --model M --input L --out O`.
+fn compensate(model: &Path, log: &Path, out: &Path) -> (i32, String, String) {
+    gyrotherm(&[
+        "compensate",
+        "--model",
+        p(model),
+        "--input",
+        p(log),
+        "--out",
+        p(out),
+    ])
+}
+
 fn linear_model(bias: [f64; 3], scale: [f64; 3]) -> serde_json::Value {
     serde_json::json!({
         "format_version": 1, "method": "linear",
@@ -148,15 +161,7 @@ fn a_model_whose_scale_factor_crosses_zero_is_blamed_not_the_log() {
     )
     .unwrap();
     let out = dir.path().join("out.csv");
-    let (code, _, err) = gyrotherm(&[
-        "compensate",
-        "--model",
-        p(&model),
-        "--input",
-        p(&log),
-        "--out",
-        p(&out),
-    ]);
+    let (code, _, err) = compensate(&model, &log, &out);
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("bad.json") && err.contains("scale: predicts K = "),
@@ -342,15 +347,7 @@ fn an_error_says_each_cause_once() {
     let model = dir.path().join("junk.json");
     std::fs::write(&model, "{not json").unwrap();
     let out = dir.path().join("out.csv");
-    let (code, _, err) = gyrotherm(&[
-        "compensate",
-        "--model",
-        p(&model),
-        "--input",
-        p(&log),
-        "--out",
-        p(&out),
-    ]);
+    let (code, _, err) = compensate(&model, &log, &out);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("junk.json: not valid JSON"), "{err}");
     assert_eq!(err.matches("line 1 column 2").count(), 1, "{err}");
