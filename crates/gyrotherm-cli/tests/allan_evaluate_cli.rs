@@ -1,21 +1,11 @@
 //! `gyrotherm allan` and `gyrotherm evaluate` run as a user would, on small temporary logs.
 
 use std::path::Path;
-use std::process::Command;
 
 use serde_json::Value;
 
-fn gyrotherm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
-        .args(args)
-        .output()
-        .expect("run gyrotherm");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod cli;
+use cli::outcome as gyrotherm;
 
 /// NBS 1000-point set (NIST SP 1065 p. 107) as gyro_dps at 1 Hz.
 fn write_nbs_log(path: &Path) {

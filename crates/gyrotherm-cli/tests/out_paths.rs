@@ -10,9 +10,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn gyrotherm() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
-}
+mod cli;
+use cli::gyrotherm;
 
 /// A 30 s constant-temperature profile: a simulate run of 30 rows.
 fn profile(dir: &Path) -> PathBuf {

@@ -3,22 +3,12 @@
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use gyrotherm::csvlog::write_log;
 use gyrotherm::sim::{simulate, Profile, Segment, SimConfig};
 
-fn gyrotherm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
-        .args(args)
-        .output()
-        .expect("run gyrotherm");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod cli;
+use cli::outcome as gyrotherm;
 
 /// A 3900 s temperature cycle (22 → -10 → +50 → 22 °C, about 3 °C/min), 1 Hz.
 fn write_sim(dir: &Path, name: &str, seed: u64, table: bool) -> PathBuf {

@@ -3,19 +3,10 @@
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
-fn gyrotherm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
-        .args(args)
-        .output()
-        .expect("run gyrotherm");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod cli;
+use cli::outcome as gyrotherm;
 
 fn p(path: &Path) -> &str {
     path.to_str().unwrap()
@@ -243,7 +234,7 @@ fn a_closed_output_pipe_ends_quietly_with_0() {
     for i in 0..200_000 {
         input.push_str(&format!("{i},0.001,25\n"));
     }
-    let mut child = Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
+    let mut child = cli::gyrotherm()
         .args([
             "compensate",
             "--stream",

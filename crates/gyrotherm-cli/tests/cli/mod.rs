@@ -9,6 +9,16 @@ pub fn gyrotherm() -> Command {
     Command::new(env!("CARGO_BIN_EXE_gyrotherm"))
 }
 
+/// `gyrotherm ARGS`: exit status (-1 when killed by a signal), stdout and stderr.
+pub fn outcome(args: &[&str]) -> (i32, String, String) {
+    let out = gyrotherm().args(args).output().expect("run gyrotherm");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// Runs `cmd`, failing the test with its stdout and stderr unless it exits 0.
 pub fn run_ok(cmd: &mut Command) -> Output {
     let out = cmd.output().expect("run gyrotherm");
