@@ -138,23 +138,30 @@ pub(crate) fn cross_validate(
             if f {
                 return f64::INFINITY;
             }
-            let (mut ss, mut n) = (0.0, 0usize);
-            for r in runs {
-                let v: Vec<f64> = r.iter().copied().filter(|x| x.is_finite()).collect();
-                if v.is_empty() {
-                    continue;
-                }
-                let m = v.iter().sum::<f64>() / v.len() as f64;
-                ss += v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
-                n += v.len();
-            }
-            if n == 0 {
-                f64::INFINITY
-            } else {
-                (ss / n as f64).sqrt()
-            }
+            pooled_within_run_rms(runs)
         })
         .collect()
+}
+
+/// Score of held-out residuals, one vector a run: their RMS about each run's own mean (a
+/// run's constant offset is not scored), pooled over the runs. Non-finite entries (steps not
+/// held out) are skipped; ∞ when nothing was held out.
+pub(crate) fn pooled_within_run_rms(runs: &[Vec<f64>]) -> f64 {
+    let (mut ss, mut n) = (0.0, 0usize);
+    for r in runs {
+        let v: Vec<f64> = r.iter().copied().filter(|x| x.is_finite()).collect();
+        if v.is_empty() {
+            continue;
+        }
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        ss += v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
+        n += v.len();
+    }
+    if n == 0 {
+        f64::INFINITY
+    } else {
+        (ss / n as f64).sqrt()
+    }
 }
 
 /// Choose among `cands` by blocked cross-validation: the candidate with the fewest terms whose

@@ -463,15 +463,7 @@ fn fold_range(n: usize, f: usize, folds: usize) -> (usize, usize) {
 /// Blocked cross-validated RMS residual (per-run means removed) for each ridge strength.
 fn cv_scores(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -> Vec<f64> {
     let nr = d.x.len();
-    let total: Vec<Stats> = (0..nr)
-        .map(|r| {
-            let mut s = Stats::new(nc);
-            for (k, y) in d.y[r].iter().enumerate() {
-                s.add(&d.x[r][k * nc..(k + 1) * nc], *y, 1.0);
-            }
-            s
-        })
-        .collect();
+    let total = run_stats(d, nc);
     // Out-of-fold residuals per λ, per run.
     let mut resid: Vec<Vec<Vec<f64>>> = lambdas
         .iter()
@@ -515,22 +507,11 @@ fn cv_scores(d: &Design, nc: usize, folds: usize, gap: usize, lambdas: &[f64]) -
     resid
         .iter()
         .map(|runs| {
-            let (mut ss, mut n) = (0.0, 0usize);
-            for v in runs {
-                if v.iter().any(|x| !x.is_finite()) {
-                    return f64::INFINITY;
-                }
-                if v.is_empty() {
-                    continue;
-                }
-                let m = v.iter().sum::<f64>() / v.len() as f64;
-                ss += v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
-                n += v.len();
-            }
-            if n == 0 {
+            // Every held-out step has a residual here: a non-finite one is a failed fit.
+            if runs.iter().flatten().any(|x| !x.is_finite()) {
                 f64::INFINITY
             } else {
-                (ss / n as f64).sqrt()
+                super::select::pooled_within_run_rms(runs)
             }
         })
         .collect()
@@ -889,8 +870,9 @@ pub fn identify(
     })
 }
 
-fn in_sample_rms(d: &Design, nc: usize, lambda: f64) -> f64 {
-    let stats: Vec<Stats> = (0..d.x.len())
+/// Sufficient statistics of each run's labelled steps (`nc` columns).
+fn run_stats(d: &Design, nc: usize) -> Vec<Stats> {
+    (0..d.x.len())
         .map(|r| {
             let mut s = Stats::new(nc);
             for (k, y) in d.y[r].iter().enumerate() {
@@ -898,7 +880,11 @@ fn in_sample_rms(d: &Design, nc: usize, lambda: f64) -> f64 {
             }
             s
         })
-        .collect();
+        .collect()
+}
+
+fn in_sample_rms(d: &Design, nc: usize, lambda: f64) -> f64 {
+    let stats = run_stats(d, nc);
     let (g, b, n) = centred_normal(&stats, nc);
     let Some(beta) = ridge_solve(&g, &b, nc, lambda) else {
         return f64::INFINITY;
@@ -999,15 +985,7 @@ pub fn fit_target(
             if s.is_finite() { l } else { cfg.fallback_ridge },
         )
     };
-    let stats: Vec<Stats> = (0..d.x.len())
-        .map(|r| {
-            let mut s = Stats::new(nc);
-            for (k, y) in d.y[r].iter().enumerate() {
-                s.add(&d.x[r][k * nc..(k + 1) * nc], *y, 1.0);
-            }
-            s
-        })
-        .collect();
+    let stats = run_stats(&d, nc);
     let (g, b, _) = centred_normal(&stats, nc);
     let beta = ridge_solve(&g, &b, nc, lambda).ok_or(ThermalError::Singular)?;
     // The constant: the labelled-step-weighted mean of the per-run offsets.
