@@ -509,7 +509,7 @@ fn check_window(window_s: f64, what: &str) -> Result<(), ReportError> {
 }
 
 /// `100` rather than `100.0`, `0.5` as is.
-fn fmt_num(v: f64) -> String {
+pub(crate) fn fmt_num(v: f64) -> String {
     if v.fract() == 0.0 && v.abs() < 1e15 {
         format!("{}", v as i64)
     } else {

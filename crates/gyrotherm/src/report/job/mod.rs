@@ -23,6 +23,7 @@ use rate_table::rate_table_figures;
 
 use std::path::{Path, PathBuf};
 
+pub(super) use super::figures::fmt_num;
 use super::figures::{
     bias_figure, compensation_figure, loss_figure, raw_output_figure, temperature_figure, BiasData,
     CompensationData, LossCurve, NamedSeries, RawOutputData, TemperatureData,
@@ -485,15 +486,6 @@ pub(super) fn sig(v: f64) -> String {
             (2 - v.abs().log10().floor() as i32).max(0) as usize
         };
         format!("{v:.digits$}")
-    }
-}
-
-/// `100` rather than `100.0`.
-pub(super) fn fmt_num(v: f64) -> String {
-    if v.fract() == 0.0 && v.abs() < 1e15 {
-        format!("{}", v as i64)
-    } else {
-        format!("{v}")
     }
 }
 
