@@ -303,12 +303,7 @@ fn main() {
 
 fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let get = |k: &str| {
-        args.iter()
-            .position(|a| a == k)
-            .and_then(|i| args.get(i + 1))
-            .cloned()
-    };
+    let get = |k: &str| gyrotherm_experiments::arg_value(&args, k);
     let family = get("--family").unwrap_or_else(|| "design".into());
     let base = match family.as_str() {
         "design" => DESIGN_BASE_SEED,

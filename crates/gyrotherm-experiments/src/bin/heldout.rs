@@ -103,12 +103,7 @@ fn figures(stat_out: &[f64], table_log: &TestLog, table_out: &[f64]) -> Figures 
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let get = |k: &str| {
-        args.iter()
-            .position(|a| a == k)
-            .and_then(|i| args.get(i + 1))
-            .cloned()
-    };
+    let get = |k: &str| gyrotherm_experiments::arg_value(&args, k);
     let train_profiles = get("--train").unwrap_or_else(|| "seed-shock".into());
     let test_profile = get("--test").unwrap_or_else(|| "slow-ramp".into());
     let train_seed: u64 = get("--train-seed").map_or(7, |v| v.parse().unwrap());
