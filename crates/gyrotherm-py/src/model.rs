@@ -1,12 +1,11 @@
 //! Fitting and model files: `fit` (the CLI's `train`), the model file (the CLI's JSON), and
 //! compensation with the flight compensator (the CLI's `compensate`).
 
-use std::io::{BufWriter, Write as _};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
 use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
-use gyrotherm::compensate_lines::{compensate_lines, LinesError, Mode};
+use gyrotherm::compensate_lines::compensate_file;
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, LstmVerdict, NamedLog, Target};
 use gyrotherm::model::{Method, ModelFile};
@@ -181,28 +180,8 @@ impl RawModel {
         options: LogOptions,
     ) -> PyResult<(u64, u64, u64, u64, u64, Vec<String>)> {
         let opts = options.read_options()?;
-        let summary = py.detach(|| -> Result<_, String> {
-            let file = std::fs::File::open(&input)
-                .map_err(|e| format!("cannot open {}: {e}", input.display()))?;
-            gyrotherm::atomic_file::write_atomically(&out, |w: &mut BufWriter<std::fs::File>| {
-                let s = compensate_lines(
-                    &self.file,
-                    std::io::BufReader::new(&file),
-                    &input,
-                    &opts,
-                    &mut *w,
-                    Mode::Strict,
-                    false,
-                )?;
-                w.flush()?;
-                Ok::<_, LinesError>(s)
-            })
-            .map_err(|e| match e {
-                LinesError::Io(io) => format!("cannot compensate into {}: {io}", out.display()),
-                other => other.to_string(),
-            })
-        });
-        let s = summary.map_err(CompensationError::new_err)?;
+        let summary = py.detach(|| compensate_file(&self.file, &input, &out, &opts));
+        let s = summary.map_err(|e| CompensationError::new_err(e.to_string()))?;
         Ok((s.rows, s.ok, s.held, s.degraded, s.invalid, s.warnings))
     }
 

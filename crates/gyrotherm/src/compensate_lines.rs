@@ -196,6 +196,81 @@ fn parse_number(raw: &[u8]) -> Option<f64> {
     std::str::from_utf8(raw.trim_ascii()).ok()?.parse().ok()
 }
 
+/// Compensate the log `input` into the CSV file `out` ([`Mode::Strict`]), written to a
+/// temporary file and renamed into place: what `gyrotherm compensate --input --out` does.
+pub fn compensate_file(
+    model: &ModelFile,
+    input: &Path,
+    out: &Path,
+    opts: &ReadOptions,
+) -> Result<LinesSummary, FileError> {
+    let file = std::fs::File::open(input).map_err(|source| FileError::Open {
+        path: input.to_path_buf(),
+        source,
+    })?;
+    crate::atomic_file::write_atomically(out, |w: &mut std::io::BufWriter<std::fs::File>| {
+        let s = compensate_lines(
+            model,
+            std::io::BufReader::new(&file),
+            input,
+            opts,
+            &mut *w,
+            Mode::Strict,
+            false,
+        )?;
+        w.flush()?;
+        Ok::<_, LinesError>(s)
+    })
+    .map_err(|e| match e {
+        LinesError::Io(source) => FileError::Write {
+            path: out.to_path_buf(),
+            source,
+        },
+        other => FileError::Lines(other),
+    })
+}
+
+/// Why [`compensate_file`] failed.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum FileError {
+    /// The input log could not be opened.
+    Open {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    /// Reading the input or writing the output failed; the output was not replaced.
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    /// The model or the log: see [`LinesError`].
+    Lines(LinesError),
+}
+
+impl std::fmt::Display for FileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FileError::Open { path, source } => {
+                write!(f, "cannot open {}: {source}", path.display())
+            }
+            FileError::Write { path, source } => {
+                write!(f, "cannot compensate into {}: {source}", path.display())
+            }
+            FileError::Lines(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for FileError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            FileError::Open { source, .. } | FileError::Write { source, .. } => Some(source),
+            FileError::Lines(e) => Some(e),
+        }
+    }
+}
+
 /// Compensate `input` (CSV with a header) into `output`; see the module doc. `source` names
 /// the input in errors. With `flush_each_row` every line is flushed as soon as it is written.
 pub fn compensate_lines<R: BufRead, W: Write>(

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use std::rc::Rc;
 
 use anyhow::Context as _;
-use gyrotherm::compensate_lines::{compensate_lines, Mode};
+use gyrotherm::compensate_lines::{compensate_file, compensate_lines, Mode};
 use gyrotherm::model::{ModelFile, TempSensorDef};
 use gyrotherm_core::TempLimits;
 
@@ -90,27 +90,7 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
         let (Some(input), Some(out)) = (&args.input, &args.out) else {
             anyhow::bail!("give --input FILE and --out FILE, or --stream");
         };
-        let file = std::fs::File::open(input)
-            .with_context(|| format!("cannot open {}", input.display()))?;
-        let summary =
-            gyrotherm::atomic_file::write_atomically(out, |w: &mut BufWriter<std::fs::File>| {
-                let s = compensate_lines(
-                    &model,
-                    std::io::BufReader::new(&file),
-                    input,
-                    &opts,
-                    &mut *w,
-                    Mode::Strict,
-                    false,
-                )?;
-                w.flush()?;
-                Ok::<_, gyrotherm::compensate_lines::LinesError>(s)
-            })
-            .map_err(|e| match e {
-                gyrotherm::compensate_lines::LinesError::Io(io) => anyhow::Error::new(io)
-                    .context(format!("cannot compensate into {}", out.display())),
-                other => anyhow::Error::new(other),
-            })?;
+        let summary = compensate_file(&model, input, out, &opts)?;
         eprintln!(
             "gyrotherm: wrote {} ({})",
             out.display(),
