@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Stdio;
 
 mod cli;
-use cli::{gyrotherm, run_ok};
+use cli::{gyrotherm, run_ok, simulate_args};
 
 fn simulate(dir: &Path, name: &str, profile: &str, seed: u64, table: bool) -> PathBuf {
     let path = dir.join(name);
@@ -417,20 +417,17 @@ fn bad_inputs_say_where_and_exit_2() {
 #[test]
 fn simulate_random_unit_writes_its_parameters() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("r.csv");
-    run_ok(
-        gyrotherm()
-            .args([
-                "simulate",
-                "--profile",
-                "room-steady",
-                "--unit",
-                "random",
-                "--unit-seed",
-                "12",
-                "--out",
-            ])
-            .arg(&out),
+    let out = simulate_args(
+        dir.path(),
+        "r.csv",
+        &[
+            "--profile",
+            "room-steady",
+            "--unit",
+            "random",
+            "--unit-seed",
+            "12",
+        ],
     );
     let text = std::fs::read_to_string(dir.path().join("r.csv.unit.json")).unwrap();
     let unit = gyrotherm::sim::FogUnit::from_json_str(&text, "sidecar").unwrap();
@@ -449,18 +446,15 @@ fn simulate_random_unit_writes_its_parameters() {
 #[test]
 fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("coarse.csv");
-    run_ok(
-        gyrotherm()
-            .args([
-                "simulate",
-                "--profile",
-                "room-steady",
-                "--rate-hz",
-                "0.06666666666666667",
-                "--out",
-            ])
-            .arg(&path),
+    let path = simulate_args(
+        dir.path(),
+        "coarse.csv",
+        &[
+            "--profile",
+            "room-steady",
+            "--rate-hz",
+            "0.06666666666666667",
+        ],
     );
     let out = run_ok(
         gyrotherm()
@@ -486,16 +480,9 @@ fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
 fn compare_and_report_take_the_nearest_multiple_of_a_coarse_period() {
     let dir = tempfile::tempdir().unwrap();
     let sim = |name: &str, profile: &str, seed: &str, extra: &[&str]| {
-        let path = dir.path().join(name);
-        run_ok(
-            gyrotherm()
-                .args(["simulate", "--profile", profile, "--seed", seed])
-                .args(["--rate-hz", "0.06666666666666667"])
-                .args(extra)
-                .arg("--out")
-                .arg(&path),
-        );
-        path
+        let args = ["--profile", profile, "--seed", seed];
+        let coarse = ["--rate-hz", "0.06666666666666667"];
+        simulate_args(dir.path(), name, &[&args[..], &coarse, extra].concat())
     };
     let train_s = sim("train_static.csv", "seed-shock", "1", &[]);
     let train_t = sim(
