@@ -11,6 +11,7 @@ use gyrotherm::allan::{
 use gyrotherm::metrics::tau_means_std;
 
 mod common;
+use common::nbs_data;
 
 /// The reference file, or None (test skipped) — but a failure when CI=true.
 fn reference(name: &str) -> Option<PathBuf> {
@@ -194,18 +195,6 @@ fn ocxo_oadev_tau1_checked_value() {
         "bounds bracket σ: {:?}",
         p[0]
     );
-}
-
-/// NBS 1000-point set: n0 = 1234567890, n_{i+1} = 16807·n_i mod 2147483647,
-/// y_i = n_i/2147483647 (NIST SP 1065 p. 107).
-fn nbs_data() -> Vec<f64> {
-    let mut n: u64 = 1_234_567_890;
-    let mut out = Vec::with_capacity(1000);
-    for _ in 0..1000 {
-        out.push(n as f64 / 2_147_483_647.0);
-        n = 16_807 * n % 2_147_483_647;
-    }
-    out
 }
 
 #[test]

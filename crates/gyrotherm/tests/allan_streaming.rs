@@ -3,16 +3,8 @@
 
 use gyrotherm::allan::{deviation, DevKind, NoiseModel, StreamingOadev, TauSet};
 
-fn nbs_data() -> Vec<f64> {
-    let mut n: u64 = 1_234_567_890;
-    (0..1000)
-        .map(|_| {
-            let v = n as f64 / 2_147_483_647.0;
-            n = 16_807 * n % 2_147_483_647;
-            v
-        })
-        .collect()
-}
+mod common;
+use common::nbs_data;
 
 /// Both are sums of the same terms; only rounding differs.
 const SAME_SUM_TOL: f64 = 1e-12;

@@ -1,7 +1,10 @@
-//! Finding the shared reference data (`../shared/reference/` beside the checkout).
+//! Finding the shared reference data (`../shared/reference/` beside the checkout), and the
+//! NBS 1000-point set the Allan tests share.
 //!
 //! CI has it; a user's fresh clone does not. A test that needs a file gets `None` and prints
 //! `skipped: …` when it is missing, except under `CI=true`, where a missing file fails.
+
+#![allow(dead_code)] // each test file uses its own subset
 
 use std::path::PathBuf;
 
@@ -40,4 +43,16 @@ pub fn reference_file(rel: &str) -> Option<PathBuf> {
             None
         }
     }
+}
+
+/// NBS 1000-point set: n0 = 1234567890, n_{i+1} = 16807·n_i mod 2147483647,
+/// y_i = n_i/2147483647 (NIST SP 1065 p. 107).
+pub fn nbs_data() -> Vec<f64> {
+    let mut n: u64 = 1_234_567_890;
+    let mut out = Vec::with_capacity(1000);
+    for _ in 0..1000 {
+        out.push(n as f64 / 2_147_483_647.0);
+        n = 16_807 * n % 2_147_483_647;
+    }
+    out
 }
