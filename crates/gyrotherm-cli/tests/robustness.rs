@@ -344,3 +344,214 @@ fn an_error_says_each_cause_once() {
     assert_eq!(err.matches("line 1 column 2").count(), 1, "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
 }
+
+/// OADEV/ADEV of rates near 1e300 used to print `inf` at every τ (their sums overflowed)
+/// and MDEV/HDEV an α of 11: every kind now gives finite deviations with α in the lag-1
+/// method's range −2..=2 (Riley & Greenhall 2004), or a refusal with exit status 2.
+#[test]
+fn allan_of_finite_rates_near_1e300_is_finite_or_refused_for_every_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = log_of(dir.path(), "e300.csv", |i| 1e300 * (1.0 + noise(i)));
+    for kind in ["adev", "oadev", "mdev", "hdev", "ohdev"] {
+        let (code, out, err) = gyrotherm(&["allan", "--input", p(&log), "--kind", kind, "--json"]);
+        match code {
+            0 => {
+                let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+                let pts = v["points"].as_array().unwrap();
+                assert!(!pts.is_empty(), "{kind}: {out}");
+                for pt in pts {
+                    assert!(
+                        pt["dev"].as_f64().is_some_and(f64::is_finite),
+                        "{kind}: {pt}"
+                    );
+                    let a = pt["alpha"].as_i64().unwrap();
+                    assert!((-2..=2).contains(&a), "{kind}: α {a}");
+                }
+            }
+            2 => assert!(err.contains("too large"), "{kind}: {err}"),
+            _ => panic!("{kind}: exit {code}: {err}"),
+        }
+        let (code, out, err) = gyrotherm(&["allan", "--input", p(&log), "--kind", kind]);
+        assert!(code == 0 || code == 2, "{kind}: {err}");
+        assert!(
+            !out.contains("inf") && !out.contains("NaN"),
+            "{kind}: {out}"
+        );
+    }
+}
+
+/// A model trained on a short simulated run (linear fit: fast) for the compensate tests.
+fn small_model(dir: &Path) -> (PathBuf, PathBuf) {
+    let run = cli::simulate_args(dir, "s.csv", &["--profile", "seed-shock", "--seed", "1"]);
+    let model = dir.join("m.json");
+    let (code, _, err) = gyrotherm(&[
+        "train",
+        "--method",
+        "linear",
+        "--input",
+        p(&run),
+        "--out",
+        p(&model),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    (run, model)
+}
+
+/// `compensate --delimiter ';'` and `--delimiter tab`, with decimal commas, in batch and in
+/// the stream, give the numbers of the same log written with commas and decimal points (the
+/// independent computation); the output keeps the input's separator.
+#[test]
+fn compensate_reads_semicolon_and_tab_logs_with_decimal_commas() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, model) = small_model(dir.path());
+    let text: String = std::fs::read_to_string(&run)
+        .unwrap()
+        .lines()
+        .take(400)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let comma = dir.path().join("comma.csv");
+    std::fs::write(&comma, &text).unwrap();
+    let out = dir.path().join("comma_out.csv");
+    let (code, _, err) = gyrotherm(&[
+        "compensate",
+        "--model",
+        p(&model),
+        "--input",
+        p(&comma),
+        "--out",
+        p(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let want = std::fs::read_to_string(&out).unwrap();
+    let numbers = |s: &str, sep: char| -> Vec<Vec<String>> {
+        s.lines()
+            .skip(1)
+            .map(|l| {
+                l.split(sep)
+                    .map(|f| f.replace(',', "."))
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    };
+    let want_rows = numbers(&want, ',');
+    assert_eq!(want_rows.len(), 399);
+    for (sep, name) in [(';', ";"), ('\t', "tab")] {
+        // Decimal commas in every number of the input.
+        let converted: String = text
+            .lines()
+            .map(|l| {
+                let fields: Vec<String> = l.split(',').map(|f| f.replace('.', ",")).collect();
+                format!("{}\n", fields.join(&sep.to_string()))
+            })
+            .collect();
+        let input = dir.path().join(format!("in_{}.csv", sep as u32));
+        std::fs::write(&input, &converted).unwrap();
+        let out = dir.path().join(format!("out_{}.csv", sep as u32));
+        let (code, _, err) = gyrotherm(&[
+            "compensate",
+            "--model",
+            p(&model),
+            "--input",
+            p(&input),
+            "--out",
+            p(&out),
+            "--delimiter",
+            name,
+        ]);
+        assert_eq!(code, 0, "{name}: {err}");
+        let got = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            got.lines().next().unwrap().contains(sep),
+            "{name}: header {got:.80}"
+        );
+        assert_eq!(numbers(&got, sep), want_rows, "{name}: batch");
+        let mut child = cli::gyrotherm()
+            .args([
+                "compensate",
+                "--model",
+                p(&model),
+                "--stream",
+                "--delimiter",
+                name,
+            ])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(converted.as_bytes())
+            .unwrap();
+        let o = child.wait_with_output().unwrap();
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let got = String::from_utf8(o.stdout).unwrap();
+        assert_eq!(numbers(&got, sep), want_rows, "{name}: stream");
+    }
+}
+
+/// Peak resident memory of a running process, kB (Linux: VmHWM in /proc/PID/status).
+fn peak_rss_kb(pid: u32) -> Option<u64> {
+    let s = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// A 100 MB line in the stream is one `invalid` output line, the lines around it are
+/// compensated, and the process never holds the line: peak RSS stays under 50 MB (it grew
+/// with the line before: 398 MB for a 400 MB line).
+#[test]
+fn a_100_mb_stream_line_is_one_invalid_line_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, model) = small_model(dir.path());
+    let mut child = cli::gyrotherm()
+        .args(["compensate", "--model", p(&model), "--stream"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let mut stdin = child.stdin.take().unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    stdin
+        .write_all(b"time_s,gyro_dps,temp_c\n0,0.001,20\n1,")
+        .unwrap();
+    let chunk = vec![b'9'; 1 << 20];
+    for _ in 0..100 {
+        stdin.write_all(&chunk).unwrap();
+    }
+    stdin.write_all(b",20\n2,0.001,20\n").unwrap();
+    stdin.flush().unwrap();
+    let mut lines = Vec::new();
+    for _ in 0..4 {
+        let mut l = String::new();
+        stdout.read_line(&mut l).unwrap();
+        lines.push(l);
+    }
+    // Still running (stdin open): its peak so far covers the long line.
+    let rss = peak_rss_kb(pid);
+    drop(stdin);
+    let status = child.wait().unwrap();
+    assert!(status.success());
+    assert!(lines[1].ends_with(",ok\n"), "{lines:?}");
+    assert_eq!(
+        lines[2],
+        ",,,,,,invalid\n".replacen(",", "\"\",", 1),
+        "{lines:?}"
+    );
+    assert!(lines[3].ends_with(",ok\n"), "{lines:?}");
+    if let Some(kb) = rss {
+        eprintln!("peak RSS with a 100 MB line: {kb} kB");
+        assert!(kb < 50 * 1024, "peak RSS {kb} kB");
+    } else {
+        eprintln!("skipped the RSS check: /proc/PID/status has no VmHWM on this system");
+    }
+}

@@ -16,7 +16,11 @@
 //! their count is wrong, and empty outputs) and reads the next line, except a time that does
 //! not increase, which the compensator holds (`held`: the sample cannot be placed in time). Time gaps are bridged by
 //! the compensator (no gap filling, no period estimate: the first output line follows the first
-//! input line at once). Quoted fields may hold commas and quotes but not line breaks.
+//! input line at once). Quoted fields may hold the separator and quotes but not line breaks.
+//! The separator is [`ReadOptions::delimiter`](crate::csvlog::ReadOptions::delimiter); with
+//! `;` or tab, numbers may use a decimal comma, and the output uses the same separator (numbers
+//! with a decimal point, which the reader accepts beside the comma). A line longer than
+//! [`MAX_LINE_BYTES`] is malformed (its bytes are skipped, not kept).
 
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -25,6 +29,11 @@ use gyrotherm_core::compensator::{Corrected, Status};
 
 use crate::csvlog::{GyroUnit, LogError, LogErrorKind, LogReader, LogWriter, ReadOptions};
 use crate::model::ModelFile;
+
+/// Longest line read, bytes (line break included). A longer line is malformed: in
+/// [`Mode::Stream`] it gives one `invalid` output line and its bytes are skipped without being
+/// kept, so one endless line cannot take the memory of a flight computer.
+pub const MAX_LINE_BYTES: usize = 64 * 1024;
 
 /// Columns appended to every row, in order.
 pub const OUTPUT_COLUMNS: [&str; 4] = ["bias_dps", "scale", "gyro_comp_dps", "status"];
@@ -126,14 +135,14 @@ struct Fields {
 }
 
 impl Fields {
-    /// Split `line`; false on a broken quote.
-    fn split(&mut self, line: &[u8]) -> bool {
+    /// Split `line` at `delimiter`; false on a broken quote.
+    fn split(&mut self, line: &[u8], delimiter: u8) -> bool {
         self.ranges.clear();
         self.quoted = line.contains(&b'"');
         if !self.quoted {
             let mut start = 0;
             for (i, &b) in line.iter().enumerate() {
-                if b == b',' {
+                if b == delimiter {
                     self.ranges.push(start..i);
                     start = i + 1;
                 }
@@ -159,7 +168,7 @@ impl Fields {
                 } else {
                     self.buf.push(b);
                 }
-            } else if b == b',' {
+            } else if b == delimiter {
                 self.ranges.push(start..self.buf.len());
                 start = self.buf.len();
                 at_start = true;
@@ -191,9 +200,76 @@ impl Fields {
     }
 }
 
-/// A numeric field (ASCII spaces around it allowed), as the log reader parses it.
-fn parse_number(raw: &[u8]) -> Option<f64> {
-    std::str::from_utf8(raw.trim_ascii()).ok()?.parse().ok()
+/// A numeric field (ASCII spaces around it allowed), as the log reader parses it: with a
+/// separator other than the comma, a decimal comma (`0,5`) is accepted too.
+fn parse_number(raw: &[u8], decimal_comma: bool) -> Option<f64> {
+    let dotted = std::str::from_utf8(raw.trim_ascii()).ok()?.parse().ok();
+    match dotted {
+        None if decimal_comma => crate::csvlog::parse_f64_decimal_comma(raw),
+        v => v,
+    }
+}
+
+/// What [`read_line_capped`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LineRead {
+    /// End of input, nothing read.
+    Eof,
+    /// A line (in the buffer, its line break included when there was one).
+    Line,
+    /// A line longer than the cap: its first `cap` bytes are in the buffer, the rest was
+    /// read and dropped, up to and including its line break.
+    TooLong,
+}
+
+/// `read_until(b'\n')` that keeps at most `cap` bytes of a line, so memory stays bounded
+/// whatever the input.
+fn read_line_capped<R: BufRead>(
+    input: &mut R,
+    buf: &mut Vec<u8>,
+    cap: usize,
+) -> std::io::Result<LineRead> {
+    buf.clear();
+    let mut too_long = false;
+    let mut any = false;
+    loop {
+        let (done, used) = {
+            let avail = match input.fill_buf() {
+                Ok(a) => a,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            };
+            if avail.is_empty() {
+                break;
+            }
+            any = true;
+            let (done, used) = match avail.iter().position(|&b| b == b'\n') {
+                Some(i) => (true, i + 1),
+                None => (false, avail.len()),
+            };
+            if !too_long {
+                let room = cap - buf.len();
+                if used > room {
+                    buf.extend_from_slice(&avail[..room]);
+                    too_long = true;
+                } else {
+                    buf.extend_from_slice(&avail[..used]);
+                }
+            }
+            (done, used)
+        };
+        input.consume(used);
+        if done {
+            break;
+        }
+    }
+    Ok(if too_long {
+        LineRead::TooLong
+    } else if any {
+        LineRead::Line
+    } else {
+        LineRead::Eof
+    })
 }
 
 /// Compensate the log `input` into the CSV file `out` ([`Mode::Strict`]), written to a
@@ -288,12 +364,29 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     let mut head = Vec::new();
     let mut line_no = 0u64;
     let mut buf = Vec::new();
+    let too_long = |line| {
+        LinesError::Log(LogError::new(
+            LogErrorKind::LineTooLong,
+            source,
+            Some(line),
+            None,
+            format!(
+                "line longer than {MAX_LINE_BYTES} bytes; a log line holds a few numbers: check \
+                 that this is a log with one record per line"
+            ),
+        ))
+    };
     loop {
-        buf.clear();
-        if input.read_until(b'\n', &mut buf)? == 0 {
-            break;
+        match read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)? {
+            LineRead::Eof => break,
+            LineRead::TooLong => return Err(too_long(line_no + 1)),
+            LineRead::Line => {}
         }
         line_no += 1;
+        if head.len() + buf.len() > MAX_LINE_BYTES {
+            // Comments before the header count too: they are kept for the header check.
+            return Err(too_long(line_no));
+        }
         head.extend_from_slice(&buf);
         let t = buf.trim_ascii();
         if !t.is_empty() && !t.starts_with(b"#") {
@@ -324,9 +417,12 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         GyroUnit::Dph => 1.0 / 3600.0,
         GyroUnit::RadPerS => 180.0 / std::f64::consts::PI,
     };
-    let mut writer = LogWriter::new(
+    let delimiter = opts.delimiter;
+    let decimal_comma = delimiter != b',';
+    let mut writer = LogWriter::with_delimiter(
         output,
         headers.iter().map(String::as_str).chain(OUTPUT_COLUMNS),
+        delimiter,
     )?;
     writer.set_flush_each_row(flush_each_row);
     let err = |kind, line, column: Option<&str>, message: String| {
@@ -338,11 +434,25 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
     let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
     loop {
-        buf.clear();
-        if input.read_until(b'\n', &mut buf)? == 0 {
+        let read = read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)?;
+        if read == LineRead::Eof {
             break;
         }
         line_no += 1;
+        if read == LineRead::TooLong {
+            if mode == Mode::Strict {
+                return Err(too_long(line_no));
+            }
+            summary.rows += 1;
+            for _ in 0..headers.len() + 3 {
+                writer.push_raw(b"");
+            }
+            writer.push_raw(Status::Invalid.as_str().as_bytes());
+            summary.count(Status::Invalid);
+            summary.malformed += 1;
+            writer.end_row()?;
+            continue;
+        }
         let line = buf.strip_suffix(b"\n").unwrap_or(&buf);
         let line = line.strip_suffix(b"\r").unwrap_or(line);
         let trimmed = line.trim_ascii();
@@ -352,20 +462,24 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         summary.rows += 1;
         // Parse; `None` is a malformed line (with the reason for strict mode).
         let parsed: Result<(f64, f64, f64), LinesError> = (|| {
-            if !fields.split(line) || fields.len() != headers.len() {
+            if !fields.split(line, delimiter) || fields.len() != headers.len() {
                 return Err(err(
                     LogErrorKind::FieldCount,
                     line_no,
                     None,
                     format!(
                         "{} fields, but the header has {}; fix the line (a missing or extra \
-                         ',') or comment it out with '#'",
+                         {}) or comment it out with '#'",
                         fields.len(),
-                        headers.len()
+                        headers.len(),
+                        match delimiter {
+                            b'\t' => "tab".to_string(),
+                            d => format!("'{}'", char::from(d)),
+                        }
                     ),
                 ));
             }
-            let time_s = match parse_number(fields.get(line, ti)) {
+            let time_s = match parse_number(fields.get(line, ti), decimal_comma) {
                 Some(t) if t.is_finite() => t,
                 _ => {
                     return Err(err(
@@ -393,7 +507,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                     ));
                 }
             }
-            let gyro = match parse_number(fields.get(line, gi)) {
+            let gyro = match parse_number(fields.get(line, gi), decimal_comma) {
                 Some(g) => g * gyro_scale,
                 None => {
                     return Err(err(
@@ -409,7 +523,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                 }
             };
             // A temperature that is not a number is a sensor fault: NaN, held.
-            let temp = parse_number(fields.get(line, ci)).unwrap_or(f64::NAN);
+            let temp = parse_number(fields.get(line, ci), decimal_comma).unwrap_or(f64::NAN);
             Ok((time_s, gyro, temp))
         })();
         let c: Option<Corrected> = match parsed {
@@ -478,13 +592,13 @@ mod tests {
     fn splits_plain_and_quoted_fields() {
         let mut f = Fields::default();
         let line = br#"1,"a,""b""",,x"#;
-        assert!(f.split(line));
+        assert!(f.split(line, b','));
         let got: Vec<&[u8]> = (0..f.len()).map(|k| f.get(line, k)).collect();
         assert_eq!(got, [&b"1"[..], b"a,\"b\"", b"", b"x"]);
         let line = b"0.5,1e-3,,NaN";
-        assert!(f.split(line));
+        assert!(f.split(line, b','));
         let got: Vec<&[u8]> = (0..f.len()).map(|k| f.get(line, k)).collect();
         assert_eq!(got, [&b"0.5"[..], b"1e-3", b"", b"NaN"]);
-        assert!(!f.split(br#"1,"open"#));
+        assert!(!f.split(br#"1,"open"#, b','));
     }
 }

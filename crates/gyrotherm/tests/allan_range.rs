@@ -206,3 +206,111 @@ fn noise_terms_beyond_f64_are_not_reported() {
         assert!(term.value.is_finite(), "{term:?}");
     }
 }
+
+/// `deviation_owned` (the path `gyrotherm allan` takes when no second curve needs the
+/// samples) scales as `deviation` does: the NBS set times 2^±1000 gives the NBS deviations
+/// times 2^±1000, with identified α (not a fixed one) in −2..=2, for every kind.
+#[test]
+fn owned_samples_of_any_magnitude_give_scaled_deviations_and_alpha_in_range() {
+    use gyrotherm::allan::deviation_owned;
+    let y = nbs_data();
+    for kind in KINDS {
+        let base = deviation(&y, 1.0, kind, &TauSet::Octave, NoiseModel::Identify).unwrap();
+        for k in [-1000, -300, 0, 300, 1000] {
+            let c = 2f64.powi(k);
+            let scaled: Vec<f64> = y.iter().map(|v| v * c).collect();
+            let pts = deviation_owned(scaled, 1.0, kind, &TauSet::Octave, NoiseModel::Identify)
+                .unwrap_or_else(|e| panic!("{kind:?} 2^{k}: {e}"));
+            assert_eq!(pts.len(), base.len());
+            for (p, b) in pts.iter().zip(&base) {
+                let want = b.dev * c;
+                assert!(
+                    p.dev.is_finite() && (p.dev - want).abs() <= 1e-12 * want,
+                    "{kind:?} 2^{k} m={}: {} want {want}",
+                    p.m,
+                    p.dev
+                );
+                assert_eq!(p.alpha, b.alpha, "{kind:?} 2^{k} m={}", p.m);
+                assert!((-2..=2).contains(&p.alpha), "{kind:?} α = {}", p.alpha);
+            }
+        }
+    }
+}
+
+/// Finite samples give finite deviations or a refusal, and α stays in the range the lag-1
+/// identification defines (−2..=2, Riley & Greenhall 2004), for samples of every magnitude
+/// and shape: alternating (lag-1 autocorrelation near −1, which unclamped gives α > 2),
+/// constant, a ramp, and pseudo-random values spread over many decades.
+#[test]
+fn finite_samples_give_finite_results_or_a_refusal_and_alpha_in_range() {
+    use gyrotherm::allan::deviation_owned;
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let mut cases: Vec<Vec<f64>> = Vec::new();
+    for mag in [1e-300, 1e-3, 1.0, 1e3, 1e150, 1e300, 1.7e308] {
+        cases.push(
+            (0..600)
+                .map(|i| if i % 2 == 0 { mag } else { -mag })
+                .collect(),
+        );
+        cases.push(vec![mag; 600]);
+        cases.push((0..600).map(|i| mag * (i as f64 / 600.0)).collect());
+        cases.push(
+            (0..600)
+                .map(|_| {
+                    let u = (next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                    u * mag
+                })
+                .collect(),
+        );
+    }
+    for _ in 0..20 {
+        // Any finite bit pattern.
+        cases.push(
+            (0..300)
+                .map(|_| loop {
+                    let v = f64::from_bits(next());
+                    if v.is_finite() {
+                        break v;
+                    }
+                })
+                .collect(),
+        );
+    }
+    for (c, y) in cases.iter().enumerate() {
+        for kind in KINDS {
+            for owned in [false, true] {
+                let r = if owned {
+                    deviation_owned(y.clone(), 1.0, kind, &TauSet::Octave, NoiseModel::Identify)
+                } else {
+                    deviation(y, 1.0, kind, &TauSet::Octave, NoiseModel::Identify)
+                };
+                match r {
+                    Ok(pts) => {
+                        for p in pts {
+                            assert!(
+                                p.dev.is_finite() && p.dev >= 0.0,
+                                "case {c} {kind:?} owned={owned} m={}: dev {}",
+                                p.m,
+                                p.dev
+                            );
+                            assert!(
+                                (-2..=2).contains(&p.alpha),
+                                "case {c} {kind:?} owned={owned} m={}: α {}",
+                                p.m,
+                                p.alpha
+                            );
+                        }
+                    }
+                    Err(AllanError::TooLarge { .. }) | Err(AllanError::TooShort { .. }) => {}
+                    Err(e) => panic!("case {c} {kind:?} owned={owned}: unexpected {e}"),
+                }
+            }
+        }
+    }
+}

@@ -540,12 +540,30 @@ pub(crate) fn rescale_for_range(samples: &[f64]) -> Option<f64> {
     }
 }
 
+/// Index and value of the sample of largest magnitude (the one an overflow is blamed on).
+fn largest_sample(samples: &[f64]) -> (usize, f64) {
+    samples
+        .iter()
+        .copied()
+        .enumerate()
+        .fold(
+            (0, 0.0f64),
+            |(i, m), (j, v)| {
+                if v.abs() > m.abs() {
+                    (j, v)
+                } else {
+                    (i, m)
+                }
+            },
+        )
+}
+
 /// Points of rescaled samples back in the samples' unit; refused when a deviation or bound
-/// is beyond f64 (the error names the largest sample).
+/// is beyond f64 (the error names the largest sample, `largest` = (index, value)).
 fn scale_points(
     mut points: Vec<AllanPoint>,
     scale: f64,
-    samples: &[f64],
+    largest: (usize, f64),
 ) -> Result<Vec<AllanPoint>, AllanError> {
     for p in &mut points {
         p.dev *= scale;
@@ -553,21 +571,7 @@ fn scale_points(
         p.hi *= scale;
         let bounds_ok = !p.edf.is_finite() || (p.lo.is_finite() && p.hi.is_finite());
         if !(p.dev.is_finite() && bounds_ok) {
-            let (index, value) =
-                samples
-                    .iter()
-                    .copied()
-                    .enumerate()
-                    .fold(
-                        (0, 0.0f64),
-                        |(i, m), (j, v)| {
-                            if v.abs() > m.abs() {
-                                (j, v)
-                            } else {
-                                (i, m)
-                            }
-                        },
-                    );
+            let (index, value) = largest;
             return Err(AllanError::TooLarge { index, value });
         }
     }
@@ -599,7 +603,7 @@ pub fn deviation(
     if let Some(scale) = rescale_for_range(samples) {
         let scaled: Vec<f64> = samples.iter().map(|v| v / scale).collect();
         let points = deviation(&scaled, tau0_s, kind, taus, noise)?;
-        return scale_points(points, scale, samples);
+        return scale_points(points, scale, largest_sample(samples));
     }
     let ms = averaging_factors(taus, kind, samples.len(), tau0_s)?;
     let x = phase_from_rate(samples);
@@ -624,6 +628,17 @@ pub fn deviation_owned(
     }
     if !(tau0_s.is_finite() && tau0_s > 0.0) {
         return Err(AllanError::BadSamplePeriod(tau0_s));
+    }
+    // Samples of extreme magnitude are worked on divided by a power of two (exact), as in
+    // `deviation`; their sum above may also have overflowed, so the mean is taken again.
+    if let Some(scale) = rescale_for_range(&samples) {
+        let largest = largest_sample(&samples);
+        let mut samples = samples;
+        for v in &mut samples {
+            *v /= scale;
+        }
+        let points = deviation_owned(samples, tau0_s, kind, taus, noise)?;
+        return scale_points(points, scale, largest);
     }
     let ms = averaging_factors(taus, kind, samples.len(), tau0_s)?;
     let x = phase_in_place(samples, mean);

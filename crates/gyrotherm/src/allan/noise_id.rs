@@ -10,7 +10,7 @@
 /// Result of one identification.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NoiseId {
-    /// Integer noise exponent α.
+    /// Integer noise exponent α, in −2..=2.
     pub alpha: i32,
     /// Unrounded estimate −2(ρ + d).
     pub alpha_est: f64,
@@ -97,7 +97,9 @@ fn identify(mut x: Vec<f64>, dmax: u32) -> Option<NoiseId> {
         let rho = r1 / (1.0 + r1);
         if rho < 0.25 || d >= dmax || x.len() < 3 {
             let alpha_est = -2.0 * (rho + f64::from(d));
-            let alpha = (-(2.0 * rho).round()) as i32 - 2 * d as i32;
+            // ρ below −1 (r1 < −1/2, an alternating sequence) would give α > 2, outside the
+            // power-law range the method identifies (−2..=2): clamp to it.
+            let alpha = ((-(2.0 * rho).round()) as i32 - 2 * d as i32).clamp(-2, 2);
             return Some(NoiseId {
                 alpha,
                 alpha_est,

@@ -32,6 +32,9 @@ pub enum LogErrorKind {
     TruncatedLine,
     /// A line (not the last) has a different number of fields than the header.
     FieldCount,
+    /// A line longer than the reader's limit (a stream caps its lines so that one line
+    /// cannot take unbounded memory).
+    LineTooLong,
     /// Time goes backwards.
     TimeNotIncreasing,
     /// The same timestamp appears on two consecutive rows.

@@ -26,6 +26,7 @@ mod writer;
 
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
+pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
 };

@@ -13,7 +13,7 @@ pub(super) fn parse_f64(raw: &[u8]) -> Option<f64> {
 
 /// A number written with a decimal comma (`-0,25`, `1,5e-3`): one comma and no point.
 #[cold]
-pub(super) fn parse_f64_decimal_comma(raw: &[u8]) -> Option<f64> {
+pub(crate) fn parse_f64_decimal_comma(raw: &[u8]) -> Option<f64> {
     let t = raw.trim_ascii();
     if t.iter().filter(|&&b| b == b',').count() != 1 || t.contains(&b'.') {
         return None;

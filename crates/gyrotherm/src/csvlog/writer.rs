@@ -35,11 +35,24 @@ pub struct LogWriter<W: Write> {
     fields: usize,
     row_start: usize,
     flush_each_row: bool,
+    delimiter: u8,
 }
 
 impl<W: Write> LogWriter<W> {
-    /// Write the header row (names quoted where CSV needs it).
+    /// Write the header row (names quoted where CSV needs it), fields separated by commas.
     pub fn new<I>(out: W, header: I) -> io::Result<Self>
+    where
+        I: IntoIterator,
+        I::Item: AsRef<str>,
+    {
+        Self::with_delimiter(out, header, b',')
+    }
+
+    /// [`new`](Self::new) with another field separator (`b';'` or `b'\t'`, as
+    /// [`ReadOptions::delimiter`](super::ReadOptions::delimiter)): a field holding it is quoted.
+    /// Numbers are still written with a decimal point, which the reader accepts beside the
+    /// decimal comma.
+    pub fn with_delimiter<I>(out: W, header: I, delimiter: u8) -> io::Result<Self>
     where
         I: IntoIterator,
         I::Item: AsRef<str>,
@@ -51,6 +64,7 @@ impl<W: Write> LogWriter<W> {
             fields: 0,
             row_start: 0,
             flush_each_row: false,
+            delimiter,
         };
         for name in header {
             w.push_raw(name.as_ref().as_bytes());
@@ -80,7 +94,7 @@ impl<W: Write> LogWriter<W> {
     #[inline]
     fn sep(&mut self) {
         if self.fields > 0 {
-            self.buf.push(b',');
+            self.buf.push(self.delimiter);
         }
         self.fields += 1;
     }
@@ -93,7 +107,7 @@ impl<W: Write> LogWriter<W> {
         format_f64(&mut self.buf, v);
     }
 
-    /// Append a field as given, quoted if it holds `,` `"` CR or LF (or, as the first field,
+    /// Append a field as given, quoted if it holds the delimiter, `"`, CR or LF (or, as the first field,
     /// starts with `#` or is empty, which a reader would take for a comment or a blank line).
     #[inline]
     pub fn push_raw(&mut self, field: &[u8]) {
@@ -101,7 +115,7 @@ impl<W: Write> LogWriter<W> {
         self.sep();
         let needs_quotes = field
             .iter()
-            .any(|&b| matches!(b, b',' | b'"' | b'\n' | b'\r'))
+            .any(|&b| b == self.delimiter || matches!(b, b'"' | b'\n' | b'\r'))
             || (first && (field.first() == Some(&b'#') || field.is_empty()));
         if needs_quotes {
             self.buf.push(b'"');
