@@ -1,6 +1,6 @@
 //! `gyrotherm`: thin command-line front end. Parses arguments, calls the library, prints.
 //!
-//! Exit codes: 0 success; 1 ran fine but a requested threshold was missed; 2 error.
+//! Exit codes: 0 success; 2 error (the message names the file, line and column, and what to do).
 
 use std::process::ExitCode;
 

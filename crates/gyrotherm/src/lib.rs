@@ -20,7 +20,7 @@
 //!   [`nn`].
 //! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]).
 //! - [`compensate`]: run the flight compensator (`gyrotherm-core`) over a log or a CSV
-//!   stream with a status per line ([`compensate_log`], [`compensate_lines`]).
+//!   stream with a status per line ([`compensate_log`], [`compensate_lines`](mod@compensate_lines)).
 //! - [`allan`], [`metrics`]: the standard gyro figures (IEEE Std 952 / GJB 2426A).
 //! - [`compare`]: held-out comparison of methods (the numbers); [`report`]: the pictures and
 //!   the HTML report.

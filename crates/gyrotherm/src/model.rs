@@ -221,7 +221,7 @@ pub enum SubModel {
         input_norm: ZScore,
         target_norm: ZScore,
     },
-    /// A baseline: Σ coefficients[j] · monomial j of the raw features.
+    /// A baseline: Σ coefficients\[j\] · monomial j of the raw features.
     Baseline {
         terms: Terms,
         coefficients: Vec<f64>,

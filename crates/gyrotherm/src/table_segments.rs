@@ -1,5 +1,5 @@
 //! Rate-table segments: runs of samples with one commanded table rate. The one segmentation
-//! that the scale-factor figures ([`crate::metrics::scale_factor`]) and the scale-factor
+//! that the scale-factor figures ([`crate::metrics::scale_factor()`]) and the scale-factor
 //! training targets ([`crate::targets::scale_targets`]) share, so the two always agree on
 //! where a segment starts and ends.
 //!

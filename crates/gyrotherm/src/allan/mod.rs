@@ -6,11 +6,11 @@
 //!
 //! - ADEV (non-overlapping): σ² = Σ_{k=0,m,2m,…} (θ_{k+2m} − 2θ_{k+m} + θ_k)² / (2τ²·n),
 //!   n = ⌊N/m⌋ − 1 terms.
-//! - OADEV (overlapping): the same sum over every k, n = N + 1 − 2m terms (METHOD.md).
+//! - OADEV (overlapping): the same sum over every k, n = N + 1 − 2m terms (docs/method.md).
 //! - MDEV: σ² = Σ_j (Σ_{i=j}^{j+m−1} θ_{i+2m} − 2θ_{i+m} + θ_i)² / (2m²τ²·n), n = N + 2 − 3m.
 //! - HDEV: non-overlapping Hadamard, σ² = Σ_{k=0,m,…} (θ_{k+3m} − 3θ_{k+2m} + 3θ_{k+m} − θ_k)²
 //!   / (6τ²·n), n = ⌊N/m⌋ − 2. This is what Stable32 calls "Hadamard" and what NIST SP 1065's
-//!   table lists as HDEV (both reference sets in METHOD.md are this estimator).
+//!   table lists as HDEV (both reference sets in docs/method.md are this estimator).
 //! - OHDEV: the overlapping Hadamard deviation, n = N + 1 − 3m.
 //!
 //! Frequency data y is the same math as rate data Ω (τ0 cancels: θ is kept in units of
@@ -88,7 +88,7 @@ impl DevKind {
 
     /// Largest m used by the automatic τ sets (`octave`, `decade`, `all`): ⌊N/5⌋ for the
     /// non-overlapping estimators, ⌊N/4⌋ otherwise — the limits Stable32 uses (they reproduce
-    /// the τ lists of the reference files in METHOD.md).
+    /// the τ lists of the reference files in docs/method.md).
     pub fn auto_max_m(self, n_samples: usize) -> usize {
         match self {
             DevKind::Adev | DevKind::Hdev => n_samples / 5,

@@ -30,7 +30,7 @@ use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
 use crate::model::Method;
 use crate::targets;
 
-/// Bias-stability smoothing time of the comparison, s (100 s: METHOD.md, He et al. 2024).
+/// Bias-stability smoothing time of the comparison, s (100 s: docs/method.md, He et al. 2024).
 pub const BIAS_STABILITY_TAU_S: f64 = 100.0;
 
 /// The column name of the published recipe: the seed's method, named after its authors.

@@ -15,7 +15,7 @@ use super::{
 /// Settings of an evaluation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EvaluationOptions {
-    /// Smoothing time of the bias stability, s (100 s per METHOD.md).
+    /// Smoothing time of the bias stability, s (100 s per docs/method.md).
     pub tau_s: f64,
     /// Time dropped at the start of each rate-table segment, s.
     pub settle_s: f64,

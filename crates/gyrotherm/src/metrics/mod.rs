@@ -1,9 +1,9 @@
-//! Standard gyro performance figures (IEEE Std 952 / GJB 2426A; definitions in METHOD.md).
+//! Standard gyro performance figures (IEEE Std 952 / GJB 2426A; definitions in docs/method.md).
 //!
 //! - [`bias_dph`]: bias B0, the mean output, °/h.
 //! - [`bias_stability_dph`]: sample standard deviation (n − 1) of consecutive non-overlapping
 //!   means over τ, °/h.
-//! - [`scale_factor`]: scale factor, nonlinearity, asymmetry and the scale-factor thermal
+//! - [`scale_factor`](mod@scale_factor): scale factor, nonlinearity, asymmetry and the scale-factor thermal
 //!   error from a rate-table log.
 //! - [`repeatability`]: sample standard deviation over repeated runs.
 //! - [`evaluate`]: all of these for one rate column of a log ([`Evaluation`]).

@@ -1,4 +1,4 @@
-//! Scale factor from a rate-table log (IEEE Std 952 / GJB 2426A; METHOD.md definitions).
+//! Scale factor from a rate-table log (IEEE Std 952 / GJB 2426A; docs/method.md definitions).
 //!
 //! 1. Segments: runs of constant commanded table rate `table_dps`; the first `settle_s`
 //!    seconds of each are dropped, the rest averaged to F (mean output, °/s).

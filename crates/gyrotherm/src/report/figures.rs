@@ -357,7 +357,7 @@ pub struct AllanCurve {
     pub points: Vec<AllanPointPlot>,
 }
 
-/// A noise term identified on the Allan curve (IEEE Std 952-1997 annex C; METHOD.md), in the
+/// A noise term identified on the Allan curve (IEEE Std 952-1997 annex C; docs/method.md), in the
 /// figure's unit `u` with τ in seconds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum NoiseTerm {

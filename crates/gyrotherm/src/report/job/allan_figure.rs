@@ -77,7 +77,7 @@ pub fn allan_curve(label: &str, points: &[AllanPoint], to_unit: f64) -> AllanCur
 /// Slope lines (in °/h, τ in s) of the noise terms read by [`allan::noise_terms`], labelled
 /// with their values and `source` (e.g. "raw"). Conversions (IEEE Std 952 annex C):
 /// N[°/h·√s] = 60·N[°/√h]; B in °/h as is; K[°/h/√s] = K[°/h/√h] / 60;
-/// Q[°/h·s] = Q[arcsec] (σ = √3·Q/τ). The rate ramp has no line.
+/// Q\[°/h·s\] = Q\[arcsec\] (σ = √3·Q/τ). The rate ramp has no line.
 pub fn noise_lines(terms: &NoiseTerms, source: &str) -> Vec<NoiseLine> {
     let suffix = if source.is_empty() {
         String::new()
@@ -120,7 +120,7 @@ mod tests {
     #[test]
     fn noise_line_units_follow_ieee952() {
         // IEEE Std 952 annex C: σ(1 s) = N[°/h·√s] = 60·N[°/√h]; σ(3 s) = K[°/h/√s]
-        // = K[°/h/√h] / 60; σ(√3 s) = Q[°/h·s] = Q[arcsec]; flat 0.6643·B.
+        // = K[°/h/√h] / 60; σ(√3 s) = Q\[°/h·s\] = Q\[arcsec\]; flat 0.6643·B.
         let term = |value| allan::NoiseTerm {
             value,
             tau_read_s: 1.0,

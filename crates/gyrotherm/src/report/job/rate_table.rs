@@ -16,7 +16,7 @@ pub struct ScalePoints {
     /// Middle of each rate segment, s.
     pub time_s: Vec<f64>,
     /// Measured K − 1, ppm: K = (segment mean − local bias) / table rate of the raw output
-    /// ([`metrics::scale_factor`], `scale_over_time`).
+    /// ([`metrics::scale_factor()`], `scale_over_time`).
     pub measured_ppm: Vec<f64>,
     /// Predicted K − 1, ppm: mean of `scale` over the samples the measurement used (the
     /// segment after its settle time).
