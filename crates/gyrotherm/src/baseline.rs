@@ -332,7 +332,7 @@ impl std::fmt::Display for LsqError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             LsqError::Shape(m) => write!(f, "baseline fit: {m}"),
-            LsqError::Terms(e) => write!(f, "baseline fit: {e}"),
+            LsqError::Terms(_) => f.write_str("baseline fit: the terms are invalid"),
             LsqError::ConstantTerm { term } => write!(
                 f,
                 "term {term} does not vary within the training runs: cannot fit it"

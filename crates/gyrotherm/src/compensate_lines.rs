@@ -101,7 +101,7 @@ pub enum LinesError {
 impl std::fmt::Display for LinesError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            LinesError::Model(m) => write!(f, "model: {m}"),
+            LinesError::Model(_) => f.write_str("model"),
             LinesError::Log(e) => write!(f, "{e}"),
             LinesError::Io(e) => write!(f, "{e}"),
         }
@@ -111,8 +111,9 @@ impl std::fmt::Display for LinesError {
 impl std::error::Error for LinesError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            LinesError::Io(e) => Some(e),
-            LinesError::Log(e) => Some(e),
+            // Log and I/O errors are transparent: their message is their own.
+            LinesError::Io(e) => e.source(),
+            LinesError::Log(e) => e.source(),
             LinesError::Model(e) => Some(e),
         }
     }
@@ -327,11 +328,9 @@ pub enum FileError {
 impl std::fmt::Display for FileError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            FileError::Open { path, source } => {
-                write!(f, "cannot open {}: {source}", path.display())
-            }
-            FileError::Write { path, source } => {
-                write!(f, "cannot compensate into {}: {source}", path.display())
+            FileError::Open { path, .. } => write!(f, "cannot open {}", path.display()),
+            FileError::Write { path, .. } => {
+                write!(f, "cannot compensate into {}", path.display())
             }
             FileError::Lines(e) => write!(f, "{e}"),
         }
@@ -342,7 +341,8 @@ impl std::error::Error for FileError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             FileError::Open { source, .. } | FileError::Write { source, .. } => Some(source),
-            FileError::Lines(e) => Some(e),
+            // Transparent: the message is the lines' own.
+            FileError::Lines(e) => e.source(),
         }
     }
 }

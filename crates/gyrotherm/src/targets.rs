@@ -44,8 +44,9 @@ impl fmt::Display for TargetError {
 impl std::error::Error for TargetError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            TargetError::Features(e) => Some(e),
-            TargetError::Smoothing(e) => Some(e),
+            // Transparent: the message is the inner error's own.
+            TargetError::Features(e) => e.source(),
+            TargetError::Smoothing(e) => e.source(),
             TargetError::NoTable => None,
         }
     }

@@ -98,7 +98,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     let cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
     for (fit, col) in cmp.fits.iter().zip(&cmp.columns) {
         let path = args.dir.join(format!("model_{}.json", col.key));
-        fit.model.save(&path).map_err(anyhow::Error::msg)?;
+        fit.model.save(&path).map_err(anyhow::Error::new)?;
     }
     let mut out = std::io::stdout().lock();
     print_table(&mut out, &cmp, &cfg)?;

@@ -31,7 +31,7 @@ pub struct ExportArgs {
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
-    let (model, seal) = ModelFile::load_sealed(&args.model).map_err(anyhow::Error::msg)?;
+    let (model, seal) = ModelFile::load_sealed(&args.model).map_err(anyhow::Error::new)?;
     if let Some(w) = seal.warning(&args.model) {
         eprintln!("gyrotherm: warning: {w}");
     }

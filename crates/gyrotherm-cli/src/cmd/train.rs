@@ -170,13 +170,13 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let outcome = fit_model(&named, &cfg, &|t: Target, e, l| bars.update("", t, e, l));
     bars.finish();
     let mut outcome = outcome
-        .map_err(anyhow::Error::msg)
+        .map_err(anyhow::Error::new)
         .context("training failed")?;
     outcome.model.features.temp_sensor = temp_sensor;
     outcome
         .model
         .save(&args.out)
-        .map_err(anyhow::Error::msg)
+        .map_err(anyhow::Error::new)
         .context("cannot write the model")?;
     let m = &outcome.model;
     eprintln!(

@@ -58,7 +58,7 @@ impl std::fmt::Display for FitError {
         match self {
             FitError::NoLogs => write!(f, "no training logs given"),
             FitError::NoUsableLogs => write!(f, "no usable training logs"),
-            FitError::Targets { run, source } => write!(f, "{run}: {source}"),
+            FitError::Targets { run, .. } => write!(f, "{run}: cannot make the training targets"),
             FitError::NoScaleSegments { run } => write!(
                 f,
                 "{run}: no rate segment has a stop segment on both sides, so no scale factor can \
@@ -101,9 +101,9 @@ impl std::fmt::Display for FitError {
                 "the thermal recipe identifies its features from the logs: fit it with fit_model"
             ),
             FitError::Model(e) => e.fmt(f),
-            FitError::Target { target, source } => match target {
-                Target::Bias => write!(f, "bias model: {source}"),
-                Target::Scale => write!(f, "scale-factor model: {source}"),
+            FitError::Target { target, .. } => match target {
+                Target::Bias => f.write_str("bias model"),
+                Target::Scale => f.write_str("scale-factor model"),
             },
             FitError::ThreadPanicked { target } => {
                 write!(f, "{} training thread panicked", target.as_str())
@@ -115,10 +115,12 @@ impl std::fmt::Display for FitError {
 impl std::error::Error for FitError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            FitError::LeastSquares(e) => Some(e),
-            FitError::Train(e) => Some(e),
-            FitError::Thermal(e) => Some(e),
-            FitError::Model(e) => Some(e),
+            // Transparent wrappers: their message is the inner error's own.
+            FitError::LeastSquares(e) => e.source(),
+            FitError::Train(e) => e.source(),
+            FitError::Thermal(e) => e.source(),
+            FitError::Model(e) => e.source(),
+            FitError::Targets { source, .. } => Some(source),
             FitError::Target { source, .. } => Some(source.as_ref()),
             _ => None,
         }

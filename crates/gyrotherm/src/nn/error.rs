@@ -192,7 +192,8 @@ impl std::fmt::Display for TrainError {
 impl std::error::Error for TrainError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            TrainError::Params(e) => Some(e),
+            // Transparent: the message is the parameters' own.
+            TrainError::Params(e) => e.source(),
             _ => None,
         }
     }

@@ -163,9 +163,9 @@ impl std::fmt::Display for ParamsError {
                 "model has input_size {input_size}, hidden_size {hidden_size}; the flight network \
                  was built for {flight_input_size}, {flight_hidden_size}"
             ),
-            ParamsError::Flight(e) => {
-                write!(f, "{e} after conversion to f32 (value beyond ±3.4e38)")
-            }
+            ParamsError::Flight(_) => f.write_str(
+                "the weights do not convert to the flight network's f32 (a value beyond ±3.4e38)",
+            ),
         }
     }
 }
