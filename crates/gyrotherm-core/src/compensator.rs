@@ -578,7 +578,9 @@ impl Compensator {
         } else {
             let unplaced_s = self.spec().step_period_s * f64::from(self.unplaced);
             match (self.last_ok_s, self.base_s) {
-                (Some(ok), Some(now)) if (now - ok) + unplaced_s <= self.limits.degraded_after_s => {
+                (Some(ok), Some(now))
+                    if (now - ok) + unplaced_s <= self.limits.degraded_after_s =>
+                {
                     Status::Held
                 }
                 _ => Status::Degraded,

@@ -425,7 +425,15 @@ fn a_single_time_glitch_costs_one_rejected_temperature() {
         let reference = ramp_run(mk(), 400, |i, (t, g, temp)| {
             (t, g, if i == 100 { f64::NAN } else { temp })
         });
-        for glitch in [1e308, 100.0 + 1e9, f64::NAN, f64::INFINITY, 99.0, 0.0, -1e308] {
+        for glitch in [
+            1e308,
+            100.0 + 1e9,
+            f64::NAN,
+            f64::INFINITY,
+            99.0,
+            0.0,
+            -1e308,
+        ] {
             let run = ramp_run(mk(), 400, |i, (t, g, temp)| {
                 (if i == 100 { glitch } else { t }, g, temp)
             });
@@ -556,8 +564,8 @@ fn step_index_never_saturates() {
     };
     let mut b = BaselineModel::new(2).unwrap();
     b.push_term(&[1, 0], 1e-4).unwrap();
-    let mut c = Compensator::with_limits(spec, model(b), TargetModel::constant(1.0), limits)
-        .unwrap();
+    let mut c =
+        Compensator::with_limits(spec, model(b), TargetModel::constant(1.0), limits).unwrap();
     assert_eq!(c.step(0.0, 0.0, 20.0).status, Status::Ok);
     // Re-based here: degraded while the 20 ns settle runs, B from the new step (T = 21).
     let o = c.step(1e7, 0.0, 21.0);
@@ -576,11 +584,11 @@ fn fault_sample(kind: u8, t: f64, base_temp: f64, wild: f64) -> (f64, f64, f64) 
         2 => (f64::NEG_INFINITY, g, base_temp),
         3 => (1e308, g, base_temp),
         4 => (-1e308, g, base_temp),
-        5 => (t - 1.0, g, base_temp),        // repeats the previous time stamp
-        6 => (t - 30.0, g, base_temp),       // backward step
-        7 => (t - t.floor(), g, base_temp),  // reset towards 0
-        8 => (t + 1e9, g, base_temp),        // forward jump
-        9 => (t + 45.0, g, base_temp),       // forward, within degraded_after_s
+        5 => (t - 1.0, g, base_temp), // repeats the previous time stamp
+        6 => (t - 30.0, g, base_temp), // backward step
+        7 => (t - t.floor(), g, base_temp), // reset towards 0
+        8 => (t + 1e9, g, base_temp), // forward jump
+        9 => (t + 45.0, g, base_temp), // forward, within degraded_after_s
         10 => (t, g, f64::NAN),
         11 => (t, g, 85.0),
         12 => (t, g, -127.0),
