@@ -444,9 +444,9 @@ impl FeaturePipeline {
             return Err(InputError::TimeNotIncreasing);
         }
         let q = (time_s - self.t0_s) / self.spec.step_period_s + BOUNDARY_TOL_STEPS;
-        // q > 0 here. A huge or infinite q would saturate `as u64`, and every later sample
+        // q > 0 and not NaN here. A huge or infinite q would saturate `as u64`, and every later sample
         // would fall on the same step and hold for good: refuse it instead.
-        if !(q < MAX_STEP_INDEX as f64) {
+        if q >= MAX_STEP_INDEX as f64 {
             return Err(InputError::TimeOutOfRange);
         }
         let k = libm::floor(q) as u64;

@@ -468,7 +468,8 @@ fn a_lasting_clock_change_rebases_settles_and_recovers() {
     use gyrotherm_core::compensator::REBASE_AFTER;
     let settle = FeatureSpec::PUBLISHED.settle_s();
     assert_eq!(settle, 20.0);
-    let cases: [(&str, fn(usize, f64) -> f64); 3] = [
+    type TimeOf = fn(usize, f64) -> f64;
+    let cases: [(&str, TimeOf); 3] = [
         ("reset to 0", |i, t| if i >= 300 { t - 300.0 } else { t }),
         ("+1e9 s", |i, t| if i >= 300 { t + 1e9 } else { t }),
         ("1e308 first", |i, t| if i == 0 { 1e308 } else { t }),

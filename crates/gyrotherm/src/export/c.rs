@@ -725,7 +725,7 @@ static int pipe_push(gt_state *s, double time_s, double temp_c, double *feat)
         return -1;
     }
     q = (time_s - s->t0_s) / STEP_P + BOUNDARY_TOL;
-    if (!(q < MAX_STEP_INDEX)) {
+    if (q >= MAX_STEP_INDEX) {
         return -2;
     }
     k = (uint64_t)floor(q);
