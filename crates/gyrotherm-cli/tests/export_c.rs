@@ -608,6 +608,7 @@ fn gcc(opt: &str, args: &[&str], files: &[&Path], out: &Path) {
             ])
             .args(args)
             .args(files)
+            .arg("-lm")
             .arg("-o")
             .arg(out),
     );
