@@ -199,7 +199,7 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
     fault_args.extend(["--dropouts-per-hour", "1"]);
     let gaps = simulate(d, "faulty_gaps.csv", &fault_args);
     // Gyro faults too: every 997th line's gyro is NaN (invalid), every 1009th line's time
-    // repeats the previous one (held).
+    // repeats the previous one (held); and the time faults below.
     let text = std::fs::read_to_string(&faulty).unwrap();
     let mut prev_time = String::new();
     let edited: Vec<String> = text
@@ -212,6 +212,27 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
             }
             if i > 1 && i % 1009 == 0 {
                 f[0] = prev_time.clone();
+            }
+            // Time faults (single: 1e308, NaN, +1e9 s, −1e308, five repeats; lasting: a clock
+            // reset to 0 at line 20,000, a +1e9 s jump at 25,000) and overflow gyro samples.
+            if i > 0 {
+                let t: f64 = f[0].parse().unwrap();
+                let t = match i {
+                    20_000..25_000 => t - 20_000.0,
+                    25_000.. => t + 1e9,
+                    _ => t,
+                };
+                f[0] = format!("{t:?}");
+                match i {
+                    5_003 => f[0] = "1e308".into(),
+                    7_001 => f[0] = format!("{:?}", t + 1e9),
+                    9_001 => f[0] = "NaN".into(),
+                    10_001 => f[0] = "-1e308".into(),
+                    11_001..=11_005 => f[0] = prev_time.clone(),
+                    13_001 | 21_001 => f[1] = "1.797e308".into(),
+                    13_003 | 21_003 => f[1] = "-1.797e308".into(),
+                    _ => {}
+                }
             }
             prev_time = f[0].clone();
             f.join(",")
