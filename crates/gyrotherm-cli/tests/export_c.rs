@@ -199,7 +199,7 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
     fault_args.extend(["--dropouts-per-hour", "1"]);
     let gaps = simulate(d, "faulty_gaps.csv", &fault_args);
     // Gyro faults too: every 997th line's gyro is NaN (invalid), every 1009th line's time
-    // repeats the previous one (held).
+    // repeats the previous one (held); and the time faults below.
     let text = std::fs::read_to_string(&faulty).unwrap();
     let mut prev_time = String::new();
     let edited: Vec<String> = text
@@ -212,6 +212,27 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
             }
             if i > 1 && i % 1009 == 0 {
                 f[0] = prev_time.clone();
+            }
+            // Time faults (single: 1e308, NaN, +1e9 s, −1e308, five repeats; lasting: a clock
+            // reset to 0 at line 20,000, a +1e9 s jump at 25,000) and overflow gyro samples.
+            if i > 0 {
+                let t: f64 = f[0].parse().unwrap();
+                let t = match i {
+                    20_000..25_000 => t - 20_000.0,
+                    25_000.. => t + 1e9,
+                    _ => t,
+                };
+                f[0] = format!("{t:?}");
+                match i {
+                    5_003 => f[0] = "1e308".into(),
+                    7_001 => f[0] = format!("{:?}", t + 1e9),
+                    9_001 => f[0] = "NaN".into(),
+                    10_001 => f[0] = "-1e308".into(),
+                    11_001..=11_005 => f[0] = prev_time.clone(),
+                    13_001 | 21_001 => f[1] = "1.797e308".into(),
+                    13_003 | 21_003 => f[1] = "-1.797e308".into(),
+                    _ => {}
+                }
             }
             prev_time = f[0].clone();
             f.join(",")
@@ -314,4 +335,470 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+// The differential test: many generated models, C against the stream, line by line.
+
+/// Models in the differential test (each method, scale factor above and below 1).
+const DIFF_MODELS: usize = 1000;
+/// Models linked into one driver binary.
+const BATCH: usize = 100;
+
+/// A whole model file (unsealed) around `features`, `bias` and `scale`.
+fn model_json(
+    method: &str,
+    features: serde_json::Value,
+    bias: serde_json::Value,
+    scale: Option<serde_json::Value>,
+) -> serde_json::Value {
+    let mut m = serde_json::json!({
+        "format_version": 1, "method": method, "features": features, "bias": bias,
+        "training": {"temp_range_c": {"min": -40.0, "max": 60.0},
+                     "rate_range_c_per_s": {"min": -0.05, "max": 0.05},
+                     "data_digest_sha256": "0".repeat(64), "epochs": null, "final_loss": null,
+                     "seed": null, "created_by": "export_c differential test",
+                     "inputs": ["generated"]},
+    });
+    if let Some(s) = scale {
+        m["scale"] = s;
+    }
+    m
+}
+
+/// Model `i`: kind `i % 6` is linear, poly, thermal-state least squares, LSTM, residual LSTM
+/// (with or without the base value as input), bias-only; the scale factor's constant is
+/// below 1 for even `i / 6` and above 1 for odd (with an LSTM scale model, its target mean).
+fn generated_model(i: usize) -> serde_json::Value {
+    let mut rng = Lcg(0x5eed + i as u64);
+    let kind = i % 6;
+    let k0 = if (i / 6) % 2 == 0 {
+        0.5 + 0.45 * (rng.next() + 0.5)
+    } else {
+        1.05 + 0.9 * (rng.next() + 0.5)
+    };
+    let pick = |rng: &mut Lcg, n: usize| ((rng.next() + 0.5) * n as f64) as usize % n;
+    let step = if i % 7 == 0 { 0.5 } else { 1.0 };
+    let lag = [20.0, 10.0, 5.0, 30.0][pick(&mut rng, 4)];
+    let smooth = [0.0, 0.0, 10.0, 30.0][pick(&mut rng, 4)];
+    let thermal = kind == 2 || (kind >= 3 && i % 2 == 0);
+    let taus: Vec<f64> = if thermal {
+        let n = 1 + pick(&mut rng, 4);
+        [300.0, 1000.0, 3000.0, 60.0][..n].to_vec()
+    } else {
+        Vec::new()
+    };
+    let outputs = ["diff_from_t", "level", "both"][pick(&mut rng, 3)];
+    let per_lag = if outputs == "both" { 2 } else { 1 };
+    let nf = 2 + usize::from(smooth > 0.0) + taus.len() * per_lag;
+    let degraded = [60.0, 30.0, 120.0][pick(&mut rng, 3)];
+    let max_rate = [2.0, 0.5][pick(&mut rng, 2)];
+    let allowance = [1.0, 0.2][pick(&mut rng, 2)];
+    let features = serde_json::json!({
+        "step_period_s": step, "rate_lag_s": lag, "smoothing_window_s": smooth,
+        "lag_tau_s": taus, "lag_outputs": outputs,
+        "temp_sensor": {"min_c": -60.0, "max_c": 100.0,
+                        "max_rate_c_per_s": max_rate, "step_allowance_c": allowance,
+                        "degraded_after_s": degraded}});
+    let baseline = |rng: &mut Lcg, c0: f64, poly: bool| {
+        let (mut terms, mut c) = linear_terms(nf, rng, 1e-5);
+        c[0] = c0;
+        if poly {
+            // T², T·dT, dT² (and T³): within MAX_TERMS for nf ≤ 12 only when nf is small.
+            let extra: &[[u8; 2]] = &[[2, 0], [1, 1], [0, 2], [3, 0]];
+            for p in extra.iter().take(16usize.saturating_sub(nf + 1)) {
+                let mut row = vec![0u8; nf];
+                row[0] = p[0];
+                row[1] = p[1];
+                terms["powers"].as_array_mut().unwrap().push(row.into());
+                c.push(1e-7 * rng.next());
+            }
+        }
+        serde_json::json!({"terms": terms, "coefficients": c})
+    };
+    let norm = |n: usize| {
+        let mut mean = vec![20.0, 0.0];
+        mean.resize(n, 1.0);
+        let mut std = vec![30.0, 0.03];
+        std.resize(n, 5.0);
+        (mean, std)
+    };
+    let lstm = |rng: &mut Lcg, target: (f64, f64)| {
+        let (mean, std) = norm(nf);
+        lstm_json(rng, nf, &mean, &std, target)
+    };
+    let residual = |rng: &mut Lcg, c0: f64, target: (f64, f64)| {
+        let reads_base = nf < 12 && rng.next() > 0.0;
+        let n_in = nf + usize::from(reads_base);
+        let (mut mean, mut std) = norm(n_in);
+        if reads_base {
+            mean[nf] = c0;
+            std[nf] = 5e-5;
+        }
+        let mut r = lstm_json(rng, n_in, &mean, &std, target);
+        let b = baseline(rng, c0, false);
+        r["terms"] = b["terms"].clone();
+        r["coefficients"] = b["coefficients"].clone();
+        r["lstm_reads_base"] = reads_base.into();
+        r
+    };
+    let bias_c0 = 2.7e-3;
+    let (method, bias, scale) = match kind {
+        0 => (
+            "linear",
+            serde_json::json!({"baseline": baseline(&mut rng, bias_c0, false)}),
+            Some(serde_json::json!({"baseline": baseline(&mut rng, k0, false)})),
+        ),
+        1 => (
+            "poly",
+            serde_json::json!({"baseline": baseline(&mut rng, bias_c0, true)}),
+            Some(serde_json::json!({"baseline": baseline(&mut rng, k0, true)})),
+        ),
+        2 => (
+            "linear",
+            serde_json::json!({"baseline": baseline(&mut rng, bias_c0, false)}),
+            Some(serde_json::json!({"baseline": baseline(&mut rng, k0, false)})),
+        ),
+        3 => (
+            "lstm",
+            serde_json::json!({"lstm": lstm(&mut rng, (bias_c0, 2e-5))}),
+            Some(serde_json::json!({"lstm": lstm(&mut rng, (k0, 1e-3))})),
+        ),
+        4 => (
+            "lstm",
+            serde_json::json!({"residual": residual(&mut rng, bias_c0, (0.0, 2e-5))}),
+            Some(serde_json::json!({"residual": residual(&mut rng, k0, (0.0, 1e-4))})),
+        ),
+        _ => {
+            let bias = match pick(&mut rng, 3) {
+                0 => serde_json::json!({"baseline": baseline(&mut rng, bias_c0, false)}),
+                1 => serde_json::json!({"lstm": lstm(&mut rng, (bias_c0, 2e-5))}),
+                _ => serde_json::json!({"residual": residual(&mut rng, bias_c0, (0.0, 2e-5))}),
+            };
+            let method = if bias.get("baseline").is_some() {
+                "linear"
+            } else {
+                "lstm"
+            };
+            (method, bias, None)
+        }
+    };
+    model_json(method, features, bias, scale)
+}
+
+/// Largest finite gyro sample the tester used: with K < 1, (Ĝ − B) / K overflows.
+const HUGE: f64 = 1.797e308;
+
+/// The fixed stream: 1 Hz, a temperature cycle and ramp, with every time fault (1e308,
+/// −1e308, NaN, +inf, single +1e9 s, repeated, backward, a 90 s dropout, 70 NaN times, a
+/// lasting reset to 0 and a lasting +1e9 s jump), overflow and NaN gyro samples, and
+/// temperature faults.
+fn fixed_stream() -> Vec<(f64, f64, f64)> {
+    let mut out = Vec::new();
+    for i in 0..900usize {
+        if (200..290).contains(&i) || (300..305).contains(&i) {
+            continue; // dropouts
+        }
+        let x = i as f64;
+        let mut t = match i {
+            600..=749 => x - 600.0,
+            750.. => x + 1e9,
+            _ => x,
+        };
+        let mut g = 0.01 + 1e-4 * (x / 7.0).sin();
+        let mut temp = 20.0 + 15.0 * (x / 150.0).sin() + 0.01 * x;
+        match i {
+            50 => t = 1e308,
+            60 => t = f64::NAN,
+            70 => t = f64::INFINITY,
+            80 => t = x + 1e9,
+            90..=95 => t = 89.0,
+            100 => t = -1e308,
+            110 => t = x - 30.0,
+            120 => g = HUGE,
+            121 => g = -HUGE,
+            122 => g = f64::NAN,
+            123 => g = f64::INFINITY,
+            130 | 160..=189 => temp = f64::NAN,
+            140 => temp = 85.0,
+            150 => temp = -127.0,
+            400..=469 => t = f64::NAN,
+            500 => (t, g) = (1e308, HUGE),
+            _ => {}
+        }
+        out.push((t, g, temp));
+    }
+    out
+}
+
+/// A random stream for model `seed`: about one line in eight is a fault of any kind, and
+/// clock resets and jumps sometimes last.
+fn random_stream(seed: u64) -> Vec<(f64, f64, f64)> {
+    let mut rng = Lcg(seed);
+    let (mut offset, mut out) = (0.0f64, Vec::new());
+    for i in 0..700usize {
+        let x = i as f64;
+        let u = rng.next() + 0.5;
+        let kind = ((rng.next() + 0.5) * 40.0) as usize;
+        let mut t = x + offset;
+        let mut g = 0.01 + 1e-3 * rng.next();
+        let mut temp = 15.0 + 20.0 * (x / 100.0).sin();
+        if u < 0.13 {
+            match kind {
+                0 => t = f64::NAN,
+                1 => t = f64::INFINITY,
+                2 => t = f64::NEG_INFINITY,
+                3 => t = 1e308,
+                4 => t = -1e308,
+                5 => t -= 1.0,
+                6 => t -= 30.0,
+                7 => t += 1e9,
+                8 => t += 45.0,
+                9 => {
+                    offset = -x; // lasting reset to 0
+                    t = 0.0;
+                }
+                10 => {
+                    offset += 1e9; // lasting jump
+                    t += 1e9;
+                }
+                11 => offset += 90.0, // a dropout from here on
+                12 => temp = f64::NAN,
+                13 => temp = 85.0,
+                14 => temp = -127.0,
+                15 => temp = 95.0,
+                16 => g = f64::NAN,
+                17 => g = HUGE,
+                18 => g = -HUGE,
+                19 => g = f64::INFINITY,
+                20 => (t, g, temp) = (f64::NAN, HUGE, f64::NAN),
+                _ => temp += 30.0 * rng.next(),
+            }
+        }
+        out.push((t, g, temp));
+    }
+    out
+}
+
+/// `compensate --stream`, in process: (status, rate or NaN when empty, bias, scale) per line.
+fn stream_in_process(
+    model: &gyrotherm::ModelFile,
+    samples: &[(f64, f64, f64)],
+) -> Vec<(usize, f64, f64, f64)> {
+    let mut text = String::from("time_s,gyro_dps,temp_c\n");
+    for (t, g, c) in samples {
+        text.push_str(&format!("{t:?},{g:?},{c:?}\n"));
+    }
+    let mut out = Vec::new();
+    gyrotherm::compensate_lines(
+        model,
+        text.as_bytes(),
+        Path::new("generated"),
+        &gyrotherm::ReadOptions::default(),
+        &mut out,
+        gyrotherm::compensate_lines::Mode::Stream,
+        false,
+    )
+    .unwrap();
+    let text = String::from_utf8(out).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            let status = ["ok", "held", "degraded", "invalid"]
+                .iter()
+                .position(|s| *s == f[6])
+                .unwrap();
+            let num = |s: &str| s.parse::<f64>().unwrap_or(f64::NAN);
+            (status, num(f[5]), num(f[3]), num(f[4]))
+        })
+        .collect()
+}
+
+/// gcc with the flags above at optimisation level `opt`.
+fn gcc(opt: &str, args: &[&str], files: &[&Path], out: &Path) {
+    run_ok(
+        Command::new("gcc")
+            .arg(opt)
+            .args([
+                "-std=c99",
+                "-ffp-contract=off",
+                "-Wall",
+                "-Wextra",
+                "-Werror",
+                "-pedantic",
+            ])
+            .args(args)
+            .args(files)
+            .arg("-lm")
+            .arg("-o")
+            .arg(out),
+    );
+}
+
+/// 1,000 generated models (every method; scale factor above and below 1), each exported to
+/// C, built with the same flags as above (at -O0) and run over two faulted streams (the
+/// fixed one and a random one per model, both with time faults and overflow gyro samples):
+/// every line's status, rate, bias and scale equal `compensate --stream`'s to the last bit.
+#[test]
+fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
+    if !have_gcc() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "gcc is required in CI for the C export test"
+        );
+        eprintln!("skipped: gcc not found (the C export test needs it)");
+        return;
+    }
+    let start = std::time::Instant::now();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
+    let fixed = fixed_stream();
+    let (mut lines, mut differ, mut statuses) = (0usize, 0usize, [0usize; 4]);
+    let mut failures = Vec::new();
+    let workers = std::thread::available_parallelism().map_or(2, |n| n.get().min(4));
+    for batch in 0..DIFF_MODELS.div_ceil(BATCH) {
+        let ids: Vec<usize> = (batch * BATCH..((batch + 1) * BATCH).min(DIFF_MODELS)).collect();
+        let bdir = d.join(format!("batch{batch}"));
+        std::fs::create_dir_all(&bdir).unwrap();
+        // Export and compile each model into its own object (in parallel).
+        let mut models = Vec::new();
+        for &i in &ids {
+            let text = serde_json::to_string(&generated_model(i)).unwrap();
+            let m = gyrotherm::ModelFile::from_json(&text)
+                .unwrap_or_else(|e| panic!("generated model {i}: {e}"));
+            let mdir = bdir.join(format!("m{i}"));
+            gyrotherm::export::export(&m, gyrotherm::export::Lang::C, &mdir).unwrap();
+            models.push((i, m, mdir));
+        }
+        let objs: Vec<PathBuf> = std::thread::scope(|s| {
+            let chunks: Vec<&[(usize, gyrotherm::ModelFile, PathBuf)]> =
+                models.chunks(models.len().div_ceil(workers)).collect();
+            let handles: Vec<_> = chunks
+                .into_iter()
+                .map(|chunk| {
+                    let here = &here;
+                    s.spawn(move || {
+                        chunk
+                            .iter()
+                            .map(|(i, _, mdir)| {
+                                let obj = mdir.join("model.o");
+                                // -O0: compiling 1,000 models is most of this test's
+                                // time (0.2 s each at -O0, 0.3 s at -O2, measured); the
+                                // -O2 build is the other test's. x86-64 SSE arithmetic is
+                                // IEEE at every level, and -ffp-contract=off holds.
+                                gcc(
+                                    "-O0",
+                                    &[
+                                        "-c",
+                                        &format!("-DGT_RUN=run_{i}"),
+                                        &format!("-Dgt_init=gt_init_{i}"),
+                                        &format!("-Dgt_step=gt_step_{i}"),
+                                        "-I",
+                                        mdir.to_str().unwrap(),
+                                    ],
+                                    &[&here.join("wrap.c")],
+                                    &obj,
+                                );
+                                obj
+                            })
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap())
+                .collect()
+        });
+        let mut runners = String::from("#define STREAMS 2u\n");
+        for &i in &ids {
+            runners.push_str(&format!(
+                "void run_{i}(size_t n, const double *in, unsigned char *status, double *out);\n"
+            ));
+        }
+        let list: Vec<String> = ids.iter().map(|i| format!("run_{i}")).collect();
+        runners.push_str(&format!(
+            "static const runner RUNS[] = {{{}}};\n",
+            list.join(", ")
+        ));
+        std::fs::write(bdir.join("batch_runners.h"), runners).unwrap();
+        let exe = bdir.join("batch");
+        let mut files: Vec<&Path> = vec![];
+        let main = here.join("batch_main.c");
+        files.push(&main);
+        files.extend(objs.iter().map(PathBuf::as_path));
+        gcc("-O2", &["-I", bdir.to_str().unwrap()], &files, &exe);
+        // Input: each model's two streams.
+        let streams: Vec<[Vec<(f64, f64, f64)>; 2]> = ids
+            .iter()
+            .map(|&i| [fixed.clone(), random_stream(0xfa17 + i as u64)])
+            .collect();
+        let mut input = Vec::new();
+        for ss in &streams {
+            for s in ss {
+                input.extend((s.len() as u64).to_le_bytes());
+                for (t, g, c) in s {
+                    for v in [t, g, c] {
+                        input.extend(v.to_le_bytes());
+                    }
+                }
+            }
+        }
+        std::fs::write(bdir.join("in.bin"), input).unwrap();
+        run_ok(
+            Command::new(&exe)
+                .arg(bdir.join("in.bin"))
+                .arg(bdir.join("out.bin")),
+        );
+        let out = std::fs::read(bdir.join("out.bin")).unwrap();
+        let mut at = 0usize;
+        let f64_at = |at: &mut usize| {
+            let v = f64::from_le_bytes(out[*at..*at + 8].try_into().unwrap());
+            *at += 8;
+            v
+        };
+        for ((i, m, _), ss) in models.iter().zip(&streams) {
+            for (k, s) in ss.iter().enumerate() {
+                let want = stream_in_process(m, s);
+                assert_eq!(want.len(), s.len(), "model {i}: one line out per line in");
+                let st: Vec<u8> = out[at..at + s.len()].to_vec();
+                at += s.len();
+                for (line, (w, c_status)) in want.iter().zip(st).enumerate() {
+                    let (r, b, sc) = (f64_at(&mut at), f64_at(&mut at), f64_at(&mut at));
+                    let c_status = c_status as usize;
+                    let same = c_status == w.0
+                        && b.to_bits() == w.2.to_bits()
+                        && sc.to_bits() == w.3.to_bits()
+                        && (c_status == 3 || r.to_bits() == w.1.to_bits());
+                    lines += 1;
+                    statuses[c_status.min(3)] += 1;
+                    if !same {
+                        differ += 1;
+                        if failures.len() < 5 {
+                            failures.push(format!(
+                                "model {i} stream {k} line {line} {:?}: C ({c_status}, {r:e}, \
+                                 {b:e}, {sc:e}) vs stream {w:?}",
+                                s[line]
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(at, out.len(), "driver output length");
+    }
+    println!(
+        "differential: {DIFF_MODELS} models × 2 streams: {lines} lines compared, {differ} differ \
+         (ok {}, held {}, degraded {}, invalid {}); {:.1} s",
+        statuses[0],
+        statuses[1],
+        statuses[2],
+        statuses[3],
+        start.elapsed().as_secs_f64()
+    );
+    assert!(
+        failures.is_empty() && differ == 0,
+        "{differ} lines differ: {failures:#?}"
+    );
 }

@@ -14,28 +14,69 @@
 //! Every sample gets a [`Status`]:
 //! - [`Status::Ok`]: the temperature was accepted and B and K are current (from the latest
 //!   feature step).
-//! - [`Status::Held`]: this temperature sample was rejected (see below). The feature pipeline
-//!   (thermal state, rate window, lags) and the LSTM states are not advanced, and B and K keep
-//!   their last good values. Also given when the models produced no usable B or K at a step
-//!   (non-finite, or K ≤ 0): the last good values are kept.
-//! - [`Status::Degraded`]: as held, but no good temperature has been seen for longer than
-//!   [`TempLimits::degraded_after_s`] (60 s by default), or never since the start: before the
-//!   first accepted temperature there is no model output, so B = 0 and K = 1 (the rate is the
-//!   raw gyro output).
+//! - [`Status::Held`]: this temperature sample was rejected, or its time stamp could not be
+//!   placed (see the time axis below). The feature pipeline (thermal state, rate window, lags)
+//!   and the LSTM states are not advanced, and B and K keep their last good values. Also given
+//!   when the models produced no usable B or K at a step (non-finite, or K ≤ 0): the last good
+//!   values are kept.
+//! - [`Status::Degraded`]: as held, but no good temperature for longer than
+//!   [`TempLimits::degraded_after_s`] (60 s by default) on the degraded clock (below), or never
+//!   since the start: before the first accepted temperature there is no model output, so B = 0
+//!   and K = 1 (the rate is the raw gyro output). Also given while a restarted pipeline
+//!   settles after a new time base (below), with B and K current.
 //! - [`Status::Invalid`]: the gyro sample itself is not finite, or so large that
 //!   (Ĝ − B) / K is beyond f64; there is no rate
-//!   ([`Corrected::rate`] is `None`, `rate_dps` is 0). The temperature is still judged and used.
+//!   ([`Corrected::rate`] is `None`, `rate_dps` is 0). The temperature and time are still
+//!   judged and used.
 //!
 //! A temperature sample is rejected when it is not finite; when it lies outside
 //! [`TempLimits::min_c`]..=[`TempLimits::max_c`]; when it implies a rate of change no chamber or
 //! aircraft bay produces: `|T − T_good| > max_rate_c_per_s · (t − t_good) + step_allowance_c`
-//! against the last accepted sample (`T_good` at `t_good`); or when its time stamp is not
-//! finite or not after the previous finite time stamp (the sample cannot be placed). The
-//! allowance absorbs sensor noise and resolution at high sample rates (a one-LSB flip of a
-//! DS18B20 at 100 Hz is 6 °C/s); because the allowed change grows with the time since the last
-//! good reading, a real temperature that moved during a long outage is accepted again after
-//! at most `|ΔT| / max_rate_c_per_s` seconds. The first sample's temperature is judged by the
-//! range alone.
+//! against the last accepted sample (`T_good` at `t_good`); or when its time stamp cannot be
+//! placed on the time base. The allowance absorbs sensor noise and resolution at high sample
+//! rates (a one-LSB flip of a DS18B20 at 100 Hz is 6 °C/s); because the allowed change grows
+//! with the time since the last good reading, a real temperature that moved during a long
+//! outage is accepted again after at most `|ΔT| / max_rate_c_per_s` seconds. The first sample's
+//! temperature (and the first on a new time base) is judged by the range alone.
+//!
+//! # The time axis
+//! A state machine with one current **time base** (`t_base`, the time of the latest placed
+//! sample) and at most one **candidate** base (the latest unplaced finite time and how many
+//! consecutive samples agree on it). With `D` = [`TempLimits::degraded_after_s`], a sample at
+//! time `t`:
+//! 1. **Placed** when `t` is finite and `0 < t − t_base ≤ D` (or there is no base yet: the first
+//!    finite time is placed). `t_base = t`, the candidate is dropped, and the temperature is
+//!    judged and used as above; the pipeline bridges the gap exactly (next section).
+//! 2. **Not placed** when `t` is NaN or ±∞, repeats `t_base`, is before it (a clock reset,
+//!    `−1e308`), or jumps more than `D` past it (`1e308`, `+1e9` s, a long silence): status
+//!    held (or degraded, below); its temperature is not used, the pipeline and the LSTM states
+//!    do not advance, B and K are held. A finite `t` becomes the candidate: count 1, or one
+//!    more than the candidate's count when `0 < t − t_cand ≤ D`. A non-finite `t` drops the
+//!    candidate.
+//! 3. **New base**: when the candidate's count reaches [`REBASE_AFTER`] (3 consecutive samples
+//!    that agree with each other but not with `t_base`), this sample is placed on a new base:
+//!    the pipeline restarts (rate window, moving average and lags, as at start), the LSTM
+//!    states are zeroed, and the temperature history is forgotten (the next good temperature
+//!    is judged by range alone); B and K stay held until the new pipeline's first step. From
+//!    that first step on, for [`FeatureSpec::settle_s`](crate::features::FeatureSpec::settle_s)
+//!    seconds (max of the rate lag and the smoothing window: 20 s published) the status is
+//!    degraded, with B and K from the new steps; then ok again. A single glitch (one bad time
+//!    among good ones) never re-bases: the next good sample is placed on the old base and
+//!    drops the candidate, so the glitch costs exactly what one rejected temperature costs.
+//!
+//! The **degraded clock** runs on placed time plus one step period per unplaced sample:
+//! a sample is degraded when `(t_base − t_ok) + P · n_unplaced > D`, with `t_ok` the time of
+//! the latest ok sample on this base and `n_unplaced` the samples since the latest placed one,
+//! so a stream of NaN, repeated or backward times turns degraded after `D / P` samples (60 at
+//! the default 1 s step; sooner in seconds for faster logs, which errs on the safe side).
+//! Nothing is held for good: once clean 1 Hz samples follow any faults, the status is ok
+//! again after at most `max(REBASE_AFTER − 1 + settle_s, (max_c − min_c − step_allowance_c) /
+//! max_rate_c_per_s)` seconds: either the samples fit the old base and only the rate limit
+//! can delay a temperature that moved, or they re-base and the new base judges temperature by
+//! range alone (80 s for the published spec and default limits). The pipeline's step index
+//! stays below
+//! [`MAX_STEP_INDEX`](crate::features::MAX_STEP_INDEX): a placed sample that would reach it
+//! re-bases at once.
 //!
 //! # Recovery without a transient
 //! Rejected samples never enter the pipeline, so nothing stale or spiky reaches the 20 s rate
@@ -50,6 +91,11 @@ use crate::error::{Channel, InputError};
 use crate::features::{FeaturePipeline, FeatureSpec, Features, SpecError, MAX_FEATURES};
 use crate::lstm::{Lstm, LstmWeights};
 use core::fmt;
+
+/// Consecutive samples that must agree on a new time base before it replaces the current one
+/// (see the module doc's time axis): three, so that one or two glitched time stamps among good
+/// ones never restart the pipeline, while a real clock reset costs two held samples.
+pub const REBASE_AFTER: u8 = 3;
 
 /// Hidden units of the flight LSTM: 8, as published (He et al. 2024, §2).
 pub const HIDDEN: usize = 8;
@@ -275,9 +321,11 @@ impl TargetModel {
 pub enum Status {
     /// Temperature accepted; B and K current.
     Ok = 0,
-    /// Temperature rejected: features, thermal state and LSTM states held; B and K held.
+    /// Temperature rejected or time stamp not placed: features, thermal state and LSTM states
+    /// held; B and K held.
     Held = 1,
-    /// No good temperature for longer than [`TempLimits::degraded_after_s`] (or none yet).
+    /// No good temperature for longer than [`TempLimits::degraded_after_s`] on the degraded
+    /// clock (or none yet), or settling on a new time base.
     Degraded = 2,
     /// The gyro sample is not finite (or its corrected rate would overflow): no rate.
     Invalid = 3,
@@ -422,11 +470,20 @@ pub struct Compensator {
     held: Option<(f64, f64)>,
     /// `held` came from the latest step (false after a step whose models failed).
     current: bool,
-    /// Latest finite time stamp, s (time order is judged against it).
-    last_time_s: Option<f64>,
+    /// Time of the latest placed sample, s: the current time base.
+    base_s: Option<f64>,
+    /// Samples since the latest placed one (saturating): the degraded clock's count.
+    unplaced: u32,
+    /// Candidate new time base: latest unplaced finite time and how many consecutive samples
+    /// agree on it.
+    candidate: Option<(f64, u8)>,
+    /// Re-based, and the new pipeline has not had its first step yet.
+    rebased: bool,
+    /// After a re-base: degraded while the time base is before this time.
+    settle_end_s: Option<f64>,
     /// Time and value of the latest accepted temperature.
     last_good: Option<(f64, f64)>,
-    /// Time of the latest sample with status `Ok` (or its temperature accepted).
+    /// Time of the latest sample with fresh B and K on this base.
     last_ok_s: Option<f64>,
 }
 
@@ -460,7 +517,11 @@ impl Compensator {
             limits,
             held: None,
             current: false,
-            last_time_s: None,
+            base_s: None,
+            unplaced: 0,
+            candidate: None,
+            rebased: false,
+            settle_end_s: None,
             last_good: None,
             last_ok_s: None,
         })
@@ -476,8 +537,8 @@ impl Compensator {
         &self.limits
     }
 
-    /// Whether a temperature reading at `time_s` (already known finite and after every
-    /// earlier time stamp) is believed.
+    /// Whether a temperature reading at `time_s` (already placed on the time base) is
+    /// believed.
     fn plausible(&self, time_s: f64, temp_c: f64) -> bool {
         let l = &self.limits;
         if !(temp_c >= l.min_c && temp_c <= l.max_c) {
@@ -495,37 +556,33 @@ impl Compensator {
     /// One sample: time (s, increasing), gyro output Ĝ (°/s), temperature (°C). Never fails:
     /// the [`Status`] says what the output is worth (see the module doc).
     pub fn step(&mut self, time_s: f64, gyro_dps: f64, temp_c: f64) -> Corrected {
-        let time_ok = time_s.is_finite() && self.last_time_s.is_none_or(|t| time_s > t);
         let mut fresh = false;
-        if time_ok {
-            self.last_time_s = Some(time_s);
-            if self.plausible(time_s, temp_c) {
-                match self.pipeline.push(time_s, temp_c) {
-                    Ok(Some(step)) => {
-                        self.last_good = Some((time_s, temp_c));
-                        fresh = self.eval(&step.features);
-                    }
-                    Ok(None) => {
-                        self.last_good = Some((time_s, temp_c));
-                        fresh = self.current;
-                    }
-                    // Unreachable: time and temperature were checked above.
-                    Err(_) => {}
-                }
-            }
+        if self.place(time_s) && self.plausible(time_s, temp_c) {
+            fresh = self.push(time_s, temp_c);
         }
         if fresh {
-            self.last_ok_s = self.last_time_s;
+            self.last_ok_s = self.base_s;
         }
         let (bias_dps, scale) = self.held.unwrap_or((0.0, 1.0));
+        let settling = match (self.settle_end_s, self.base_s) {
+            (Some(end), Some(now)) => now < end,
+            _ => false,
+        };
         // A finite sample so large that (Ĝ − B) / K overflows has no rate either.
         let status = if !(gyro_dps.is_finite() && ((gyro_dps - bias_dps) / scale).is_finite()) {
             Status::Invalid
+        } else if settling {
+            Status::Degraded
         } else if fresh {
             Status::Ok
         } else {
-            match (self.last_ok_s, self.last_time_s) {
-                (Some(ok), Some(now)) if now - ok <= self.limits.degraded_after_s => Status::Held,
+            let unplaced_s = self.spec().step_period_s * f64::from(self.unplaced);
+            match (self.last_ok_s, self.base_s) {
+                (Some(ok), Some(now))
+                    if (now - ok) + unplaced_s <= self.limits.degraded_after_s =>
+                {
+                    Status::Held
+                }
                 _ => Status::Degraded,
             }
         };
@@ -538,6 +595,79 @@ impl Compensator {
             bias_dps,
             scale,
             rate_dps,
+        }
+    }
+
+    /// The time axis (module doc): whether `time_s` is placed on the time base, re-basing
+    /// when the candidate has gathered [`REBASE_AFTER`] samples.
+    fn place(&mut self, time_s: f64) -> bool {
+        let d = self.limits.degraded_after_s;
+        let fits = |base: f64| time_s > base && time_s - base <= d;
+        if !time_s.is_finite() {
+            self.candidate = None;
+            self.unplaced = self.unplaced.saturating_add(1);
+            return false;
+        }
+        if self.base_s.is_none_or(fits) {
+            self.base_s = Some(time_s);
+            self.unplaced = 0;
+            self.candidate = None;
+            return true;
+        }
+        let n = match self.candidate {
+            Some((t, n)) if fits(t) => n.saturating_add(1),
+            _ => 1,
+        };
+        if n >= REBASE_AFTER {
+            self.rebase();
+            self.base_s = Some(time_s);
+            self.unplaced = 0;
+            self.candidate = None;
+            return true;
+        }
+        self.candidate = Some((time_s, n));
+        self.unplaced = self.unplaced.saturating_add(1);
+        false
+    }
+
+    /// Start a new time base: restart the pipeline and the LSTM states, forget the
+    /// temperature history; B and K stay held until the new pipeline's first step.
+    fn rebase(&mut self) {
+        self.pipeline.reset();
+        self.bias.reset();
+        self.scale.reset();
+        self.current = false;
+        self.last_good = None;
+        self.last_ok_s = None;
+        self.rebased = true;
+        self.settle_end_s = None;
+    }
+
+    /// Feed a placed, believed sample to the pipeline; true when B and K are fresh.
+    fn push(&mut self, time_s: f64, temp_c: f64) -> bool {
+        let pushed = match self.pipeline.push(time_s, temp_c) {
+            // Steps can no longer be counted exactly on this base: start a new one here.
+            Err(InputError::TimeOutOfRange) => {
+                self.rebase();
+                self.pipeline.push(time_s, temp_c)
+            }
+            r => r,
+        };
+        match pushed {
+            Ok(Some(step)) => {
+                self.last_good = Some((time_s, temp_c));
+                if self.rebased {
+                    self.rebased = false;
+                    self.settle_end_s = Some(time_s + self.spec().settle_s());
+                }
+                self.eval(&step.features)
+            }
+            Ok(None) => {
+                self.last_good = Some((time_s, temp_c));
+                self.current
+            }
+            // Unreachable: time and temperature were checked before.
+            Err(_) => false,
         }
     }
 
@@ -569,7 +699,11 @@ impl Compensator {
         self.scale.reset();
         self.held = None;
         self.current = false;
-        self.last_time_s = None;
+        self.base_s = None;
+        self.unplaced = 0;
+        self.candidate = None;
+        self.rebased = false;
+        self.settle_end_s = None;
         self.last_good = None;
         self.last_ok_s = None;
     }

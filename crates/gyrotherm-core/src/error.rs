@@ -24,6 +24,10 @@ pub enum InputError {
     NonFinite(Channel),
     /// Time did not increase from the previous sample.
     TimeNotIncreasing,
+    /// Time so far after the first sample that its step index would reach
+    /// [`MAX_STEP_INDEX`](crate::features::MAX_STEP_INDEX) (steps could no longer be counted
+    /// exactly).
+    TimeOutOfRange,
 }
 
 impl fmt::Display for Channel {
@@ -42,6 +46,9 @@ impl fmt::Display for InputError {
         match self {
             InputError::NonFinite(c) => write!(f, "non-finite {c} input"),
             InputError::TimeNotIncreasing => f.write_str("time did not increase"),
+            InputError::TimeOutOfRange => {
+                f.write_str("time too far after the first sample to count its step exactly")
+            }
         }
     }
 }

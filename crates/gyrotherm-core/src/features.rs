@@ -50,6 +50,10 @@ pub const MAX_LAGS: usize = 4;
 pub const HISTORY_STEPS: usize = 64;
 /// A sample this many step periods before a boundary counts as at the boundary.
 pub const BOUNDARY_TOL_STEPS: f64 = 1e-6;
+/// Step indices stay below 2^53, so that every index and every difference of indices is an
+/// exact f64 (and `f64 as u64` never saturates); a later sample is refused with
+/// [`InputError::TimeOutOfRange`].
+pub const MAX_STEP_INDEX: u64 = 1 << 53;
 
 /// Which lag outputs are features.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -232,6 +236,13 @@ impl FeatureSpec {
         Ok(())
     }
 
+    /// The longest history a feature reads step by step: the rate lag or the smoothing
+    /// window, s. A restarted pipeline has its full windows again this long after its first
+    /// sample (20 s for [`PUBLISHED`](Self::PUBLISHED)).
+    pub fn settle_s(&self) -> f64 {
+        self.rate_lag_s.max(self.smoothing_window_s)
+    }
+
     fn has_smoothing(&self) -> bool {
         self.smoothing_window_s != 0.0
     }
@@ -409,7 +420,9 @@ impl FeaturePipeline {
     /// first sample always does), `Ok(None)` while holding between boundaries.
     ///
     /// Errors, with the pipeline left exactly as it was: `NonFinite(Time)`,
-    /// `NonFinite(Temperature)`, `TimeNotIncreasing` (time not above the previous sample's).
+    /// `NonFinite(Temperature)`, `TimeNotIncreasing` (time not above the previous sample's),
+    /// `TimeOutOfRange` (the step index since the first sample would reach
+    /// [`MAX_STEP_INDEX`]; only [`reset`](Self::reset) makes the pipeline usable again).
     pub fn push(&mut self, time_s: f64, temp_c: f64) -> Result<Option<Step>, InputError> {
         if !time_s.is_finite() {
             return Err(InputError::NonFinite(Channel::Time));
@@ -431,7 +444,11 @@ impl FeaturePipeline {
             return Err(InputError::TimeNotIncreasing);
         }
         let q = (time_s - self.t0_s) / self.spec.step_period_s + BOUNDARY_TOL_STEPS;
-        // q > 0 here; `as` saturates for huge or infinite q, which then holds forever.
+        // q > 0 and not NaN here. A huge or infinite q would saturate `as u64`, and every later sample
+        // would fall on the same step and hold for good: refuse it instead.
+        if q >= MAX_STEP_INDEX as f64 {
+            return Err(InputError::TimeOutOfRange);
+        }
         let k = libm::floor(q) as u64;
         self.last_time_s = time_s;
         if k <= self.last_step {

@@ -397,3 +397,251 @@ proptest! {
         }
     }
 }
+
+// The time axis (module doc of `compensator`): placed, not placed, new base.
+
+/// One run of 1 Hz samples on a ramp (20 °C + 0.01 °C/s, gyro 0.01 °/s), with `edit` applied
+/// to sample `i`'s (time, gyro, temp); the outputs.
+fn ramp_run(
+    mut c: Compensator,
+    n: usize,
+    edit: impl Fn(usize, (f64, f64, f64)) -> (f64, f64, f64),
+) -> Vec<gyrotherm_core::Corrected> {
+    (0..n)
+        .map(|i| {
+            let t = i as f64;
+            let (t, g, temp) = edit(i, (t, 0.01, 20.0 + 0.01 * t));
+            c.step(t, g, temp)
+        })
+        .collect()
+}
+
+/// One glitched time stamp (1e308, +1e9 s, NaN, a repeat, a reset to 0) among good ones costs
+/// exactly what one rejected temperature costs: the run equals, on every line, the run whose
+/// sample 100 has a NaN temperature instead; the glitch line is held, none is degraded.
+#[test]
+fn a_single_time_glitch_costs_one_rejected_temperature() {
+    for mk in [linear_compensator, lstm_compensator] {
+        let reference = ramp_run(mk(), 400, |i, (t, g, temp)| {
+            (t, g, if i == 100 { f64::NAN } else { temp })
+        });
+        for glitch in [
+            1e308,
+            100.0 + 1e9,
+            f64::NAN,
+            f64::INFINITY,
+            99.0,
+            0.0,
+            -1e308,
+        ] {
+            let run = ramp_run(mk(), 400, |i, (t, g, temp)| {
+                (if i == 100 { glitch } else { t }, g, temp)
+            });
+            assert_eq!(run, reference, "glitch time {glitch}");
+            assert_eq!(run[100].status, Status::Held, "glitch time {glitch}");
+            assert!(run.iter().all(|o| o.status != Status::Degraded));
+        }
+    }
+}
+
+/// The hostile tester's case: 100 good lines, one at 1e308, then a ramp: before the fix every
+/// later line was held with B frozen. Now only the glitch line is held and B follows T.
+#[test]
+fn time_1e308_does_not_freeze_the_compensator() {
+    let run = ramp_run(linear_compensator(), 3701, |i, (t, g, temp)| {
+        (if i == 100 { 1e308 } else { t }, g, temp)
+    });
+    let held = run.iter().filter(|o| o.status == Status::Held).count();
+    assert_eq!(held, 1);
+    let last = run.last().unwrap();
+    // bias = 1e-3 + 2e-5·T at T = 20 + 0.01·3700 (linear_compensator).
+    let want = 1e-3 + 2e-5 * (20.0 + 0.01 * 3700.0);
+    assert!((last.bias_dps - want).abs() < 1e-15, "{}", last.bias_dps);
+}
+
+/// A lasting clock change (a reset to 0, a +1e9 s jump, a first time stamp of 1e308 on a new
+/// compensator): `REBASE_AFTER - 1` samples held, then a new base with `settle_s` (20 s)
+/// degraded, then ok; after the settling the outputs equal those of a new compensator started
+/// at the re-basing sample, bit for bit (pipeline and LSTM states restarted).
+#[test]
+fn a_lasting_clock_change_rebases_settles_and_recovers() {
+    use gyrotherm_core::compensator::REBASE_AFTER;
+    let settle = FeatureSpec::PUBLISHED.settle_s();
+    assert_eq!(settle, 20.0);
+    type TimeOf = fn(usize, f64) -> f64;
+    let cases: [(&str, TimeOf); 3] = [
+        ("reset to 0", |i, t| if i >= 300 { t - 300.0 } else { t }),
+        ("+1e9 s", |i, t| if i >= 300 { t + 1e9 } else { t }),
+        ("1e308 first", |i, t| if i == 0 { 1e308 } else { t }),
+    ];
+    for mk in [linear_compensator, lstm_compensator] {
+        for (name, time) in cases {
+            let from = if name == "1e308 first" { 1 } else { 300 };
+            let run = ramp_run(mk(), 600, |i, (t, g, temp)| (time(i, t), g, temp));
+            let adopt = from + REBASE_AFTER as usize - 1;
+            for (i, o) in run.iter().enumerate().skip(from) {
+                let want = if i < adopt {
+                    Status::Held
+                } else if (i - adopt) < settle as usize {
+                    Status::Degraded
+                } else {
+                    Status::Ok
+                };
+                assert_eq!(o.status, want, "{name}: sample {i}");
+            }
+            let fresh = ramp_run(mk(), 600, |i, (t, g, temp)| {
+                if i < adopt {
+                    (f64::NAN, g, f64::NAN)
+                } else {
+                    (time(i, t), g, temp)
+                }
+            });
+            for i in adopt..600 {
+                assert_eq!(
+                    (run[i].bias_dps, run[i].scale, run[i].rate_dps),
+                    (fresh[i].bias_dps, fresh[i].scale, fresh[i].rate_dps),
+                    "{name}: sample {i}"
+                );
+            }
+        }
+    }
+}
+
+/// Repeated and NaN time stamps: each is one step period (1 s) on the degraded clock, so after
+/// 60 of them (degraded_after_s at the default 1 s step) the status is degraded, not held for
+/// good; when good time stamps come back on the old base it is ok at once.
+#[test]
+fn repeated_and_nan_times_run_the_degraded_clock() {
+    for bad in [99.0, f64::NAN] {
+        let run = ramp_run(linear_compensator(), 200, |i, (t, g, temp)| {
+            if (100..161).contains(&i) {
+                (bad, g, temp)
+            } else {
+                // Good times resume at 100 + 55 s: on the old base (base 99, ≤ 60 s later).
+                (if i >= 161 { t - 161.0 + 154.0 } else { t }, g, temp)
+            }
+        });
+        for (i, o) in run.iter().enumerate().take(161).skip(100) {
+            // Unplaced sample n = i − 99: degraded once n · 1 s > 60 s.
+            let want = if i - 99 > 60 {
+                Status::Degraded
+            } else {
+                Status::Held
+            };
+            assert_eq!(o.status, want, "time {bad}: sample {i}");
+        }
+        assert_eq!(run[161].status, Status::Ok, "time {bad}");
+        assert!(run[161..].iter().all(|o| o.status == Status::Ok));
+    }
+}
+
+/// The step index stays below 2^53: with a 1 ns step and degraded_after_s = 1e7 s, a sample
+/// 1e7 s after the first would be step 1e16; it re-bases instead of saturating into a hold.
+#[test]
+fn step_index_never_saturates() {
+    use gyrotherm_core::features::{FeaturePipeline, MAX_STEP_INDEX};
+    use gyrotherm_core::InputError;
+    let spec = FeatureSpec {
+        step_period_s: 1e-9,
+        rate_lag_s: 20e-9,
+        ..FeatureSpec::PUBLISHED
+    };
+    let mut p = FeaturePipeline::new(spec).unwrap();
+    p.push(0.0, 20.0).unwrap();
+    assert!(1e7 / 1e-9 > MAX_STEP_INDEX as f64);
+    assert_eq!(p.push(1e7, 20.0), Err(InputError::TimeOutOfRange));
+    // Left as it was: the next in-range sample is step 1000.
+    assert_eq!(p.push(1e-6, 20.0).unwrap().unwrap().index, 1000);
+
+    let limits = TempLimits {
+        degraded_after_s: 1e7,
+        ..TempLimits::DEFAULT
+    };
+    let model = |m| TargetModel {
+        offset: 0.0,
+        baseline: Some(m),
+        lstm: None,
+        lstm_reads_base: false,
+    };
+    let mut b = BaselineModel::new(2).unwrap();
+    b.push_term(&[1, 0], 1e-4).unwrap();
+    let mut c =
+        Compensator::with_limits(spec, model(b), TargetModel::constant(1.0), limits).unwrap();
+    assert_eq!(c.step(0.0, 0.0, 20.0).status, Status::Ok);
+    // Re-based here: degraded while the 20 ns settle runs, B from the new step (T = 21).
+    let o = c.step(1e7, 0.0, 21.0);
+    assert_eq!((o.status, o.bias_dps), (Status::Degraded, 21.0 * 1e-4));
+    let o = c.step(1e7 + 1.0, 0.0, 22.0);
+    assert_eq!((o.status, o.bias_dps), (Status::Ok, 22.0 * 1e-4));
+}
+
+/// A fault of any kind, as (time, gyro, temp) from the true clock `t` and temperature.
+fn fault_sample(kind: u8, t: f64, base_temp: f64, wild: f64) -> (f64, f64, f64) {
+    const BIG: f64 = 1.797e308;
+    let g = 0.01;
+    match kind {
+        0 => (f64::NAN, g, base_temp),
+        1 => (f64::INFINITY, g, base_temp),
+        2 => (f64::NEG_INFINITY, g, base_temp),
+        3 => (1e308, g, base_temp),
+        4 => (-1e308, g, base_temp),
+        5 => (t - 1.0, g, base_temp), // repeats the previous time stamp
+        6 => (t - 30.0, g, base_temp), // backward step
+        7 => (t - t.floor(), g, base_temp), // reset towards 0
+        8 => (t + 1e9, g, base_temp), // forward jump
+        9 => (t + 45.0, g, base_temp), // forward, within degraded_after_s
+        10 => (t, g, f64::NAN),
+        11 => (t, g, 85.0),
+        12 => (t, g, -127.0),
+        13 => (t, g, wild),
+        14 => (t, f64::NAN, base_temp),
+        15 => (t, BIG, base_temp),
+        16 => (t, -BIG, base_temp),
+        17 => (t, f64::INFINITY, f64::INFINITY),
+        18 => (wild, wild, wild),
+        19 => (t, g, 95.0), // in range, wrong, accepted if the rate limit allows
+        _ => (t, g, base_temp),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// Any sequence of faults (time: NaN, ±inf, ±1e308, repeats, backward steps, resets,
+    /// forward jumps; temperature and gyro faults) followed by 150 s of clean 1 Hz samples
+    /// ends ok, and is ok from clean sample 80 on (the documented bound for the published
+    /// spec and default limits: max(2 + 20 s, (160 − 1) / 2 s) = 79.5 s); the rate is finite
+    /// whenever the gyro sample is finite and the status is not invalid.
+    #[test]
+    fn any_faults_then_clean_samples_end_ok(
+        faults in prop::collection::vec((0u8..24, any::<f64>()), 0..200),
+        clean_start in prop_oneof![Just(None), Just(Some(0.0)), Just(Some(-5000.0)),
+                                   Just(Some(1e9)), Just(Some(1e12)), (-1e6f64..1e6).prop_map(Some)],
+        clean_temp in -40.0f64..80.0,
+        slope in -0.05f64..0.05,
+    ) {
+        for mut c in [linear_compensator(), lstm_compensator()] {
+            let mut t = 1000.0;
+            let check = |o: &gyrotherm_core::Corrected, g: f64| {
+                !(g.is_finite() && o.status != Status::Invalid) || o.rate_dps.is_finite()
+            };
+            for (i, (kind, wild)) in faults.iter().enumerate() {
+                let base_temp = 20.0 + 0.01 * i as f64;
+                let (ts, g, temp) = fault_sample(*kind, t, base_temp, *wild);
+                let o = c.step(ts, g, temp);
+                prop_assert!(check(&o, g), "fault {kind}: {o:?}");
+                t += 1.0;
+            }
+            let t0 = clean_start.unwrap_or(t);
+            for k in 0..150 {
+                let tk = t0 + k as f64;
+                let g = 0.01 + 1e-4 * k as f64;
+                let o = c.step(tk, g, clean_temp + slope * k as f64);
+                prop_assert!(check(&o, g), "clean {k}: {o:?}");
+                if k >= 80 {
+                    prop_assert_eq!(o.status, Status::Ok, "clean sample {} after {:?}", k, faults);
+                }
+            }
+        }
+    }
+}

@@ -10,17 +10,19 @@
 //! Temperature faults never stop the run: an empty, non-numeric, NaN or implausible temperature
 //! is handed to the compensator as a fault and the line is `held` (or `degraded`). A gyro field
 //! that is NaN or infinite gives `invalid` with an empty `gyro_comp_dps`. Malformed lines
-//! (wrong field count, a time or gyro field that is not a number, time not increasing) depend
-//! on the [`Mode`]: [`Mode::Strict`] (batch files) stops with an error naming the file, line
-//! and column; [`Mode::Stream`] writes the line as `invalid` (its fields, or empty fields when
-//! their count is wrong, and empty outputs) and reads the next line, except a time that does
-//! not increase, which the compensator holds (`held`: the sample cannot be placed in time). Time gaps are bridged by
-//! the compensator (no gap filling, no period estimate: the first output line follows the first
-//! input line at once). Quoted fields may hold the separator and quotes but not line breaks.
-//! The separator is [`ReadOptions::delimiter`](crate::csvlog::ReadOptions::delimiter); with
-//! `;` or tab, numbers may use a decimal comma, and the output uses the same separator (numbers
-//! with a decimal point, which the reader accepts beside the comma). A line longer than
-//! [`MAX_LINE_BYTES`] is malformed (its bytes are skipped, not kept).
+//! (wrong field count, a time or gyro field that is not a number, a time that is not finite or
+//! does not increase) depend on the [`Mode`]: [`Mode::Strict`] (batch files) stops with an
+//! error naming the file, line and column; [`Mode::Stream`] writes the line as `invalid` (its
+//! fields, or empty fields when their count is wrong, and empty outputs) and reads the next
+//! line, except a time that is a number but NaN, infinite or out of order, which goes to the
+//! compensator's time axis (`held` or `degraded`, see [`gyrotherm_core::compensator`]). Time
+//! gaps are bridged by the compensator (no gap filling, no period estimate: the first output
+//! line follows the first input line at once). Quoted fields may hold the separator and quotes
+//! but not line breaks. The separator is
+//! [`ReadOptions::delimiter`](crate::csvlog::ReadOptions::delimiter); with `;` or tab, numbers
+//! may use a decimal comma, and the output uses the same separator (numbers with a decimal
+//! point, which the reader accepts beside the comma). A line longer than [`MAX_LINE_BYTES`] is
+//! malformed (its bytes are skipped, not kept).
 
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -481,6 +483,9 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             }
             let time_s = match parse_number(fields.get(line, ti), decimal_comma) {
                 Some(t) if t.is_finite() => t,
+                // A live feed hands a NaN or infinite time to the compensator, whose time
+                // axis gives it a status (and the gyro sample a rate).
+                Some(t) if mode == Mode::Stream => t,
                 _ => {
                     return Err(err(
                         LogErrorKind::NotANumber,

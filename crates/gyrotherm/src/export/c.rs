@@ -14,7 +14,8 @@
 
 use std::fmt::Write as _;
 
-use gyrotherm_core::features::{LagOutputs, HISTORY_STEPS};
+use gyrotherm_core::compensator::REBASE_AFTER;
+use gyrotherm_core::features::{LagOutputs, HISTORY_STEPS, MAX_STEP_INDEX};
 use gyrotherm_core::static_model::{StaticModel, StaticTarget};
 
 use super::{f32_lit, f64_lit};
@@ -171,8 +172,13 @@ pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
         LagOutputs::DiffFromT => (0, 1),
         LagOutputs::Both => (1, 1),
     };
+    let l = &m.limits;
     let header = HEADER
         .replace("@ABOUT@", about)
+        .replace("@DEGRADED_S@", &l.degraded_after_s.to_string())
+        .replace("@REBASE_AFTER@", &REBASE_AFTER.to_string())
+        .replace("@SETTLE_S@", &spec.settle_s().to_string())
+        .replace("@STEP_S@", &p.to_string())
         .replace("@NF@", &nf.to_string())
         .replace("@LAGS@", &lag_slots.to_string())
         .replace("@HIST@", &HISTORY_STEPS.to_string());
@@ -190,7 +196,6 @@ pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
         1.0,
     ];
     let p7: f32 = 1.0 / 5_040.0;
-    let l = &m.limits;
     let source = SOURCE
         .replace("@ABOUT@", about)
         .replace("@N_LAGS@", &n_lags.to_string())
@@ -210,6 +215,9 @@ pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
         .replace("@RATE_MAX@", &d(l.max_rate_c_per_s))
         .replace("@ALLOW@", &d(l.step_allowance_c))
         .replace("@DEGRADED@", &d(l.degraded_after_s))
+        .replace("@SETTLE@", &d(spec.settle_s()))
+        .replace("@MAX_STEP@", &d(MAX_STEP_INDEX as f64))
+        .replace("@REBASE_AFTER@", &REBASE_AFTER.to_string())
         .replace("@LOG2E@", &f(core::f32::consts::LOG2_E))
         .replace("@LN2_HI@", &f(0.693_145_75))
         .replace("@LN2_LO@", &f(1.428_606_8e-6))
@@ -230,10 +238,23 @@ const HEADER: &str = r#"/* gyrotherm_model.h: FOG thermal compensation, generate
  * G = (gyro - B) / K:
  *   GT_OK       temperature accepted, B and K current;
  *   GT_HELD     this temperature sample was rejected (not finite, outside the plausible
- *               range, or changing faster than the rate limit, or a time stamp that is not
- *               finite or not increasing): features and LSTM states held, B and K last good;
- *   GT_DEGRADED held for longer than the limit (or no good temperature yet: B = 0, K = 1);
- *   GT_INVALID  the gyro sample is not finite: no rate (*rate_dps = 0).
+ *               range, or changing faster than the rate limit) or its time stamp was not
+ *               placed (below): features and LSTM states held, B and K last good;
+ *   GT_DEGRADED held for longer than the limit on the degraded clock (or no good temperature
+ *               yet: B = 0, K = 1), or settling on a new time base (B and K current);
+ *   GT_INVALID  the gyro sample is not finite, or (gyro - B) / K is not: no rate
+ *               (*rate_dps = 0).
+ * Time axis (as gyrotherm-core's compensator module doc), with D = @DEGRADED_S@ s:
+ *   placed      t finite and 0 < t - t_base <= D (or the first finite time): t_base = t, the
+ *               candidate is dropped, the temperature is judged and used;
+ *   not placed  t NaN or infinite, repeated, backward or more than D ahead: held (degraded
+ *               below), temperature unused, B and K held; a finite t becomes the candidate
+ *               (count 1, or one more when 0 < t - t_cand <= D); a non-finite t drops it;
+ *   new base    when the candidate count reaches @REBASE_AFTER@: features, lags and LSTM states
+ *               restart at this sample, the temperature history is forgotten, and the status
+ *               is degraded for @SETTLE_S@ s from the new first step, then ok.
+ *   A single bad time among good ones never re-bases. Degraded clock: degraded when
+ *   (t_base - t_ok) + @STEP_S@ s * (samples since the last placed one) > D.
  * The numbers equal gyrotherm-core's (and `gyrotherm compensate --stream`'s) to the last bit
  * when compiled with -ffp-contract=off on IEEE 754 hardware with FLT_EVAL_METHOD == 0. */
 #ifndef GYROTHERM_MODEL_H
@@ -266,11 +287,16 @@ struct gt_state {
     float lstm_c[2][GT_HIDDEN];
     double held_bias;
     double held_scale;
-    double last_time_s;                /* latest finite, increasing time stamp */
+    double base_s;                     /* time base: latest placed time stamp */
+    double cand_s;                     /* candidate base: latest unplaced finite time */
+    double settle_end_s;               /* after a new base: degraded before this time */
     double good_time_s;                /* latest accepted temperature and its time */
     double good_temp_c;
-    double ok_time_s;                  /* latest sample with GT_OK */
-    uint8_t started, has_held, current, has_last_time, has_good, has_ok;
+    double ok_time_s;                  /* latest sample with fresh B and K on this base */
+    uint32_t unplaced;                 /* samples since the latest placed one */
+    uint8_t cand_n;                    /* samples agreeing on the candidate */
+    uint8_t started, has_held, current, has_base, has_cand, rebased, has_settle, has_good,
+        has_ok;
 };
 
 typedef enum { GT_OK = 0, GT_HELD = 1, GT_DEGRADED = 2, GT_INVALID = 3 } gt_status;
@@ -309,6 +335,9 @@ static const double T_MAX = @T_MAX@;
 static const double RATE_MAX = @RATE_MAX@;
 static const double STEP_ALLOWANCE = @ALLOW@;
 static const double DEGRADED_AFTER = @DEGRADED@;
+static const double SETTLE_S = @SETTLE@;
+static const double MAX_STEP_INDEX = @MAX_STEP@;
+#define REBASE_AFTER @REBASE_AFTER@u
 
 typedef struct {
     int n_terms;
@@ -669,22 +698,12 @@ static void emit(gt_state *s, uint64_t k, uint64_t n, double t, double *feat)
     }
 }
 
-/* Rust's saturating `f64 as u64`. */
-static uint64_t sat_u64(double x)
-{
-    if (!(x > 0.0)) {
-        return 0u;
-    }
-    if (x >= 18446744073709551616.0) {
-        return UINT64_MAX;
-    }
-    return (uint64_t)x;
-}
-
-/* FeaturePipeline::push: 1 new step (features in feat), 0 holding, -1 refused. */
+/* FeaturePipeline::push: 1 new step (features in feat), 0 holding, -1 refused, -2 time out
+ * of range (the step index would reach MAX_STEP_INDEX). */
 static int pipe_push(gt_state *s, double time_s, double temp_c, double *feat)
 {
     uint64_t k, n;
+    double q;
     int j;
     if (!isfinite(time_s) || !isfinite(temp_c)) {
         return -1;
@@ -705,7 +724,11 @@ static int pipe_push(gt_state *s, double time_s, double temp_c, double *feat)
     if (time_s <= s->pipe_last_s) {
         return -1;
     }
-    k = sat_u64(floor((time_s - s->t0_s) / STEP_P + BOUNDARY_TOL));
+    q = (time_s - s->t0_s) / STEP_P + BOUNDARY_TOL;
+    if (q >= MAX_STEP_INDEX) {
+        return -2;
+    }
+    k = (uint64_t)floor(q);
     s->pipe_last_s = time_s;
     if (k <= s->last_step) {
         return 0;
@@ -716,6 +739,130 @@ static int pipe_push(gt_state *s, double time_s, double temp_c, double *feat)
     return 1;
 }
 
+/* Compensator::rebase: restart the pipeline and the LSTM states, forget the temperature
+ * history; B and K stay held until the new pipeline's first step. */
+static void rebase(gt_state *s)
+{
+    int j;
+    s->hist_head = 0u;
+    s->hist_len = 0u;
+    for (j = 0; j < GT_LAG_SLOTS; j++) {
+        s->lag_c[j] = 0.0;
+    }
+    s->started = 0u;
+    s->last_step = 0u;
+    memset(s->lstm_h, 0, sizeof s->lstm_h);
+    memset(s->lstm_c, 0, sizeof s->lstm_c);
+    s->current = 0u;
+    s->has_good = 0u;
+    s->has_ok = 0u;
+    s->rebased = 1u;
+    s->has_settle = 0u;
+}
+
+/* Compensator::place: whether time_s is placed on the time base (the time axis in the
+ * header), re-basing when the candidate has gathered REBASE_AFTER samples. */
+static int place(gt_state *s, double time_s)
+{
+    uint8_t n = 1u;
+    if (!isfinite(time_s)) {
+        s->has_cand = 0u;
+        if (s->unplaced < UINT32_MAX) {
+            s->unplaced++;
+        }
+        return 0;
+    }
+    if (!s->has_base || (time_s > s->base_s && time_s - s->base_s <= DEGRADED_AFTER)) {
+        s->has_base = 1u;
+        s->base_s = time_s;
+        s->unplaced = 0u;
+        s->has_cand = 0u;
+        return 1;
+    }
+    if (s->has_cand && time_s > s->cand_s && time_s - s->cand_s <= DEGRADED_AFTER) {
+        n = s->cand_n < 255u ? (uint8_t)(s->cand_n + 1u) : 255u;
+    }
+    if (n >= REBASE_AFTER) {
+        rebase(s);
+        s->has_base = 1u;
+        s->base_s = time_s;
+        s->unplaced = 0u;
+        s->has_cand = 0u;
+        return 1;
+    }
+    s->has_cand = 1u;
+    s->cand_s = time_s;
+    s->cand_n = n;
+    if (s->unplaced < UINT32_MAX) {
+        s->unplaced++;
+    }
+    return 0;
+}
+
+/* Compensator::plausible. */
+static int plausible(const gt_state *s, double time_s, double temp_c)
+{
+    if (!(temp_c >= T_MIN && temp_c <= T_MAX)) {
+        return 0;
+    }
+    if (s->has_good) {
+        double allowed = RATE_MAX * (time_s - s->good_time_s) + STEP_ALLOWANCE;
+        return fabs(temp_c - s->good_temp_c) <= allowed;
+    }
+    return 1;
+}
+
+/* Compensator::eval: both models on a new step; keep B and K only if both are usable. */
+static int eval(gt_state *s, const double *feat)
+{
+    int ok_b, ok_k;
+    double vb = 0.0, vk = 0.0;
+    s->current = 0u;
+    ok_b = target_eval(&bias_target, s->lstm_h[0], s->lstm_c[0], feat, &vb);
+    ok_k = target_eval(&scale_target, s->lstm_h[1], s->lstm_c[1], feat, &vk);
+    if (!(ok_b && ok_k)) {
+        return 0;
+    }
+    if (!(vk > 0.0 && isfinite(vb) && isfinite(vk))) {
+        return 0;
+    }
+    s->held_bias = vb;
+    s->held_scale = vk;
+    s->has_held = 1u;
+    s->current = 1u;
+    return 1;
+}
+
+/* Compensator::push: a placed, believed sample into the pipeline; 1 when B and K are fresh. */
+static int push(gt_state *s, double time_s, double temp_c)
+{
+    double feat[GT_N_FEATURES];
+    int r = pipe_push(s, time_s, temp_c, feat);
+    if (r == -2) {
+        /* Steps can no longer be counted exactly on this base: start a new one here. */
+        rebase(s);
+        r = pipe_push(s, time_s, temp_c, feat);
+    }
+    if (r == 1) {
+        s->has_good = 1u;
+        s->good_time_s = time_s;
+        s->good_temp_c = temp_c;
+        if (s->rebased) {
+            s->rebased = 0u;
+            s->has_settle = 1u;
+            s->settle_end_s = time_s + SETTLE_S;
+        }
+        return eval(s, feat);
+    }
+    if (r == 0) {
+        s->has_good = 1u;
+        s->good_time_s = time_s;
+        s->good_temp_c = temp_c;
+        return s->current;
+    }
+    return 0;
+}
+
 void gt_init(gt_state *s)
 {
     memset(s, 0, sizeof *s);
@@ -724,61 +871,38 @@ void gt_init(gt_state *s)
 gt_status gt_step(gt_state *s, double time_s, double gyro_dps, double temp_c,
                   double *rate_dps, double *bias_dps, double *scale)
 {
-    double feat[GT_N_FEATURES];
     double b = 0.0, k = 1.0;
-    int fresh = 0;
+    int fresh = 0, settling = 0;
     gt_status status;
-    int time_ok = isfinite(time_s) && (!s->has_last_time || time_s > s->last_time_s);
-    if (time_ok) {
-        int plausible = temp_c >= T_MIN && temp_c <= T_MAX;
-        s->has_last_time = 1u;
-        s->last_time_s = time_s;
-        if (plausible && s->has_good) {
-            double allowed = RATE_MAX * (time_s - s->good_time_s) + STEP_ALLOWANCE;
-            plausible = fabs(temp_c - s->good_temp_c) <= allowed;
-        }
-        if (plausible) {
-            int r = pipe_push(s, time_s, temp_c, feat);
-            if (r == 1) {
-                int ok_b, ok_k;
-                double vb = 0.0, vk = 0.0;
-                s->has_good = 1u;
-                s->good_time_s = time_s;
-                s->good_temp_c = temp_c;
-                s->current = 0u;
-                ok_b = target_eval(&bias_target, s->lstm_h[0], s->lstm_c[0], feat, &vb);
-                ok_k = target_eval(&scale_target, s->lstm_h[1], s->lstm_c[1], feat, &vk);
-                if (ok_b && ok_k && vk > 0.0 && isfinite(vb) && isfinite(vk)) {
-                    s->held_bias = vb;
-                    s->held_scale = vk;
-                    s->has_held = 1u;
-                    s->current = 1u;
-                    fresh = 1;
-                }
-            } else if (r == 0) {
-                s->has_good = 1u;
-                s->good_time_s = time_s;
-                s->good_temp_c = temp_c;
-                fresh = s->current;
-            }
-        }
+    if (place(s, time_s) && plausible(s, time_s, temp_c)) {
+        fresh = push(s, time_s, temp_c);
     }
     if (fresh) {
         s->has_ok = 1u;
-        s->ok_time_s = s->last_time_s;
+        s->ok_time_s = s->base_s;
     }
     if (s->has_held) {
         b = s->held_bias;
         k = s->held_scale;
     }
-    if (!isfinite(gyro_dps)) {
+    if (s->has_settle && s->has_base) {
+        settling = s->base_s < s->settle_end_s;
+    }
+    /* A finite sample so large that (gyro - B) / K overflows has no rate either. */
+    if (!(isfinite(gyro_dps) && isfinite((gyro_dps - b) / k))) {
         status = GT_INVALID;
+    } else if (settling) {
+        status = GT_DEGRADED;
     } else if (fresh) {
         status = GT_OK;
-    } else if (s->has_ok && s->has_last_time && s->last_time_s - s->ok_time_s <= DEGRADED_AFTER) {
-        status = GT_HELD;
     } else {
-        status = GT_DEGRADED;
+        double unplaced_s = STEP_P * (double)s->unplaced;
+        if (s->has_ok && s->has_base
+            && (s->base_s - s->ok_time_s) + unplaced_s <= DEGRADED_AFTER) {
+            status = GT_HELD;
+        } else {
+            status = GT_DEGRADED;
+        }
     }
     *bias_dps = b;
     *scale = k;
