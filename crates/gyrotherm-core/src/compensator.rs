@@ -136,16 +136,29 @@ pub enum ModelError {
 impl core::fmt::Display for ModelError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            ModelError::Spec(e) => write!(f, "feature spec: {e}"),
+            ModelError::Spec(_) => f.write_str("feature spec"),
             ModelError::BadNormalisation => {
                 f.write_str("normalisation has a non-finite value or a non-positive std")
             }
             ModelError::FeatureCount { expected, got } => {
                 write!(f, "model takes {got} features, the spec gives {expected}")
             }
-            ModelError::Limits(e) => write!(f, "temperature-sensor limits: {e}"),
-            ModelError::Baseline(e) => write!(f, "baseline: {e}"),
-            ModelError::Weights(e) => write!(f, "lstm weights: {e}"),
+            ModelError::Limits(_) => f.write_str("temperature-sensor limits"),
+            ModelError::Baseline(_) => f.write_str("baseline"),
+            ModelError::Weights(_) => f.write_str("lstm weights"),
+        }
+    }
+}
+
+/// The message states this level (which part of the model); `source()` gives the cause.
+impl core::error::Error for ModelError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            ModelError::Spec(e) => Some(e),
+            ModelError::Limits(e) => Some(e),
+            ModelError::Baseline(e) => Some(e),
+            ModelError::Weights(e) => Some(e),
+            ModelError::BadNormalisation | ModelError::FeatureCount { .. } => None,
         }
     }
 }

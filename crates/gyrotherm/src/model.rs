@@ -1126,7 +1126,9 @@ impl std::error::Error for CompensateError {
             CompensateError::Params(e) => Some(e),
             CompensateError::Baseline(e) => Some(e),
             CompensateError::InTarget { source, .. } => Some(source.as_ref()),
-            CompensateError::LstmInputs { .. } | CompensateError::Flight(_) => None,
+            // Transparent: the flight crate's message is this error's own.
+            CompensateError::Flight(e) => e.source(),
+            CompensateError::LstmInputs { .. } => None,
         }
     }
 }
