@@ -5,11 +5,12 @@
 //! Python half (`python/gyrotherm/`) holds what is Python-specific: the allantools τ
 //! generator and tuple layout, pandas, warnings and progress printing.
 //!
-//! Errors become exceptions derived from `gyrotherm.GyrothermError` (a `ValueError`) with the
-//! library's message, the one the CLI prints.
+//! Errors become exceptions derived from `gyrotherm.GyrothermError` (both a `ValueError` and
+//! a `RuntimeError`, as allantools raises for the same faults) with the library's message,
+//! the one the CLI prints.
 
 use pyo3::create_exception;
-use pyo3::exceptions::PyValueError;
+use pyo3::import_exception;
 use pyo3::prelude::*;
 
 mod allan;
@@ -17,12 +18,9 @@ mod figures;
 mod logs;
 mod model;
 
-create_exception!(
-    gyrotherm,
-    GyrothermError,
-    PyValueError,
-    "Base of every gyrotherm error; the message names the file, line and column where one is at fault, and what to do."
-);
+// The base class has two bases (`ValueError`, `RuntimeError`), which `create_exception!`
+// cannot express: it is defined in `python/gyrotherm/_errors.py` and imported here.
+import_exception!(gyrotherm._errors, GyrothermError);
 create_exception!(
     gyrotherm,
     LogError,

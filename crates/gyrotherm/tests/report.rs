@@ -101,6 +101,7 @@ fn check_png(files: &FigureFiles) {
         files.png.display(),
         colours.len()
     );
+    check_legends(files, &img);
     // The y-axis title is drawn rotated in the leftmost ~40 px, where nothing else is drawn:
     // dark pixels there are glyphs, so text renders.
     let dark_in_margin = (0..40)
@@ -114,6 +115,48 @@ fn check_png(files: &FigureFiles) {
          is the font rendering?",
         files.png.display()
     );
+}
+
+/// Legends hide no data: each legend box lies inside the image and overlaps no panel's
+/// plotting area, and the box is drawn where the layout says (its top edge is the legend
+/// border colour, a colour no series or grid line uses).
+fn check_legends(files: &FigureFiles, img: &image::RgbImage) {
+    let name = files.png.display();
+    let (w, h) = (img.width() as i32, img.height() as i32);
+    assert!(!files.layout.is_empty(), "{name}: no panel layout");
+    for (k, panel) in files.layout.iter().enumerate() {
+        let p = panel.plot;
+        assert!(
+            p.x0 >= 0 && p.y0 >= 0 && p.x1 <= w && p.y1 <= h && p.x0 < p.x1 && p.y0 < p.y1,
+            "{name}: panel {k} plotting area {p:?} outside the {w}x{h} image"
+        );
+        let Some(l) = panel.legend else { continue };
+        assert!(
+            l.x0 >= 0 && l.y0 >= 0 && l.x1 <= w && l.y1 <= h,
+            "{name}: panel {k} legend {l:?} outside the {w}x{h} image"
+        );
+        for (j, other) in files.layout.iter().enumerate() {
+            assert!(
+                !l.overlaps(&other.plot),
+                "{name}: legend of panel {k} {l:?} covers the plotting area of panel {j} {:?}",
+                other.plot
+            );
+        }
+        let border = [
+            LEGEND_BORDER_RGB.0,
+            LEGEND_BORDER_RGB.1,
+            LEGEND_BORDER_RGB.2,
+        ];
+        let top = (l.x0..l.x1 - 1)
+            .filter(|&x| img.get_pixel(x as u32, l.y0 as u32).0 == border)
+            .count() as i32;
+        assert!(
+            top * 10 >= (l.x1 - l.x0 - 1) * 9,
+            "{name}: legend of panel {k}: {top} of {} pixels of its top edge {l:?} are the \
+             border colour; it is not drawn where the layout says",
+            l.x1 - l.x0 - 1
+        );
+    }
 }
 
 /// SVG: starts with `<svg`, has the stated size, contains each given text, is closed.
@@ -366,6 +409,10 @@ fn report_over_two_synthetic_runs() {
         check_png(files);
         check_svg(files, texts);
     }
+    // Both panels of the temperature figure have a legend (so the legend checks above are
+    // not vacuous).
+    assert_eq!(figures[0].0.layout.len(), 2);
+    assert!(figures[0].0.layout.iter().all(|p| p.legend.is_some()));
     // Stated sizes (figure.rs: 1000 wide, 600 high for one panel, 800 for two).
     let size = |k: usize| (figures[k].0.width_px, figures[k].0.height_px);
     assert_eq!(size(0), (1000, 800));
@@ -386,6 +433,10 @@ fn report_over_two_synthetic_runs() {
             ],
         }),
         metadata: vec![("hidden units".into(), "16".into())],
+        models: Some(Table {
+            headers: vec!["field".into(), "a <model>".into(), "b".into()],
+            rows: vec![vec!["inputs".into(), "T".into(), "—".into()]],
+        }),
         warnings: vec!["temperature 70 °C is outside the training range <-40, 60>".into()],
         figures: figures
             .iter()
@@ -421,6 +472,10 @@ fn report_over_two_synthetic_runs() {
             "index.html references {r}, which does not exist"
         );
     }
+    // The model table: a column per model, escaped.
+    assert!(html.contains(
+        "<table class=\"models\">\n<thead><tr><th>field</th><th>a &lt;model&gt;</th><th>b</th></tr>"
+    ));
     // A short row is padded to the header width.
     assert!(html.contains("<td>LSTM</td><td>0.071</td><td></td>"));
     // Only the figures and the page were written: no temporary files left behind.
@@ -645,5 +700,67 @@ fn non_finite_values_break_lines() {
     assert!(
         in_gap.is_empty(),
         "line drawn across the gap at columns {in_gap:?}"
+    );
+}
+
+#[test]
+fn legend_hides_no_data_in_the_corner() {
+    // A line rising to the top right corner of its plot, where a legend inside the plot
+    // (upper right) would sit: the line's own colour must show there, and the legend must
+    // lie below the plotting area.
+    let dir = tempfile::tempdir().unwrap();
+    let x: Vec<f64> = (0..=100).map(f64::from).collect();
+    let y: Vec<f64> = x.iter().map(|v| v * v).collect();
+    let rgb = (213, 94, 0);
+    let fig = Figure {
+        title: "corner".into(),
+        x_label: "x (s)".into(),
+        log_x: false,
+        width_px: FIGURE_WIDTH_PX,
+        height_px: FIGURE_HEIGHT_PX,
+        panels: vec![Panel {
+            y_label: "y (°C)".into(),
+            log_y: false,
+            series: vec![
+                Series::line("a long legend label for the rising series", &x, &y).with_color(rgb),
+                Series::line("second label", &x, &x),
+            ],
+        }],
+    };
+    let files = write_figure(&dir.path().join("corner"), &fig).unwrap();
+    assert_eq!(
+        figure_layout(&fig).unwrap(),
+        files.layout,
+        "layout without drawing"
+    );
+    let img = decode(&files.png);
+    check_legends(&files, &img);
+    let panel = files.layout[0];
+    let (p, l) = (
+        panel.plot,
+        panel.legend.expect("labelled series have a legend"),
+    );
+    assert!(
+        l.y0 >= p.y1,
+        "legend {l:?} not below the plotting area {p:?}"
+    );
+    // The top right fifth of the plotting area (where the line ends).
+    let corner = PixelRect {
+        x0: p.x1 - (p.x1 - p.x0) / 5,
+        y0: p.y0,
+        x1: p.x1,
+        y1: p.y0 + (p.y1 - p.y0) / 5,
+    };
+    let line_pixels = (corner.x0..corner.x1)
+        .flat_map(|x| (corner.y0..corner.y1).map(move |y| (x, y)))
+        .filter(|&(x, y)| img.get_pixel(x as u32, y as u32).0 == [rgb.0, rgb.1, rgb.2])
+        .count();
+    // The line crosses the corner's height (≈ 100 px) at a slope under 2: 2 px wide, well
+    // over 50 pixels of its colour.
+    const MIN_LINE_PIXELS: usize = 50;
+    assert!(
+        line_pixels >= MIN_LINE_PIXELS,
+        "{line_pixels} pixels of the series colour in the top right corner {corner:?} (want \
+         >= {MIN_LINE_PIXELS}): something covers the data there"
     );
 }

@@ -42,7 +42,35 @@ fn short_profile() -> Profile {
 }
 
 fn sim(seed: u64, table: bool) -> TestLog {
-    let mut cfg = SimConfig::new(short_profile());
+    sim_profile(short_profile(), seed, table)
+}
+
+/// A cycle hotter, colder and faster than [`short_profile`]: a model trained on the short
+/// one extrapolates in temperature and in temperature rate.
+fn wide_profile() -> Profile {
+    let rows = [
+        (300.0, 22.0),
+        (400.0, -30.0),
+        (600.0, -30.0),
+        (600.0, 70.0),
+        (600.0, 70.0),
+        (600.0, 22.0),
+    ];
+    Profile {
+        name: "wide".into(),
+        start_c: 22.0,
+        segments: rows
+            .iter()
+            .map(|&(duration_s, target_c)| Segment {
+                duration_s,
+                target_c,
+            })
+            .collect(),
+    }
+}
+
+fn sim_profile(profile: Profile, seed: u64, table: bool) -> TestLog {
+    let mut cfg = SimConfig::new(profile);
     cfg.seed = seed;
     cfg.truth = true;
     if table {
@@ -191,20 +219,43 @@ fn full_report_over_simulated_logs_draws_every_figure() {
         html.contains(&format!("<td>{sf:.1}</td>")),
         "raw SF error {sf:.1} missing"
     );
-    // Metadata: the digest the model file carries and the LSTM epochs.
+    // Metadata: the digest the model file carries.
     for f in &cmp.fits {
         assert!(html.contains(&f.model.training.data_digest_sha256));
     }
-    assert!(html.contains("3 epochs"), "LSTM recipe epochs missing");
-    // The published recipe has its own column, named after its authors.
+    // The model table: one column per model, named as in the comparison table (the
+    // published recipe has its own, named after its authors), every row as wide.
+    let models = html_table(&html, "models");
+    let labels: Vec<&str> = cmp.columns.iter().map(|c| c.label).collect();
+    assert_eq!(models[0][1..], labels[..], "one column per model, in order");
+    assert!(labels.contains(&"LSTM, He et al."), "no published column");
+    for row in &models {
+        assert_eq!(row.len(), 1 + labels.len(), "ragged row {row:?}");
+    }
+    let col = |key: &str| 1 + cmp.columns.iter().position(|c| c.key == key).unwrap();
+    let recipe = table_row(&models, "recipe");
+    assert_eq!(
+        recipe[col("linear")],
+        "—",
+        "a least-squares fit has no recipe"
+    );
+    assert_eq!(recipe[col("lstm")], "residual");
+    assert_eq!(recipe[col("published")], "published");
+    // Epochs and loss only where an LSTM was kept: the published recipe always keeps one.
+    let net = table_row(&models, "bias LSTM training");
+    assert_eq!(net[col("linear")], "—");
+    assert_eq!(net[col("poly")], "—");
     assert!(
-        html.contains("<th>LSTM, He et al.</th>"),
-        "no published column"
+        net[col("published")].starts_with("3 epochs, final loss "),
+        "{net:?}"
     );
     assert!(
-        html.contains("published recipe"),
-        "published recipe missing"
+        !html.contains("0 epochs"),
+        "a model without an LSTM shows no epochs"
     );
+    // Lags read as whole seconds.
+    check_input_names(&table_row(&models, "inputs")[1..]);
+    assert!(!html.contains("T_lag"), "raw feature names on the page");
     // Only the figures and the page: no temporary files left.
     let names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
@@ -258,6 +309,141 @@ fn figures_that_cannot_apply_are_noted_not_errors() {
             "index.html references missing {r}"
         );
     }
+}
+
+/// The cells of the HTML table of class `class` in `html`: the header row first, each cell's
+/// text with the spaces normalised (no-break spaces read as spaces).
+fn html_table(html: &str, class: &str) -> Vec<Vec<String>> {
+    let start = html
+        .find(&format!("<table class=\"{class}\">"))
+        .unwrap_or_else(|| panic!("no table of class {class}"));
+    let end = start + html[start..].find("</table>").expect("unterminated table");
+    html[start..end]
+        .split("<tr>")
+        .skip(1)
+        .map(|row| {
+            row.split(['<'])
+                .filter_map(|part| {
+                    part.strip_prefix("td>")
+                        .or_else(|| part.strip_prefix("th>"))
+                        .map(|t| t.replace('\u{a0}', " "))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The row of `table` whose first cell is `field`.
+fn table_row<'a>(table: &'a [Vec<String>], field: &str) -> &'a [String] {
+    table
+        .iter()
+        .find(|r| r.first().map(String::as_str) == Some(field))
+        .unwrap_or_else(|| panic!("no row {field:?} in {table:?}"))
+}
+
+/// The items of the page's warning list.
+fn html_warnings(html: &str) -> Vec<String> {
+    let Some(start) = html.find("<ul class=\"warnings\">") else {
+        return Vec::new();
+    };
+    let end = start + html[start..].find("</ul>").unwrap();
+    html[start..end]
+        .split("<li>")
+        .skip(1)
+        .map(|li| li.split("</li>").next().unwrap().to_owned())
+        .collect()
+}
+
+/// Each input of each model reads `T`, `dT/dt` or `T − lag N s` / `T lag N s` with N a
+/// whole number of seconds.
+fn check_input_names(cells: &[String]) {
+    for cell in cells.iter().filter(|c| c.as_str() != "—") {
+        for name in cell.split(", ") {
+            if let Some(rest) = name
+                .strip_prefix("T − lag ")
+                .or_else(|| name.strip_prefix("T lag "))
+            {
+                let secs = rest
+                    .strip_suffix(" s")
+                    .unwrap_or_else(|| panic!("{name:?}"));
+                assert!(
+                    secs.parse::<u64>().is_ok(),
+                    "lag {name:?} is not in whole seconds"
+                );
+            } else {
+                assert!(["T", "dT/dt"].contains(&name), "unexpected input {name:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn lag_inputs_read_in_whole_seconds() {
+    let mut spec = gyrotherm::features::FeatureSpec::THERMAL_STATE;
+    spec.lag_tau_s[0] = 266.26613644776796;
+    let names: Vec<String> = gyrotherm::report::input_names(&spec)
+        .iter()
+        .map(|n| n.replace('\u{a0}', " "))
+        .collect();
+    assert_eq!(names[..3], ["T", "dT/dt", "T − lag 266 s"], "{names:?}");
+    check_input_names(&[names.join(", ")]);
+    // A name never breaks across lines inside a table cell.
+    for n in gyrotherm::report::input_names(&spec) {
+        assert!(!n.contains(' '), "{n:?} holds a breaking space");
+    }
+}
+
+#[test]
+fn extrapolation_is_said_once_naming_the_models() {
+    // Trained on the short cycle, tested on a hotter, faster one: both models extrapolate in
+    // temperature and in temperature rate, two findings the comparison states per model.
+    let train = vec![("train.csv".to_owned(), sim(10, false))];
+    let test = vec![("hot.csv".to_owned(), sim_profile(wide_profile(), 11, false))];
+    let (train_n, test_n) = (named(&train), named(&test));
+    let cfg = CompareConfig {
+        candidates: vec![Candidate::linear(), Candidate::poly()],
+        ..CompareConfig::default()
+    };
+    let cmp = run_compare(&train_n, &test_n, &cfg);
+    assert_eq!(
+        cmp.tests[0].warnings.len(),
+        4,
+        "two findings for each of two models: {:?}",
+        cmp.tests[0].warnings
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let index = write_full_report(dir.path(), &train_n, &test_n, &cmp, &cfg).expect("report");
+    let html = std::fs::read_to_string(&index).unwrap();
+    let warnings = html_warnings(&html);
+    assert_eq!(warnings.len(), 2, "one line per finding: {warnings:#?}");
+    let unique: HashSet<&String> = warnings.iter().collect();
+    assert_eq!(unique.len(), warnings.len(), "repeated: {warnings:#?}");
+    for (w, what) in warnings.iter().zip(["temperature ", "temperature rate "]) {
+        assert!(w.starts_with(&format!("hot.csv: {what}")), "{w}");
+        assert!(
+            w.contains("the models “linear” and “poly” extrapolate there"),
+            "both models named: {w}"
+        );
+        // Each model is named once in the line.
+        for label in ["“linear”", "“poly”"] {
+            assert_eq!(w.matches(label).count(), 1, "{w}");
+        }
+    }
+    // No field of an LSTM appears for least-squares models: those rows are dropped.
+    let models = html_table(&html, "models");
+    assert_eq!(models[0], ["field", "linear", "poly"]);
+    for field in [
+        "recipe",
+        "seed",
+        "bias LSTM training",
+        "scale-factor LSTM training",
+    ] {
+        assert!(
+            models.iter().all(|r| r[0] != field),
+            "row {field:?} applies to no model here: {models:?}"
+        );
+    }
+    check_input_names(&table_row(&models, "inputs")[1..]);
 }
 
 #[test]

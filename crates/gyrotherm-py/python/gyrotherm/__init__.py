@@ -8,7 +8,8 @@
 - Logs and models: ``read_log``, ``fit`` → ``Model`` (``save``, ``Model.load``,
   ``compensate``, ``summary``); model files are the CLI's JSON.
 
-Errors derive from ``GyrothermError`` (a ``ValueError``) and carry the CLI's messages.
+Errors derive from ``GyrothermError`` (a ``ValueError`` and, as allantools raises for the
+same faults, a ``RuntimeError``) and carry the CLI's messages.
 """
 
 from ._gyrotherm import (

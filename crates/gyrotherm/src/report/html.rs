@@ -50,8 +50,10 @@ pub struct ReportContent {
     pub title: String,
     /// The comparison table of `gyrotherm compare`.
     pub table: Option<Table>,
-    /// Model metadata, key then value.
+    /// Settings shared by all models, key then value (shown above [`ReportContent::models`]).
     pub metadata: Vec<(String, String)>,
+    /// The models side by side: one column per model, one row per field.
+    pub models: Option<Table>,
     /// Warnings (extrapolation, gaps filled, ...).
     pub warnings: Vec<String>,
     pub figures: Vec<ReportFigure>,
@@ -66,7 +68,8 @@ margin:.5em 0}th,td{border:1px solid #bbb;padding:.3em .7em;text-align:right}\
 th{background:#eee}td:first-child,th:first-child{text-align:left}dl{display:grid;\
 grid-template-columns:max-content auto;gap:.2em 1.2em}dt{font-weight:bold}dd{margin:0;\
 font-family:monospace}ul.warnings li{color:#8a4b00}figure{margin:1.2em 0}\
-figure img{max-width:100%;border:1px solid #ddd}figcaption{font-size:.95em;color:#444}";
+figure img{max-width:100%;border:1px solid #ddd}figcaption{font-size:.95em;color:#444}\
+table.models td{text-align:left;overflow-wrap:anywhere}table.models th{text-align:left}";
 
 /// Write `dir/index.html` for `content` (creating `dir` if missing) and return its path.
 /// Every referenced image must already exist in `dir`: a missing one is an error naming it,
@@ -119,28 +122,21 @@ pub fn render_html(c: &ReportContent) -> String {
          <title>{title}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<h1>{title}</h1>\n"
     );
     if let Some(t) = &c.table {
-        h.push_str("<h2>Comparison</h2>\n<table>\n<thead><tr>");
-        for head in &t.headers {
-            let _ = write!(h, "<th>{}</th>", escape(head));
-        }
-        h.push_str("</tr></thead>\n<tbody>\n");
-        for row in &t.rows {
-            h.push_str("<tr>");
-            let width = t.headers.len().max(row.len());
-            for i in 0..width {
-                let cell = row.get(i).map(String::as_str).unwrap_or("");
-                let _ = write!(h, "<td>{}</td>", escape(cell));
-            }
-            h.push_str("</tr>\n");
-        }
-        h.push_str("</tbody>\n</table>\n");
+        h.push_str("<h2>Comparison</h2>\n");
+        push_table(&mut h, t, "comparison");
+    }
+    if !c.metadata.is_empty() || c.models.is_some() {
+        h.push_str("<h2>Model</h2>\n");
     }
     if !c.metadata.is_empty() {
-        h.push_str("<h2>Model</h2>\n<dl>\n");
+        h.push_str("<dl>\n");
         for (k, v) in &c.metadata {
             let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
         }
         h.push_str("</dl>\n");
+    }
+    if let Some(t) = &c.models {
+        push_table(&mut h, t, "models");
     }
     h.push_str("<h2>Warnings</h2>\n");
     if c.warnings.is_empty() {
@@ -177,6 +173,25 @@ pub fn render_html(c: &ReportContent) -> String {
     }
     h.push_str("</body>\n</html>\n");
     h
+}
+
+/// `t` as an HTML table of class `class`; rows shorter than the headers are padded.
+fn push_table(h: &mut String, t: &Table, class: &str) {
+    let _ = write!(h, "<table class=\"{class}\">\n<thead><tr>");
+    for head in &t.headers {
+        let _ = write!(h, "<th>{}</th>", escape(head));
+    }
+    h.push_str("</tr></thead>\n<tbody>\n");
+    for row in &t.rows {
+        h.push_str("<tr>");
+        let width = t.headers.len().max(row.len());
+        for i in 0..width {
+            let cell = row.get(i).map(String::as_str).unwrap_or("");
+            let _ = write!(h, "<td>{}</td>", escape(cell));
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</tbody>\n</table>\n");
 }
 
 /// Escape `& < > " '` for text and attribute values.

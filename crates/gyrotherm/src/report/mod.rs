@@ -3,7 +3,8 @@
 //! Everything here works over plain data (slices of `f64` and small structs), so the report
 //! does not depend on how the numbers were made.
 //! - `plot`: the generic plot writer ([`write_figure`]: time series, x-y, log-log; one or
-//!   more stacked panels), written as PNG and SVG of a stated size, atomically.
+//!   more stacked panels, each legend below its panel so it hides no data), written as PNG
+//!   and SVG of a stated size, atomically.
 //! - [`figures`]: the eight named figures of the report and the Allan figure that
 //!   `gyrotherm allan --plot` reuses, each a function over plain data.
 //! - [`html`]: `DIR/index.html`, self-contained (inline CSS, no script, no network).
@@ -31,12 +32,14 @@ pub use figures::{
 };
 pub use html::{write_report, ReportContent, ReportFigure, Table};
 pub use job::{
-    allan_curve, comparison_table, noise_lines, scale_factor_points, temperature_rate_c_per_min,
-    write_full_report, write_full_report_with, ScalePoints, FIGURE_STEMS, FIGURE_WINDOW_S,
+    allan_curve, comparison_table, grouped_warnings, input_names, model_table, noise_lines,
+    scale_factor_points, shared_settings, temperature_rate_c_per_min, write_full_report,
+    write_full_report_with, ScalePoints, FIGURE_STEMS, FIGURE_WINDOW_S, NOT_APPLICABLE,
 };
 pub use plot::{
-    figure_paths, write_figure, Figure, FigureFiles, Panel, Series, SeriesStyle,
-    FIGURE_HEIGHT_2_PANELS_PX, FIGURE_HEIGHT_PX, FIGURE_WIDTH_PX,
+    figure_layout, figure_paths, write_figure, Figure, FigureFiles, Panel, PanelLayout, PixelRect,
+    Series, SeriesStyle, FIGURE_HEIGHT_2_PANELS_PX, FIGURE_HEIGHT_PX, FIGURE_WIDTH_PX,
+    LEGEND_BORDER_RGB,
 };
 
 /// Why a figure or report could not be written.

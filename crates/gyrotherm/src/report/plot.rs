@@ -2,6 +2,10 @@
 //! axes, lines / dashed lines / points with optional error bars, a legend per panel. Every
 //! figure is written twice, as PNG and as SVG of the same size, each atomically
 //! ([`crate::atomic_file`]).
+//!
+//! Legends sit below their panel's x axis, outside the plotting area, so they never hide
+//! data (a legend inside the plot covers whatever the data does in that corner);
+//! [`figure_layout`] gives the boxes, for tests and for callers placing annotations.
 
 use std::path::{Path, PathBuf};
 
@@ -26,6 +30,53 @@ const LEGEND_FONT_PX: u32 = 15;
 const TICK_FONT_PX: u32 = 15;
 const AXIS_FONT_PX: u32 = 17;
 const TITLE_FONT_PX: u32 = 22;
+
+/// Legend geometry, pixels: the line sample's length, the gap between sample and text, the
+/// gap between entries on a row, the height of a row, the padding inside the box and the
+/// gap between the x-axis title and the box.
+const LEGEND_SAMPLE_PX: i32 = 22;
+const LEGEND_SAMPLE_GAP_PX: i32 = 6;
+const LEGEND_ENTRY_GAP_PX: i32 = 18;
+const LEGEND_ROW_PX: i32 = LEGEND_FONT_PX as i32 + 7;
+const LEGEND_PAD_PX: i32 = 6;
+const LEGEND_GAP_PX: i32 = 4;
+/// Colour of the legend's border; no series or grid line uses it.
+pub const LEGEND_BORDER_RGB: (u8, u8, u8) = (120, 120, 120);
+/// Space the chart keeps around its plotting area: outer margin, x-axis label band,
+/// y-axis label band.
+const CHART_MARGIN_PX: i32 = 12;
+const X_LABEL_AREA_PX: i32 = 48;
+const Y_LABEL_AREA_PX: i32 = 90;
+
+/// A rectangle in figure pixels: `x0..x1` by `y0..y1` (the ends excluded), origin at the
+/// top left.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PixelRect {
+    pub x0: i32,
+    pub y0: i32,
+    pub x1: i32,
+    pub y1: i32,
+}
+
+impl PixelRect {
+    /// Whether the two rectangles share a pixel.
+    pub fn overlaps(&self, other: &PixelRect) -> bool {
+        self.x0 < other.x1 && other.x0 < self.x1 && self.y0 < other.y1 && other.y0 < self.y1
+    }
+
+    /// Whether `(x, y)` lies inside.
+    pub fn contains(&self, x: i32, y: i32) -> bool {
+        (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
+    }
+}
+
+/// Where one panel was drawn: its plotting area (the data, inside the axes) and its legend
+/// box, if it has labelled series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PanelLayout {
+    pub plot: PixelRect,
+    pub legend: Option<PixelRect>,
+}
 
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,6 +161,8 @@ pub struct FigureFiles {
     pub svg: PathBuf,
     pub width_px: u32,
     pub height_px: u32,
+    /// Where each panel's plotting area and legend were drawn, top panel first.
+    pub layout: Vec<PanelLayout>,
 }
 
 /// The PNG and SVG paths for `path`: a trailing `.png` or `.svg` is replaced, any other name
@@ -141,9 +194,9 @@ pub fn write_figure(path: &Path, fig: &Figure) -> Result<FigureFiles, ReportErro
     let (w, h) = (fig.width_px, fig.height_px);
 
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
-    {
+    let layout = {
         let root = GlyphFix::new(BitMapBackend::with_buffer(&mut rgb, (w, h))).into_drawing_area();
-        draw_figure(&root, fig).map_err(|message| ReportError::Draw {
+        let layout = draw_figure(&root, fig).map_err(|message| ReportError::Draw {
             path: png_path.clone(),
             message,
         })?;
@@ -151,7 +204,8 @@ pub fn write_figure(path: &Path, fig: &Figure) -> Result<FigureFiles, ReportErro
             path: png_path.clone(),
             message: e.to_string(),
         })?;
-    }
+        layout
+    };
     let mut png = Vec::new();
     {
         use image::ImageEncoder;
@@ -188,6 +242,21 @@ pub fn write_figure(path: &Path, fig: &Figure) -> Result<FigureFiles, ReportErro
         svg: svg_path,
         width_px: w,
         height_px: h,
+        layout,
+    })
+}
+
+/// Where [`write_figure`] puts each panel's plotting area and legend, top panel first: the
+/// figure is drawn the same way, into memory, and nothing is written.
+pub fn figure_layout(fig: &Figure) -> Result<Vec<PanelLayout>, ReportError> {
+    validate(fig)?;
+    ensure_font()?;
+    let (w, h) = (fig.width_px, fig.height_px);
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    let root = GlyphFix::new(BitMapBackend::with_buffer(&mut rgb, (w, h))).into_drawing_area();
+    draw_figure(&root, fig).map_err(|message| ReportError::Draw {
+        path: PathBuf::from(format!("(layout of \"{}\")", fig.title)),
+        message,
     })
 }
 
@@ -306,8 +375,6 @@ fn finite_runs(x: &[f64], y: &[f64]) -> Vec<std::ops::Range<usize>> {
     runs
 }
 
-type DrawResult = Result<(), String>;
-
 /// Tick text: plain decimals without trailing zeros (`2000`, `0.5`), scientific outside
 /// 1e-3..1e5 (`1.5e5`); values within 1e-12 of zero (tick arithmetic) print as `0`.
 pub(crate) fn tick_label(v: f64) -> String {
@@ -399,7 +466,10 @@ fn log_axis(lo: f64, hi: f64) -> WithKeyPoints<LogCoord<f64>> {
         .with_light_points(ticks)
 }
 
-fn draw_figure<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> DrawResult
+fn draw_figure<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &Figure,
+) -> Result<Vec<PanelLayout>, String>
 where
     DB::ErrorType: 'static,
 {
@@ -420,6 +490,8 @@ where
         .flat_map(|p| &p.series)
         .flat_map(|s| s.x.iter().copied());
     let (x0, x1) = padded_range(xs, fig.log_x, fig.log_x || has_markers);
+    let legend_font: TextStyle = (FONT_FAMILY, LEGEND_FONT_PX).into_font().into();
+    let mut layouts = Vec::with_capacity(fig.panels.len());
     for (area, panel) in areas.iter().zip(&fig.panels) {
         let ys = panel.series.iter().flat_map(|s| {
             let bars = s
@@ -429,13 +501,40 @@ where
             s.y.iter().copied().chain(bars)
         });
         let (y0, y1) = padded_range(ys, panel.log_y, true);
-        let mut builder = ChartBuilder::on(area);
+
+        // The legend takes a band below the chart, at most as wide as the plotting area.
+        let labelled: Vec<(usize, &Series)> = panel
+            .series
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| !s.label.is_empty())
+            .collect();
+        let (area_w, area_h) = area.dim_in_pixel();
+        let plot_w = area_w as i32 - 2 * CHART_MARGIN_PX - Y_LABEL_AREA_PX;
+        let legend = if labelled.is_empty() {
+            None
+        } else {
+            let widths = labelled
+                .iter()
+                .map(|(_, s)| {
+                    area.estimate_text_size(&s.label, &legend_font)
+                        .map(|(w, _)| w as i32)
+                        .map_err(|e| e.to_string())
+                })
+                .collect::<Result<Vec<i32>, String>>()?;
+            Some(legend_layout(&widths, plot_w.max(1)))
+        };
+        let band = legend.as_ref().map_or(0, |l| l.height + 1 + LEGEND_GAP_PX);
+        let chart_h = (area_h as i32 - band).max(1);
+        let (chart_area, legend_area) = area.split_vertically(chart_h);
+
+        let mut builder = ChartBuilder::on(&chart_area);
         builder
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(90);
+            .margin(CHART_MARGIN_PX)
+            .x_label_area_size(X_LABEL_AREA_PX)
+            .y_label_area_size(Y_LABEL_AREA_PX);
         let columns = area.dim_in_pixel().0.saturating_sub(110).max(50) as usize;
-        let r = match (fig.log_x, panel.log_y) {
+        let plot = match (fig.log_x, panel.log_y) {
             (false, false) => draw_panel(
                 builder
                     .build_cartesian_2d(x0..x1, y0..y1)
@@ -468,10 +567,121 @@ where
                 panel,
                 columns,
             ),
+        }?;
+        let legend_rect = match &legend {
+            Some(l) => Some(draw_legend(
+                &legend_area,
+                &legend_font,
+                l,
+                &labelled,
+                plot.x0,
+            )?),
+            None => None,
         };
-        r?;
+        layouts.push(PanelLayout {
+            plot,
+            legend: legend_rect,
+        });
     }
-    Ok(())
+    Ok(layouts)
+}
+
+/// Entries of a legend laid out in rows: each entry's offset inside the box, and the box
+/// size, pixels.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct LegendLayout {
+    entries: Vec<(i32, i32)>,
+    width: i32,
+    height: i32,
+}
+
+/// Lay out entries whose texts are `text_widths` wide left to right, starting a new row
+/// when the next one would pass `max_width` (an entry wider than that gets a row of its
+/// own).
+fn legend_layout(text_widths: &[i32], max_width: i32) -> LegendLayout {
+    let mut entries = Vec::with_capacity(text_widths.len());
+    let (mut x, mut row, mut widest) = (LEGEND_PAD_PX, 0, 0);
+    for &tw in text_widths {
+        let w = LEGEND_SAMPLE_PX + LEGEND_SAMPLE_GAP_PX + tw;
+        if x > LEGEND_PAD_PX && x + w + LEGEND_PAD_PX > max_width {
+            x = LEGEND_PAD_PX;
+            row += 1;
+        }
+        entries.push((x, LEGEND_PAD_PX + row * LEGEND_ROW_PX));
+        widest = widest.max(x + w);
+        x += w + LEGEND_ENTRY_GAP_PX;
+    }
+    let rows = if text_widths.is_empty() { 0 } else { row + 1 };
+    LegendLayout {
+        entries,
+        width: widest + LEGEND_PAD_PX,
+        height: rows * LEGEND_ROW_PX + 2 * LEGEND_PAD_PX,
+    }
+}
+
+/// Draw the legend box in `area` (the band below a chart), its left edge at the absolute
+/// x `left` (the plotting area's), and return the box in figure pixels.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    font: &TextStyle,
+    layout: &LegendLayout,
+    entries: &[(usize, &Series)],
+    left: i32,
+) -> Result<PixelRect, String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let (bx, by) = area.get_base_pixel();
+    let x0 = left - bx;
+    let y0 = LEGEND_GAP_PX;
+    let (r, g, b) = LEGEND_BORDER_RGB;
+    area.draw(&Rectangle::new(
+        [(x0, y0), (x0 + layout.width, y0 + layout.height)],
+        RGBColor(r, g, b).stroke_width(1),
+    ))
+    .map_err(err)?;
+    let text_style = font
+        .color(&BLACK)
+        .pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Left,
+            plotters::style::text_anchor::VPos::Center,
+        ));
+    for (&(i, s), &(ex, ey)) in entries.iter().zip(&layout.entries) {
+        let color = color_of(s, i);
+        let marker = matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints);
+        let line = !matches!(s.style, SeriesStyle::Points);
+        let none = ShapeStyle::from(&TRANSPARENT);
+        let stroke = if line { color.stroke_width(2) } else { none };
+        let dot = if marker { color.filled() } else { none };
+        // Dashed lines show a gap in the middle of their legend stroke.
+        let gap = if matches!(s.style, SeriesStyle::Dashed) {
+            none
+        } else {
+            stroke
+        };
+        let (x, y) = (x0 + ex, y0 + ey + LEGEND_ROW_PX / 2);
+        area.draw(
+            &(EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (8, 0)], stroke)
+                + PathElement::new(vec![(8, 0), (14, 0)], gap)
+                + PathElement::new(vec![(14, 0), (22, 0)], stroke)
+                + Circle::new((11, 0), 3, dot)),
+        )
+        .map_err(err)?;
+        area.draw_text(
+            &s.label,
+            &text_style,
+            (x + LEGEND_SAMPLE_PX + LEGEND_SAMPLE_GAP_PX, y),
+        )
+        .map_err(err)?;
+    }
+    Ok(PixelRect {
+        x0: bx + x0,
+        y0: by + y0,
+        x1: bx + x0 + layout.width + 1,
+        y1: by + y0 + layout.height + 1,
+    })
 }
 
 fn draw_panel<'a, DB, X, Y>(
@@ -479,7 +689,7 @@ fn draw_panel<'a, DB, X, Y>(
     fig: &Figure,
     panel: &Panel,
     columns: usize,
-) -> DrawResult
+) -> Result<PixelRect, String>
 where
     DB: DrawingBackend + 'a,
     DB::ErrorType: 'static,
@@ -543,7 +753,7 @@ where
             2
         };
         let line_style = color.stroke_width(width);
-        // Every run but the last is drawn here; the last one below carries the legend entry.
+        // Every run but the last is drawn here, the last one below.
         let last_run = runs.len().saturating_sub(1);
         for run in &runs[..last_run] {
             match s.style {
@@ -566,50 +776,35 @@ where
             }
         }
         let last: &[(f64, f64)] = runs.get(last_run).map(Vec::as_slice).unwrap_or(&[]);
-        let anno = match s.style {
-            SeriesStyle::Line => chart
-                .draw_series(LineSeries::new(last.iter().copied(), line_style))
-                .map_err(err)?,
-            SeriesStyle::Dashed => chart
-                .draw_series(DashedLineSeries::new(
-                    last.iter().copied(),
-                    10,
-                    6,
-                    line_style,
-                ))
-                .map_err(err)?,
-            SeriesStyle::Points => chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
-                .map_err(err)?,
+        match s.style {
+            SeriesStyle::Line => {
+                chart
+                    .draw_series(LineSeries::new(last.iter().copied(), line_style))
+                    .map_err(err)?;
+            }
+            SeriesStyle::Dashed => {
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        last.iter().copied(),
+                        10,
+                        6,
+                        line_style,
+                    ))
+                    .map_err(err)?;
+            }
+            SeriesStyle::Points => {
+                chart
+                    .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                    .map_err(err)?;
+            }
             SeriesStyle::LinePoints => {
                 chart
                     .draw_series(LineSeries::new(points.iter().copied(), line_style))
                     .map_err(err)?;
                 chart
                     .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
-                    .map_err(err)?
+                    .map_err(err)?;
             }
-        };
-        if !s.label.is_empty() {
-            let style = s.style;
-            let marker = matches!(style, SeriesStyle::Points | SeriesStyle::LinePoints);
-            let line = !matches!(style, SeriesStyle::Points);
-            let none = ShapeStyle::from(&TRANSPARENT);
-            let stroke = if line { color.stroke_width(2) } else { none };
-            let dot = if marker { color.filled() } else { none };
-            // Dashed lines show a gap in the middle of their legend stroke.
-            let gap = if matches!(style, SeriesStyle::Dashed) {
-                none
-            } else {
-                stroke
-            };
-            anno.label(s.label.as_str()).legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (8, 0)], stroke)
-                    + PathElement::new(vec![(8, 0), (14, 0)], gap)
-                    + PathElement::new(vec![(14, 0), (22, 0)], stroke)
-                    + Circle::new((11, 0), 3, dot)
-            });
         }
         if let Some((lo, hi)) = &s.bars {
             // Vertical bar from lo to hi with 8 px caps.
@@ -630,17 +825,13 @@ where
         }
     }
 
-    if panel.series.iter().any(|s| !s.label.is_empty()) {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(120, 120, 120))
-            .label_font((FONT_FAMILY, LEGEND_FONT_PX))
-            .draw()
-            .map_err(err)?;
-    }
-    Ok(())
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    Ok(PixelRect {
+        x0: xr.start,
+        y0: yr.start,
+        x1: xr.end,
+        y1: yr.end,
+    })
 }
 
 #[cfg(test)]
@@ -688,6 +879,36 @@ mod tests {
             assert!(t.iter().all(|&v| v >= lo && v <= hi), "[{lo}, {hi}]: {t:?}");
         }
         assert!(log_ticks(0.0, 1.0).is_empty());
+    }
+
+    /// Entries flow left to right and wrap before passing the width; the box encloses them.
+    #[test]
+    fn legend_entries_wrap_into_rows() {
+        let entry = |tw: i32| LEGEND_SAMPLE_PX + LEGEND_SAMPLE_GAP_PX + tw;
+        let one_row = legend_layout(&[40, 60], 1000);
+        assert_eq!(
+            one_row.entries,
+            vec![
+                (LEGEND_PAD_PX, LEGEND_PAD_PX),
+                (
+                    LEGEND_PAD_PX + entry(40) + LEGEND_ENTRY_GAP_PX,
+                    LEGEND_PAD_PX
+                )
+            ]
+        );
+        assert_eq!(one_row.height, LEGEND_ROW_PX + 2 * LEGEND_PAD_PX);
+        // Three entries of 300 px text in 700 px: two on the first row, one on the second.
+        let wrapped = legend_layout(&[300, 300, 300], 700);
+        assert_eq!(
+            wrapped.entries[2],
+            (LEGEND_PAD_PX, LEGEND_PAD_PX + LEGEND_ROW_PX)
+        );
+        assert_eq!(wrapped.height, 2 * LEGEND_ROW_PX + 2 * LEGEND_PAD_PX);
+        assert!(wrapped.width <= 700, "{wrapped:?}");
+        // An entry wider than the room gets its own row rather than vanishing.
+        let wide = legend_layout(&[900, 10], 500);
+        assert_eq!(wide.entries.len(), 2);
+        assert_eq!(wide.entries[1].1, LEGEND_PAD_PX + LEGEND_ROW_PX);
     }
 
     #[test]

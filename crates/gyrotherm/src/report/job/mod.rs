@@ -13,10 +13,12 @@
 mod allan_figure;
 mod rate_table;
 mod tables;
+mod warnings;
 
 pub use allan_figure::{allan_curve, noise_lines};
 pub use rate_table::{scale_factor_points, ScalePoints};
-pub use tables::{comparison_table, metadata};
+pub use tables::{comparison_table, input_names, model_table, shared_settings, NOT_APPLICABLE};
+pub use warnings::grouped_warnings;
 
 use allan_figure::allan_report_figure;
 use rate_table::rate_table_figures;
@@ -70,7 +72,8 @@ pub fn write_full_report(
 /// Write the figures, then `dir/index.html` (creating `dir`), and return the page's path.
 /// `test` must be the held-out logs `cmp` was computed on, in the same order; `train` the
 /// training logs (named on the page). `extra_warnings` (e.g. gaps filled on reading) are
-/// listed after the extrapolation warnings of `cmp`.
+/// listed after the extrapolation warnings of `cmp` (each finding once per held-out log,
+/// naming the models it concerns).
 pub fn write_full_report_with(
     dir: &Path,
     train: &[NamedLog],
@@ -111,17 +114,14 @@ pub fn write_full_report_with(
     fig_before_after(&mut b, main_pair)?;
     fig_allan(&mut b, static_pair)?;
 
-    let mut warnings: Vec<String> = cmp
-        .tests
-        .iter()
-        .flat_map(|t| t.warnings.iter().cloned())
-        .collect();
+    let mut warnings = grouped_warnings(test, cmp);
     warnings.extend(extra_warnings.iter().cloned());
 
     let content = ReportContent {
         title: "gyrotherm report: thermal compensation of held-out logs".to_owned(),
         table: Some(comparison_table(cmp, cfg)),
-        metadata: metadata(train, cmp, cfg),
+        metadata: shared_settings(train, cmp, cfg),
+        models: Some(model_table(cmp, cfg)),
         warnings,
         figures: b.figures,
         notes: b.notes,

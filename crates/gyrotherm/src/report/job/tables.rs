@@ -1,10 +1,11 @@
-//! The report's tables: the comparison table and the model metadata.
+//! The report's tables: the comparison table, the model table (one column per model) and
+//! the settings the models share.
 
 use super::fmt_num;
-use crate::compare::{Candidate, Column, CompareConfig, Comparison};
-use crate::features::feature_names;
-use crate::fit::NamedLog;
-use crate::model::{Method, ModelFile};
+use crate::compare::{CompareConfig, Comparison};
+use crate::features::{FeatureKind, FeatureSpec};
+use crate::fit::{FitOutcome, NamedLog, TrainSummary};
+use crate::model::{Method, ModelFile, SubModel};
 use crate::report::html::Table;
 
 /// The comparison table of `gyrotherm compare` ([`Comparison::table`]) as the report's HTML
@@ -29,9 +30,10 @@ pub fn comparison_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
     Table { headers, rows }
 }
 
-/// Key-value facts of the models: method, recipe and epochs, seed, training ranges, data
-/// digest, inputs.
-pub fn metadata(
+/// Settings shared by every model of the comparison, key then value: the training logs and
+/// the comparison's windows, then the provenance fields (data digest, training inputs,
+/// writer) when every model carries the same value; [`model_table`] shows them otherwise.
+pub fn shared_settings(
     train: &[NamedLog],
     cmp: &Comparison,
     cfg: &CompareConfig,
@@ -54,72 +56,214 @@ pub fn metadata(
             format!("{} s", fmt_num(cfg.settle_s)),
         ),
     ];
-    for ((f, col), cand) in cmp.fits.iter().zip(&cmp.columns).zip(&cfg.candidates) {
-        model_metadata(&mut md, &f.model, col, cand, cfg);
-        for (name, t) in [
-            ("bias network", &f.bias_training),
-            ("scale-factor network", &f.scale_training),
-        ] {
-            if let Some(t) = t {
-                md.push((
-                    format!("{} {name}", col.key),
-                    format!("{} epochs, final loss {:.4e}", t.epochs, t.final_loss),
-                ));
-            }
+    for field in PROVENANCE {
+        if let Some(v) = shared_value(cmp, field) {
+            md.push((format!("{} (all models)", field.label()), v));
         }
     }
     md
 }
 
-fn model_metadata(
-    md: &mut Vec<(String, String)>,
-    m: &ModelFile,
-    col: &Column,
-    cand: &Candidate,
-    cfg: &CompareConfig,
-) {
-    let p = col.key;
-    let ti = &m.training;
-    let targets = match (m.bias.is_some(), m.scale.is_some()) {
-        (true, true) => "bias and scale factor",
-        (true, false) => "bias only (no static training log)",
-        (false, true) => "scale factor only (no rate-table training log)",
-        (false, false) => "none",
-    };
-    md.push((
-        format!("{p} model"),
-        format!("{} ({} method) — {targets}", col.label, m.method.as_str()),
-    ));
-    if m.method == Method::Lstm {
-        let recipe = cand.fit_config(&cfg.fit).recipe;
-        md.push((
-            format!("{p} recipe"),
-            format!("{}, at most {} epochs", recipe.kind.as_str(), recipe.epochs),
-        ));
+/// The models side by side: a header row naming each model, then one row per field.
+/// A cell whose field does not apply to that model (epochs of a least-squares fit, the
+/// recipe of a method without one) holds "—"; a field that applies to no model has no row.
+pub fn model_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
+    let n = cmp.fits.len().min(cmp.columns.len());
+    let mut headers = vec!["field".to_owned()];
+    headers.extend(cmp.columns[..n].iter().map(|c| c.label.to_owned()));
+    let mut rows = Vec::new();
+    for field in FIELDS {
+        if PROVENANCE.contains(&field) && shared_value(cmp, field).is_some() {
+            continue;
+        }
+        let cells: Vec<Option<String>> = (0..n)
+            .map(|i| {
+                let recipe = cfg
+                    .candidates
+                    .get(i)
+                    .map(|c| c.fit_config(&cfg.fit).recipe.kind.as_str());
+                field.value(&cmp.fits[i], recipe)
+            })
+            .collect();
+        if cells.iter().all(Option::is_none) {
+            continue;
+        }
+        let mut row = vec![field.label().to_owned()];
+        row.extend(
+            cells
+                .into_iter()
+                .map(|c| c.unwrap_or_else(|| NOT_APPLICABLE.to_owned())),
+        );
+        rows.push(row);
     }
-    if let Ok(spec) = m.feature_spec() {
-        md.push((format!("{p} inputs"), feature_names(&spec).0.join(", ")));
+    Table { headers, rows }
+}
+
+/// The cell of a field that does not apply to a model.
+pub const NOT_APPLICABLE: &str = "—";
+
+/// The rows of [`model_table`], in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Field {
+    Method,
+    Recipe,
+    BiasModel,
+    ScaleModel,
+    Inputs,
+    TempRange,
+    RateRange,
+    Seed,
+    BiasNetwork,
+    ScaleNetwork,
+    DataDigest,
+    TrainingInputs,
+    WrittenBy,
+}
+
+const FIELDS: [Field; 13] = [
+    Field::Method,
+    Field::Recipe,
+    Field::BiasModel,
+    Field::ScaleModel,
+    Field::Inputs,
+    Field::TempRange,
+    Field::RateRange,
+    Field::Seed,
+    Field::BiasNetwork,
+    Field::ScaleNetwork,
+    Field::DataDigest,
+    Field::TrainingInputs,
+    Field::WrittenBy,
+];
+
+/// Fields that are usually the same for every model (the same training data, the same
+/// program): said once, beside the shared settings, when they are.
+const PROVENANCE: [Field; 3] = [Field::DataDigest, Field::TrainingInputs, Field::WrittenBy];
+
+impl Field {
+    fn label(self) -> &'static str {
+        match self {
+            Field::Method => "method",
+            Field::Recipe => "recipe",
+            Field::BiasModel => "bias model",
+            Field::ScaleModel => "scale-factor model",
+            Field::Inputs => "inputs",
+            Field::TempRange => "training temperature (°C)",
+            Field::RateRange => "training temperature rate (°C/min)",
+            Field::Seed => "seed",
+            Field::BiasNetwork => "bias LSTM training",
+            Field::ScaleNetwork => "scale-factor LSTM training",
+            Field::DataDigest => "data digest (SHA-256)",
+            Field::TrainingInputs => "training inputs",
+            Field::WrittenBy => "written by",
+        }
     }
-    md.push((
-        format!("{p} training range"),
-        format!(
-            "temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min",
-            ti.temp_range_c.min,
-            ti.temp_range_c.max,
-            ti.rate_range_c_per_s.min * 60.0,
-            ti.rate_range_c_per_s.max * 60.0
-        ),
-    ));
-    if let Some(e) = ti.epochs {
-        md.push((format!("{p} epochs"), e.to_string()));
+
+    /// The cell of this field for one model (`recipe`: the recipe its column trained);
+    /// None where the field does not apply.
+    fn value(self, f: &FitOutcome, recipe: Option<&str>) -> Option<String> {
+        let m = &f.model;
+        let ti = &m.training;
+        match self {
+            Field::Method => Some(m.method.as_str().to_owned()),
+            Field::Recipe => recipe
+                .filter(|_| m.method == Method::Lstm)
+                .map(str::to_owned),
+            Field::BiasModel => Some(sub_model(&m.bias, "no static training log")),
+            Field::ScaleModel => Some(sub_model(&m.scale, "no rate-table training log")),
+            Field::Inputs => m.feature_spec().ok().map(|s| input_names(&s).join(", ")),
+            Field::TempRange => Some(format!(
+                "{:.2} to {:.2}",
+                ti.temp_range_c.min, ti.temp_range_c.max
+            )),
+            Field::RateRange => Some(format!(
+                "{:.3} to {:.3}",
+                ti.rate_range_c_per_s.min * 60.0,
+                ti.rate_range_c_per_s.max * 60.0
+            )),
+            // A seed only matters to a model with a network it initialised.
+            Field::Seed => holds_lstm(m)
+                .then_some(ti.seed)
+                .flatten()
+                .map(|s| s.to_string()),
+            Field::BiasNetwork => network(&m.bias, &f.bias_training),
+            Field::ScaleNetwork => network(&m.scale, &f.scale_training),
+            Field::DataDigest => Some(ti.data_digest_sha256.clone()),
+            Field::TrainingInputs => Some(ti.inputs.join(", ")),
+            Field::WrittenBy => Some(ti.created_by.clone()),
+        }
     }
-    if let Some(s) = ti.seed {
-        md.push((format!("{p} seed"), s.to_string()));
+}
+
+/// The value every model has for `field`, if they all have the same one.
+fn shared_value(cmp: &Comparison, field: Field) -> Option<String> {
+    let mut values = cmp.fits.iter().map(|f| field.value(f, None));
+    let first = values.next()??;
+    values
+        .all(|v| v.as_deref() == Some(first.as_str()))
+        .then_some(first)
+}
+
+/// What a sub-model is made of, or why there is none.
+fn sub_model(s: &Option<SubModel>, missing: &str) -> String {
+    match s {
+        Some(s) => s.kind().to_owned(),
+        None => format!("none ({missing})"),
     }
-    md.push((
-        format!("{p} data digest (SHA-256)"),
-        ti.data_digest_sha256.clone(),
-    ));
-    md.push((format!("{p} training inputs"), ti.inputs.join(", ")));
-    md.push((format!("{p} written by"), ti.created_by.clone()));
+}
+
+/// Whether the model holds an LSTM in either sub-model.
+fn holds_lstm(m: &ModelFile) -> bool {
+    [&m.bias, &m.scale]
+        .iter()
+        .any(|s| s.as_ref().is_some_and(|s| s.lstm().is_some()))
+}
+
+/// Epochs and final loss of the LSTM of one sub-model: only where the model kept an LSTM
+/// there and its training ran (a recipe whose least-squares base won keeps none, and its
+/// summary would read "0 epochs").
+fn network(s: &Option<SubModel>, t: &Option<TrainSummary>) -> Option<String> {
+    s.as_ref().and_then(SubModel::lstm)?;
+    let t = t.as_ref().filter(|t| t.epochs > 0)?;
+    Some(format!(
+        "{} epochs, final loss {:.3e} (normalised MSE)",
+        t.epochs, t.final_loss
+    ))
+}
+
+/// The model inputs as a reader says them: `T`, `dT/dt`, `T mean 20 s`, `T lag 266 s`,
+/// `T − lag 266 s` (a lag is a first-order low-pass of T with that time constant, rounded
+/// to whole seconds in the text; the model file keeps the exact value). The spaces inside
+/// a name are no-break spaces, so a table cell wraps only between names.
+pub fn input_names(spec: &FeatureSpec) -> Vec<String> {
+    (0..spec.n_features())
+        .map(|i| {
+            let name = match spec.kind(i) {
+                Some(FeatureKind::Temperature) => "T".to_owned(),
+                Some(FeatureKind::Rate) => "dT/dt".to_owned(),
+                Some(FeatureKind::MovingAverage) => {
+                    format!("T mean {} s", whole_seconds(spec.smoothing_window_s))
+                }
+                Some(FeatureKind::Lag(j)) => format!("T lag {} s", lag_s(spec, j)),
+                Some(FeatureKind::LagDiff(j)) => format!("T − lag {} s", lag_s(spec, j)),
+                None => format!("x{i}"),
+            };
+            name.replace(' ', "\u{a0}")
+        })
+        .collect()
+}
+
+fn lag_s(spec: &FeatureSpec, j: u8) -> String {
+    spec.lag_tau_s
+        .get(usize::from(j))
+        .map_or_else(|| "?".to_owned(), |&t| whole_seconds(t))
+}
+
+/// `v` rounded to whole seconds, as text.
+fn whole_seconds(v: f64) -> String {
+    if v.is_finite() {
+        format!("{:.0}", v.round())
+    } else {
+        v.to_string()
+    }
 }
