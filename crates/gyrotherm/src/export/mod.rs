@@ -183,6 +183,13 @@ pub fn export(model: &ModelFile, lang: Lang, dir: &Path) -> Result<Vec<PathBuf>,
         path: dir.to_path_buf(),
         source,
     })?;
+    // Every destination is checked before any is written, so a refused one (a link planted
+    // in the folder) leaves no partial export behind.
+    for (name, _) in &files {
+        let path = dir.join(name);
+        crate::atomic_file::destination(&path)
+            .map_err(|source| ExportError::Io { path, source })?;
+    }
     let mut out = Vec::new();
     for (name, text) in files {
         let path = dir.join(name);
