@@ -1,5 +1,6 @@
 //! `--out` as a user gives it: a symbolic link, a FIFO, a device, `-` for standard output,
-//! and an interrupted run. Links are written through, FIFOs and devices written straight,
+//! and an interrupted run. Links are refused (never written through), FIFOs and devices
+//! written straight,
 //! `-` is standard output, and a SIGTERM leaves neither a temporary file nor a damaged
 //! output behind.
 #![cfg(unix)]
@@ -51,26 +52,38 @@ fn is_fifo(path: &Path) -> bool {
         .is_fifo()
 }
 
+/// Exit 2 naming the link and what to do; the link and everything else in `dir` as before.
+fn assert_link_refused(dir: &Path, out: &Output, link: &str, before: &[&str]) {
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("{link} is a symbolic link"))
+            && stderr.contains("remove the link"),
+        "{stderr}"
+    );
+    assert!(std::fs::symlink_metadata(dir.join(link))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(entries(dir), before);
+}
+
 #[test]
-fn out_through_a_symlink_writes_the_target_and_keeps_the_link() {
+fn out_through_a_symlink_is_refused_and_the_target_kept() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("real.csv"), "old").unwrap();
     std::os::unix::fs::symlink("real.csv", dir.path().join("link.csv")).unwrap();
     let out = simulate_to(dir.path(), "link.csv");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    assert_link_refused(
+        dir.path(),
+        &out,
+        "link.csv",
+        &["link.csv", "profile.txt", "real.csv"],
     );
-    let link = dir.path().join("link.csv");
-    assert!(std::fs::symlink_metadata(&link)
-        .unwrap()
-        .file_type()
-        .is_symlink());
-    let text = std::fs::read_to_string(dir.path().join("real.csv")).unwrap();
-    assert!(text.starts_with("time_s,gyro_dps,temp_c\n"), "{text}");
-    assert_eq!(text.lines().count(), 31);
-    assert_eq!(entries(dir.path()), ["link.csv", "profile.txt", "real.csv"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("real.csv")).unwrap(),
+        "old"
+    );
 }
 
 #[test]
@@ -100,15 +113,11 @@ fn out_to_a_fifo_writes_into_it() {
 }
 
 #[test]
-fn out_to_a_link_to_dev_null_keeps_the_link_and_the_device() {
+fn out_to_a_link_to_dev_null_is_refused_and_keeps_the_link_and_the_device() {
     let dir = tempfile::tempdir().unwrap();
     std::os::unix::fs::symlink("/dev/null", dir.path().join("sink")).unwrap();
     let out = simulate_to(dir.path(), "sink");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_link_refused(dir.path(), &out, "sink", &["profile.txt", "sink"]);
     assert_eq!(
         std::fs::read_link(dir.path().join("sink")).unwrap(),
         Path::new("/dev/null")
@@ -117,7 +126,6 @@ fn out_to_a_link_to_dev_null_keeps_the_link_and_the_device() {
         .unwrap()
         .file_type()
         .is_char_device());
-    assert_eq!(entries(dir.path()), ["profile.txt", "sink"]);
 }
 
 #[test]

@@ -64,6 +64,22 @@ def test_bad_model_file_raises_the_cli_message(cli, logs, tmp_path):
         gt.Model.load(tmp_path / "absent.json")
 
 
+def test_model_file_with_a_key_named_twice_raises_the_cli_message(cli, logs, tmp_path):
+    # A decoy array before the real one: JSON readers disagree on which counts, and the
+    # content checksum covered only the last, so the loader refuses the file.
+    text = gt.fit(static=logs["static"], method="linear").to_json()
+    assert '"coefficients": [' in text
+    dup = text.replace('"coefficients": [', '"coefficients": [0.5, 0, 0],\n      "coefficients": [', 1)
+    path = tmp_path / "dup.json"
+    path.write_text(dup)
+    where = 'bias.baseline.coefficients: key "coefficients" appears twice'
+    with pytest.raises(gt.ModelError, match="dup.json: " + where) as e:
+        gt.Model.load(path)
+    assert str(e.value) in cli_error(cli, "model", "check", path)
+    with pytest.raises(gt.ModelError, match=where):
+        gt.Model.from_json(dup)
+
+
 def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
     with pytest.raises(gt.FitError, match="unknown LSTM recipe \"fancy\""):
         gt.fit(static=logs["static"], recipe="fancy")

@@ -3,13 +3,20 @@
 //!
 //! Where the output goes decides how it is written ([`destination`]):
 //! - a new path or a regular file: temporary file beside it, renamed over it;
-//! - a symbolic link: followed to its final target, which is written as above, so the link
-//!   stays a link (a dangling link creates its target);
-//! - a FIFO, a character or block device, a socket (or a link to one, such as
-//!   `/dev/null`): opened and written straight, nothing renamed or created beside it;
+//! - a symbolic link (dangling or not): refused, and left as it is. A link planted where an
+//!   output goes (say in an export folder) would otherwise make the program write wherever
+//!   it points; the message names the link and says what to do;
+//! - a FIFO, a character or block device, a socket (such as `/dev/null`): opened and written
+//!   straight (without following a link put there in the meantime), nothing renamed or
+//!   created beside it;
 //! - `-`, `/dev/stdout` (and `/dev/stderr`): the process's own standard output (error),
-//!   written straight, sharing its position with the shell's redirection;
+//!   written straight, sharing its position with the shell's redirection; likewise
+//!   `/dev/fd/N` and `/proc/self/fd/N`, the kernel's names for files the shell opened for
+//!   the process (links only in name: no one can plant them);
 //! - a directory: refused.
+//!
+//! Only the last component is checked: folders on the way (`/tmp` on some systems, a
+//! build folder on another disk) may be links.
 //!
 //! Temporary files being written are kept in a process-wide list, so that a signal handler
 //! (installed by the command-line program) can remove them before the process exits:
@@ -28,55 +35,62 @@ pub enum Destination {
     Stdout,
     /// The process's standard error (`/dev/stderr`, `/dev/fd/2`).
     Stderr,
-    /// Opened and written in place: a FIFO, device or socket (possibly behind links).
+    /// Opened and written in place: a FIFO, device or socket, or a file the process has open
+    /// (`/dev/fd/N`).
     Direct(PathBuf),
-    /// Written to a temporary file beside this path (a regular file or none yet; links
-    /// already followed) and renamed over it.
+    /// Written to a temporary file beside this path (a regular file or none yet, never a
+    /// link) and renamed over it.
     Replace(PathBuf),
 }
 
-/// Most symbolic links followed before giving up (as Linux's `ELOOP` limit).
-const MAX_LINKS: usize = 40;
-
-/// Decide how `path` is written (see the module documentation). Errors: a directory, a link
-/// loop, or a path whose kind cannot be read (permission).
+/// Decide how `path` is written (see the module documentation). Errors: a symbolic link, a
+/// directory, or a path whose kind cannot be read (permission).
 pub fn destination(path: &Path) -> io::Result<Destination> {
     if let Some(stream) = standard_stream(path) {
         return Ok(stream);
+    }
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() && !open_file_name(path) => {
+            return Err(link_refused(path))
+        }
+        Ok(_) => {}
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            return Ok(Destination::Replace(path.to_path_buf()))
+        }
+        Err(e) => return Err(cannot_inspect(path, e)),
     }
     match std::fs::metadata(path) {
         Ok(meta) if meta.is_dir() => Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             format!("{} is a directory; give a file name", path.display()),
         )),
-        Ok(meta) if meta.is_file() => {
-            if under_dev_or_proc(path) {
-                // e.g. /dev/fd/3 opened by the shell onto a file: writing in place keeps
-                // the shell's view of it; a rename would put a file into /dev.
-                return Ok(Destination::Direct(path.to_path_buf()));
-            }
-            let is_link = std::fs::symlink_metadata(path)?.file_type().is_symlink();
-            if is_link {
-                Ok(Destination::Replace(std::fs::canonicalize(path)?))
-            } else {
-                Ok(Destination::Replace(path.to_path_buf()))
-            }
+        Ok(meta) if meta.is_file() && !under_dev_or_proc(path) => {
+            Ok(Destination::Replace(path.to_path_buf()))
         }
+        // e.g. /dev/fd/3 opened by the shell onto a file: writing in place keeps the
+        // shell's view of it; a rename would put a file into /dev.
         Ok(_) => Ok(Destination::Direct(path.to_path_buf())),
-        Err(e) if e.kind() == io::ErrorKind::NotFound => {
-            match std::fs::symlink_metadata(path) {
-                // A dangling link: create what it points at.
-                Ok(m) if m.file_type().is_symlink() => {
-                    Ok(Destination::Replace(final_link_target(path)?))
-                }
-                _ => Ok(Destination::Replace(path.to_path_buf())),
-            }
-        }
-        Err(e) => Err(io::Error::new(
-            e.kind(),
-            format!("cannot inspect {}: {e}", path.display()),
-        )),
+        Err(e) => Err(cannot_inspect(path, e)),
     }
+}
+
+fn cannot_inspect(path: &Path, e: io::Error) -> io::Error {
+    io::Error::new(e.kind(), format!("cannot inspect {}: {e}", path.display()))
+}
+
+fn link_refused(path: &Path) -> io::Error {
+    let target = match std::fs::read_link(path) {
+        Ok(t) => format!(" (to {})", t.display()),
+        Err(_) => String::new(),
+    };
+    io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!(
+            "{} is a symbolic link{target}: outputs are never written through links; \
+             give the file's real path, or remove the link",
+            path.display()
+        ),
+    )
 }
 
 /// `-` and the names of the standard streams.
@@ -88,31 +102,30 @@ fn standard_stream(path: &Path) -> Option<Destination> {
     }
 }
 
+/// `/dev/fd/N` or `/proc/self/fd/N` (`/proc/PID/fd/N`): the kernel's link to a file this
+/// process already has open, which no one else can put there (unlike a link in a
+/// world-writable folder such as `/dev/shm`).
+fn open_file_name(path: &Path) -> bool {
+    let names: Option<Vec<&str>> = path
+        .components()
+        .map(|c| match c {
+            Component::RootDir => Some("/"),
+            Component::Normal(n) => n.to_str(),
+            _ => None,
+        })
+        .collect();
+    let number = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    match names.as_deref() {
+        Some(["/", "dev", "fd", n]) => number(n),
+        Some(["/", "proc", pid, "fd", n]) => (*pid == "self" || number(pid)) && number(n),
+        _ => false,
+    }
+}
+
 fn under_dev_or_proc(path: &Path) -> bool {
     let mut c = path.components();
     c.next() == Some(Component::RootDir)
         && matches!(c.next(), Some(Component::Normal(n)) if n == "dev" || n == "proc")
-}
-
-/// Follow a chain of links whose last target does not exist; that last target.
-fn final_link_target(path: &Path) -> io::Result<PathBuf> {
-    let mut p = path.to_path_buf();
-    for _ in 0..MAX_LINKS {
-        match std::fs::symlink_metadata(&p) {
-            Ok(m) if m.file_type().is_symlink() => {
-                let target = std::fs::read_link(&p)?;
-                p = match p.parent() {
-                    Some(dir) if target.is_relative() => dir.join(target),
-                    _ => target,
-                };
-            }
-            _ => return Ok(p),
-        }
-    }
-    Err(io::Error::new(
-        io::ErrorKind::InvalidInput,
-        format!("{}: too many levels of symbolic links", path.display()),
-    ))
 }
 
 /// Write `path` safely: `write` gets a buffered writer; on success it is flushed. For a file
@@ -134,13 +147,26 @@ where
         }
         Destination::Stderr => write_straight(clone_stderr()?, write),
         Destination::Direct(p) => {
-            let file = OpenOptions::new().write(true).open(&p).map_err(|e| {
-                io::Error::new(e.kind(), format!("cannot open {}: {e}", p.display()))
-            })?;
+            let file = open_direct(&p)?;
             write_straight(file, write)
         }
         Destination::Replace(target) => write_replacing(&target, write),
     }
+}
+
+/// Open a FIFO, device or socket for writing, in place. A link put there since
+/// [`destination`] looked is refused by the open itself (ELOOP), not followed.
+fn open_direct(p: &Path) -> io::Result<File> {
+    let mut options = OpenOptions::new();
+    options.write(true);
+    #[cfg(unix)]
+    if !open_file_name(p) {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NOFOLLOW);
+    }
+    options
+        .open(p)
+        .map_err(|e| io::Error::new(e.kind(), format!("cannot open {}: {e}", p.display())))
 }
 
 fn write_straight<T, E>(
@@ -401,45 +427,57 @@ mod tests {
         assert!(entries(dir.path()).is_empty());
     }
 
+    /// The refusal names the link and what to do, and nothing in `dir` changed.
+    #[cfg(unix)]
+    fn assert_link_refused(dir: &Path, link: &Path, before: &[String]) {
+        let err = write_bytes_atomically(link, b"new").unwrap_err();
+        assert_eq!(err.kind(), io::ErrorKind::InvalidInput, "{err}");
+        let msg = err.to_string();
+        assert!(
+            msg.contains(&link.display().to_string())
+                && msg.contains("is a symbolic link")
+                && msg.contains("remove the link"),
+            "{msg}"
+        );
+        assert_eq!(entries(dir), before, "no file was created or removed");
+        assert!(std::fs::symlink_metadata(link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    }
+
     #[cfg(unix)]
     #[test]
-    fn a_symlink_is_written_through_to_its_target() {
+    fn a_symlink_is_refused_and_its_target_left_untouched() {
         let dir = tempfile::tempdir().unwrap();
         let real = dir.path().join("real.csv");
         let link = dir.path().join("link.csv");
         std::fs::write(&real, b"old").unwrap();
         std::os::unix::fs::symlink("real.csv", &link).unwrap();
-        write_bytes_atomically(&link, b"new").unwrap();
-        assert!(std::fs::symlink_metadata(&link)
-            .unwrap()
-            .file_type()
-            .is_symlink());
+        assert_link_refused(dir.path(), &link, &["link.csv".into(), "real.csv".into()]);
+        assert_eq!(std::fs::read(&real).unwrap(), b"old");
         assert_eq!(std::fs::read_link(&link).unwrap(), Path::new("real.csv"));
-        assert_eq!(std::fs::read(&real).unwrap(), b"new");
-        assert_eq!(entries(dir.path()), ["link.csv", "real.csv"]);
     }
 
     #[cfg(unix)]
     #[test]
-    fn a_chain_of_links_to_a_missing_file_creates_the_file() {
+    fn a_dangling_symlink_is_refused_and_creates_nothing() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir(dir.path().join("sub")).unwrap();
         let a = dir.path().join("a");
         std::os::unix::fs::symlink("b", &a).unwrap();
         std::os::unix::fs::symlink("sub/new.csv", dir.path().join("b")).unwrap();
-        assert_eq!(
-            destination(&a).unwrap(),
-            Destination::Replace(dir.path().join("sub/new.csv"))
-        );
-        write_bytes_atomically(&a, b"new").unwrap();
-        assert_eq!(
-            std::fs::read(dir.path().join("sub/new.csv")).unwrap(),
-            b"new"
-        );
-        assert!(std::fs::symlink_metadata(&a)
-            .unwrap()
-            .file_type()
-            .is_symlink());
+        assert_link_refused(dir.path(), &a, &["a".into(), "b".into(), "sub".into()]);
+        assert!(!dir.path().join("sub/new.csv").exists());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_to_a_device_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let sink = dir.path().join("sink");
+        std::os::unix::fs::symlink("/dev/null", &sink).unwrap();
+        assert_link_refused(dir.path(), &sink, &["sink".into()]);
     }
 
     #[cfg(unix)]
@@ -449,8 +487,38 @@ mod tests {
         let a = dir.path().join("a");
         std::os::unix::fs::symlink("b", &a).unwrap();
         std::os::unix::fs::symlink("a", dir.path().join("b")).unwrap();
-        assert!(write_bytes_atomically(&a, b"x").is_err());
-        assert_eq!(entries(dir.path()), ["a", "b"]);
+        assert_link_refused(dir.path(), &a, &["a".into(), "b".into()]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_swapped_in_for_a_fifo_is_not_followed() {
+        // As if the FIFO `destination` saw was replaced by a link before the open.
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.csv");
+        std::fs::write(&real, b"old").unwrap();
+        let swapped = dir.path().join("pipe");
+        std::os::unix::fs::symlink("real.csv", &swapped).unwrap();
+        assert!(open_direct(&swapped).is_err(), "opened through the link");
+        assert_eq!(std::fs::read(&real).unwrap(), b"old");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn only_the_kernels_names_of_open_files_are_exempt() {
+        for p in ["/dev/fd/3", "/proc/self/fd/10", "/proc/123/fd/0"] {
+            assert!(open_file_name(Path::new(p)), "{p}");
+        }
+        for p in [
+            "/dev/shm/x",
+            "/dev/fd/../../tmp/x",
+            "/dev/fd/3/x",
+            "/proc/self/cwd/x",
+            "dev/fd/3",
+            "/dev/fd/",
+        ] {
+            assert!(!open_file_name(Path::new(p)), "{p}");
+        }
     }
 
     #[test]

@@ -53,6 +53,7 @@ pub mod csvlog;
 pub mod export;
 pub mod features;
 pub mod fit;
+pub mod json_keys;
 pub mod metrics;
 pub mod model;
 pub mod moving_average;

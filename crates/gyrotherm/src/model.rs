@@ -18,12 +18,15 @@
 //! `G = (Ĝ - B) / K` (eq. 4 of He et al. 2024); either may be absent. Floats are written in
 //! shortest round-trip form, so save → load is bit-exact. [`ModelFile::load`] checks the
 //! version first, then the fields (unknown fields are refused), then shapes and finiteness.
+//! A key named twice in one object is refused anywhere in the file (see
+//! [`crate::json_keys`]).
 
 use crate::atomic_file::write_bytes_atomically;
 use crate::baseline::TermsError;
 use crate::baseline::{self, Terms};
 use crate::csvlog::TestLog;
 use crate::features::FeatureTable;
+use crate::json_keys::{check_unique_keys, DuplicateKey, KeyCheckError};
 use crate::nn::params::{LstmParams, ParamsError};
 use crate::nn::zscore::ZScore;
 use gyrotherm_core::baseline::{BaselineError, BaselineModel};
@@ -568,6 +571,9 @@ pub enum ModelFileError {
     NotSaved(Box<ModelFileError>),
     /// The text is not JSON.
     NotJson(serde_json::Error),
+    /// An object names a key twice (`path` says where, e.g. `bias.baseline.coefficients`):
+    /// which value counts would depend on the reader, and the content hash covers only one.
+    DuplicateKey(DuplicateKey),
     /// A field is missing, unknown or of the wrong type.
     Fields(serde_json::Error),
     /// No `format_version` field.
@@ -607,6 +613,7 @@ impl std::fmt::Display for ModelFileError {
             ModelFileError::InFile { path, source } => write!(f, "{}: {source}", path.display()),
             ModelFileError::NotSaved(e) => write!(f, "not saved: {e}"),
             ModelFileError::NotJson(e) => write!(f, "not valid JSON: {e}"),
+            ModelFileError::DuplicateKey(d) => d.fmt(f),
             ModelFileError::Fields(e) => e.fmt(f),
             ModelFileError::MissingVersion => f.write_str("missing field `format_version`"),
             ModelFileError::UnsupportedVersion { found } => write!(
@@ -901,6 +908,12 @@ impl ModelFile {
     /// The model and whether the text held a checksum (checked only when `verify`).
     fn parse(text: &str, verify: bool) -> Result<(ModelFile, bool), ModelFileError> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        // Before anything reads a value: a repeated key would give the checksum one value
+        // and another reader the other.
+        check_unique_keys(text).map_err(|e| match e {
+            KeyCheckError::Duplicate(d) => ModelFileError::DuplicateKey(d),
+            KeyCheckError::NotJson(e) => ModelFileError::NotJson(e),
+        })?;
         // Version first, so that a newer file gets "unsupported version", not a field error.
         let mut v: serde_json::Value =
             serde_json::from_str(text).map_err(ModelFileError::NotJson)?;

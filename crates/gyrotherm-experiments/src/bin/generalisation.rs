@@ -398,7 +398,11 @@ fn run() -> Result<(), String> {
                 c.note
             ));
         }
-        std::fs::write(&path, text).map_err(|e| format!("{path}: {e}"))?;
+        gyrotherm::atomic_file::write_bytes_atomically(
+            std::path::Path::new(&path),
+            text.as_bytes(),
+        )
+        .map_err(|e| format!("{path}: {e}"))?;
     }
     print_table(&family, &cases, &methods, &settings);
     println!(

@@ -20,7 +20,7 @@ use gyrotherm_core::features::MAX_FEATURES;
 use gyrotherm_core::static_model::{StaticBaseline, StaticLstm, StaticModel, StaticTarget};
 
 use crate::compensate::CompensateError;
-use crate::model::{ModelFile, ModelFileError, SubModel, Target};
+use crate::model::{Method, ModelFile, ModelFileError, SubModel, Target, CHECKSUM_KEY};
 
 /// Why a model cannot be exported.
 #[derive(Debug)]
@@ -157,21 +157,39 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, Co
 // The generators index the core's arrays by these sizes.
 const _: () = assert!(LSTM_INPUTS == MAX_FEATURES && HIDDEN == 8);
 
+/// The generated files of `model` for `lang`, as `(file name, text)`, without writing
+/// anything. Every byte of the text is one the generator chose: its templates, numbers it
+/// formatted and fixed words; no string of the model file (who created it, the training
+/// files' names) is copied into it, so a model cannot inject code or directives into flight
+/// source. See [`is_generated_text`].
+pub fn generate(model: &ModelFile, lang: Lang) -> Result<Vec<(&'static str, String)>, ExportError> {
+    let m = static_model(model)?;
+    let about = describe(model)?;
+    let files = match lang {
+        Lang::C => {
+            let (h, c) = c::generate(&m, &about);
+            vec![("gyrotherm_model.h", h), ("gyrotherm_model.c", c)]
+        }
+        Lang::Rust => vec![("gyrotherm_model.rs", rust::generate(&m, &about))],
+    };
+    Ok(files)
+}
+
 /// Write the export of `model` for `lang` into `dir` (created if missing), each file
 /// atomically; returns the files written.
 pub fn export(model: &ModelFile, lang: Lang, dir: &Path) -> Result<Vec<PathBuf>, ExportError> {
-    let m = static_model(model)?;
-    let files: Vec<(&str, String)> = match lang {
-        Lang::C => {
-            let (h, c) = c::generate(&m, &describe(model));
-            vec![("gyrotherm_model.h", h), ("gyrotherm_model.c", c)]
-        }
-        Lang::Rust => vec![("gyrotherm_model.rs", rust::generate(&m, &describe(model)))],
-    };
+    let files = generate(model, lang)?;
     std::fs::create_dir_all(dir).map_err(|source| ExportError::Io {
         path: dir.to_path_buf(),
         source,
     })?;
+    // Every destination is checked before any is written, so a refused one (a link planted
+    // in the folder) leaves no partial export behind.
+    for (name, _) in &files {
+        let path = dir.join(name);
+        crate::atomic_file::destination(&path)
+            .map_err(|source| ExportError::Io { path, source })?;
+    }
     let mut out = Vec::new();
     for (name, text) in files {
         let path = dir.join(name);
@@ -186,17 +204,40 @@ pub fn export(model: &ModelFile, lang: Lang, dir: &Path) -> Result<Vec<PathBuf>,
     Ok(out)
 }
 
-/// One line saying what the model is, for the generated files' headers.
-fn describe(model: &ModelFile) -> String {
-    let kind = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
-    format!(
-        "method {}, bias: {}, scale factor: {}; trained by {} on {}",
-        model.method.as_str(),
+/// Whether `text` holds only what the generator writes: printable ASCII (0x20 to 0x7E) and
+/// `\n`, and no `??` (the start of every C trigraph, which `-std=c99` would translate).
+/// Control characters, bidirectional overrides and other non-ASCII text can only come
+/// from outside the generator, so their absence is checked in the tests and the fuzz target.
+pub fn is_generated_text(text: &str) -> bool {
+    text.bytes()
+        .all(|b| b == b'\n' || (0x20..=0x7e).contains(&b))
+        && !text.contains("??")
+}
+
+/// One line saying what the model is, for the generated files' headers: only the
+/// generator's own words for the method and the sub-model kinds, and the model's content
+/// hash (hex), by which the model file can be found again. The file's free-text fields
+/// (`training.created_by`, `training.inputs`) are left out: they are whatever the file
+/// says, and in a comment of generated source they could close the comment and add code.
+fn describe(model: &ModelFile) -> Result<String, ExportError> {
+    let method = match model.method {
+        Method::Lstm => "lstm",
+        Method::Linear => "linear",
+        Method::Poly => "poly",
+    };
+    let kind = |s: &Option<SubModel>| match s {
+        None => "none",
+        Some(SubModel::Lstm { .. }) => "lstm",
+        Some(SubModel::Baseline { .. }) => "least squares",
+        Some(SubModel::Residual { .. }) => "least squares + lstm",
+    };
+    // SHA-256 computed here, as lower-case hex (`sha256_hex`), not read from the file.
+    let digest = model.content_digest().map_err(ExportError::Model)?;
+    Ok(format!(
+        "method {method}, bias: {}, scale factor: {}; {CHECKSUM_KEY} {digest}",
         kind(&model.bias),
         kind(&model.scale),
-        model.training.created_by,
-        model.training.inputs.join(", ")
-    )
+    ))
 }
 
 /// Shortest round-trip text of an f64, valid as a C and a Rust literal (`1e0`, `-2.5e-3`).
