@@ -314,7 +314,7 @@ fn compare_shows_the_published_recipe_beside_the_default() {
 }
 
 /// `--validate-on-runs` with two static logs: the output names each log with its figure for
-/// the LSTM trained without it (`fit::LstmRecipe::validate_on_runs`).
+/// the LSTM trained without it (`fit::RecipeSettings::validate_on_runs`).
 #[test]
 fn validate_on_runs_reports_each_left_out_log() {
     let dir = tempfile::tempdir().unwrap();

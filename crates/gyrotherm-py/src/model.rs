@@ -7,7 +7,7 @@ use std::sync::Mutex;
 use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
 use gyrotherm::compensate_lines::compensate_file;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, LstmVerdict, NamedLog, Target};
+use gyrotherm::fit::{fit_model, FitConfig, LstmVerdict, NamedLog, RecipeSettings, Target};
 use gyrotherm::model::{Method, ModelFile};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -309,7 +309,7 @@ impl FitSettings {
     fn config(&self) -> PyResult<FitConfig> {
         let mut cfg = FitConfig::new(parse_method(&self.method)?);
         let kind = gyrotherm::RecipeKind::parse(&self.recipe).map_err(py_err::<FitError>)?;
-        cfg.recipe = LstmRecipe::of_kind(kind);
+        cfg.recipe = RecipeSettings::of_kind(kind);
         if let Some(e) = self.epochs {
             if e == 0 {
                 return Err(FitError::new_err("epochs must be at least 1"));

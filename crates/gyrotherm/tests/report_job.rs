@@ -121,7 +121,7 @@ fn full_report_over_simulated_logs_draws_every_figure() {
     let mut cfg = CompareConfig::default();
     // A recipe with an LSTM (the training-loss figure needs one; the default `thermal` has
     // none), and a few epochs: the figures, not the fit quality, are under test.
-    cfg.fit.recipe = gyrotherm::fit::LstmRecipe::residual();
+    cfg.fit.recipe = gyrotherm::fit::RecipeSettings::residual();
     cfg.fit.recipe.epochs = 3;
     cfg.candidates = vec![
         Candidate::linear(),

@@ -68,6 +68,45 @@ pub enum Lang {
     Rust,
 }
 
+/// Names of the export languages.
+pub const LANG_NAMES: [&str; 2] = ["c", "rust"];
+
+impl Lang {
+    /// The name on the command line (`--lang`).
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Lang::C => "c",
+            Lang::Rust => "rust",
+        }
+    }
+
+    /// One line on what is written (the `--help` text of the value).
+    pub fn help(&self) -> &'static str {
+        match self {
+            Lang::C => {
+                "C99: gyrotherm_model.h and gyrotherm_model.c (no heap, no global mutable state)"
+            }
+            Lang::Rust => "Rust: gyrotherm_model.rs, the model as a `static` for gyrotherm-core",
+        }
+    }
+}
+
+impl std::fmt::Display for Lang {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::str::FromStr for Lang {
+    type Err = crate::settings::SettingError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        [Lang::C, Lang::Rust]
+            .into_iter()
+            .find(|l| l.as_str() == s)
+            .ok_or_else(|| crate::settings::SettingError::unknown("lang", s, &LANG_NAMES))
+    }
+}
+
 /// The static (flight) form of a model file: the numbers the core's compensator is built
 /// from, after the same conversions (`f64` LSTM weights to `f32`, inputs padded to
 /// `LSTM_INPUTS` slots).

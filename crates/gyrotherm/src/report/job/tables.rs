@@ -4,7 +4,7 @@ use super::fmt_num;
 use crate::compare::{Candidate, Column, CompareConfig, Comparison};
 use crate::features::feature_names;
 use crate::fit::NamedLog;
-use crate::model::{Method, ModelFile};
+use crate::model::ModelFile;
 use crate::report::html::Table;
 
 /// The comparison table of `gyrotherm compare` ([`Comparison::table`]) as the report's HTML
@@ -90,7 +90,7 @@ fn model_metadata(
         format!("{p} model"),
         format!("{} ({} method) — {targets}", col.label, m.method.as_str()),
     ));
-    if m.method == Method::Lstm {
+    if m.method.is_recipe() {
         let recipe = cand.fit_config(&cfg.fit).recipe;
         md.push((
             format!("{p} recipe"),
