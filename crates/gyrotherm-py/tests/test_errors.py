@@ -65,7 +65,7 @@ def test_bad_model_file_raises_the_cli_message(cli, logs, tmp_path):
 
 
 def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
-    with pytest.raises(gt.FitError, match="unknown LSTM recipe \"fancy\""):
+    with pytest.raises(gt.FitError, match="recipe: unknown value \"fancy\""):
         gt.fit(static=logs["static"], recipe="fancy")
     with pytest.raises(gt.FitError, match="unknown method \"spline\""):
         gt.fit(static=logs["static"], method="spline")
@@ -81,8 +81,8 @@ def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
         gt.fit(static=logs["static"], time_column="t")
     with pytest.raises(gt.LogError, match="unknown gyro unit"):
         gt.read_log(logs["static"], gyro_unit="mrad")
-    with pytest.raises(gt.LogError, match="fill_gaps = -1 is not a positive number of seconds"):
-        gt.read_log(logs["static"], fill_gaps=-1)
+    with pytest.raises(gt.LogError, match="fill_gaps_max_s = -1 is not a positive number of seconds"):
+        gt.read_log(logs["static"], fill_gaps_max_s=-1)
 
 
 @pytest.mark.parametrize(

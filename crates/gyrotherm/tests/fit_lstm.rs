@@ -20,7 +20,7 @@ use gyrotherm::targets::TargetSet;
 fn residual_cfg() -> FitConfig {
     FitConfig {
         recipe: RecipeSettings::residual(),
-        ..FitConfig::new(Method::Lstm)
+        ..FitConfig::new(Method::Residual)
     }
 }
 

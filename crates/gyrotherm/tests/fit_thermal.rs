@@ -11,7 +11,7 @@ use gyrotherm::model::{Method, SubModel};
 use gyrotherm::sim::{random_unit, simulate, FogUnit, Profile, SensorNode, SimConfig};
 
 fn thermal() -> FitConfig {
-    let mut c = FitConfig::new(Method::Lstm);
+    let mut c = FitConfig::new(Method::Thermal);
     c.recipe = RecipeSettings::of_kind(RecipeKind::Thermal);
     c
 }

@@ -163,6 +163,13 @@ impl fmt::Display for SettingError {
                 setting,
                 value,
                 rule,
+            } if *rule == Rule::AtLeastOne => {
+                write!(f, "{setting} {}, not {value}", rule.text())
+            }
+            SettingError::Invalid {
+                setting,
+                value,
+                rule,
             } => write!(f, "{setting} = {value} {}", rule.text()),
             SettingError::Conflict {
                 setting,
