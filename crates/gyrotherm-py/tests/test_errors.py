@@ -67,7 +67,7 @@ def test_bad_model_file_raises_the_cli_message(cli, logs, tmp_path):
 def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
     with pytest.raises(gt.FitError, match="recipe: unknown value \"fancy\""):
         gt.fit(static=logs["static"], recipe="fancy")
-    with pytest.raises(gt.FitError, match="unknown method \"spline\""):
+    with pytest.raises(gt.FitError, match="method: unknown value \"spline\""):
         gt.fit(static=logs["static"], method="spline")
     with pytest.raises(gt.FitError, match="epochs must be at least 1"):
         gt.fit(static=logs["static"], epochs=0)

@@ -144,5 +144,5 @@ def test_read_log_column_mapping_units_and_frame(tmp_path):
 def test_read_log_fills_gaps_when_asked(tmp_path):
     p = tmp_path / "gap.csv"
     p.write_text("time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n")
-    cols = gt.read_log(p, as_frame=False, fill_gaps=2)
+    cols = gt.read_log(p, as_frame=False, fill_gaps_max_s=2)
     np.testing.assert_array_equal(cols["time_s"], [0.0, 1.0, 2.0, 3.0])
