@@ -25,6 +25,9 @@ pub struct OptionSpec {
     pub switch: bool,
     /// Deprecated spelling, kept one release.
     pub deprecated: bool,
+    /// Whether a value outside `values` is accepted too (`taus`: a list of seconds;
+    /// `delimiter`: other spellings of the same separators).
+    pub open: bool,
 }
 
 fn opt(name: &'static str, default: Option<String>) -> OptionSpec {
@@ -34,6 +37,7 @@ fn opt(name: &'static str, default: Option<String>) -> OptionSpec {
         values: Vec::new(),
         switch: false,
         deprecated: false,
+        open: false,
     }
 }
 
@@ -62,7 +66,11 @@ pub fn log_options() -> Vec<OptionSpec> {
         choice("gyro_unit", d.gyro_unit.as_str(), &GYRO_UNIT_NAMES),
         opt("fill_gaps_max_s", d.fill_gaps_max_s.map(|v| v.to_string())),
         opt("sample_period_s", d.sample_period_s.map(|v| v.to_string())),
-        choice("delimiter", delimiter_name(d.delimiter), &DELIMITER_NAMES),
+        // Open: `comma`, `semicolon`, a literal tab and `\t` are accepted spellings too.
+        OptionSpec {
+            open: true,
+            ..choice("delimiter", delimiter_name(d.delimiter), &DELIMITER_NAMES)
+        },
     ]
 }
 
@@ -101,7 +109,10 @@ pub fn allan_options() -> Vec<OptionSpec> {
     vec![
         opt("column", Some(d.column)),
         choice("kind", d.kind.name(), &KIND_NAMES),
-        choice("taus", &d.taus.to_string(), &TAU_SET_NAMES),
+        OptionSpec {
+            open: true,
+            ..choice("taus", &d.taus.to_string(), &TAU_SET_NAMES)
+        },
         opt("alpha", d.alpha.map(|a| a.to_string())),
     ]
 }
@@ -136,7 +147,7 @@ pub fn describe() -> Vec<(&'static str, Vec<OptionSpec>)> {
 }
 
 /// [`describe`] as JSON text: `{"train": [{"name", "default", "values", "switch",
-/// "deprecated"}, …], …}`.
+/// "deprecated", "open"}, …], …}`.
 pub fn describe_json() -> String {
     let map: serde_json::Map<String, serde_json::Value> = describe()
         .into_iter()
