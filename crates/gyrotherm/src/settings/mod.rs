@@ -65,8 +65,9 @@ impl Rule {
                  about 1)"
             }
             Rule::NoiseAlpha => {
-                "is not a noise exponent: α is an integer from -4 to 2 (2 white PM, 1 flicker \
-                 PM, 0 white FM, -1 flicker FM, -2 random-walk FM, -3 and -4 for Hadamard only)"
+                "is not allowed: the noise exponent α is an integer from -4 to 2 (2 white PM, 1 \
+                 flicker PM, 0 white FM, -1 flicker FM, -2 random-walk FM, -3 and -4 for \
+                 Hadamard only)"
             }
             Rule::Number => "is not a number",
         }
