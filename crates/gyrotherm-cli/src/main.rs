@@ -33,7 +33,7 @@ enum Command {
     Allan(cmd::allan::AllanArgs),
     /// Bias, bias stability and (rate-table logs) scale-factor figures of a log.
     Evaluate(cmd::evaluate::EvaluateArgs),
-    /// Fit a compensation model (LSTM, linear or polynomial) to test logs.
+    /// Fit a compensation model (thermal-state, LSTM, linear or polynomial) to test logs.
     Train(cmd::train::TrainArgs),
     /// Apply a fitted model to a log (batch, or --stream on stdin/stdout).
     Compensate(cmd::compensate::CompensateArgs),
@@ -45,6 +45,10 @@ enum Command {
     Model(cmd::model::ModelArgs),
     /// Write a model as flight code: C99 or a Rust module for gyrotherm-core.
     Export(cmd::export::ExportArgs),
+    /// Every setting of train, compensate, allan and evaluate with its default and accepted
+    /// values, as JSON (the library's own description; for tests and tools).
+    #[command(hide = true)]
+    Settings(cmd::settings::SettingsArgs),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Report(a) => cmd::report::run(a),
         Command::Model(a) => cmd::model::run(a),
         Command::Export(a) => cmd::export::run(a),
+        Command::Settings(a) => cmd::settings::run(a),
     };
     match result {
         Ok(code) => code,

@@ -140,7 +140,7 @@ fn lstm_training_from_the_cli_writes_a_loadable_model() {
     run_ok(
         gyrotherm()
             .args([
-                "train", "--method", "lstm", "--epochs", "3", "--seed", "9", "--input",
+                "train", "--method", "residual", "--epochs", "3", "--seed", "9", "--input",
             ])
             .arg(&train_s)
             .arg("--out")
@@ -148,7 +148,7 @@ fn lstm_training_from_the_cli_writes_a_loadable_model() {
     );
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
-    assert_eq!(m["method"], "lstm");
+    assert_eq!(m["method"], "residual");
     assert_eq!(m["training"]["seed"], 9);
     assert!(m["bias"].is_object() && m["scale"].is_null());
     let comp = dir.path().join("c.csv");
@@ -177,10 +177,10 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
     let test_s = simulate(dir.path(), "test_static.csv", "slow-ramp", 3, false);
     let out = run_ok(
         gyrotherm()
-            // The residual recipe: this test reads its LSTM gate. The published column is
+            // The residual method: this test reads its LSTM gate. The published column is
             // left out (its own test below).
-            .args(["compare", "--json", "--recipe", "residual"])
-            .args(["--methods", "linear,poly,lstm", "--train"])
+            .args(["compare", "--json"])
+            .args(["--methods", "linear,poly,residual", "--train"])
             .arg(&train_s)
             .arg("--train")
             .arg(&train_t)
@@ -207,26 +207,26 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
     );
     let fig = |m: &str| t["methods"][m]["bias_stability_dph"].as_f64().unwrap();
     assert!(
-        fig("lstm") < fig("linear"),
-        "lstm {} vs linear {}",
-        fig("lstm"),
+        fig("residual") < fig("linear"),
+        "residual {} vs linear {}",
+        fig("residual"),
         fig("linear")
     );
     let models = v["models"].as_array().unwrap();
     let model = |m: &str| models.iter().find(|x| x["key"] == m).unwrap();
-    assert!(model("lstm")["bias_lstm_validation_improvement"].is_number());
+    assert!(model("residual")["bias_lstm_validation_improvement"].is_number());
     assert!(
-        model("lstm")["bias_lstm_run_gate"].is_null(),
+        model("residual")["bias_lstm_run_gate"].is_null(),
         "one static log: no run gate"
     );
     assert!(model("linear")["bias_lstm_validation_improvement"].is_null());
     // A model is named by what it holds: the label says "LSTM" exactly when a sub-model has one.
     let lstm_kept = ["bias_model", "scale_model"].iter().any(|k| {
-        model("lstm")[*k]
+        model("residual")[*k]
             .as_str()
             .is_some_and(|s| s.contains("lstm"))
     });
-    let label = model("lstm")["label"].as_str().unwrap();
+    let label = model("residual")["label"].as_str().unwrap();
     assert_eq!(
         label,
         if lstm_kept {
@@ -235,10 +235,14 @@ fn compare_json_matches_evaluate_and_reports_the_lstm_gate() {
             "thermal-state LS"
         },
         "{:?}",
-        model("lstm")
+        model("residual")
     );
     assert_eq!(model("linear")["label"], "linear");
-    assert_eq!(models.len(), 3, "--methods linear,poly,lstm: three columns");
+    assert_eq!(
+        models.len(),
+        3,
+        "--methods linear,poly,residual: three columns"
+    );
 }
 
 /// By default the published recipe (He et al. 2024) has its own column beside the default
@@ -269,10 +273,10 @@ fn compare_shows_the_published_recipe_beside_the_default() {
         .iter()
         .map(|m| m["key"].as_str().unwrap())
         .collect();
-    assert_eq!(keys, ["linear", "poly", "lstm", "published"]);
+    assert_eq!(keys, ["linear", "poly", "thermal", "published"]);
     let published = &v["models"][3];
     assert_eq!(published["label"], "LSTM, He et al.");
-    assert_eq!(published["method"], "lstm");
+    assert_eq!(published["method"], "published");
     assert_eq!(published["recipe"], "published");
     assert_eq!(published["bias_model"], "lstm");
     assert_eq!(published["bias_epochs"], 5);
@@ -299,8 +303,9 @@ fn compare_shows_the_published_recipe_beside_the_default() {
         cols,
         ["figure", "raw", "LSTM, He et al.", "linear", "noise floor"]
     );
-    // `--recipe published` makes the lstm column the published one: asking for both is
-    // refused, and the default columns hold it once.
+    // The deprecated `--recipe published` makes the default recipe column (and the
+    // deprecated `lstm` in `--methods`) the published one: asking for both is refused, and
+    // the default columns hold it once.
     let out = compare(&["--recipe", "published", "--methods", "lstm,published"])
         .output()
         .unwrap();
@@ -314,7 +319,7 @@ fn compare_shows_the_published_recipe_beside_the_default() {
 }
 
 /// `--validate-on-runs` with two static logs: the output names each log with its figure for
-/// the LSTM trained without it (`fit::LstmRecipe::validate_on_runs`).
+/// the LSTM trained without it (`fit::RecipeSettings::validate_on_runs`).
 #[test]
 fn validate_on_runs_reports_each_left_out_log() {
     let dir = tempfile::tempdir().unwrap();
@@ -326,8 +331,6 @@ fn validate_on_runs_reports_each_left_out_log() {
             .args([
                 "train",
                 "--method",
-                "lstm",
-                "--recipe",
                 "residual",
                 "--epochs",
                 "3",

@@ -254,14 +254,10 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
     train("linear", &["--method", "linear"], true);
     train("poly", &["--method", "poly"], true);
     for recipe in ["residual", "generic", "direct", "published"] {
-        train(recipe, &["--method", "lstm", "--recipe", recipe], true);
+        train(recipe, &["--method", recipe], true);
     }
     train("linear-bias-only", &["--method", "linear"], false);
-    train(
-        "published-bias-only",
-        &["--method", "lstm", "--recipe", "published"],
-        false,
-    );
+    train("published-bias-only", &["--method", "published"], false);
     let template = models[0].1.clone();
     models.extend(constructed_models(d, &template));
 

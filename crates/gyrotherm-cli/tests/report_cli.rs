@@ -86,9 +86,9 @@ fn report_writes_the_page_and_every_figure() {
         &s(&test_t),
         "--out",
         &s(&out),
-        // A recipe with an LSTM: its training-loss figure is one of the eight.
-        "--recipe",
-        "residual",
+        // A method with an LSTM: its training-loss figure is one of the eight.
+        "--methods",
+        "linear,poly,residual,published",
         "--epochs",
         "3",
     ]);

@@ -89,7 +89,7 @@ fn numeric_options_are_checked_in_their_own_terms() {
         ),
         (
             &["evaluate", "--tau", "1e308"],
-            "--tau 1e308 s is longer than half the log",
+            "tau_s = 1e308 s is longer than half the log",
         ),
         (
             &["allan", "--alpha", "100"],

@@ -77,6 +77,22 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ONE_SIGMA_CI", gyrotherm::allan::ONE_SIGMA_CI)?;
     m.add("BIAS_WINDOW_S", gyrotherm::targets::BIAS_WINDOW_S)?;
     m.add("SETTLE_S", gyrotherm::targets::SETTLE_S)?;
+    // The library's defaults and name lists: Python states none of them itself.
+    m.add("FIT_DEFAULTS", model::fit_defaults(py)?)?;
+    m.add("READ_DEFAULTS", logs::read_defaults(py)?)?;
+    m.add("METHOD_NAMES", gyrotherm::settings::METHOD_NAMES.to_vec())?;
+    m.add(
+        "GYRO_UNIT_NAMES",
+        gyrotherm::settings::read::GYRO_UNIT_NAMES.to_vec(),
+    )?;
+    m.add(
+        "DELIMITER_NAMES",
+        gyrotherm::settings::read::DELIMITER_NAMES.to_vec(),
+    )?;
+    m.add(
+        "SETTINGS_JSON",
+        gyrotherm::settings::describe::describe_json(),
+    )?;
     m.add(
         "STATUS_NAMES",
         model::status_names()

@@ -3,18 +3,20 @@
 use std::path::{Path, PathBuf};
 
 use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
+use gyrotherm::settings::read;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::LogError;
+use crate::{py_err, LogError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
     Ok(())
 }
 
-/// How to read a log; the Python side passes every key (its defaults are the CLI's).
+/// How to read a log; the Python side passes every key (its defaults are
+/// [`read_defaults`], the library's).
 #[derive(Debug, Clone, FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct LogOptions {
@@ -23,34 +25,43 @@ pub struct LogOptions {
     pub temp_col: String,
     pub table_col: String,
     pub gyro_unit: String,
-    pub fill_gaps: Option<f64>,
-    pub sample_period: Option<f64>,
-}
-
-fn positive(name: &str, v: Option<f64>) -> PyResult<Option<f64>> {
-    match v {
-        Some(x) if !(x.is_finite() && x > 0.0) => Err(LogError::new_err(format!(
-            "{name} = {x} is not a positive number of seconds"
-        ))),
-        _ => Ok(v),
-    }
+    pub fill_gaps_max_s: Option<f64>,
+    pub sample_period_s: Option<f64>,
+    pub delimiter: String,
 }
 
 impl LogOptions {
-    /// The library's read options (the same mapping as the CLI's `--time-col` … flags).
+    /// The library's read options, parsed and checked by the library.
     pub fn read_options(&self) -> PyResult<ReadOptions> {
         let gyro_unit: GyroUnit = self.gyro_unit.parse().map_err(LogError::new_err)?;
-        Ok(ReadOptions {
+        let opts = ReadOptions {
             time_col: self.time_col.clone(),
             gyro_col: self.gyro_col.clone(),
             temp_col: self.temp_col.clone(),
             table_col: self.table_col.clone(),
             gyro_unit,
-            fill_gaps_max_s: positive("fill_gaps", self.fill_gaps)?,
-            sample_period_s: positive("sample_period", self.sample_period)?,
-            ..ReadOptions::default()
-        })
+            fill_gaps_max_s: self.fill_gaps_max_s,
+            sample_period_s: self.sample_period_s,
+            delimiter: read::parse_delimiter(&self.delimiter).map_err(py_err::<LogError>)?,
+        };
+        opts.validate().map_err(py_err::<LogError>)?;
+        Ok(opts)
     }
+}
+
+/// The library's defaults for reading a log, keyed as Python's log options.
+pub fn read_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = ReadOptions::default();
+    let out = PyDict::new(py);
+    out.set_item("time_col", &d.time_col)?;
+    out.set_item("gyro_col", &d.gyro_col)?;
+    out.set_item("temp_col", &d.temp_col)?;
+    out.set_item("table_col", &d.table_col)?;
+    out.set_item("gyro_unit", d.gyro_unit.as_str())?;
+    out.set_item("fill_gaps_max_s", d.fill_gaps_max_s)?;
+    out.set_item("sample_period_s", d.sample_period_s)?;
+    out.set_item("delimiter", read::delimiter_name(d.delimiter))?;
+    Ok(out)
 }
 
 /// Read a whole log; the error is the library's message (file, line, column, the fix).

@@ -7,8 +7,9 @@ use std::sync::Mutex;
 use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
 use gyrotherm::compensate_lines::compensate_file;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, LstmVerdict, NamedLog, Target};
-use gyrotherm::model::{Method, ModelFile};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, Target};
+use gyrotherm::model::ModelFile;
+use gyrotherm::settings::FitSettings;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -277,86 +278,63 @@ pub fn status_names() -> Vec<(u8, &'static str)> {
         .collect()
 }
 
-fn parse_method(name: &str) -> PyResult<Method> {
-    match name {
-        "lstm" => Ok(Method::Lstm),
-        "linear" => Ok(Method::Linear),
-        "poly" => Ok(Method::Poly),
-        other => Err(FitError::new_err(format!(
-            "unknown method {other:?}; use lstm, linear or poly"
-        ))),
-    }
-}
-
-/// Fitting settings; the Python side passes every key (defaults are the CLI's).
+/// Fitting settings as Python passes them (every key; the defaults are [`fit_defaults`],
+/// the library's); parsed and checked by the library.
 #[derive(Debug, Clone, FromPyObject)]
 #[pyo3(from_item_all)]
-pub struct FitSettings {
+pub struct FitArgs {
     method: String,
-    recipe: String,
+    recipe: Option<String>,
     epochs: Option<usize>,
     seed: u64,
-    bias_window: f64,
-    settle: f64,
+    bias_window_s: f64,
+    settle_s: f64,
     poly_temp_degree: u8,
     poly_rate_degree: u8,
     cross: bool,
     validate_on_runs: bool,
 }
 
-impl FitSettings {
-    /// The same checks and mapping as the CLI's `FitArgs::fit_config`.
-    fn config(&self) -> PyResult<FitConfig> {
-        let mut cfg = FitConfig::new(parse_method(&self.method)?);
-        let kind = gyrotherm::RecipeKind::parse(&self.recipe).map_err(py_err::<FitError>)?;
-        cfg.recipe = LstmRecipe::of_kind(kind);
-        if let Some(e) = self.epochs {
-            if e == 0 {
-                return Err(FitError::new_err("epochs must be at least 1"));
-            }
-            cfg.recipe.epochs = e;
-        }
-        if !(self.bias_window.is_finite() && self.bias_window > 0.0) {
-            return Err(FitError::new_err(
-                "bias_window must be a positive number of seconds",
-            ));
-        }
-        if !(self.settle.is_finite() && self.settle >= 0.0) {
-            return Err(FitError::new_err(
-                "settle must be zero or a positive number of seconds",
-            ));
-        }
-        cfg.seed = self.seed;
-        cfg.bias_window_s = self.bias_window;
-        cfg.settle_s = self.settle;
-        cfg.poly.temp = self.poly_temp_degree;
-        cfg.poly.rate = self.poly_rate_degree;
-        cfg.poly.cross = self.cross;
-        cfg.recipe.validate_on_runs = self.validate_on_runs;
-        Ok(cfg)
+impl FitArgs {
+    /// The library's fit configuration and what a deprecated spelling now means.
+    fn config(&self) -> PyResult<(FitConfig, Option<String>)> {
+        let settings = FitSettings {
+            method: self.method.parse().map_err(py_err::<FitError>)?,
+            recipe: self
+                .recipe
+                .as_deref()
+                .map(str::parse::<RecipeKind>)
+                .transpose()
+                .map_err(py_err::<FitError>)?,
+            epochs: self.epochs,
+            seed: self.seed,
+            bias_window_s: self.bias_window_s,
+            settle_s: self.settle_s,
+            poly_temp_degree: self.poly_temp_degree,
+            poly_rate_degree: self.poly_rate_degree,
+            cross: self.cross,
+            validate_on_runs: self.validate_on_runs,
+        };
+        let (cfg, note) = settings.fit_config().map_err(py_err::<FitError>)?;
+        Ok((cfg, note.map(|n| n.to_string())))
     }
 }
 
-fn verdict_text(v: LstmVerdict) -> &'static str {
-    match v {
-        LstmVerdict::Kept => "kept",
-        LstmVerdict::LeftOut {
-            validation_blocks: true,
-            left_out_runs: true,
-        } => "left out: it beat the least-squares base neither on the validation blocks nor on every left-out run",
-        LstmVerdict::LeftOut {
-            validation_blocks: true,
-            left_out_runs: false,
-        } => "left out: it did not beat the least-squares base on the validation blocks",
-        LstmVerdict::LeftOut {
-            validation_blocks: false,
-            left_out_runs: true,
-        } => "left out: it did not beat the least-squares base on every left-out run",
-        LstmVerdict::LeftOut {
-            validation_blocks: false,
-            left_out_runs: false,
-        } => "left out: its correction fitted none of the validation residual",
-    }
+/// The library's fit defaults, keyed as `fit()`'s keywords.
+pub fn fit_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = FitSettings::default();
+    let out = PyDict::new(py);
+    out.set_item("method", d.method.as_str())?;
+    out.set_item("recipe", d.recipe.map(|r| r.as_str()))?;
+    out.set_item("epochs", d.epochs)?;
+    out.set_item("seed", d.seed)?;
+    out.set_item("bias_window_s", d.bias_window_s)?;
+    out.set_item("settle_s", d.settle_s)?;
+    out.set_item("poly_temp_degree", d.poly_temp_degree)?;
+    out.set_item("poly_rate_degree", d.poly_rate_degree)?;
+    out.set_item("cross", d.cross)?;
+    out.set_item("validate_on_runs", d.validate_on_runs)?;
+    Ok(out)
 }
 
 /// Fit a model to logs: `static_logs` train the bias model, `table_logs` the scale-factor
@@ -368,11 +346,11 @@ fn fit(
     py: Python<'_>,
     static_logs: Vec<PathBuf>,
     table_logs: Vec<PathBuf>,
-    settings: FitSettings,
+    settings: FitArgs,
     options: LogOptions,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<RawModel> {
-    let cfg = settings.config()?;
+    let (cfg, deprecation) = settings.config()?;
     let opts = options.read_options()?;
     let failed: Mutex<Option<PyErr>> = Mutex::new(None);
     let result = py.detach(|| -> Result<_, PyErr> {
@@ -427,7 +405,7 @@ fn fit(
         if let Some(t) = t {
             line += &format!(", {} epochs, final loss {:.4e}", t.epochs, t.final_loss);
             if let Some(v) = t.lstm_verdict {
-                line += &format!("; LSTM {}", verdict_text(v));
+                line += &format!("; LSTM {}", v.text());
             }
         }
         notes.push(line);
@@ -435,6 +413,6 @@ fn fit(
     Ok(RawModel {
         file: result.model,
         training_notes: notes,
-        load_warnings: Vec::new(),
+        load_warnings: deprecation.into_iter().collect(),
     })
 }

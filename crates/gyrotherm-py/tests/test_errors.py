@@ -81,9 +81,9 @@ def test_model_file_with_a_key_named_twice_raises_the_cli_message(cli, logs, tmp
 
 
 def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
-    with pytest.raises(gt.FitError, match="unknown LSTM recipe \"fancy\""):
+    with pytest.raises(gt.FitError, match="recipe: unknown value \"fancy\""):
         gt.fit(static=logs["static"], recipe="fancy")
-    with pytest.raises(gt.FitError, match="unknown method \"spline\""):
+    with pytest.raises(gt.FitError, match="method: unknown value \"spline\""):
         gt.fit(static=logs["static"], method="spline")
     with pytest.raises(gt.FitError, match="epochs must be at least 1"):
         gt.fit(static=logs["static"], epochs=0)
@@ -97,8 +97,8 @@ def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
         gt.fit(static=logs["static"], time_column="t")
     with pytest.raises(gt.LogError, match="unknown gyro unit"):
         gt.read_log(logs["static"], gyro_unit="mrad")
-    with pytest.raises(gt.LogError, match="fill_gaps = -1 is not a positive number of seconds"):
-        gt.read_log(logs["static"], fill_gaps=-1)
+    with pytest.raises(gt.LogError, match="fill_gaps_max_s = -1 is not a positive number of seconds"):
+        gt.read_log(logs["static"], fill_gaps_max_s=-1)
 
 
 @pytest.mark.parametrize(

@@ -22,21 +22,19 @@ def read_csv_columns(path):
 FITS = [
     ("linear", {}),
     ("poly", {}),
-    ("lstm", {"recipe": "published", "epochs": 3}),
-    ("lstm", {"recipe": "residual", "epochs": 3}),
+    ("published", {"epochs": 3}),
+    ("residual", {"epochs": 3}),
 ]
 
 
 def cli_train_args(method, kw):
     args = ["--method", method]
-    if "recipe" in kw:
-        args += ["--recipe", kw["recipe"]]
     if "epochs" in kw:
         args += ["--epochs", kw["epochs"]]
     return args
 
 
-@pytest.mark.parametrize("method,kw", FITS, ids=[f"{m}-{k.get('recipe', '')}" for m, k in FITS])
+@pytest.mark.parametrize("method,kw", FITS, ids=[m for m, _ in FITS])
 def test_fit_writes_the_cli_model_file(cli, logs, tmp_path, method, kw):
     model = gt.fit(static=[str(logs["static"])], table=[str(logs["table"])], method=method, **kw)
     model.save(tmp_path / "py.json")
@@ -48,7 +46,7 @@ def test_fit_writes_the_cli_model_file(cli, logs, tmp_path, method, kw):
     assert model.to_json().encode() == (tmp_path / "cli.json").read_bytes()
 
 
-@pytest.mark.parametrize("method,kw", FITS, ids=[f"{m}-{k.get('recipe', '')}" for m, k in FITS])
+@pytest.mark.parametrize("method,kw", FITS, ids=[m for m, _ in FITS])
 def test_round_trip_equals_cli_compensate_to_the_last_bit(cli, logs, tmp_path, method, kw):
     model = gt.fit(static=logs["static"], table=logs["table"], method=method, **kw)
     path = tmp_path / "model.json"
@@ -94,13 +92,13 @@ def test_extrapolation_warns(logs):
 
 
 def test_model_properties_and_summary(logs):
-    model = gt.fit(static=logs["static"], table=logs["table"], method="lstm", recipe="published", epochs=2)
-    assert model.method == "lstm"
+    model = gt.fit(static=logs["static"], table=logs["table"], method="published", epochs=2)
+    assert model.method == "published"
     assert model.bias_kind == "lstm" and model.scale_kind == "lstm"
     t = model.training
     assert t["epochs"] == 2 and t["inputs"] == [str(logs["static"]), str(logs["table"])]
     s = model.summary()
-    assert "method lstm" in s and "bias model: lstm" in s and "2 epochs" in s
+    assert "method published" in s and "bias model: lstm" in s and "2 epochs" in s
     static_only = gt.fit(static=logs["static"], method="linear")
     assert static_only.scale_kind is None
     assert "none (no rate-table log)" in static_only.summary()
@@ -108,13 +106,13 @@ def test_model_properties_and_summary(logs):
 
 def test_progress_only_when_asked(logs, capfd):
     seen = []
-    gt.fit(static=logs["static"], table=logs["table"], recipe="published", epochs=3,
+    gt.fit(static=logs["static"], table=logs["table"], method="published", epochs=3,
            progress=lambda target, epoch, loss: seen.append((target, epoch)))
     assert sorted(seen) == sorted([(t, e) for t in ("bias", "scale") for e in range(3)])
     capfd.readouterr()
-    gt.fit(static=logs["static"], recipe="published", epochs=3)
+    gt.fit(static=logs["static"], method="published", epochs=3)
     assert capfd.readouterr().err == ""
-    gt.fit(static=logs["static"], recipe="published", epochs=3, progress=True)
+    gt.fit(static=logs["static"], method="published", epochs=3, progress=True)
     err = capfd.readouterr().err
     assert "gyrotherm: bias epoch 3/3, loss" in err
 
@@ -124,7 +122,7 @@ def test_progress_callback_error_is_raised(logs):
         raise RuntimeError("stop here")
 
     with pytest.raises(RuntimeError, match="stop here"):
-        gt.fit(static=logs["static"], recipe="published", epochs=2, progress=boom)
+        gt.fit(static=logs["static"], method="published", epochs=2, progress=boom)
 
 
 def test_read_log_column_mapping_units_and_frame(tmp_path):
@@ -146,5 +144,5 @@ def test_read_log_column_mapping_units_and_frame(tmp_path):
 def test_read_log_fills_gaps_when_asked(tmp_path):
     p = tmp_path / "gap.csv"
     p.write_text("time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n")
-    cols = gt.read_log(p, as_frame=False, fill_gaps=2)
+    cols = gt.read_log(p, as_frame=False, fill_gaps_max_s=2)
     np.testing.assert_array_equal(cols["time_s"], [0.0, 1.0, 2.0, 3.0])

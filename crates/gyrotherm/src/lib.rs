@@ -16,7 +16,7 @@
 //! - [`targets`]: what the models learn: bias from static runs, scale factor from rate-table
 //!   runs ([`TargetSet`]).
 //! - [`fit`]: fit a compensation model from training logs ([`fit_model`], [`FitConfig`],
-//!   [`LstmRecipe`]); least squares is [`baseline`], the LSTM network and its training
+//!   [`RecipeSettings`]); least squares is [`baseline`], the LSTM network and its training
 //!   [`nn`].
 //! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]).
 //! - [`compensate`]: run the flight compensator (`gyrotherm-core`) over a log or a CSV
@@ -26,6 +26,8 @@
 //!   the HTML report.
 //! - [`moving_average`], [`table_segments`]: the one centred moving average and the one
 //!   rate-table segmentation every step above uses.
+//! - [`settings`]: what a user can choose for each job, with every default, list of values
+//!   and check defined once (the command line and Python only translate).
 //! - [`atomic_file`]: the output helper: every output is written to a temporary file and
 //!   renamed into place.
 //!
@@ -59,6 +61,7 @@ pub mod model;
 pub mod moving_average;
 pub mod nn;
 pub mod report;
+pub mod settings;
 pub mod sim;
 pub mod table_segments;
 pub mod targets;
@@ -67,8 +70,9 @@ pub use compensate::{compensate_log, compensator, CompensateError};
 pub use compensate_lines::{compensate_lines, LinesError, LinesSummary};
 pub use csvlog::{read_log, write_log, LogError, ReadOptions, TestLog};
 pub use features::{FeatureSpec, FeatureTable};
-pub use fit::{fit_model, FitConfig, FitError, FitOutcome, LstmRecipe, NamedLog, RecipeKind};
+pub use fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog, RecipeKind, RecipeSettings};
 pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
+pub use settings::{FitSettings, SettingError};
 pub use sim::{simulate, SimConfig};
 pub use targets::TargetSet;
 

@@ -65,28 +65,7 @@ pub enum Seal {
     Absent,
 }
 
-/// How the model was fitted.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Method {
-    /// LSTM networks (He et al. 2024).
-    Lstm,
-    /// Linear baseline `c0 + c1·T + c2·dT (+ further features)`.
-    Linear,
-    /// Polynomial baseline.
-    Poly,
-}
-
-impl Method {
-    /// The name used in files and on the command line.
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            Method::Lstm => "lstm",
-            Method::Linear => "linear",
-            Method::Poly => "poly",
-        }
-    }
-}
+pub use crate::settings::Method;
 
 /// [`LagOutputs`] in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -718,9 +697,11 @@ impl ModelFile {
     pub fn label(&self) -> &'static str {
         let subs = || [&self.bias, &self.scale].into_iter().flatten();
         match self.method {
-            Method::Lstm if subs().any(|s| matches!(s, SubModel::Residual { .. })) => "LS + LSTM",
-            Method::Lstm if subs().any(|s| matches!(s, SubModel::Lstm { .. })) => "LSTM",
-            Method::Lstm => "thermal-state LS",
+            m if m.is_recipe() && subs().any(|s| matches!(s, SubModel::Residual { .. })) => {
+                "LS + LSTM"
+            }
+            m if m.is_recipe() && subs().any(|s| matches!(s, SubModel::Lstm { .. })) => "LSTM",
+            m if m.is_recipe() => "thermal-state LS",
             m => m.as_str(),
         }
     }

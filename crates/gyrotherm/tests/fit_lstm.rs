@@ -7,8 +7,8 @@ use gyrotherm::csvlog::TestLog;
 use gyrotherm::features::FeatureSpec;
 use gyrotherm::fit::terms::{bias_terms, generic_linear_terms, ladder, BaseTerms};
 use gyrotherm::fit::{
-    fit_model, fit_target, select, terms, FitConfig, FitOutcome, LstmRecipe, NamedLog, RecipeKind,
-    Target,
+    fit_model, fit_target, select, terms, FitConfig, FitOutcome, NamedLog, RecipeKind,
+    RecipeSettings, Target,
 };
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
@@ -19,8 +19,8 @@ use gyrotherm::targets::TargetSet;
 /// The residual recipe (the tests below are about it; the default recipe is `thermal`).
 fn residual_cfg() -> FitConfig {
     FitConfig {
-        recipe: LstmRecipe::residual(),
-        ..FitConfig::new(Method::Lstm)
+        recipe: RecipeSettings::residual(),
+        ..FitConfig::new(Method::Residual)
     }
 }
 
@@ -188,10 +188,10 @@ fn physical_fit_recovers_known_coefficients_across_run_offsets() {
         exact_set("seed-shock", 1, oa),
         exact_set("fast-cycle", 2, ob),
     ];
-    let recipe = LstmRecipe {
+    let recipe = RecipeSettings {
         epochs: 0,
         base: BaseTerms::Tailored,
-        ..LstmRecipe::residual()
+        ..RecipeSettings::residual()
     };
     let (sub, summary) = fit_target(&sets, &recipe, Target::Bias, 0, &mut |_, _| {}).unwrap();
     let SubModel::Baseline {
@@ -292,7 +292,7 @@ fn residual_lstm_is_kept_when_it_learns_what_the_physical_terms_cannot() {
     );
 }
 
-/// The leave-one-run-out gate (`LstmRecipe::validate_on_runs`, early stopping on a
+/// The leave-one-run-out gate (`RecipeSettings::validate_on_runs`, early stopping on a
 /// validation run): when the part the base cannot express does not carry from one run to
 /// the other (here only one of the two runs has it, so what the LSTM learns from that run
 /// makes the other worse, and the other run teaches it nothing), the LSTM is left out, with
@@ -404,14 +404,14 @@ fn residual_lstm_can_read_the_base_prediction() {
 /// `--recipe published` is the paper's recipe: T and dT in, a plain LSTM, full BPTT.
 #[test]
 fn published_recipe_is_kept() {
-    let r = LstmRecipe::of_kind(RecipeKind::parse("published").unwrap());
-    assert_eq!(r, LstmRecipe::published());
+    let r = RecipeSettings::of_kind(RecipeKind::parse("published").unwrap());
+    assert_eq!(r, RecipeSettings::published());
     assert_eq!((r.epochs, r.lr), (1000, 0.01));
     assert_eq!(
         gyrotherm::fit::recipe::feature_spec(&r),
         FeatureSpec::PUBLISHED
     );
-    assert_eq!(LstmRecipe::default().kind, RecipeKind::Thermal);
+    assert_eq!(RecipeSettings::default().kind, RecipeKind::Thermal);
     assert!(RecipeKind::parse("fancy")
         .unwrap_err()
         .to_string()
@@ -423,12 +423,12 @@ fn published_recipe_is_kept() {
         RecipeKind::Direct,
     ] {
         assert_eq!(RecipeKind::parse(kind.as_str()), Ok(kind));
-        assert_eq!(LstmRecipe::of_kind(kind).kind, kind);
+        assert_eq!(RecipeSettings::of_kind(kind).kind, kind);
     }
-    assert_eq!(LstmRecipe::generic().base, BaseTerms::LinearT2);
-    assert_eq!(LstmRecipe::direct().base, BaseTerms::Constant);
-    assert_eq!(LstmRecipe::residual().base, BaseTerms::Selected);
-    assert_eq!(LstmRecipe::residual().scale_base, BaseTerms::Selected);
+    assert_eq!(RecipeSettings::generic().base, BaseTerms::LinearT2);
+    assert_eq!(RecipeSettings::direct().base, BaseTerms::Constant);
+    assert_eq!(RecipeSettings::residual().base, BaseTerms::Selected);
+    assert_eq!(RecipeSettings::residual().scale_base, BaseTerms::Selected);
     for b in [
         BaseTerms::Selected,
         BaseTerms::Tailored,
@@ -446,9 +446,9 @@ fn published_recipe_is_kept() {
 
     let log = sim("seed-shock", 6, false, false);
     let mut cfg = residual_cfg();
-    cfg.recipe = LstmRecipe {
+    cfg.recipe = RecipeSettings {
         epochs: 3,
-        ..LstmRecipe::published()
+        ..RecipeSettings::published()
     };
     let out = fit(&[("static", &log)], &cfg);
     assert!(matches!(out.model.bias, Some(SubModel::Lstm { .. })));
@@ -511,9 +511,9 @@ fn direct_recipe_base_is_the_mean_over_runs() {
         exact_set("seed-shock", 1, 2e-4),
         exact_set("fast-cycle", 2, -3e-4),
     ];
-    let recipe = LstmRecipe {
+    let recipe = RecipeSettings {
         epochs: 0,
-        ..LstmRecipe::direct()
+        ..RecipeSettings::direct()
     };
     let (sub, summary) = fit_target(&sets, &recipe, Target::Bias, 0, &mut |_, _| {}).unwrap();
     let SubModel::Baseline {

@@ -149,12 +149,15 @@ fn full_report_over_simulated_logs_draws_every_figure() {
     let mut cfg = CompareConfig::default();
     // A recipe with an LSTM (the training-loss figure needs one; the default `thermal` has
     // none), and a few epochs: the figures, not the fit quality, are under test.
-    cfg.fit.recipe = gyrotherm::fit::LstmRecipe::residual();
-    cfg.fit.recipe.epochs = 3;
+    let mut residual = gyrotherm::fit::RecipeSettings::residual();
+    residual.epochs = 3;
     cfg.candidates = vec![
         Candidate::linear(),
         Candidate::poly(),
-        Candidate::lstm(),
+        Candidate {
+            method: gyrotherm::Method::Residual,
+            recipe: Some(residual),
+        },
         Candidate::published(Some(3)),
     ];
     let cmp = run_compare(&train_n, &test_n, &cfg);

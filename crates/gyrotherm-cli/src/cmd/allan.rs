@@ -7,12 +7,14 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
-use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
+use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseTerms, TauSet};
 use gyrotherm::csvlog::{rate_column_to_dph, TestLog};
 use gyrotherm::report;
+use gyrotherm::settings::allan as allan_settings;
+use gyrotherm::settings::{AllanAnalysis, AllanSettings};
 use serde::Serialize;
 
-use super::common::{read_log_reporting, LogArgs};
+use super::common::{choice, read_log_reporting, LogArgs};
 
 #[derive(Debug, clap::Args)]
 pub struct AllanArgs {
@@ -22,17 +24,19 @@ pub struct AllanArgs {
     #[command(flatten)]
     pub log: LogArgs,
     /// Column to analyse: gyro_dps (default), temp_c, table_dps or any numeric extra column.
-    #[arg(long, default_value = "gyro_dps")]
+    #[arg(long, default_value_t = AllanSettings::default().column)]
     pub column: String,
     /// Deviation.
-    #[arg(long, value_enum, default_value_t = KindArg::Oadev)]
-    pub kind: KindArg,
+    #[arg(long, default_value_t = allan_settings::DEFAULT_KIND,
+          value_parser = choice::<DevKind>(KINDS.map(|k| (k.name(), k.help()))))]
+    pub kind: DevKind,
     /// τ values: octave, decade, all, or seconds such as 1,10,100.
-    #[arg(long, default_value = "octave", value_parser = parse_taus)]
+    #[arg(long, default_value_t = allan_settings::DEFAULT_TAUS,
+          value_parser = |s: &str| s.parse::<TauSet>())]
     pub taus: TauSet,
     /// Noise exponent α (S(f) ∝ f^α) for the confidence intervals at every τ instead of the
     /// lag-1 autocorrelation noise identification.
-    #[arg(long, allow_hyphen_values = true, value_parser = super::common::noise_alpha)]
+    #[arg(long, allow_hyphen_values = true, value_parser = |s: &str| allan_settings::parse_alpha(s))]
     pub alpha: Option<i32>,
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -43,35 +47,25 @@ pub struct AllanArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// `--kind` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum KindArg {
-    /// overlapping Allan deviation
-    Oadev,
-    /// non-overlapping Allan deviation
-    Adev,
-    /// modified Allan deviation
-    Mdev,
-    /// non-overlapping Hadamard deviation (as Stable32 "Hadamard")
-    Hdev,
-    /// overlapping Hadamard deviation
-    Ohdev,
-}
+/// The deviations in `--help` order (the library's name list).
+const KINDS: [DevKind; 5] = [
+    DevKind::Oadev,
+    DevKind::Adev,
+    DevKind::Mdev,
+    DevKind::Hdev,
+    DevKind::Ohdev,
+];
 
-impl From<KindArg> for DevKind {
-    fn from(k: KindArg) -> Self {
-        match k {
-            KindArg::Oadev => DevKind::Oadev,
-            KindArg::Adev => DevKind::Adev,
-            KindArg::Mdev => DevKind::Mdev,
-            KindArg::Hdev => DevKind::Hdev,
-            KindArg::Ohdev => DevKind::Ohdev,
+impl AllanArgs {
+    /// The library's settings.
+    pub fn settings(&self) -> AllanSettings {
+        AllanSettings {
+            column: self.column.clone(),
+            kind: self.kind,
+            taus: self.taus.clone(),
+            alpha: self.alpha,
         }
     }
-}
-
-fn parse_taus(s: &str) -> Result<TauSet, String> {
-    s.parse().map_err(|e: allan::AllanError| e.to_string())
 }
 
 /// Reads the log and picks a numeric column; returns (log, values, sample period s). The
@@ -131,7 +125,7 @@ fn plot(
         Some(f) => (f, "°/h".to_owned()),
         None => (1.0, plain_unit(&args.column)),
     };
-    let kind: DevKind = args.kind.into();
+    let kind = args.kind;
     let label = format!("{} of {}", kind.name().to_uppercase(), args.column);
     let curve = report::allan_curve(&label, points, factor);
     let lines = match (kind, noise) {
@@ -151,43 +145,19 @@ fn plot(
 }
 
 pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
-    let kind: DevKind = args.kind.into();
+    let settings = args.settings();
+    settings.validate()?;
+    let kind = settings.kind;
     let mut w = std::io::stdout().lock();
     let (_log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
-    let noise_model = args.alpha.map_or(NoiseModel::Identify, NoiseModel::Alpha);
     let n_samples = values.len();
-    let to_dph = rate_column_to_dph(&args.column);
-    // The samples are handed over (the phase is built in their buffer) unless an OADEV curve
-    // for the noise terms still needs them.
-    let needs_oadev = to_dph.is_some() && !matches!(kind, DevKind::Adev | DevKind::Oadev);
-    let (points, values) = if needs_oadev {
-        let p = allan::deviation(&values, tau0_s, kind, &args.taus, noise_model);
-        (p, values)
-    } else {
-        let p = allan::deviation_owned(values, tau0_s, kind, &args.taus, noise_model);
-        (p, Vec::new())
-    };
-    let points = points.with_context(|| format!("{} of column {}", kind.name(), args.column))?;
-    // Noise terms are defined on the Allan deviation: from this curve for adev/oadev, else
-    // from an OADEV curve at the same τ.
-    let (noise, noise_from) = match to_dph {
-        None => (None, None),
-        Some(f) => {
-            let curve: Vec<AllanPoint> = match kind {
-                DevKind::Adev | DevKind::Oadev => points.clone(),
-                _ => {
-                    let taus = TauSet::Seconds(points.iter().map(|p| p.tau_s).collect());
-                    allan::deviation(&values, tau0_s, DevKind::Oadev, &taus, noise_model)
-                        .unwrap_or_default()
-                }
-            };
-            let from = match kind {
-                DevKind::Adev => "adev",
-                _ => "oadev",
-            };
-            (Some(allan::noise_terms(&curve, f)), Some(from))
-        }
-    };
+    let AllanAnalysis {
+        points,
+        noise,
+        noise_from,
+    } = settings
+        .analyse(values, tau0_s)
+        .with_context(|| format!("{} of column {}", kind.name(), args.column))?;
     if let Some(path) = &args.plot {
         plot(path, &args, &points, noise.as_ref())?;
     }

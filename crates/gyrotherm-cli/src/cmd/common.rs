@@ -5,11 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
 use gyrotherm::fit::NamedLog;
+use gyrotherm::settings::{read, Rule};
 
-/// How to read test logs: which columns hold what, the gyro unit, the gap policy.
+/// How to read test logs: which columns hold what, the gyro unit, the gap policy (the
+/// library's [`ReadOptions`], with its defaults, names and checks).
 #[derive(Debug, Clone, Args)]
 pub struct LogArgs {
     /// Header of the time column (seconds).
@@ -24,42 +26,54 @@ pub struct LogArgs {
     /// Header of the rate-table column (°/s); optional unless renamed here.
     #[arg(long, value_name = "NAME", default_value = csvlog::DEFAULT_TABLE_COL)]
     pub table_col: String,
-    /// Unit of the gyro column; converted to °/s on reading.
-    #[arg(long, value_enum, value_name = "UNIT", default_value_t = GyroUnitArg::Dps)]
-    pub gyro_unit: GyroUnitArg,
+    /// Unit of the gyro column (dps: °/s, dph: °/h, rad/s); converted to °/s on reading.
+    #[arg(long, value_name = "UNIT", default_value_t = ReadOptions::default().gyro_unit,
+          value_parser = choice::<GyroUnit>(read::GYRO_UNIT_NAMES.map(|n| (n, ""))))]
+    pub gyro_unit: GyroUnit,
     /// Interpolate gaps (steps over 1.5 sample periods) up to MAX_S seconds long, instead of
     /// stopping with an error.
-    #[arg(long, value_name = "MAX_S", value_parser = positive_seconds)]
-    pub fill_gaps: Option<f64>,
+    #[arg(long, alias = "fill-gaps", value_name = "MAX_S",
+          value_parser = seconds("fill_gaps_max_s", Rule::PositiveSeconds))]
+    pub fill_gaps_max_s: Option<f64>,
     /// Nominal sample period in seconds (default: median of the first 100 time steps).
-    #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
-    pub sample_period: Option<f64>,
+    #[arg(long, alias = "sample-period", value_name = "SECONDS",
+          value_parser = seconds("sample_period_s", Rule::PositiveSeconds))]
+    pub sample_period_s: Option<f64>,
     /// Field separator of the log: `,` (default), `;` or `tab`. With `;` or `tab`, numbers
     /// may use a decimal comma (`0,5`).
-    #[arg(long, value_name = "SEP", default_value = ",", value_parser = delimiter)]
+    #[arg(long, value_name = "SEP", default_value = read::delimiter_name(ReadOptions::default().delimiter),
+          value_parser = |s: &str| read::parse_delimiter(s))]
     pub delimiter: u8,
 }
 
-/// `--gyro-unit` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum GyroUnitArg {
-    /// degrees per second
-    Dps,
-    /// degrees per hour
-    Dph,
-    /// radians per second
-    #[value(name = "rad/s")]
-    RadPerS,
+/// A value parser for a library setting with a list of names: the names (with their help
+/// texts, empty for none) are the possible values `--help` lists, the library's `FromStr`
+/// turns the one given into its value.
+pub fn choice<T>(
+    values: impl IntoIterator<Item = (&'static str, &'static str)>,
+) -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: std::str::FromStr + Clone + Send + Sync + 'static,
+    T::Err: std::fmt::Display,
+{
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
+    PossibleValuesParser::new(values.into_iter().map(|(n, h)| {
+        let v = PossibleValue::new(n);
+        if h.is_empty() {
+            v
+        } else {
+            v.help(h)
+        }
+    }))
+    .try_map(|s| s.parse::<T>().map_err(|e| e.to_string()))
 }
 
-impl From<GyroUnitArg> for GyroUnit {
-    fn from(u: GyroUnitArg) -> Self {
-        match u {
-            GyroUnitArg::Dps => GyroUnit::Dps,
-            GyroUnitArg::Dph => GyroUnit::Dph,
-            GyroUnitArg::RadPerS => GyroUnit::RadPerS,
-        }
-    }
+/// A value parser for a numeric library setting: the library's parser and rule.
+pub fn seconds(
+    setting: &'static str,
+    rule: Rule,
+) -> impl Fn(&str) -> Result<f64, gyrotherm::SettingError> + Clone + Send + Sync + 'static {
+    move |s: &str| gyrotherm::settings::parse_number(setting, s, rule)
 }
 
 impl LogArgs {
@@ -70,9 +84,9 @@ impl LogArgs {
             gyro_col: self.gyro_col.clone(),
             temp_col: self.temp_col.clone(),
             table_col: self.table_col.clone(),
-            gyro_unit: self.gyro_unit.into(),
-            fill_gaps_max_s: self.fill_gaps,
-            sample_period_s: self.sample_period,
+            gyro_unit: self.gyro_unit,
+            fill_gaps_max_s: self.fill_gaps_max_s,
+            sample_period_s: self.sample_period_s,
             delimiter: self.delimiter,
         }
     }
@@ -83,7 +97,7 @@ pub fn read_log_reporting(path: &Path, args: &LogArgs) -> anyhow::Result<TestLog
     read_log_noting_gaps(path, args).map(|(log, _)| log)
 }
 
-/// Read a log; when `--fill-gaps` made samples, say so on stderr and return that warning.
+/// Read a log; when `--fill-gaps-max-s` made samples, say so on stderr and return that warning.
 pub fn read_log_noting_gaps(
     path: &Path,
     args: &LogArgs,
@@ -92,7 +106,7 @@ pub fn read_log_noting_gaps(
         .with_context(|| format!("cannot use log {}", path.display()))?;
     let warning = (report.filled_gaps > 0).then(|| {
         format!(
-            "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps)",
+            "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps-max-s)",
             path.display(),
             report.filled_gaps,
             report.filled_samples
@@ -151,51 +165,6 @@ pub fn builtin_profile() -> clap::builder::PossibleValuesParser {
             .iter()
             .map(|(name, what)| clap::builder::PossibleValue::new(*name).help(*what)),
     )
-}
-
-pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("{s:?} is not a positive number of seconds")),
-    }
-}
-
-/// `--delimiter`: `,`, `;` or `tab` (also a literal tab or `\t`).
-fn delimiter(s: &str) -> Result<u8, String> {
-    match s {
-        "," | "comma" => Ok(b','),
-        ";" | "semicolon" => Ok(b';'),
-        "tab" | "\t" | "\\t" => Ok(b'\t'),
-        _ => Err(format!("{s:?}: the separator is `,`, `;` or `tab`")),
-    }
-}
-
-/// A time that may be zero: finite and ≥ 0 s.
-pub(crate) fn non_negative_seconds(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
-        _ => Err(format!("{s:?} is not zero or a positive number of seconds")),
-    }
-}
-
-/// A scale factor (gyro output over input rate, nominally 1): finite and > 0.
-pub(crate) fn positive_scale_factor(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!(
-            "{s:?} is not a scale factor: give a positive number (gyro output over table rate, about 1)"
-        )),
-    }
-}
-
-/// A power-law noise exponent α (S(f) ∝ f^α): an integer from -4 to 2.
-pub(crate) fn noise_alpha(s: &str) -> Result<i32, String> {
-    let what = "the noise exponent α is an integer from -4 to 2 (2 white PM, 1 flicker PM, \
-                0 white FM, -1 flicker FM, -2 random-walk FM, -3 and -4 for Hadamard only)";
-    match s.trim().parse::<i32>() {
-        Ok(a) if (-4..=2).contains(&a) => Ok(a),
-        _ => Err(format!("{s:?}: {what}")),
-    }
 }
 
 /// An error and its causes on one line, `: `-separated, each cause left out when the text so

@@ -1,5 +1,5 @@
-//! `gyrotherm compare`: fit linear, polynomial, the default `lstm`-method model and the
-//! published recipe of He et al. 2024 on training logs and judge them on held-out logs — the
+//! `gyrotherm compare`: fit linear, polynomial, the default `thermal` model and the
+//! `published` method (He et al. 2024) on training logs and judge them on held-out logs — the
 //! paper's results table, for the user's own data, one column per model.
 
 use std::io::Write;
@@ -8,12 +8,13 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use gyrotherm::compare::{compare, Candidate, CompareConfig, Comparison};
-use gyrotherm::fit::{NamedLog, RecipeKind};
+use gyrotherm::fit::NamedLog;
+use gyrotherm::settings::{Method, DEFAULT_METHOD};
 
 use super::common::LogArgs;
 use super::common::{named, read_logs};
 use super::progress::TrainingBars;
-use super::train::FitArgs;
+use super::train::{deprecation_text, method_parser, FitArgs};
 
 #[derive(Debug, clap::Args)]
 pub struct CompareArgs {
@@ -25,8 +26,8 @@ pub struct CompareArgs {
     pub test: Vec<PathBuf>,
     /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
     /// sample period nearest to it when 100 s is not one; said on stderr).
-    #[arg(long, value_parser = super::common::positive_seconds)]
-    pub tau: Option<f64>,
+    #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
+    pub tau_s: Option<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -41,59 +42,24 @@ pub struct CompareArgs {
 /// Which models the comparison fits, one column each (`compare`, `demo`, `report`).
 #[derive(Debug, clap::Args)]
 pub struct ColumnArgs {
-    /// Columns to compare, comma-separated, in table order: `linear`, `poly`, `lstm` (the
-    /// `--recipe`, default `thermal`; its column is named by what the model holds) and
-    /// `published` (He et al. 2024 as published, column "LSTM, He et al."; `--epochs`
-    /// applies to it too). Default: all four (`published` only once when `--recipe
-    /// published`).
-    #[arg(long, value_enum, value_delimiter = ',', value_name = "LIST")]
-    pub methods: Option<Vec<ColumnArg>>,
-}
-
-/// A `--methods` entry.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ColumnArg {
-    /// Linear least squares in T and dT (the paper's comparison).
-    Linear,
-    /// Polynomial least squares in T and dT.
-    Poly,
-    /// The `lstm` method with `--recipe` (default `thermal`).
-    Lstm,
-    /// The `lstm` method with the published recipe (He et al. 2024).
-    Published,
+    /// Methods to compare, comma-separated, in table order (the names of `train --method`;
+    /// a recipe method's column is named by what its model holds, `published` is "LSTM, He
+    /// et al."; `--epochs` applies to every LSTM). Default: linear, poly, thermal, published.
+    #[arg(long, value_delimiter = ',', value_name = "LIST", value_parser = method_parser())]
+    pub methods: Option<Vec<Method>>,
 }
 
 impl ColumnArgs {
-    /// The comparison's columns; `fit` gives the `--epochs` the published column also takes.
-    pub fn candidates(&self, fit: &FitArgs) -> Vec<Candidate> {
-        let recipe_is_published = RecipeKind::from(fit.recipe) == RecipeKind::Published;
-        let wanted = match &self.methods {
-            Some(m) => m.clone(),
-            None => {
-                let mut all = vec![ColumnArg::Linear, ColumnArg::Poly, ColumnArg::Lstm];
-                if !recipe_is_published {
-                    all.push(ColumnArg::Published);
-                }
-                all
-            }
-        };
-        wanted
-            .into_iter()
-            .map(|c| match c {
-                ColumnArg::Linear => Candidate::linear(),
-                ColumnArg::Poly => Candidate::poly(),
-                ColumnArg::Lstm => Candidate::lstm(),
-                ColumnArg::Published => Candidate::published(fit.epochs),
-            })
-            .collect()
-    }
-
-    /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`.
+    /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`;
+    /// a deprecated spelling is said on stderr.
     pub fn compare_config(&self, fit: &FitArgs, tau_s: f64) -> anyhow::Result<CompareConfig> {
-        Ok(CompareConfig {
-            candidates: self.candidates(fit),
-            ..fit.compare_config(tau_s)?
-        })
+        let (cfg, note) = fit
+            .settings(DEFAULT_METHOD)
+            .compare_config(self.methods.as_deref(), tau_s)?;
+        if let Some(n) = note {
+            eprintln!("gyrotherm: warning: {}", deprecation_text(n));
+        }
+        Ok(cfg)
     }
 }
 
@@ -142,7 +108,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let test = read_logs(&args.test, &args.log, &mut warnings)?;
     let train_named = named(&train);
     let test_named = named(&test);
-    let tau_s = resolve_tau(args.tau, &test_named);
+    let tau_s = resolve_tau(args.tau_s, &test_named);
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let mut out = std::io::stdout().lock();

@@ -41,11 +41,11 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
         eprintln!("gyrotherm: warning: {w}");
     }
     anyhow::ensure!(
-        args.log.fill_gaps.is_none(),
+        args.log.fill_gaps_max_s.is_none(),
         "--fill-gaps does not apply to compensate: the compensator bridges time gaps itself and \
          writes one output line per input line"
     );
-    if args.log.sample_period.is_some() {
+    if args.log.sample_period_s.is_some() {
         eprintln!(
             "gyrotherm: note: --sample-period is not needed by compensate (output starts with \
              the first line); ignored"
@@ -160,36 +160,36 @@ impl Write for DeferredFlush<'_> {
 #[derive(Debug, Clone, clap::Args)]
 pub struct TempSensorArgs {
     /// Lowest plausible temperature reading, °C.
-    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.min_c)]
-    pub temp_min: f64,
+    #[arg(long, alias = "temp-min", value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.min_c)]
+    pub temp_min_c: f64,
     /// Highest plausible temperature reading, °C.
-    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.max_c)]
-    pub temp_max: f64,
+    #[arg(long, alias = "temp-max", value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.max_c)]
+    pub temp_max_c: f64,
     /// Fastest plausible temperature change, °C/s.
-    #[arg(long, value_name = "C_PER_S", default_value_t = TempLimits::DEFAULT.max_rate_c_per_s)]
-    pub temp_max_rate: f64,
+    #[arg(long, alias = "temp-max-rate", value_name = "C_PER_S", default_value_t = TempLimits::DEFAULT.max_rate_c_per_s)]
+    pub temp_max_rate_c_per_s: f64,
     /// Temperature change always allowed between two readings (noise, resolution), °C.
-    #[arg(long, value_name = "C", default_value_t = TempLimits::DEFAULT.step_allowance_c)]
-    pub temp_step_allowance: f64,
+    #[arg(long, alias = "temp-step-allowance", value_name = "C", default_value_t = TempLimits::DEFAULT.step_allowance_c)]
+    pub temp_step_allowance_c: f64,
     /// Seconds without a good temperature before the output is `degraded` instead of `held`.
-    #[arg(long, value_name = "S", default_value_t = TempLimits::DEFAULT.degraded_after_s)]
-    pub degraded_after: f64,
+    #[arg(long, alias = "degraded-after", value_name = "S", default_value_t = TempLimits::DEFAULT.degraded_after_s)]
+    pub degraded_after_s: f64,
 }
 
 impl TempSensorArgs {
     /// The model-file form, checked.
     pub fn to_def(&self) -> anyhow::Result<TempSensorDef> {
         let def = TempSensorDef {
-            min_c: self.temp_min,
-            max_c: self.temp_max,
-            max_rate_c_per_s: self.temp_max_rate,
-            step_allowance_c: self.temp_step_allowance,
-            degraded_after_s: self.degraded_after,
+            min_c: self.temp_min_c,
+            max_c: self.temp_max_c,
+            max_rate_c_per_s: self.temp_max_rate_c_per_s,
+            step_allowance_c: self.temp_step_allowance_c,
+            degraded_after_s: self.degraded_after_s,
         };
         def.to_core().map_err(|e| {
             anyhow::anyhow!(
-                "temperature-sensor limits (--temp-min, --temp-max, --temp-max-rate, \
-                 --temp-step-allowance, --degraded-after): {e}"
+                "temperature-sensor limits (--temp-min-c, --temp-max-c, --temp-max-rate-c-per-s, \
+                 --temp-step-allowance-c, --degraded-after-s): {e}"
             )
         })?;
         Ok(def)

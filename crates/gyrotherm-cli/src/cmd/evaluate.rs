@@ -5,11 +5,10 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{bail, Context};
-use gyrotherm::csvlog::rate_column_to_dph;
-use gyrotherm::metrics::{self, EvaluationOptions};
+use gyrotherm::settings::{EvaluateSettings, Rule};
 
 use super::allan::read_column;
+use super::common::seconds;
 
 #[derive(Debug, clap::Args)]
 pub struct EvaluateArgs {
@@ -19,17 +18,18 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub log: super::common::LogArgs,
     /// Rate column to judge: gyro_dps (default) or a numeric extra column (*_dps, *_dph, *_rad_s).
-    #[arg(long, default_value = "gyro_dps")]
+    #[arg(long, default_value_t = EvaluateSettings::default().column)]
     pub column: String,
     /// Smoothing time of the bias stability, s (default 100 s, or the multiple of the sample
     /// period nearest to it when 100 s is not one).
-    #[arg(long, value_parser = super::common::positive_seconds)]
-    pub tau: Option<f64>,
+    #[arg(long, alias = "tau", value_parser = seconds("tau_s", Rule::PositiveSeconds))]
+    pub tau_s: Option<f64>,
     /// Time dropped at the start of each rate-table segment, s.
-    #[arg(long, default_value_t = 10.0, value_parser = super::common::non_negative_seconds)]
-    pub settle: f64,
+    #[arg(long, alias = "settle", default_value_t = EvaluateSettings::default().settle_s,
+          value_parser = seconds("settle_s", Rule::NonNegativeSeconds))]
+    pub settle_s: f64,
     /// Room-temperature scale factor for the thermal error (default: first rate segment's).
-    #[arg(long, value_parser = super::common::positive_scale_factor)]
+    #[arg(long, value_parser = seconds("reference_scale", Rule::PositiveScaleFactor))]
     pub reference_scale: Option<f64>,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -39,52 +39,16 @@ pub struct EvaluateArgs {
 pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     let mut w = std::io::stdout().lock();
     let (log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
-    let Some(to_dph) = rate_column_to_dph(&args.column) else {
-        bail!(
-            "column `{}` has no rate unit in its name; name it *_dps, *_dph or *_rad_s",
-            args.column
-        );
-    };
-    let tau_s = match args.tau {
-        Some(t) => t,
-        None => {
-            let (t, adjusted) = metrics::default_tau_s(tau0_s, 100.0);
-            if adjusted {
-                eprintln!(
-                    "gyrotherm: τ = {t} s, the multiple of the {tau0_s} s sample period nearest \
-                     100 s (100 s is not one; give --tau to choose)"
-                );
-            }
-            t
-        }
-    };
-    let duration_s = tau0_s * values.len() as f64;
-    if tau_s > duration_s / 2.0 {
-        bail!(
-            "--tau {:?} s is longer than half the log ({} samples of {tau0_s} s = {duration_s} s): \
-             the bias stability needs at least two means; give at most {} s",
-            tau_s,
-            values.len(),
-            duration_s / 2.0
-        );
-    }
-    // Factor first: v·to_dph could overflow where v·(to_dph/3600) does not.
-    let to_dps = to_dph / 3600.0;
-    let rate_dps: Vec<f64> = values.iter().map(|v| v * to_dps).collect();
-    let opts = EvaluationOptions {
-        tau_s,
-        settle_s: args.settle,
+    let settings = EvaluateSettings {
+        column: args.column.clone(),
+        tau_s: args.tau_s,
+        settle_s: args.settle_s,
         reference_scale: args.reference_scale,
     };
-    let e = metrics::evaluate(
-        &args.column,
-        &log.time_s,
-        &rate_dps,
-        tau0_s,
-        log.table_dps.as_deref(),
-        &opts,
-    )
-    .with_context(|| format!("column {}", args.column))?;
+    let (e, tau) = settings.evaluate(&log, &values, tau0_s)?;
+    if let Some(note) = tau.note(tau0_s) {
+        eprintln!("gyrotherm: {note}");
+    }
     if args.json {
         writeln!(w, "{}", serde_json::to_string_pretty(&e)?)?;
         return Ok(ExitCode::SUCCESS);

@@ -8,14 +8,7 @@ use std::process::ExitCode;
 use gyrotherm::export::{export, Lang};
 use gyrotherm::model::ModelFile;
 
-/// `--lang` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum LangArg {
-    /// C99: gyrotherm_model.h and gyrotherm_model.c (no heap, no global mutable state).
-    C,
-    /// Rust: gyrotherm_model.rs, the model as a `static` for gyrotherm-core.
-    Rust,
-}
+use super::common::choice;
 
 #[derive(Debug, clap::Args)]
 pub struct ExportArgs {
@@ -23,8 +16,8 @@ pub struct ExportArgs {
     #[arg(long)]
     pub model: PathBuf,
     /// Target language.
-    #[arg(long, value_enum)]
-    pub lang: LangArg,
+    #[arg(long, value_parser = choice::<Lang>([Lang::C, Lang::Rust].map(|l| (l.as_str(), l.help()))))]
+    pub lang: Lang,
     /// Output directory (created if missing).
     #[arg(long)]
     pub out: PathBuf,
@@ -35,10 +28,7 @@ pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
     if let Some(w) = seal.warning(&args.model) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    let lang = match args.lang {
-        LangArg::C => Lang::C,
-        LangArg::Rust => Lang::Rust,
-    };
+    let lang = args.lang;
     let files = export(&model, lang, &args.out)?;
     for f in files {
         eprintln!("gyrotherm: wrote {}", f.display());

@@ -11,5 +11,6 @@ pub mod export;
 pub mod model;
 pub mod progress;
 pub mod report;
+pub mod settings;
 pub mod simulate;
 pub mod train;

@@ -27,8 +27,8 @@ pub struct ReportArgs {
     pub out: PathBuf,
     /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
     /// sample period nearest to it when 100 s is not one; said on stderr).
-    #[arg(long, value_parser = super::common::positive_seconds)]
-    pub tau: Option<f64>,
+    #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
+    pub tau_s: Option<f64>,
     #[command(flatten)]
     pub columns: ColumnArgs,
     #[command(flatten)]
@@ -43,7 +43,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let test = read_logs(&args.test, &args.log, &mut gap_warnings)?;
     let train_named = named(&train);
     let test_named = named(&test);
-    let tau_s = resolve_tau(args.tau, &test_named);
+    let tau_s = resolve_tau(args.tau_s, &test_named);
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let index = write_full_report_with(

@@ -4,36 +4,53 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::RecipeKind;
-use gyrotherm::fit::{fit_model, FitConfig, LstmVerdict, NamedLog, Target};
-use gyrotherm::model::Method;
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, Target};
+use gyrotherm::settings::fit::{self, RECIPE_NAMES};
+use gyrotherm::settings::{Deprecation, FitSettings, Method, Rule, DEFAULT_METHOD, METHODS};
 
-use super::common::{named, read_logs, LogArgs};
+use super::common::{choice, named, read_logs, seconds, LogArgs};
+
+/// The `--method` parser: the library's methods with their help, and the deprecated `lstm`
+/// accepted but not listed.
+pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
+    PossibleValuesParser::new(
+        METHODS
+            .iter()
+            .map(|m| PossibleValue::new(m.as_str()).help(m.help()))
+            .chain([PossibleValue::new(Method::Lstm.as_str()).hide(true)]),
+    )
+    .try_map(|s| s.parse::<Method>())
+}
 use super::progress::TrainingBars;
 
-/// Fitting options shared by `train` and `compare`.
+/// Fitting options shared by `train`, `compare`, `report` and `demo`: the library's
+/// [`FitSettings`] (defaults, names and checks are the library's).
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
-    /// LSTM recipe.
-    #[arg(long, value_enum, default_value_t = RecipeArg::Thermal)]
-    pub recipe: RecipeArg,
-    /// LSTM training epochs (default: the recipe's).
+    /// Deprecated (one release): the recipe of the former `lstm` method, now a method of its
+    /// own (`--method lstm --recipe residual` is `--method residual`).
+    #[arg(long, hide = true, value_parser = choice::<RecipeKind>(RECIPE_NAMES.map(|n| (n, ""))))]
+    pub recipe: Option<RecipeKind>,
+    /// Training epochs of the method's LSTM (default: the method's own).
     #[arg(long)]
     pub epochs: Option<usize>,
     /// Random seed of the LSTM initialisation and window order.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = fit::DEFAULT_SEED)]
     pub seed: u64,
     /// Bias target smoothing window, s (centred moving average; 100 s as published).
-    #[arg(long, default_value_t = gyrotherm::targets::BIAS_WINDOW_S)]
-    pub bias_window: f64,
+    #[arg(long, alias = "bias-window", default_value_t = fit::DEFAULT_BIAS_WINDOW_S,
+          value_parser = seconds("bias_window_s", Rule::PositiveSeconds))]
+    pub bias_window_s: f64,
     /// Time dropped at the start of each rate-table segment, s.
-    #[arg(long, default_value_t = gyrotherm::targets::SETTLE_S)]
-    pub settle: f64,
+    #[arg(long, alias = "settle", default_value_t = fit::DEFAULT_SETTLE_S,
+          value_parser = seconds("settle_s", Rule::NonNegativeSeconds))]
+    pub settle_s: f64,
     /// Highest power of T in the `poly` bias model.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = fit::DEFAULT_POLY_TEMP_DEGREE)]
     pub poly_temp_degree: u8,
     /// Highest power of dT in the `poly` bias model.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = fit::DEFAULT_POLY_RATE_DEGREE)]
     pub poly_rate_degree: u8,
     /// Leave the T·dT cross term out of the `poly` bias model.
     #[arg(long)]
@@ -46,95 +63,43 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
-    /// The comparison settings (all methods) with bias stability over `tau_s`.
-    pub fn compare_config(&self, tau_s: f64) -> anyhow::Result<gyrotherm::compare::CompareConfig> {
-        anyhow::ensure!(
-            tau_s.is_finite() && tau_s > 0.0,
-            "--tau must be a positive number of seconds"
-        );
-        Ok(gyrotherm::compare::CompareConfig {
-            fit: self.fit_config(Method::Lstm)?,
-            tau_s,
-            settle_s: self.settle,
-            ..Default::default()
-        })
+    /// The library's settings for `method`.
+    pub fn settings(&self, method: Method) -> FitSettings {
+        FitSettings {
+            method,
+            recipe: self.recipe,
+            epochs: self.epochs,
+            seed: self.seed,
+            bias_window_s: self.bias_window_s,
+            settle_s: self.settle_s,
+            poly_temp_degree: self.poly_temp_degree,
+            poly_rate_degree: self.poly_rate_degree,
+            cross: !self.no_cross,
+            validate_on_runs: self.validate_on_runs,
+        }
     }
 
-    /// The library's fit configuration for `method`.
+    /// The library's fit configuration for `method`; a deprecated spelling is said on stderr.
     pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
-        let mut cfg = FitConfig::new(method);
-        cfg.recipe = gyrotherm::fit::LstmRecipe::of_kind(self.recipe.into());
-        if let Some(e) = self.epochs {
-            anyhow::ensure!(e > 0, "--epochs must be at least 1");
-            cfg.recipe.epochs = e;
+        let (cfg, note) = self.settings(method).fit_config()?;
+        if let Some(n) = note {
+            eprintln!("gyrotherm: warning: {}", deprecation_text(n));
         }
-        anyhow::ensure!(
-            self.bias_window.is_finite() && self.bias_window > 0.0,
-            "--bias-window must be a positive number of seconds"
-        );
-        anyhow::ensure!(
-            self.settle.is_finite() && self.settle >= 0.0,
-            "--settle must be zero or a positive number of seconds"
-        );
-        cfg.seed = self.seed;
-        cfg.bias_window_s = self.bias_window;
-        cfg.settle_s = self.settle;
-        cfg.poly.temp = self.poly_temp_degree;
-        cfg.poly.rate = self.poly_rate_degree;
-        cfg.poly.cross = !self.no_cross;
-        cfg.recipe.validate_on_runs = self.validate_on_runs;
         Ok(cfg)
     }
 }
 
-/// `--recipe` values (the library's `fit::lstm::RecipeKind`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum RecipeArg {
-    /// Thermal time constants identified from the logs and a ridge fit on them, no LSTM
-    /// (the default: chosen on a family of simulated units, docs/experiments/generalisation.md);
-    /// degrades on short or coarse logs and says how.
-    Thermal,
-    /// Least squares on thermal-state inputs (T, dT, T − first-order lags of 300/1000/3000 s)
-    /// plus an LSTM on its residual, kept only where it beats the least-squares base on
-    /// validation blocks.
-    Residual,
-    /// As `residual`, on a generic linear + T² base.
-    Generic,
-    /// An LSTM alone on the thermal-state inputs.
-    Direct,
-    /// He et al. 2024 exactly (whole run, T and dT inputs, 1000 Adam steps at lr 0.01).
-    Published,
-}
-
-impl From<RecipeArg> for RecipeKind {
-    fn from(r: RecipeArg) -> RecipeKind {
-        match r {
-            RecipeArg::Thermal => RecipeKind::Thermal,
-            RecipeArg::Residual => RecipeKind::Residual,
-            RecipeArg::Generic => RecipeKind::Generic,
-            RecipeArg::Direct => RecipeKind::Direct,
-            RecipeArg::Published => RecipeKind::Published,
+/// A deprecation in the command line's words.
+pub fn deprecation_text(d: Deprecation) -> String {
+    match d {
+        Deprecation::LstmMethod { now } => {
+            format!("--method lstm is deprecated: use --method {now} (same model)")
         }
-    }
-}
-
-/// `--method` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    /// LSTM networks (He et al. 2024), bias and scale factor.
-    Lstm,
-    /// bias = c0 + c1·T + c2·dT (the paper's comparison).
-    Linear,
-    /// Polynomial in T and dT (industry standard).
-    Poly,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Method {
-        match m {
-            MethodArg::Lstm => Method::Lstm,
-            MethodArg::Linear => Method::Linear,
-            MethodArg::Poly => Method::Poly,
+        Deprecation::Recipe { now } => {
+            format!("--recipe is deprecated: the recipes are methods now; use --method {now}")
+        }
+        Deprecation::RecipeIgnored { method } => {
+            format!("--recipe is deprecated, and --method {method} has none: ignored")
         }
     }
 }
@@ -146,8 +111,8 @@ pub struct TrainArgs {
     #[arg(long, required = true)]
     pub input: Vec<PathBuf>,
     /// Fitting method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Lstm)]
-    pub method: MethodArg,
+    #[arg(long, default_value_t = DEFAULT_METHOD, value_parser = method_parser())]
+    pub method: Method,
     #[command(flatten)]
     pub fit: FitArgs,
     /// Model file to write (JSON).
@@ -162,11 +127,11 @@ pub struct TrainArgs {
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let logs = read_logs(&args.input, &args.log, &mut Vec::new())?;
     let named = named(&logs);
-    let method: Method = args.method.into();
-    let cfg = args.fit.fit_config(method)?;
+    let cfg = args.fit.fit_config(args.method)?;
+    let method = cfg.model_method();
     let temp_sensor = args.sensor.to_def()?;
     let started = std::time::Instant::now();
-    let bars = TrainingBars::new(method == Method::Lstm, cfg.recipe.epochs, &[""]);
+    let bars = TrainingBars::new(method.is_recipe(), cfg.recipe.epochs, &[""]);
     let outcome = fit_model(&named, &cfg, &|t: Target, e, l| bars.update("", t, e, l));
     bars.finish();
     let mut outcome = outcome
@@ -231,32 +196,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 "    LSTM: {} epochs, final loss {:.4e} (normalised MSE); {}",
                 t.epochs,
                 t.final_loss,
-                match verdict {
-                    LstmVerdict::Kept => "kept",
-                    LstmVerdict::LeftOut {
-                        validation_blocks: true,
-                        left_out_runs: true,
-                    } => {
-                        "left out: it beat the least-squares base neither on the validation \
-                         blocks nor on every left-out run"
-                    }
-                    LstmVerdict::LeftOut {
-                        validation_blocks: true,
-                        left_out_runs: false,
-                    } => {
-                        "left out: it did not beat the least-squares base on the validation blocks"
-                    }
-                    LstmVerdict::LeftOut {
-                        validation_blocks: false,
-                        left_out_runs: true,
-                    } => {
-                        "left out: it did not beat the least-squares base on every left-out run"
-                    }
-                    LstmVerdict::LeftOut {
-                        validation_blocks: false,
-                        left_out_runs: false,
-                    } => "left out: its correction fitted none of the validation residual",
-                }
+                verdict.text()
             );
             if let Some(gate) = &t.run_gate {
                 let each: Vec<String> = gate

@@ -26,7 +26,7 @@ use std::time::Instant;
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::thermal::Basis;
-use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, NamedLog, RecipeKind};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, RecipeSettings};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::Method;
@@ -40,7 +40,7 @@ const CONFIRM_BASE_SEED: u64 = 5000;
 
 /// The methods the benchmark knows, by name.
 fn method_config(name: &str) -> Result<FitConfig, String> {
-    let lstm = |recipe: LstmRecipe| {
+    let lstm = |recipe: RecipeSettings| {
         let mut c = FitConfig::new(Method::Lstm);
         c.recipe = recipe;
         c
@@ -48,21 +48,21 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
     Ok(match name {
         "linear" => FitConfig::new(Method::Linear),
         "poly" => FitConfig::new(Method::Poly),
-        "residual" => lstm(LstmRecipe::residual()),
+        "residual" => lstm(RecipeSettings::residual()),
         "residual-ls" => {
-            let mut r = LstmRecipe::residual();
+            let mut r = RecipeSettings::residual();
             r.epochs = 0;
             lstm(r)
         }
-        "generic" => lstm(LstmRecipe::generic()),
-        "published" => lstm(LstmRecipe::published()),
-        "direct" => lstm(LstmRecipe::of_kind(RecipeKind::Direct)),
-        "thermal" => lstm(LstmRecipe::of_kind(RecipeKind::Thermal)),
+        "generic" => lstm(RecipeSettings::generic()),
+        "published" => lstm(RecipeSettings::published()),
+        "direct" => lstm(RecipeSettings::of_kind(RecipeKind::Direct)),
+        "thermal" => lstm(RecipeSettings::of_kind(RecipeKind::Thermal)),
         v if v.starts_with("thermal-lstm") => {
             // thermal-lstm[:<base input 0|1>[:<runs gate 0|1>[:<epochs>[:<min improvement>
             // [:<residual smoothing steps>]]]]]: the thermal model with a residual LSTM on
             // top, for the design-family sweep.
-            let mut c = lstm(LstmRecipe::of_kind(RecipeKind::Thermal));
+            let mut c = lstm(RecipeSettings::of_kind(RecipeKind::Thermal));
             c.thermal.residual_lstm = true;
             let parts: Vec<&str> = v.split(':').collect();
             c.recipe.base_input = parts.get(1) == Some(&"1");
@@ -80,7 +80,7 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         }
         v if v.starts_with("thermal:") => {
             // thermal:<lags>:<basis>[:<folds>] for the design-family sweep.
-            let mut c = lstm(LstmRecipe::of_kind(RecipeKind::Thermal));
+            let mut c = lstm(RecipeSettings::of_kind(RecipeKind::Thermal));
             let parts: Vec<&str> = v.split(':').collect();
             if let Some(n) = parts.get(1) {
                 c.thermal.n_lags = n.parse().map_err(|e| format!("{v}: {e}"))?;

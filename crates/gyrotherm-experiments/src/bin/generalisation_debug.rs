@@ -5,7 +5,7 @@
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, LstmRecipe, NamedLog, RecipeKind};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, RecipeSettings};
 use gyrotherm::model::Method;
 use gyrotherm::sim::{random_unit, simulate_series, SimConfig, SimSeries};
 
@@ -57,7 +57,7 @@ fn main() {
             _ => FitConfig::new(Method::Lstm),
         };
         if let Ok(k) = RecipeKind::parse(m) {
-            cfg.recipe = LstmRecipe::of_kind(k);
+            cfg.recipe = RecipeSettings::of_kind(k);
             cfg.thermal.basis = gyrotherm::fit::thermal::Basis::Lean;
             cfg.thermal.min_lag_ratio = 3.0;
             cfg.thermal.joint = true;

@@ -11,8 +11,8 @@
 //!  [--run-gate]`
 //!
 //! `--base-input`: the residual LSTM reads the base prediction as one more input
-//! (`LstmRecipe::base_input`). `--run-gate`: the leave-one-run-out check of the residual
-//! LSTM (`LstmRecipe::validate_on_runs`).
+//! (`RecipeSettings::base_input`). `--run-gate`: the leave-one-run-out check of the residual
+//! LSTM (`RecipeSettings::validate_on_runs`).
 //!
 //! Bases `B`: `selected` (default), `tailored`, `linear`, `linear-t2`, `constant`,
 //! `family:<set>` (one set of `fit::terms::ladder`, e.g. `family:T3+fast`). `--bases` adds a
@@ -25,7 +25,7 @@ use std::time::Instant;
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, BaseTerms, FitConfig, LstmRecipe, NamedLog, RecipeKind};
+use gyrotherm::fit::{fit_model, BaseTerms, FitConfig, NamedLog, RecipeKind, RecipeSettings};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::Method;
@@ -108,7 +108,7 @@ fn main() {
     let test_profile = get("--test").unwrap_or_else(|| "slow-ramp".into());
     let train_seed: u64 = get("--train-seed").map_or(7, |v| v.parse().unwrap());
     let test_seed: u64 = get("--test-seed").map_or(11, |v| v.parse().unwrap());
-    let mut recipe = LstmRecipe::of_kind(
+    let mut recipe = RecipeSettings::of_kind(
         RecipeKind::parse(&get("--recipe").unwrap_or_else(|| "residual".into())).unwrap(),
     );
     if let Some(e) = get("--epochs") {

@@ -21,6 +21,12 @@ from ._gyrotherm import (
     MetricsError,
     ModelError,
     __version__,
+    FIT_DEFAULTS,
+    READ_DEFAULTS,
+    METHOD_NAMES,
+    GYRO_UNIT_NAMES,
+    DELIMITER_NAMES,
+    SETTINGS_JSON as _SETTINGS_JSON,
 )
 from ._allan import (
     ONE_SIGMA_CI,
@@ -39,7 +45,23 @@ from ._figures import bias_stability, noise_terms, scale_factor
 from ._logs import read_log
 from ._model import STATUS_NAMES, Compensation, GyrothermWarning, Model, fit
 
+
+
+def settings():
+    """Every setting of ``train``, ``compensate``, ``allan`` and ``evaluate`` with its default
+    and accepted values, as the library describes them (``gyrotherm settings --json``)."""
+    import json
+
+    return json.loads(_SETTINGS_JSON)
+
+
 __all__ = [
+    "DELIMITER_NAMES",
+    "FIT_DEFAULTS",
+    "GYRO_UNIT_NAMES",
+    "METHOD_NAMES",
+    "READ_DEFAULTS",
+    "settings",
     "AllanError",
     "Compensation",
     "CompensationError",

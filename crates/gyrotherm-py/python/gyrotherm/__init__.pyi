@@ -78,17 +78,26 @@ def scale_factor(
 ) -> Dict[str, Any]: ...
 
 # Logs
+FIT_DEFAULTS: Dict[str, Any]
+READ_DEFAULTS: Dict[str, Any]
+METHOD_NAMES: List[str]
+GYRO_UNIT_NAMES: List[str]
+DELIMITER_NAMES: List[str]
+def settings() -> Dict[str, List[Dict[str, Any]]]: ...
+
 def read_log(
     path: PathLike,
     *,
     as_frame: Optional[bool] = None,
-    time_col: str = "time_s",
-    gyro_col: str = "gyro_dps",
-    temp_col: str = "temp_c",
-    table_col: str = "table_dps",
-    gyro_unit: str = "dps",
-    fill_gaps: Optional[float] = None,
-    sample_period: Optional[float] = None,
+    # Defaults: the library's (gyrotherm.READ_DEFAULTS), not restated here.
+    time_col: str = ...,
+    gyro_col: str = ...,
+    temp_col: str = ...,
+    table_col: str = ...,
+    gyro_unit: str = ...,
+    fill_gaps_max_s: Optional[float] = ...,
+    sample_period_s: Optional[float] = ...,
+    delimiter: str = ...,
 ) -> Any: ...
 
 # Models
@@ -121,17 +130,18 @@ class Model:
 def fit(
     static: Union[PathLike, Iterable[PathLike], None] = (),
     table: Union[PathLike, Iterable[PathLike], None] = (),
-    method: str = "lstm",
-    recipe: str = "residual",
+    # Defaults: the library's (gyrotherm.FIT_DEFAULTS), not restated here.
+    method: str = ...,
     *,
-    epochs: Optional[int] = None,
-    seed: int = 0,
-    bias_window: Optional[float] = None,
-    settle: Optional[float] = None,
-    poly_temp_degree: int = 3,
-    poly_rate_degree: int = 1,
-    cross: bool = True,
-    validate_on_runs: bool = False,
+    recipe: Optional[str] = ...,  # deprecated: the recipes are methods
+    epochs: Optional[int] = ...,
+    seed: int = ...,
+    bias_window_s: float = ...,
+    settle_s: float = ...,
+    poly_temp_degree: int = ...,
+    poly_rate_degree: int = ...,
+    cross: bool = ...,
+    validate_on_runs: bool = ...,
     progress: Union[bool, Callable[[str, int, float], Any], None] = False,
     **log_options: Any,
 ) -> Model: ...

@@ -11,6 +11,12 @@ __version__: str
 ONE_SIGMA_CI: float
 BIAS_WINDOW_S: float
 SETTLE_S: float
+FIT_DEFAULTS: Dict[str, Any]
+READ_DEFAULTS: Dict[str, Any]
+METHOD_NAMES: List[str]
+GYRO_UNIT_NAMES: List[str]
+DELIMITER_NAMES: List[str]
+SETTINGS_JSON: str
 STATUS_NAMES: Dict[int, str]
 
 class GyrothermError(ValueError, RuntimeError): ...

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Any, Dict, Optional, Union
 
 import numpy as np
@@ -11,20 +12,22 @@ from . import _gyrotherm as _g
 
 PathLike = Union[str, "os.PathLike[str]"]
 
-#: The CLI's defaults for reading a log (``--time-col`` … ``--sample-period``).
-READ_DEFAULTS: Dict[str, Any] = {
-    "time_col": "time_s",
-    "gyro_col": "gyro_dps",
-    "temp_col": "temp_c",
-    "table_col": "table_dps",
-    "gyro_unit": "dps",
-    "fill_gaps": None,
-    "sample_period": None,
-}
+#: The library's defaults for reading a log (the CLI's ``--time-col`` … ``--delimiter``).
+READ_DEFAULTS: Dict[str, Any] = dict(_g.READ_DEFAULTS)
+
+#: Deprecated spellings of log options (one release), and the names they now have.
+_RENAMED = {"fill_gaps": "fill_gaps_max_s", "sample_period": "sample_period_s"}
 
 
 def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
     """The full option dict for the Rust side; unknown keys are an error."""
+    options = dict(options)
+    for old, new in _RENAMED.items():
+        if old in options:
+            warnings.warn(
+                f"log option {old} is deprecated; use {new}", DeprecationWarning, stacklevel=3
+            )
+            options[new] = options.pop(old)
     unknown = sorted(set(options) - set(READ_DEFAULTS))
     if unknown:
         raise TypeError(
@@ -33,9 +36,9 @@ def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
         )
     out = dict(READ_DEFAULTS)
     out.update(options)
-    for k in ("time_col", "gyro_col", "temp_col", "table_col", "gyro_unit"):
+    for k in ("time_col", "gyro_col", "temp_col", "table_col", "gyro_unit", "delimiter"):
         out[k] = str(out[k])
-    for k in ("fill_gaps", "sample_period"):
+    for k in ("fill_gaps_max_s", "sample_period_s"):
         if out[k] is not None:
             out[k] = float(out[k])
     return out
@@ -56,8 +59,8 @@ def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any)
     ``time_s``, ``gyro_dps``, ``temp_c`` (and ``table_dps`` for a rate-table log), whatever
     they are called in the file; pass-through columns keep their names (numeric ones as float
     arrays). Options: ``time_col``, ``gyro_col``, ``temp_col``, ``table_col``,
-    ``gyro_unit`` (``"dps"``, ``"dph"``, ``"rad/s"``), ``fill_gaps`` (max gap in s to
-    interpolate), ``sample_period`` (s).
+    ``gyro_unit`` (``"dps"``, ``"dph"``, ``"rad/s"``), ``fill_gaps_max_s`` (max gap in s to
+    interpolate), ``sample_period_s`` (s), ``delimiter`` (``","``, ``";"`` or ``"tab"``).
 
     Returns a pandas DataFrame when pandas is installed (``as_frame=None``, the default) or
     ``as_frame=True``, else a dict of numpy arrays. The DataFrame's ``attrs`` hold the read

@@ -77,7 +77,8 @@ class Model:
 
     @property
     def method(self) -> str:
-        """``"lstm"``, ``"linear"`` or ``"poly"``."""
+        """The method (``gyrotherm.METHOD_NAMES``; ``"lstm"`` for files written before the
+        methods were one list)."""
         return self._raw.method
 
     @property
@@ -113,9 +114,9 @@ class Model:
         input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps`` and ``status``. Returns
         the rows written, the count per status and the extrapolation warnings (also issued as
         warnings)."""
-        if options.get("fill_gaps") is not None:
+        if options.get("fill_gaps_max_s", options.get("fill_gaps")) is not None:
             raise _g.CompensationError(
-                "fill_gaps does not apply to compensate: the compensator bridges time gaps "
+                "fill_gaps_max_s does not apply to compensate: the compensator bridges time gaps "
                 "itself and writes one output line per input line"
             )
         rows, ok, held, degraded, invalid, warns = self._raw.compensate_csv(
@@ -168,43 +169,61 @@ def _paths(logs, what: str):
     return out
 
 
+_FIT = _g.FIT_DEFAULTS
+
+#: Deprecated keyword spellings of :func:`fit` (one release), and the names they now have.
+_FIT_RENAMED = {"bias_window": "bias_window_s", "settle": "settle_s"}
+
+
 def fit(
     static: Union[PathLike, Iterable[PathLike], None] = (),
     table: Union[PathLike, Iterable[PathLike], None] = (),
-    method: str = "lstm",
-    recipe: str = "residual",
+    method: str = _FIT["method"],
     *,
-    epochs: Optional[int] = None,
-    seed: int = 0,
-    bias_window: Optional[float] = None,
-    settle: Optional[float] = None,
-    poly_temp_degree: int = 3,
-    poly_rate_degree: int = 1,
-    cross: bool = True,
-    validate_on_runs: bool = False,
+    recipe: Optional[str] = _FIT["recipe"],
+    epochs: Optional[int] = _FIT["epochs"],
+    seed: int = _FIT["seed"],
+    bias_window_s: float = _FIT["bias_window_s"],
+    settle_s: float = _FIT["settle_s"],
+    poly_temp_degree: int = _FIT["poly_temp_degree"],
+    poly_rate_degree: int = _FIT["poly_rate_degree"],
+    cross: bool = _FIT["cross"],
+    validate_on_runs: bool = _FIT["validate_on_runs"],
     progress: Progress = False,
     **log_options: Any,
 ) -> Model:
-    """Fit a compensation model, as ``gyrotherm train --input S… --input T… --method …``.
+    """Fit a compensation model, as ``gyrotherm train --input S… --input T… --method …``
+    (same defaults, same checks, same file).
 
     ``static``: static logs (bias model); ``table``: rate-table logs (scale-factor model).
-    ``method``: ``"lstm"`` (recipe ``"residual"``, ``"generic"``, ``"direct"`` or
-    ``"published"``), ``"linear"`` or ``"poly"``. ``bias_window``/``settle`` default to the
-    CLI's (100 s / 10 s). ``progress``: True prints epochs and loss to stderr; a callable gets
-    ``(target, epoch, loss)``. Log options (``time_col``, ``gyro_unit``, ``fill_gaps`` …)
-    apply to every log. The GIL is released while reading and training.
+    ``method``: one of ``gyrotherm.METHOD_NAMES``: ``"thermal"`` (the default),
+    ``"residual"``, ``"generic"``, ``"direct"``, ``"published"`` (He et al. 2024 as
+    published), ``"linear"`` or ``"poly"``. ``recipe`` is deprecated (``method="lstm",
+    recipe="residual"`` is ``method="residual"``; warns). ``bias_window_s``/``settle_s`` in
+    seconds (``bias_window``/``settle`` are deprecated spellings). ``progress``: True prints
+    epochs and loss to stderr; a callable gets ``(target, epoch, loss)``. Log options
+    (``time_col``, ``gyro_unit``, ``fill_gaps_max_s``, ``delimiter`` …) apply to every log.
+    The GIL is released while reading and training.
     """
+    for old, new in _FIT_RENAMED.items():
+        if old in log_options:
+            warnings.warn(f"{old} is deprecated; use {new}", DeprecationWarning, stacklevel=2)
+            value = log_options.pop(old)
+            if new == "bias_window_s":
+                bias_window_s = value
+            else:
+                settle_s = value
     static_paths = _paths(static, "static")
     table_paths = _paths(table, "table")
     if not static_paths and not table_paths:
         raise _g.FitError("no training logs given; pass static=[...] and/or table=[...]")
     settings = {
         "method": str(method),
-        "recipe": str(recipe),
+        "recipe": None if recipe is None else str(recipe),
         "epochs": None if epochs is None else int(epochs),
         "seed": int(seed),
-        "bias_window": float(_g.BIAS_WINDOW_S if bias_window is None else bias_window),
-        "settle": float(_g.SETTLE_S if settle is None else settle),
+        "bias_window_s": float(bias_window_s),
+        "settle_s": float(settle_s),
         "poly_temp_degree": int(poly_temp_degree),
         "poly_rate_degree": int(poly_rate_degree),
         "cross": bool(cross),
@@ -219,4 +238,5 @@ def fit(
     else:
         raise TypeError("progress: give True, False or a callable(target, epoch, loss)")
     raw = _g.fit(static_paths, table_paths, settings, read_options(log_options), callback)
+    _warn(raw.load_warnings)
     return Model(raw)

@@ -25,7 +25,7 @@ use serde::Serialize;
 
 use crate::compensate::{compensate_log, extrapolation_warnings, Compensated};
 use crate::csvlog::{TestLog, NOISE_COL};
-use crate::fit::{fit_model, FitConfig, FitOutcome, LstmRecipe, NamedLog, RecipeKind, Target};
+use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, RecipeKind, RecipeSettings, Target};
 use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
 use crate::model::Method;
 use crate::targets;
@@ -36,80 +36,75 @@ pub const BIAS_STABILITY_TAU_S: f64 = 100.0;
 /// The column name of the published recipe: the seed's method, named after its authors.
 pub const PUBLISHED_LABEL: &str = "LSTM, He et al.";
 
-/// One column of the comparison: a method and, for `lstm`, the recipe it trains.
+/// One column of the comparison: a method and, for a recipe method, the recipe it trains.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Candidate {
     pub method: Method,
-    /// The LSTM recipe (method `lstm` only; None: the comparison's [`FitConfig::recipe`]).
-    pub recipe: Option<LstmRecipe>,
+    /// The recipe (recipe methods only; None: the comparison's [`FitConfig::recipe`] when
+    /// it is this method's, else the method's own).
+    pub recipe: Option<RecipeSettings>,
 }
 
 impl Candidate {
-    /// The `linear` fit.
-    pub fn linear() -> Self {
+    /// A column fitting `method` with the comparison's settings.
+    pub fn of(method: Method) -> Self {
         Candidate {
-            method: Method::Linear,
+            method,
             recipe: None,
         }
+    }
+
+    /// The `linear` fit.
+    pub fn linear() -> Self {
+        Self::of(Method::Linear)
     }
 
     /// The `poly` fit.
     pub fn poly() -> Self {
-        Candidate {
-            method: Method::Poly,
-            recipe: None,
-        }
+        Self::of(Method::Poly)
     }
 
-    /// The `lstm` method with the comparison's recipe (the default: `thermal`).
-    pub fn lstm() -> Self {
-        Candidate {
-            method: Method::Lstm,
-            recipe: None,
-        }
-    }
-
-    /// The `lstm` method with the recipe as published (He et al. 2024), `epochs` Adam steps
-    /// (None: the published 1000).
+    /// The `published` method (He et al. 2024 as published), `epochs` Adam steps (None: the
+    /// published 1000).
     pub fn published(epochs: Option<usize>) -> Self {
-        let mut recipe = LstmRecipe::published();
+        let mut recipe = RecipeSettings::published();
         if let Some(e) = epochs {
             recipe.epochs = e;
         }
         Candidate {
-            method: Method::Lstm,
+            method: Method::Published,
             recipe: Some(recipe),
         }
     }
 
     /// The fit settings of this column: `base` with its method and recipe.
     pub fn fit_config(&self, base: &FitConfig) -> FitConfig {
+        let recipe = match (&self.recipe, self.method.recipe_kind()) {
+            (Some(r), _) => r.clone(),
+            (None, Some(kind)) if kind != base.recipe.kind => RecipeSettings::of_kind(kind),
+            _ => base.recipe.clone(),
+        };
         FitConfig {
             method: self.method,
-            recipe: self.recipe.clone().unwrap_or_else(|| base.recipe.clone()),
+            recipe,
             ..base.clone()
         }
     }
 
     /// Whether this column trains the published recipe.
     pub fn is_published(&self, base: &FitConfig) -> bool {
-        self.method == Method::Lstm && self.fit_config(base).recipe.kind == RecipeKind::Published
+        self.fit_config(base).model_method() == Method::Published
     }
 
-    /// The column's key in `gyrotherm compare --json` and `--methods`: `linear`, `poly`,
-    /// `lstm`, or `published` for the published recipe.
+    /// The column's key in `gyrotherm compare --json` and `--methods`: the method's name.
     pub fn key(&self, base: &FitConfig) -> &'static str {
-        if self.is_published(base) {
-            "published"
-        } else {
-            self.method.as_str()
-        }
+        self.fit_config(base).model_method().as_str()
     }
 
     /// Whether fitting this column trains an LSTM (and reports its epochs).
     pub fn trains_lstm(&self, base: &FitConfig) -> bool {
         let c = self.fit_config(base);
-        c.method == Method::Lstm
+        c.method.is_recipe()
             && c.recipe.epochs > 0
             && (c.recipe.kind != RecipeKind::Thermal || c.thermal.residual_lstm)
     }
@@ -157,10 +152,10 @@ impl Default for CompareConfig {
             candidates: vec![
                 Candidate::linear(),
                 Candidate::poly(),
-                Candidate::lstm(),
+                Candidate::of(Method::Thermal),
                 Candidate::published(None),
             ],
-            fit: FitConfig::new(Method::Lstm),
+            fit: FitConfig::new(crate::settings::DEFAULT_METHOD),
             tau_s: BIAS_STABILITY_TAU_S,
             settle_s: targets::SETTLE_S,
         }

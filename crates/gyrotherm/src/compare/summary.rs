@@ -89,7 +89,10 @@ impl Comparison {
                     ModelSummary {
                         key: col.key,
                         method: f.model.method.as_str(),
-                        recipe: (f.model.method == crate::model::Method::Lstm)
+                        recipe: f
+                            .model
+                            .method
+                            .is_recipe()
                             .then(|| cand.fit_config(&cfg.fit).recipe.kind.as_str()),
                         label: col.label,
                         bias_model: f.model.bias.as_ref().map(|b| b.kind()),

@@ -2,7 +2,7 @@
 //! ([`ComparisonTable::write_text`]) and as HTML by the report (`report::comparison_table`).
 
 use super::{CompareConfig, Comparison, Performance};
-use crate::model::{Method, SubModel};
+use crate::model::SubModel;
 
 impl Comparison {
     /// One line per fitted model: its sub-models, and why no residual LSTM was kept when
@@ -22,7 +22,7 @@ impl Comparison {
                 let lstm_kept = [&f.model.bias, &f.model.scale]
                     .iter()
                     .any(|s| matches!(s, Some(SubModel::Lstm { .. } | SubModel::Residual { .. })));
-                if f.model.method == Method::Lstm && !lstm_kept {
+                if f.model.method.is_recipe() && !lstm_kept {
                     line.push_str(" (holds no LSTM: the recipe has none, or no LSTM beat its least-squares base on the validation data)");
                 }
                 line

@@ -20,7 +20,7 @@ use gyrotherm_core::features::MAX_FEATURES;
 use gyrotherm_core::static_model::{StaticBaseline, StaticLstm, StaticModel, StaticTarget};
 
 use crate::compensate::CompensateError;
-use crate::model::{Method, ModelFile, ModelFileError, SubModel, Target, CHECKSUM_KEY};
+use crate::model::{ModelFile, ModelFileError, SubModel, Target, CHECKSUM_KEY};
 
 /// Why a model cannot be exported.
 #[derive(Debug)]
@@ -66,6 +66,45 @@ pub enum Lang {
     C,
     /// `gyrotherm_model.rs`, a module for `gyrotherm-core`.
     Rust,
+}
+
+/// Names of the export languages.
+pub const LANG_NAMES: [&str; 2] = ["c", "rust"];
+
+impl Lang {
+    /// The name on the command line (`--lang`).
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Lang::C => "c",
+            Lang::Rust => "rust",
+        }
+    }
+
+    /// One line on what is written (the `--help` text of the value).
+    pub fn help(&self) -> &'static str {
+        match self {
+            Lang::C => {
+                "C99: gyrotherm_model.h and gyrotherm_model.c (no heap, no global mutable state)"
+            }
+            Lang::Rust => "Rust: gyrotherm_model.rs, the model as a `static` for gyrotherm-core",
+        }
+    }
+}
+
+impl std::fmt::Display for Lang {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::str::FromStr for Lang {
+    type Err = crate::settings::SettingError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        [Lang::C, Lang::Rust]
+            .into_iter()
+            .find(|l| l.as_str() == s)
+            .ok_or_else(|| crate::settings::SettingError::unknown("lang", s, &LANG_NAMES))
+    }
 }
 
 /// The static (flight) form of a model file: the numbers the core's compensator is built
@@ -220,11 +259,8 @@ pub fn is_generated_text(text: &str) -> bool {
 /// (`training.created_by`, `training.inputs`) are left out: they are whatever the file
 /// says, and in a comment of generated source they could close the comment and add code.
 fn describe(model: &ModelFile) -> Result<String, ExportError> {
-    let method = match model.method {
-        Method::Lstm => "lstm",
-        Method::Linear => "linear",
-        Method::Poly => "poly",
-    };
+    // The enum's own fixed name, never the file's text.
+    let method: &'static str = model.method.as_str();
     let kind = |s: &Option<SubModel>| match s {
         None => "none",
         Some(SubModel::Lstm { .. }) => "lstm",

@@ -3,13 +3,13 @@
 //! BPTT, early stopping, as [`super::residual`]). Kept for comparison: held out it left 2–4 ×
 //! the noise floor where a least-squares base left 1–1.4 (`docs/experiments/lstm-recipes.md`).
 
-use super::recipe::{LstmRecipe, RecipeKind};
+use super::recipe::{RecipeKind, RecipeSettings};
 use super::terms::BaseTerms;
 
-impl LstmRecipe {
+impl RecipeSettings {
     /// The direct LSTM: the residual recipe on a constant base ([`BaseTerms::Constant`]).
     pub fn direct() -> Self {
-        LstmRecipe {
+        RecipeSettings {
             kind: RecipeKind::Direct,
             base: BaseTerms::Constant,
             scale_base: BaseTerms::Tailored,

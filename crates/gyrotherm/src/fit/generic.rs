@@ -4,13 +4,13 @@
 //! linear + `T²` scale terms left 23–92 ppm held out, against a 10 ppm target
 //! (`docs/experiments/lstm-recipes.md`).
 
-use super::recipe::{LstmRecipe, RecipeKind};
+use super::recipe::{RecipeKind, RecipeSettings};
 use super::terms::BaseTerms;
 
-impl LstmRecipe {
+impl RecipeSettings {
     /// The residual recipe on the generic base [`BaseTerms::LinearT2`].
     pub fn generic() -> Self {
-        LstmRecipe {
+        RecipeSettings {
             kind: RecipeKind::Generic,
             base: BaseTerms::LinearT2,
             scale_base: BaseTerms::Tailored,

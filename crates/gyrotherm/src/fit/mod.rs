@@ -3,7 +3,8 @@
 //! Static logs train the bias model, rate-table logs the scale-factor model (He et al. 2024,
 //! DOI 10.19452/j.issn1007-5453.2024.02.004, §2: two separate networks, because the
 //! magnitudes differ). Methods: `linear` (bias = c0 + c1·T + c2·dT, the paper's comparison),
-//! `poly` (degree n in T, m in dT, optional T·dT), `lstm` (an [`LstmRecipe`]).
+//! `poly` (degree n in T, m in dT, optional T·dT), and the recipe methods `thermal`,
+//! `residual`, `generic`, `direct`, `published` (each a [`RecipeSettings`]).
 //!
 //! Modules, each one concept, imports running one way (down this list):
 //! - [`recipe`]: which LSTM recipe, its knobs, and what training reports ([`TrainSummary`]).
@@ -35,7 +36,7 @@ use crate::targets::{self, TargetSet};
 
 pub use crate::model::Target;
 pub use error::FitError;
-pub use recipe::{LstmRecipe, LstmVerdict, RecipeKind, TrainSummary, UnknownRecipe};
+pub use recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary, UnknownRecipe};
 pub use select::TermSelection;
 pub use terms::BaseTerms;
 
@@ -50,8 +51,8 @@ pub struct NamedLog<'a> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitConfig {
     pub method: Method,
-    /// LSTM recipe (method `lstm` only).
-    pub recipe: LstmRecipe,
+    /// The recipe (recipe methods only; for them its kind names the model's method).
+    pub recipe: RecipeSettings,
     /// Degrees of the `poly` method's bias model.
     pub poly: PolyDegrees,
     /// Bias target smoothing window, s (100 s as published).
@@ -67,16 +68,31 @@ pub struct FitConfig {
 }
 
 impl FitConfig {
+    /// The defaults for `method` (a recipe method gets its recipe's knobs).
     pub fn new(method: Method) -> Self {
         FitConfig {
             method,
-            recipe: LstmRecipe::default(),
+            recipe: method
+                .recipe_kind()
+                .map_or_else(RecipeSettings::default, RecipeSettings::of_kind),
             poly: PolyDegrees::default(),
             bias_window_s: targets::BIAS_WINDOW_S,
             settle_s: targets::SETTLE_S,
             scale_window_s: targets::SCALE_WINDOW_S,
             seed: 0,
             thermal: thermal::ThermalConfig::default(),
+        }
+    }
+}
+
+impl FitConfig {
+    /// The method a fit with this configuration writes: for a recipe method, its recipe's
+    /// (the recipe may be swapped in whole, as a comparison column does).
+    pub fn model_method(&self) -> Method {
+        if self.method.is_recipe() {
+            self.recipe.kind.method()
+        } else {
+            self.method
         }
     }
 }
@@ -94,7 +110,7 @@ pub struct FitOutcome {
 pub fn feature_spec(cfg: &FitConfig) -> FeatureSpec {
     match cfg.method {
         Method::Linear | Method::Poly => FeatureSpec::PUBLISHED,
-        Method::Lstm => recipe::feature_spec(&cfg.recipe),
+        _ => recipe::feature_spec(&cfg.recipe),
     }
 }
 
@@ -180,7 +196,7 @@ fn fit_one(
             let terms = baseline_terms(cfg, target, sets[0].table.n_features);
             Ok((fit_baseline(sets, &terms)?, None))
         }
-        Method::Lstm => {
+        _ => {
             let seed = cfg.seed.wrapping_add(match target {
                 Target::Bias => 0,
                 Target::Scale => 1,
@@ -232,7 +248,7 @@ pub fn fit_model(
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
-    let identified = if cfg.method == Method::Lstm && cfg.recipe.kind == RecipeKind::Thermal {
+    let identified = if cfg.method.is_recipe() && cfg.recipe.kind == RecipeKind::Thermal {
         let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
         Some(thermal::identify(
             &named,
@@ -332,7 +348,7 @@ pub fn fit_model(
         data_digest_sha256: model::data_digest(&all_logs),
         epochs: lstm_summary.map(|s| s.epochs as u64),
         final_loss: lstm_summary.map(|s| s.final_loss),
-        seed: (cfg.method == Method::Lstm).then_some(cfg.seed),
+        seed: cfg.method.is_recipe().then_some(cfg.seed),
         created_by: model::created_by(),
         inputs: logs.iter().map(|l| l.name.to_owned()).collect(),
     };
@@ -346,7 +362,7 @@ pub fn fit_model(
     };
     let model = ModelFile {
         format_version: model::FORMAT_VERSION,
-        method: cfg.method,
+        method: cfg.model_method(),
         features: FeatureDef::from_spec(&spec),
         bias: bias_model,
         scale: scale_model,
@@ -360,7 +376,7 @@ pub fn fit_model(
     })
 }
 
-impl LstmRecipe {
+impl RecipeSettings {
     /// The recipe of a kind with its default knobs.
     pub fn of_kind(kind: RecipeKind) -> Self {
         match kind {
@@ -368,7 +384,7 @@ impl LstmRecipe {
             RecipeKind::Residual => Self::residual(),
             RecipeKind::Generic => Self::generic(),
             RecipeKind::Direct => Self::direct(),
-            RecipeKind::Thermal => LstmRecipe {
+            RecipeKind::Thermal => RecipeSettings {
                 kind: RecipeKind::Thermal,
                 ..Self::residual()
             },
@@ -379,7 +395,7 @@ impl LstmRecipe {
 /// Fit one target (bias or scale factor) on the training runs with an LSTM recipe.
 pub fn fit_target(
     train: &[TargetSet],
-    recipe: &LstmRecipe,
+    recipe: &RecipeSettings,
     target: Target,
     seed: u64,
     progress: &mut dyn FnMut(usize, f64),

@@ -5,15 +5,15 @@
 //! (`docs/experiments/lstm-recipes.md`).
 
 use super::error::FitError;
-use super::recipe::{LstmRecipe, LstmVerdict, RecipeKind, TrainSummary};
+use super::recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary};
 use crate::model::SubModel;
 use crate::nn::{train_normalised, Bptt, Sequence, TrainConfig};
 use crate::targets::TargetSet;
 
-impl LstmRecipe {
+impl RecipeSettings {
     /// The published recipe.
     pub fn published() -> Self {
-        LstmRecipe {
+        RecipeSettings {
             kind: RecipeKind::Published,
             epochs: 1000,
             lr: 0.01,
@@ -24,7 +24,7 @@ impl LstmRecipe {
 
 pub(crate) fn fit(
     train: &[TargetSet],
-    recipe: &LstmRecipe,
+    recipe: &RecipeSettings,
     n_in: usize,
     seed: u64,
     progress: &mut dyn FnMut(usize, f64),

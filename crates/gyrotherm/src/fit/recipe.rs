@@ -1,4 +1,5 @@
-//! An LSTM recipe: which one, its knobs, and what training reports. The recipes themselves
+//! A fitting recipe (the recipe methods `thermal`, `residual`, `generic`, `direct`,
+//! `published`): which one, its knobs, and what training reports. The recipes themselves
 //! are one module each ([`super::published`], [`super::residual`], [`super::generic`],
 //! [`super::direct`]).
 
@@ -6,8 +7,9 @@ use super::select::TermSelection;
 use super::terms::BaseTerms;
 use crate::features::FeatureSpec;
 
-/// Which recipe.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which recipe (each is a [`Method`](crate::settings::Method) of its own:
+/// [`RecipeKind::method`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum RecipeKind {
     /// As published ([`super::published`]).
     Published,
@@ -21,7 +23,8 @@ pub enum RecipeKind {
     /// whole bias from the thermal-state inputs (windowed truncated BPTT, early stopping).
     Direct,
     /// Thermal time constants identified from the training data and a ridge fit on them, no
-    /// LSTM ([`super::thermal`]).
+    /// LSTM ([`super::thermal`]). The default.
+    #[default]
     Thermal,
 }
 
@@ -71,9 +74,10 @@ impl std::fmt::Display for UnknownRecipe {
 
 impl std::error::Error for UnknownRecipe {}
 
-/// An LSTM recipe and its knobs (knobs marked `Residual` apply to `Generic` and `Direct` too).
+/// A recipe and its knobs: how a recipe method fits (not called an LSTM recipe: the
+/// thermal recipe, the default, holds no LSTM) (knobs marked `Residual` apply to `Generic` and `Direct` too).
 #[derive(Debug, Clone, PartialEq)]
-pub struct LstmRecipe {
+pub struct RecipeSettings {
     pub kind: RecipeKind,
     /// Maximum epochs: Adam steps for `Published` (1000 as published); passes over all
     /// training windows for `Residual`.
@@ -144,9 +148,9 @@ pub struct TrainSummary {
     /// candidate's cross-validated RMS residual, so the choice can be checked.
     pub selection: Option<TermSelection>,
     /// Leave-one-run-out check of the residual LSTM (two or more training runs and
-    /// [`LstmRecipe::validate_on_runs`]): per training run, the relative loss reduction on
+    /// [`RecipeSettings::validate_on_runs`]): per training run, the relative loss reduction on
     /// that run by an LSTM trained on the other runs' residuals (0: no help). The LSTM is kept
-    /// only if every entry reaches [`LstmRecipe::min_val_improvement`].
+    /// only if every entry reaches [`RecipeSettings::min_val_improvement`].
     pub run_gate: Option<Vec<f64>>,
     /// Whether the residual LSTM was kept, and if not which check left it out (`Residual`
     /// with an LSTM trained only).
@@ -163,7 +167,7 @@ pub enum LstmVerdict {
     /// Left out; the flags say which check it failed (neither: its validation gain fell
     /// below [`MIN_GAIN`]).
     LeftOut {
-        /// It did not beat the base by [`LstmRecipe::min_val_improvement`] on the validation
+        /// It did not beat the base by [`RecipeSettings::min_val_improvement`] on the validation
         /// blocks.
         validation_blocks: bool,
         /// It did not do so on every left-out run ([`TrainSummary::run_gate`]).
@@ -171,8 +175,46 @@ pub enum LstmVerdict {
     },
 }
 
+impl std::str::FromStr for RecipeKind {
+    type Err = crate::settings::SettingError;
+    /// The deprecated `recipe` setting: a recipe method's name.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        RecipeKind::parse(s).map_err(|_| {
+            crate::settings::SettingError::unknown("recipe", s, &crate::settings::fit::RECIPE_NAMES)
+        })
+    }
+}
+
+impl LstmVerdict {
+    /// What became of the LSTM, as a sentence fragment (`kept`, `left out: …`).
+    pub fn text(&self) -> &'static str {
+        match self {
+            LstmVerdict::Kept => "kept",
+            LstmVerdict::LeftOut {
+                validation_blocks: true,
+                left_out_runs: true,
+            } => {
+                "left out: it beat the least-squares base neither on the validation blocks nor \
+                 on every left-out run"
+            }
+            LstmVerdict::LeftOut {
+                validation_blocks: true,
+                left_out_runs: false,
+            } => "left out: it did not beat the least-squares base on the validation blocks",
+            LstmVerdict::LeftOut {
+                validation_blocks: false,
+                left_out_runs: true,
+            } => "left out: it did not beat the least-squares base on every left-out run",
+            LstmVerdict::LeftOut {
+                validation_blocks: false,
+                left_out_runs: false,
+            } => "left out: its correction fitted none of the validation residual",
+        }
+    }
+}
+
 /// The feature specification a recipe's models read.
-pub fn feature_spec(recipe: &LstmRecipe) -> FeatureSpec {
+pub fn feature_spec(recipe: &RecipeSettings) -> FeatureSpec {
     match recipe.kind {
         RecipeKind::Published => FeatureSpec::PUBLISHED,
         // Thermal: the lags are identified from the logs (`thermal::identify`); this is the

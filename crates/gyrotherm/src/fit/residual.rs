@@ -9,8 +9,8 @@
 //! windowed truncated BPTT and burn-in, and stopped early on held-out blocks of the training
 //! runs (never the test run): the runs are cut into blocks and every `validation_every`-th
 //! block is kept for validation. It is kept only if it beats "no correction" on those blocks
-//! by [`LstmRecipe::min_val_improvement`], scaled by the gain they support. The scale factor
-//! gets the base only, or a residual LSTM too with [`LstmRecipe::scale_lstm`].
+//! by [`RecipeSettings::min_val_improvement`], scaled by the gain they support. The scale factor
+//! gets the base only, or a residual LSTM too with [`RecipeSettings::scale_lstm`].
 //!
 //! Why a least-squares base under the LSTM, and why the LSTM is gated: an 8-unit LSTM alone
 //! does not extrapolate to a profile with faster temperature swings, where a base of the
@@ -18,7 +18,7 @@
 //! (`docs/experiments/lstm-recipes.md`, `docs/experiments/lstm-residual.md`).
 
 use super::error::FitError;
-use super::recipe::{LstmRecipe, LstmVerdict, RecipeKind, TrainSummary, MIN_GAIN};
+use super::recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary, MIN_GAIN};
 use super::select::{select_terms, FOLDS, GAP_STEPS};
 use super::terms::{candidates, ladder, BaseTerms};
 use crate::baseline::{fit_fixed_effects, FixedEffectsFit, Terms};
@@ -29,10 +29,10 @@ use crate::nn::{
 };
 use crate::targets::TargetSet;
 
-impl LstmRecipe {
+impl RecipeSettings {
     /// The residual recipe with its default knobs.
     pub fn residual() -> Self {
-        LstmRecipe {
+        RecipeSettings {
             kind: RecipeKind::Residual,
             epochs: 300,
             lr: 0.003,
@@ -53,7 +53,7 @@ impl LstmRecipe {
     }
 }
 
-impl Default for LstmRecipe {
+impl Default for RecipeSettings {
     /// The thermal recipe ([`super::thermal`]): chosen on a family of simulated units
     /// (docs/experiments/generalisation.md).
     fn default() -> Self {
@@ -86,7 +86,7 @@ fn run_blocks(
     s: &TargetSet,
     base: &FixedEffectsFit,
     offset: f64,
-    recipe: &LstmRecipe,
+    recipe: &RecipeSettings,
 ) -> Vec<Block> {
     let nr = s.table.n_rows();
     let n_lstm = s.table.n_features + usize::from(recipe.base_input);
@@ -142,7 +142,7 @@ fn run_blocks(
 fn leave_one_run_out(
     train: &[TargetSet],
     terms: &Terms,
-    recipe: &LstmRecipe,
+    recipe: &RecipeSettings,
     cfg: &TrainConfig,
 ) -> Result<Vec<f64>, FitError> {
     let n_lstm = train[0].table.n_features + usize::from(recipe.base_input);
@@ -205,7 +205,7 @@ fn seqs(bs: &[Block]) -> Vec<Sequence<'_>> {
 
 pub(crate) fn fit(
     train: &[TargetSet],
-    recipe: &LstmRecipe,
+    recipe: &RecipeSettings,
     target: Target,
     n_in: usize,
     seed: u64,
@@ -266,12 +266,12 @@ pub(crate) fn fit(
 
 /// Steps 2 and 3 of the recipe on a fitted least-squares `base` (its run offsets included):
 /// an LSTM trained on the base's residual, kept only where the validation blocks (and, with
-/// [`LstmRecipe::validate_on_runs`] and two or more runs, each left-out run) say it helps.
+/// [`RecipeSettings::validate_on_runs`] and two or more runs, each left-out run) say it helps.
 /// Shared by the residual recipes and the thermal recipe's optional residual LSTM.
 pub(crate) fn fit_lstm_on_base(
     train: &[TargetSet],
     base: FixedEffectsFit,
-    recipe: &LstmRecipe,
+    recipe: &RecipeSettings,
     n_in: usize,
     seed: u64,
     progress: &mut dyn FnMut(usize, f64),

@@ -177,11 +177,11 @@ pub fn candidates(target: Target) -> Vec<Candidate> {
     }
 }
 
-/// The least-squares base of the residual recipes ([`LstmRecipe::base`] for the bias,
-/// [`LstmRecipe::scale_base`] for the scale factor).
+/// The least-squares base of the residual recipes ([`RecipeSettings::base`] for the bias,
+/// [`RecipeSettings::scale_base`] for the scale factor).
 ///
-/// [`LstmRecipe::base`]: super::LstmRecipe::base
-/// [`LstmRecipe::scale_base`]: super::LstmRecipe::scale_base
+/// [`RecipeSettings::base`]: super::RecipeSettings::base
+/// [`RecipeSettings::scale_base`]: super::RecipeSettings::scale_base
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BaseTerms {
     /// Chosen from the training data among [`candidates`] by blocked cross-validation in time

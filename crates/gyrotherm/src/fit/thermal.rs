@@ -74,7 +74,7 @@ pub struct ThermalConfig {
     pub ridge_tolerance: f64,
     /// Train an LSTM on the fitted model's residual (the residual recipe's knobs and gates:
     /// validation blocks, and each left-out run with `validate_on_runs`), reading the
-    /// identified thermal states and, with [`LstmRecipe::base_input`](super::LstmRecipe),
+    /// identified thermal states and, with [`RecipeSettings::base_input`](super::RecipeSettings),
     /// the model's prediction. Off by default (`docs/experiments/lstm-on-thermal-base.md`).
     pub residual_lstm: bool,
 }

@@ -432,12 +432,17 @@ fn minus_mean(v: &[f64]) -> (Vec<f64>, f64) {
     (v.iter().map(|x| x - mean).collect(), mean)
 }
 
-/// The result of the `lstm` column (the default recipe).
+/// The result of the first recipe-method column other than `published` (the default:
+/// `thermal`): the model the report is about, beside the classic fits and the paper's.
 pub(super) fn lstm_result(r: &TestResult) -> Option<&MethodResult> {
-    r.methods.iter().find(|m| m.key == "lstm")
+    r.methods.iter().find(|m| {
+        m.key
+            .parse::<crate::settings::Method>()
+            .is_ok_and(|k| k.is_recipe() && k != crate::settings::Method::Published)
+    })
 }
 
-/// The `lstm` column's result, else the last column's.
+/// That column's result ([`lstm_result`]), else the last column's.
 pub(super) fn compensated_result(r: &TestResult) -> Option<&MethodResult> {
     lstm_result(r).or(r.methods.last())
 }

@@ -1,0 +1,222 @@
+//! Fitting settings: one struct for `gyrotherm train` (and the fit part of `compare`,
+//! `report`, `demo`) and Python's `fit()`.
+
+use super::{check, Method, Rule, SettingError, DEFAULT_METHOD};
+use crate::baseline::PolyDegrees;
+use crate::compare::{Candidate, CompareConfig};
+use crate::fit::{FitConfig, RecipeKind, RecipeSettings};
+use crate::targets;
+
+/// Default random seed of the LSTM initialisation and window order.
+pub const DEFAULT_SEED: u64 = 0;
+/// Default bias target smoothing window, s (100 s as published, He et al. 2024 §2).
+pub const DEFAULT_BIAS_WINDOW_S: f64 = targets::BIAS_WINDOW_S;
+/// Default time dropped at the start of each rate-table segment, s.
+pub const DEFAULT_SETTLE_S: f64 = targets::SETTLE_S;
+/// Default highest power of T in the `poly` bias model.
+pub const DEFAULT_POLY_TEMP_DEGREE: u8 = 3;
+/// Default highest power of dT in the `poly` bias model.
+pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
+/// Names of the deprecated `recipe` setting (the recipe methods' names).
+pub const RECIPE_NAMES: [&str; 5] = ["thermal", "residual", "generic", "direct", "published"];
+
+/// How to fit a model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitSettings {
+    /// Fitting method ([`DEFAULT_METHOD`]).
+    pub method: Method,
+    /// Deprecated for one release: the recipe of the former `lstm` method. Given with
+    /// `thermal` (the default) or `lstm`, it names the method ([`FitSettings::resolve`]).
+    pub recipe: Option<RecipeKind>,
+    /// Training epochs of the method's LSTM (None: the method's own).
+    pub epochs: Option<usize>,
+    /// Random seed of the LSTM initialisation and window order.
+    pub seed: u64,
+    /// Bias target smoothing window, s (centred moving average).
+    pub bias_window_s: f64,
+    /// Time dropped at the start of each rate-table segment, s.
+    pub settle_s: f64,
+    /// Highest power of T in the `poly` bias model.
+    pub poly_temp_degree: u8,
+    /// Highest power of dT in the `poly` bias model.
+    pub poly_rate_degree: u8,
+    /// Include the T·dT cross term in the `poly` bias model.
+    pub cross: bool,
+    /// With two or more static (or rate-table) training logs: keep the residual LSTM only if,
+    /// trained without each log in turn, it also improves that log.
+    pub validate_on_runs: bool,
+}
+
+impl Default for FitSettings {
+    fn default() -> Self {
+        FitSettings {
+            method: DEFAULT_METHOD,
+            recipe: None,
+            epochs: None,
+            seed: DEFAULT_SEED,
+            bias_window_s: DEFAULT_BIAS_WINDOW_S,
+            settle_s: DEFAULT_SETTLE_S,
+            poly_temp_degree: DEFAULT_POLY_TEMP_DEGREE,
+            poly_rate_degree: DEFAULT_POLY_RATE_DEGREE,
+            cross: true,
+            validate_on_runs: false,
+        }
+    }
+}
+
+/// A deprecated spelling that was accepted, and what it now means (to be said to the user).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Deprecation {
+    /// Method `lstm`: it is now the recipe's own method.
+    LstmMethod { now: Method },
+    /// `recipe` naming the method.
+    Recipe { now: Method },
+    /// `recipe` given with a method that has none (`linear`, `poly`): ignored, as before.
+    RecipeIgnored { method: Method },
+}
+
+impl std::fmt::Display for Deprecation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Deprecation::LstmMethod { now } => write!(
+                f,
+                "method `lstm` is deprecated and now means method `{now}`; give that instead"
+            ),
+            Deprecation::Recipe { now } => write!(
+                f,
+                "recipe is deprecated: the recipes are methods now; give method `{now}`"
+            ),
+            Deprecation::RecipeIgnored { method } => write!(
+                f,
+                "recipe is deprecated, and method `{method}` has none: ignored"
+            ),
+        }
+    }
+}
+
+impl FitSettings {
+    /// Check every value; the error names the setting and the rule.
+    pub fn validate(&self) -> Result<(), SettingError> {
+        if self.epochs == Some(0) {
+            return Err(SettingError::Invalid {
+                setting: "epochs",
+                value: "0".into(),
+                rule: Rule::AtLeastOne,
+            });
+        }
+        check("bias_window_s", self.bias_window_s, Rule::PositiveSeconds)?;
+        check("settle_s", self.settle_s, Rule::NonNegativeSeconds)?;
+        self.resolve().map(|_| ())
+    }
+
+    /// The method these settings fit, with the deprecated spellings turned into it: `lstm`
+    /// becomes the recipe's method (`thermal` without one); a `recipe` given with `thermal`
+    /// (the default, so a script's `--recipe residual` keeps its meaning) names the method;
+    /// with `linear` or `poly` it is ignored, as it always was; with another recipe method it
+    /// must agree.
+    pub fn resolve(&self) -> Result<(Method, Option<Deprecation>), SettingError> {
+        let Some(r) = self.recipe else {
+            return Ok(match self.method {
+                Method::Lstm => (
+                    DEFAULT_METHOD,
+                    Some(Deprecation::LstmMethod {
+                        now: DEFAULT_METHOD,
+                    }),
+                ),
+                m => (m, None),
+            });
+        };
+        let now = r.method();
+        match self.method {
+            Method::Lstm => Ok((now, Some(Deprecation::LstmMethod { now }))),
+            Method::Linear | Method::Poly => Ok((
+                self.method,
+                Some(Deprecation::RecipeIgnored {
+                    method: self.method,
+                }),
+            )),
+            m if m == now || m == DEFAULT_METHOD => Ok((now, Some(Deprecation::Recipe { now }))),
+            m => Err(SettingError::Conflict {
+                setting: "recipe",
+                other: "method",
+                why: format!(
+                    "recipe `{}` is method `{now}`, but method `{m}` was given",
+                    r.as_str()
+                ),
+            }),
+        }
+    }
+
+    /// The recipe settings a recipe method trains with here (`epochs` and
+    /// `validate_on_runs` applied to the method's own).
+    pub fn recipe_for(&self, kind: RecipeKind) -> RecipeSettings {
+        let mut r = RecipeSettings::of_kind(kind);
+        if let Some(e) = self.epochs {
+            r.epochs = e;
+        }
+        r.validate_on_runs = self.validate_on_runs;
+        r
+    }
+
+    /// The library's fit configuration: checked, deprecated spellings resolved (what was
+    /// resolved is returned, to be said).
+    pub fn fit_config(&self) -> Result<(FitConfig, Option<Deprecation>), SettingError> {
+        self.validate()?;
+        let (method, note) = self.resolve()?;
+        let mut cfg = FitConfig::new(method);
+        // linear and poly fit no recipe; theirs stays the default, unused.
+        cfg.recipe = self.recipe_for(method.recipe_kind().unwrap_or_default());
+        cfg.seed = self.seed;
+        cfg.bias_window_s = self.bias_window_s;
+        cfg.settle_s = self.settle_s;
+        cfg.poly = PolyDegrees {
+            temp: self.poly_temp_degree,
+            rate: self.poly_rate_degree,
+            cross: self.cross,
+        };
+        Ok((cfg, note))
+    }
+
+    /// The comparison of `methods` (None: `linear`, `poly`, this settings' method, which is
+    /// `thermal` unless the deprecated `recipe` names another, and `published`, once) with
+    /// these settings, bias stability over `tau_s`. The deprecated `lstm` in `methods` is
+    /// this settings' method.
+    pub fn compare_config(
+        &self,
+        methods: Option<&[Method]>,
+        tau_s: f64,
+    ) -> Result<(CompareConfig, Option<Deprecation>), SettingError> {
+        check("tau_s", tau_s, Rule::PositiveSeconds)?;
+        let (fit, note) = self.fit_config()?;
+        let main = fit.model_method();
+        let wanted: Vec<Method> = match methods {
+            Some(m) => m
+                .iter()
+                .map(|m| if *m == Method::Lstm { main } else { *m })
+                .collect(),
+            None => {
+                let mut all = vec![Method::Linear, Method::Poly, main];
+                if main != Method::Published {
+                    all.push(Method::Published);
+                }
+                all
+            }
+        };
+        let candidates = wanted
+            .into_iter()
+            .map(|m| Candidate {
+                method: m,
+                recipe: m.recipe_kind().map(|k| self.recipe_for(k)),
+            })
+            .collect();
+        Ok((
+            CompareConfig {
+                candidates,
+                fit,
+                tau_s,
+                settle_s: self.settle_s,
+            },
+            note,
+        ))
+    }
+}

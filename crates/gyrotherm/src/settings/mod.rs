@@ -1,0 +1,221 @@
+//! Settings: what a user can choose for each job, with the one definition of every default,
+//! every list of accepted values and every check. After ripgrep's `lowargs` → `hiargs`: the
+//! command line (`gyrotherm-cli`) and the Python package (`gyrotherm-py`) parse what the user
+//! typed into these plain structs, call `validate()`, and only then build the real objects
+//! (a [`FitConfig`](crate::fit::FitConfig), a read log). Neither restates a default or a rule.
+//!
+//! One file per settings struct:
+//! - [`read`]: reading a log ([`ReadOptions`](crate::csvlog::ReadOptions), owned by `csvlog`,
+//!   checked here; field separators).
+//! - [`method`]: the fitting methods, one flat list ([`Method`]).
+//! - [`fit`]: fitting ([`FitSettings`]), shared by `train`, `compare`, `report`, `demo` and
+//!   Python's `fit()`.
+//! - [`allan`]: Allan deviation of a log column, and which curve the noise terms are read
+//!   from ([`AllanSettings`]).
+//! - [`evaluate`]: the standard figures of a log column, and the τ policy
+//!   ([`EvaluateSettings`]).
+//! - [`compensate`]: the temperature-sensor limits a compensator believes
+//!   ([`TempSensorDef`](crate::model::TempSensorDef)).
+//! - [`describe`]: every setting of every job with its default and accepted values, as the
+//!   hidden `gyrotherm settings --json` prints it and the Python package exposes it, so
+//!   their equality can be tested.
+
+pub mod allan;
+pub mod compensate;
+pub mod describe;
+pub mod evaluate;
+pub mod fit;
+pub mod method;
+pub mod read;
+
+pub use allan::{AllanAnalysis, AllanSettings};
+pub use describe::{describe, OptionSpec};
+pub use evaluate::EvaluateSettings;
+pub use fit::{Deprecation, FitSettings};
+pub use method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
+
+use std::fmt;
+
+/// The rule a value broke.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Rule {
+    /// Finite and > 0, seconds.
+    PositiveSeconds,
+    /// Finite and ≥ 0, seconds.
+    NonNegativeSeconds,
+    /// An integer ≥ 1.
+    AtLeastOne,
+    /// A scale factor: finite and > 0 (gyro output over table rate, about 1).
+    PositiveScaleFactor,
+    /// A power-law noise exponent α: an integer from -4 to 2.
+    NoiseAlpha,
+    /// A number at all.
+    Number,
+}
+
+impl Rule {
+    fn text(self) -> &'static str {
+        match self {
+            Rule::PositiveSeconds => "is not a positive number of seconds",
+            Rule::NonNegativeSeconds => "is not zero or a positive number of seconds",
+            Rule::AtLeastOne => "must be at least 1",
+            Rule::PositiveScaleFactor => {
+                "is not a scale factor: give a positive number (gyro output over table rate, \
+                 about 1)"
+            }
+            Rule::NoiseAlpha => {
+                "is not allowed: the noise exponent α is an integer from -4 to 2 (2 white PM, 1 \
+                 flicker PM, 0 white FM, -1 flicker FM, -2 random-walk FM, -3 and -4 for \
+                 Hadamard only)"
+            }
+            Rule::Number => "is not a number",
+        }
+    }
+
+    /// Whether `v` keeps this rule (for the numeric rules).
+    pub fn holds(self, v: f64) -> bool {
+        match self {
+            Rule::PositiveSeconds | Rule::PositiveScaleFactor => v.is_finite() && v > 0.0,
+            Rule::NonNegativeSeconds => v.is_finite() && v >= 0.0,
+            Rule::AtLeastOne => v >= 1.0,
+            Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
+            Rule::Number => true,
+        }
+    }
+}
+
+/// A setting that cannot be used: which setting (its name as in the settings structs, the
+/// Python keyword and, with `-` for `_`, the command-line flag), the value, and the rule.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum SettingError {
+    /// A name not in the setting's list.
+    Unknown {
+        setting: &'static str,
+        value: String,
+        expected: &'static [&'static str],
+    },
+    /// A value that breaks the setting's rule.
+    Invalid {
+        setting: &'static str,
+        value: String,
+        rule: Rule,
+    },
+    /// Two settings that cannot be given together.
+    Conflict {
+        setting: &'static str,
+        other: &'static str,
+        why: String,
+    },
+}
+
+impl SettingError {
+    pub(crate) fn unknown(
+        setting: &'static str,
+        value: &str,
+        expected: &'static [&'static str],
+    ) -> Self {
+        SettingError::Unknown {
+            setting,
+            value: value.to_owned(),
+            expected,
+        }
+    }
+
+    /// The setting at fault.
+    pub fn setting(&self) -> &'static str {
+        match self {
+            SettingError::Unknown { setting, .. }
+            | SettingError::Invalid { setting, .. }
+            | SettingError::Conflict { setting, .. } => setting,
+        }
+    }
+}
+
+/// `a`, `a or b`, `a, b or c`.
+pub(crate) fn or_list(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => format!("`{one}`"),
+        [init @ .., last] => format!(
+            "{} or `{last}`",
+            init.iter()
+                .map(|n| format!("`{n}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+impl fmt::Display for SettingError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SettingError::Unknown {
+                setting,
+                value,
+                expected,
+            } => write!(
+                f,
+                "{setting}: unknown value {value:?}; use {}",
+                or_list(expected)
+            ),
+            SettingError::Invalid {
+                setting,
+                value,
+                rule,
+            } if *rule == Rule::AtLeastOne => {
+                write!(f, "{setting} {}, not {value}", rule.text())
+            }
+            SettingError::Invalid {
+                setting,
+                value,
+                rule,
+            } => write!(f, "{setting} = {value} {}", rule.text()),
+            SettingError::Conflict {
+                setting,
+                other,
+                why,
+            } => write!(f, "{setting} and {other} conflict: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for SettingError {}
+
+/// `v` if it keeps `rule`, else [`SettingError::Invalid`] naming `setting`.
+pub fn check(setting: &'static str, v: f64, rule: Rule) -> Result<f64, SettingError> {
+    if rule.holds(v) {
+        Ok(v)
+    } else {
+        Err(SettingError::Invalid {
+            setting,
+            value: v.to_string(),
+            rule,
+        })
+    }
+}
+
+/// [`check`] for an optional value (None passes).
+pub fn check_opt(
+    setting: &'static str,
+    v: Option<f64>,
+    rule: Rule,
+) -> Result<Option<f64>, SettingError> {
+    v.map(|x| check(setting, x, rule)).transpose()
+}
+
+/// Parse a number typed by a user and [`check`] it: the parser the command line and Python
+/// share for every numeric setting.
+pub fn parse_number(setting: &'static str, s: &str, rule: Rule) -> Result<f64, SettingError> {
+    let v: f64 = s.trim().parse().map_err(|_| SettingError::Invalid {
+        setting,
+        value: format!("{s:?}"),
+        rule: Rule::Number,
+    })?;
+    check(setting, v, rule).map_err(|_| SettingError::Invalid {
+        setting,
+        value: format!("{s:?}"),
+        rule,
+    })
+}
