@@ -18,7 +18,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 pub(crate) fn allan_err(e: LibAllanError) -> PyErr {
-    AllanError::new_err(e.to_string())
+    AllanError::new_err(gyrotherm::error_chain(&e))
 }
 
 fn kind_of(name: &str) -> PyResult<DevKind> {

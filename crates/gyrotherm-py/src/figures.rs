@@ -16,8 +16,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-fn metrics_err(e: impl std::fmt::Display) -> PyErr {
-    MetricsError::new_err(e.to_string())
+fn metrics_err(e: impl std::error::Error + 'static) -> PyErr {
+    MetricsError::new_err(gyrotherm::error_chain(&e))
 }
 
 fn sample_period(rate_hz: f64) -> PyResult<f64> {

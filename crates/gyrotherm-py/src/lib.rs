@@ -59,8 +59,8 @@ create_exception!(
 );
 
 /// A Python exception of type `E` carrying a library error's message (what the CLI prints).
-pub(crate) fn py_err<E: pyo3::PyTypeInfo>(e: impl std::fmt::Display) -> PyErr {
-    PyErr::new::<E, _>(e.to_string())
+pub(crate) fn py_err<E: pyo3::PyTypeInfo>(e: impl std::error::Error + 'static) -> PyErr {
+    PyErr::new::<E, _>(gyrotherm::error_chain(&e))
 }
 
 #[pymodule]

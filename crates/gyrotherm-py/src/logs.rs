@@ -66,7 +66,7 @@ pub fn read_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 
 /// Read a whole log; the error is the library's message (file, line, column, the fix).
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<(TestLog, csvlog::ReadReport), String> {
-    csvlog::read_log(path, opts).map_err(|e| e.to_string())
+    csvlog::read_log(path, opts).map_err(|e| gyrotherm::error_chain(&e))
 }
 
 /// Read a log into a dict of numpy arrays (extra columns: float arrays when every value is a

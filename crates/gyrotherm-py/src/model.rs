@@ -34,8 +34,8 @@ pub struct RawModel {
     load_warnings: Vec<String>,
 }
 
-fn model_err(e: impl std::fmt::Display) -> PyErr {
-    ModelError::new_err(e.to_string())
+fn model_err(e: impl std::error::Error + 'static) -> PyErr {
+    ModelError::new_err(gyrotherm::error_chain(&e))
 }
 
 type Compensated<'py> = (
@@ -182,7 +182,7 @@ impl RawModel {
     ) -> PyResult<(u64, u64, u64, u64, u64, Vec<String>)> {
         let opts = options.read_options()?;
         let summary = py.detach(|| compensate_file(&self.file, &input, &out, &opts));
-        let s = summary.map_err(|e| CompensationError::new_err(e.to_string()))?;
+        let s = summary.map_err(|e| CompensationError::new_err(gyrotherm::error_chain(&e)))?;
         Ok((s.rows, s.ok, s.held, s.degraded, s.invalid, s.warnings))
     }
 
@@ -389,7 +389,9 @@ fn fit(
             });
         };
         let outcome = fit_model(&named, &cfg, &report)
-            .map_err(|e| FitError::new_err(format!("training failed: {e}")))?;
+            .map_err(|e| {
+                FitError::new_err(format!("training failed: {}", gyrotherm::error_chain(&e)))
+            })?;
         Ok(outcome)
     })?;
     if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {

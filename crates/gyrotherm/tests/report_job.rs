@@ -236,14 +236,12 @@ fn full_report_over_simulated_logs_draws_every_figure() {
         assert_eq!(row.len(), 1 + labels.len(), "ragged row {row:?}");
     }
     let col = |key: &str| 1 + cmp.columns.iter().position(|c| c.key == key).unwrap();
-    let recipe = table_row(&models, "recipe");
-    assert_eq!(
-        recipe[col("linear")],
-        "—",
-        "a least-squares fit has no recipe"
-    );
-    assert_eq!(recipe[col("lstm")], "residual");
-    assert_eq!(recipe[col("published")], "published");
+    // Methods are one flat list: the method row names each, and no model has a recipe row.
+    let method = table_row(&models, "method");
+    assert_eq!(method[col("linear")], "linear");
+    assert_eq!(method[col("residual")], "residual");
+    assert_eq!(method[col("published")], "published");
+    assert!(models.iter().all(|r| r[0] != "recipe"), "{models:?}");
     // Epochs and loss only where an LSTM was kept: the published recipe always keeps one.
     let net = table_row(&models, "bias LSTM training");
     assert_eq!(net[col("linear")], "—");

@@ -167,22 +167,11 @@ pub fn builtin_profile() -> clap::builder::PossibleValuesParser {
     )
 }
 
-/// An error and its causes on one line, `: `-separated, each cause left out when the text so
-/// far already holds it (the library's errors put their source in their own message and
-/// also return it from `source()`, as a caller walking the chain expects).
+/// An error and its causes on one line, `: `-separated, outermost first. Each error of the
+/// library states only its own level's fact and returns its cause from `source()`, so the
+/// chain printed as it is says each cause once.
 pub fn error_message(err: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in err.chain() {
-        let part = cause.to_string();
-        if text.contains(&part) {
-            continue;
-        }
-        if !text.is_empty() {
-            text.push_str(": ");
-        }
-        text.push_str(&part);
-    }
-    text
+    format!("{err:#}")
 }
 
 #[cfg(test)]

@@ -265,9 +265,9 @@ impl fmt::Display for CompareError {
                     "the {key} column is asked for twice; name each method once"
                 )
             }
-            CompareError::Fit { key, source } => write!(f, "{key} fit: {source}"),
-            CompareError::Compensate { log, source } => write!(f, "{log}: {source}"),
-            CompareError::Performance { log, source } => write!(f, "{log}: {source}"),
+            CompareError::Fit { key, .. } => write!(f, "{key} fit"),
+            CompareError::Compensate { log, .. } => write!(f, "{log}"),
+            CompareError::Performance { log, .. } => write!(f, "{log}"),
         }
     }
 }
@@ -306,8 +306,9 @@ impl fmt::Display for PerformanceError {
 impl std::error::Error for PerformanceError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            PerformanceError::BiasStability(e) => Some(e),
-            PerformanceError::ScaleFactor(e) => Some(e),
+            // Transparent: the inner error's message is this error's own.
+            PerformanceError::BiasStability(e) => e.source(),
+            PerformanceError::ScaleFactor(e) => e.source(),
         }
     }
 }

@@ -40,11 +40,10 @@ pub enum ExportError {
 impl std::fmt::Display for ExportError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            ExportError::Model(e) => write!(f, "model cannot be exported: {e}"),
-            ExportError::Flight(e) => write!(f, "model cannot be exported: {e}"),
-            ExportError::Io { path, source } => {
-                write!(f, "cannot write {}: {source}", path.display())
+            ExportError::Model(_) | ExportError::Flight(_) => {
+                f.write_str("model cannot be exported")
             }
+            ExportError::Io { path, .. } => write!(f, "cannot write {}", path.display()),
         }
     }
 }

@@ -199,10 +199,10 @@ impl std::fmt::Display for SubModelError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SubModelError::Params(e) => e.fmt(f),
-            SubModelError::Terms(e) => write!(f, "terms: {e}"),
+            SubModelError::Terms(_) => f.write_str("terms"),
             SubModelError::Invalid(m) => f.write_str(m),
-            SubModelError::ReadsBase(e) => {
-                write!(f, "{e} (lstm_reads_base: the features plus the base value)")
+            SubModelError::ReadsBase(_) => {
+                f.write_str("lstm_reads_base (the LSTM reads the features plus the base value)")
             }
         }
     }
@@ -211,7 +211,8 @@ impl std::fmt::Display for SubModelError {
 impl std::error::Error for SubModelError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            SubModelError::Params(e) => Some(e),
+            // Transparent: the parameters' message is this error's own.
+            SubModelError::Params(e) => e.source(),
             SubModelError::Terms(e) => Some(e),
             SubModelError::ReadsBase(e) => Some(e.as_ref()),
             SubModelError::Invalid(_) => None,

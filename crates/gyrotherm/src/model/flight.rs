@@ -102,9 +102,7 @@ impl std::fmt::Display for CompensateError {
             CompensateError::Params(e) => e.fmt(f),
             CompensateError::Baseline(e) => e.fmt(f),
             CompensateError::Flight(e) => e.fmt(f),
-            CompensateError::InTarget { target, source } => {
-                write!(f, "{}: {source}", target.as_str())
-            }
+            CompensateError::InTarget { target, .. } => f.write_str(target.as_str()),
         }
     }
 }
@@ -112,9 +110,10 @@ impl std::fmt::Display for CompensateError {
 impl std::error::Error for CompensateError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            CompensateError::Model(e) => Some(e),
-            CompensateError::Params(e) => Some(e),
-            CompensateError::Baseline(e) => Some(e),
+            // Transparent wrappers: the inner error's message is this error's own.
+            CompensateError::Model(e) => e.source(),
+            CompensateError::Params(e) => e.source(),
+            CompensateError::Baseline(e) => e.source(),
             CompensateError::InTarget { source, .. } => Some(source.as_ref()),
             // Transparent: the flight crate's message is this error's own.
             CompensateError::Flight(e) => e.source(),

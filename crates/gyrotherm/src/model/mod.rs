@@ -369,13 +369,13 @@ impl ModelFileError {
 impl std::fmt::Display for ModelFileError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            ModelFileError::Read { path, source } => {
-                write!(f, "{}: cannot read model file: {source}", path.display())
+            ModelFileError::Read { path, .. } => {
+                write!(f, "{}: cannot read model file", path.display())
             }
-            ModelFileError::Write { path, source } => write!(f, "{}: {source}", path.display()),
-            ModelFileError::InFile { path, source } => write!(f, "{}: {source}", path.display()),
-            ModelFileError::NotSaved(e) => write!(f, "not saved: {e}"),
-            ModelFileError::NotJson(e) => write!(f, "not valid JSON: {e}"),
+            ModelFileError::Write { path, .. } => write!(f, "{}", path.display()),
+            ModelFileError::InFile { path, .. } => write!(f, "{}", path.display()),
+            ModelFileError::NotSaved(_) => f.write_str("not saved"),
+            ModelFileError::NotJson(_) => f.write_str("not valid JSON"),
             ModelFileError::DuplicateKey(d) => d.fmt(f),
             ModelFileError::Fields(e) => e.fmt(f),
             ModelFileError::MissingVersion => f.write_str("missing field `format_version`"),
@@ -386,10 +386,8 @@ impl std::fmt::Display for ModelFileError {
                 env!("CARGO_PKG_VERSION"),
                 supported_list()
             ),
-            ModelFileError::Features(e) => write!(f, "features: {e}"),
-            ModelFileError::SubModel { target, source } => {
-                write!(f, "{}: {source}", target.as_str())
-            }
+            ModelFileError::Features(_) => f.write_str("features"),
+            ModelFileError::SubModel { target, .. } => f.write_str(target.as_str()),
             ModelFileError::Checksum { found, computed } => write!(
                 f,
                 "{CHECKSUM_KEY} is {found} but the content gives {computed}: the file was edited \
@@ -411,7 +409,9 @@ impl std::error::Error for ModelFileError {
             ModelFileError::InFile { source, .. } | ModelFileError::NotSaved(source) => {
                 Some(source.as_ref())
             }
-            ModelFileError::NotJson(e) | ModelFileError::Fields(e) => Some(e),
+            ModelFileError::NotJson(e) => Some(e),
+            // Transparent: serde's message is this error's own.
+            ModelFileError::Fields(e) => e.source(),
             ModelFileError::Features(e) => Some(e),
             ModelFileError::SubModel { source, .. } => Some(source),
             _ => None,

@@ -62,7 +62,7 @@ pub enum ReportError {
 impl fmt::Display for ReportError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            ReportError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            ReportError::Io { path, .. } => write!(f, "{}", path.display()),
             ReportError::Draw { path, message } => {
                 write!(f, "{}: drawing failed: {message}", path.display())
             }

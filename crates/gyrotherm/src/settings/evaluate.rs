@@ -79,7 +79,7 @@ impl std::fmt::Display for EvaluateError {
                     duration_s / 2.0
                 )
             }
-            EvaluateError::Figures { column, source } => write!(f, "column {column}: {source}"),
+            EvaluateError::Figures { column, .. } => write!(f, "column {column}"),
         }
     }
 }
@@ -87,7 +87,8 @@ impl std::fmt::Display for EvaluateError {
 impl std::error::Error for EvaluateError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            EvaluateError::Setting(e) => Some(e),
+            // Transparent: the setting's message is this error's own.
+            EvaluateError::Setting(e) => e.source(),
             EvaluateError::Figures { source, .. } => Some(source),
             _ => None,
         }
