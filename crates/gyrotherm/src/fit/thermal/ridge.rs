@@ -1,0 +1,226 @@
+//! The ridge machinery of the thermal fit: sufficient statistics per run, per-run-centred
+//! normal equations, the ridge solve and its blocked cross-validation.
+
+use super::*;
+
+/// Sufficient statistics of a set of rows: n, Σx, Σy, Σxxᵀ (upper), Σxy, Σy².
+#[derive(Clone)]
+pub(super) struct Stats {
+    pub(super) n: f64,
+    pub(super) sx: Vec<f64>,
+    pub(super) sy: f64,
+    pub(super) sxx: Vec<f64>,
+    pub(super) sxy: Vec<f64>,
+}
+
+impl Stats {
+    pub(super) fn new(nc: usize) -> Self {
+        Stats {
+            n: 0.0,
+            sx: vec![0.0; nc],
+            sy: 0.0,
+            sxx: vec![0.0; nc * nc],
+            sxy: vec![0.0; nc],
+        }
+    }
+    pub(super) fn add(&mut self, x: &[f64], y: f64, sign: f64) {
+        let nc = self.sx.len();
+        self.n += sign;
+        self.sy += sign * y;
+        for i in 0..nc {
+            let xi = sign * x[i];
+            self.sx[i] += xi;
+            self.sxy[i] += xi * y;
+            let row = &mut self.sxx[i * nc..];
+            for j in i..nc {
+                row[j] += xi * x[j];
+            }
+        }
+    }
+    pub(super) fn minus(&self, o: &Stats) -> Stats {
+        let sub = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p - q).collect();
+        Stats {
+            n: self.n - o.n,
+            sx: sub(&self.sx, &o.sx),
+            sy: self.sy - o.sy,
+            sxx: sub(&self.sxx, &o.sxx),
+            sxy: sub(&self.sxy, &o.sxy),
+        }
+    }
+}
+
+/// Per-run-centred normal equations from per-run statistics: G = Σ_r (Sxx − n x̄x̄ᵀ),
+/// g = Σ_r (Sxy − n x̄ ȳ).
+pub(super) fn centred_normal(stats: &[Stats], nc: usize) -> (Vec<f64>, Vec<f64>, f64) {
+    let mut g = vec![0.0; nc * nc];
+    let mut b = vec![0.0; nc];
+    let mut n = 0.0;
+    for s in stats {
+        if s.n < 1.0 {
+            continue;
+        }
+        n += s.n;
+        for i in 0..nc {
+            b[i] += s.sxy[i] - s.sx[i] * s.sy / s.n;
+            for j in i..nc {
+                let v = s.sxx[i * nc + j] - s.sx[i] * s.sx[j] / s.n;
+                g[i * nc + j] += v;
+            }
+        }
+    }
+    for i in 0..nc {
+        for j in 0..i {
+            g[i * nc + j] = g[j * nc + i];
+        }
+    }
+    (g, b, n)
+}
+
+/// Ridge solution on RMS-scaled columns: (G + λ·n·diag(G)/n… ) — the penalty is
+/// λ·Σ_j G_jj·β_j², i.e. λ·n·Σ (s_j β_j)² with s_j the column's centred RMS.
+pub(super) fn ridge_solve(g: &[f64], b: &[f64], nc: usize, lambda: f64) -> Option<Vec<f64>> {
+    if nc == 0 {
+        return Some(Vec::new());
+    }
+    // Scale to unit diagonal for conditioning, solve, scale back.
+    let s: Vec<f64> = (0..nc).map(|i| g[i * nc + i].max(0.0).sqrt()).collect();
+    if s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return None;
+    }
+    let a = DMatrix::from_fn(nc, nc, |i, j| {
+        g[i * nc + j] / (s[i] * s[j]) + if i == j { lambda } else { 0.0 }
+    });
+    let rhs = DVector::from_fn(nc, |i, _| b[i] / s[i]);
+    let sol = match a.clone().cholesky() {
+        Some(ch) => ch.solve(&rhs),
+        None => a.svd(true, true).solve(&rhs, 1e-14).ok()?,
+    };
+    let beta: Vec<f64> = (0..nc).map(|i| sol[i] / s[i]).collect();
+    beta.iter().all(|v| v.is_finite()).then_some(beta)
+}
+
+/// Contiguous fold `f` of `folds` over `n` steps: `[a, b)`.
+pub(super) fn fold_range(n: usize, f: usize, folds: usize) -> (usize, usize) {
+    (n * f / folds, n * (f + 1) / folds)
+}
+
+/// Blocked cross-validated RMS residual (per-run means removed) for each ridge strength.
+pub(super) fn cv_scores(
+    d: &Design,
+    nc: usize,
+    folds: usize,
+    gap: usize,
+    lambdas: &[f64],
+) -> Vec<f64> {
+    let nr = d.x.len();
+    let total = run_stats(d, nc);
+    // Out-of-fold residuals per λ, per run.
+    let mut resid: Vec<Vec<Vec<f64>>> = lambdas
+        .iter()
+        .map(|_| d.y.iter().map(|y| vec![f64::NAN; y.len()]).collect())
+        .collect();
+    for f in 0..folds {
+        let mut train = Vec::with_capacity(nr);
+        for (r, tot) in total.iter().enumerate() {
+            let (a, b) = fold_range(d.n_steps[r], f, folds);
+            let (ga, gb) = (a.saturating_sub(gap), b + gap);
+            let mut out = Stats::new(nc);
+            for (k, &st) in d.step[r].iter().enumerate() {
+                if st >= ga && st < gb {
+                    out.add(&d.x[r][k * nc..(k + 1) * nc], d.y[r][k], 1.0);
+                }
+            }
+            train.push(tot.minus(&out));
+        }
+        let (g, b, _) = centred_normal(&train, nc);
+        for (li, &lam) in lambdas.iter().enumerate() {
+            let Some(beta) = ridge_solve(&g, &b, nc, lam) else {
+                continue;
+            };
+            for r in 0..nr {
+                let t = &train[r];
+                if t.n < 1.0 {
+                    continue;
+                }
+                let offset = (t.sy - t.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>()) / t.n;
+                let (a, b) = fold_range(d.n_steps[r], f, folds);
+                for (k, &st) in d.step[r].iter().enumerate() {
+                    if st >= a && st < b {
+                        let x = &d.x[r][k * nc..(k + 1) * nc];
+                        let p: f64 = x.iter().zip(&beta).map(|(u, v)| u * v).sum::<f64>() + offset;
+                        resid[li][r][k] = d.y[r][k] - p;
+                    }
+                }
+            }
+        }
+    }
+    resid
+        .iter()
+        .map(|runs| {
+            // Every held-out step has a residual here: a non-finite one is a failed fit.
+            if runs.iter().flatten().any(|x| !x.is_finite()) {
+                f64::INFINITY
+            } else {
+                crate::fit::select::pooled_within_run_rms(runs)
+            }
+        })
+        .collect()
+}
+
+/// Best (score, λ) for a design: the strongest λ within `tol` of the least score.
+pub(super) fn best_ridge(
+    d: &Design,
+    nc: usize,
+    folds: usize,
+    gap: usize,
+    lambdas: &[f64],
+    tol: f64,
+) -> (f64, f64) {
+    let scores = cv_scores(d, nc, folds, gap, lambdas);
+    let least = scores.iter().copied().fold(f64::INFINITY, f64::min);
+    scores
+        .into_iter()
+        .zip(lambdas.iter().copied())
+        .filter(|(s, _)| s.is_finite() && *s <= least * (1.0 + tol))
+        .fold((f64::INFINITY, f64::NAN), |best, (s, l)| {
+            if best.1.is_nan() || l > best.1 {
+                (s, l)
+            } else {
+                best
+            }
+        })
+}
+
+/// Sufficient statistics of each run's labelled steps (`nc` columns).
+pub(super) fn run_stats(d: &Design, nc: usize) -> Vec<Stats> {
+    (0..d.x.len())
+        .map(|r| {
+            let mut s = Stats::new(nc);
+            for (k, y) in d.y[r].iter().enumerate() {
+                s.add(&d.x[r][k * nc..(k + 1) * nc], *y, 1.0);
+            }
+            s
+        })
+        .collect()
+}
+
+pub(super) fn in_sample_rms(d: &Design, nc: usize, lambda: f64) -> f64 {
+    let stats = run_stats(d, nc);
+    let (g, b, n) = centred_normal(&stats, nc);
+    let Some(beta) = ridge_solve(&g, &b, nc, lambda) else {
+        return f64::INFINITY;
+    };
+    let mut ss = 0.0;
+    for (r, s) in stats.iter().enumerate() {
+        if s.n < 1.0 {
+            continue;
+        }
+        let off = (s.sy - s.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>()) / s.n;
+        for (k, y) in d.y[r].iter().enumerate() {
+            let x = &d.x[r][k * nc..(k + 1) * nc];
+            let p: f64 = x.iter().zip(&beta).map(|(u, v)| u * v).sum::<f64>() + off;
+            ss += (y - p) * (y - p);
+        }
+    }
+    (ss / n.max(1.0)).sqrt()
+}
