@@ -12,6 +12,17 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
 
+/// An error as the user reads it: its message and its causes (`gyrotherm::error_chain`).
+trait ChainText {
+    fn chain_text(&self) -> String;
+}
+
+impl<E: std::error::Error + 'static> ChainText for E {
+    fn chain_text(&self) -> String {
+        gyrotherm::error_chain(self)
+    }
+}
+
 fn training() -> TrainingInfo {
     TrainingInfo {
         temp_range_c: Range {
@@ -158,7 +169,7 @@ fn save_text(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
 fn expect_load_error(value: &serde_json::Value, want: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let p = save_text(dir.path(), "m.json", &value.to_string());
-    let e = ModelFile::load(&p).unwrap_err().to_string();
+    let e = ModelFile::load(&p).unwrap_err().chain_text();
     assert!(e.contains(&p.display().to_string()), "no path in {e:?}");
     for w in want {
         assert!(e.contains(w), "want {w:?} in {e:?}");
@@ -214,14 +225,14 @@ fn non_finite_weights_are_refused() {
         "a.json",
         &text.replacen(&needle, "\"b_out\":1e999", 1),
     );
-    let e = ModelFile::load(&p).unwrap_err().to_string();
+    let e = ModelFile::load(&p).unwrap_err().chain_text();
     assert!(e.contains("number out of range"), "{e}");
     let p = save_text(
         dir.path(),
         "b.json",
         &text.replacen(&needle, "\"b_out\":null", 1),
     );
-    let e = ModelFile::load(&p).unwrap_err().to_string();
+    let e = ModelFile::load(&p).unwrap_err().chain_text();
     assert!(e.contains("invalid type: null"), "{e}");
     // And a model with a NaN weight is not saved at all.
     let mut m = lstm_model();
@@ -229,7 +240,7 @@ fn non_finite_weights_are_refused() {
         params.w_hh[5] = f64::NAN;
     }
     let path = dir.path().join("nan.json");
-    let e = m.save(&path).unwrap_err().to_string();
+    let e = m.save(&path).unwrap_err().chain_text();
     assert!(e.contains("scale: w_hh[5] is not finite"), "{e}");
     assert!(!path.exists());
     let mut m = poly_model();
@@ -239,7 +250,7 @@ fn non_finite_weights_are_refused() {
     assert!(m
         .validate()
         .unwrap_err()
-        .to_string()
+        .chain_text()
         .contains("coefficients[2] is not finite"));
 }
 
@@ -270,14 +281,14 @@ fn inconsistent_content_is_refused() {
     assert!(m
         .validate()
         .unwrap_err()
-        .to_string()
+        .chain_text()
         .contains("an lstm sub-model in a model whose method is linear"));
     let mut m = poly_model();
     m.bias = None;
     assert!(m
         .validate()
         .unwrap_err()
-        .to_string()
+        .chain_text()
         .contains("nothing to compensate"));
     let mut m = poly_model();
     m.training.temp_range_c = Range {
@@ -287,14 +298,14 @@ fn inconsistent_content_is_refused() {
     assert!(m
         .validate()
         .unwrap_err()
-        .to_string()
+        .chain_text()
         .contains("temp_range_c"));
     let mut m = poly_model();
     m.training.data_digest_sha256 = "abc".into();
     assert!(m
         .validate()
         .unwrap_err()
-        .to_string()
+        .chain_text()
         .contains("64 hexadecimal"));
     let dir = tempfile::tempdir().unwrap();
     let e = ModelFile::load(&dir.path().join("absent.json")).unwrap_err();
@@ -302,7 +313,7 @@ fn inconsistent_content_is_refused() {
     let p = save_text(dir.path(), "junk.json", "{ not json");
     assert!(ModelFile::load(&p)
         .unwrap_err()
-        .to_string()
+        .chain_text()
         .contains("not valid JSON"));
 }
 
@@ -442,9 +453,12 @@ fn residual_reading_the_base_round_trips_and_is_checked() {
     gyrotherm::compensate::compensator(&back).unwrap();
 
     // Wrong input counts, either way round, are refused with the count named.
-    let e = residual_model(true, 5).validate().unwrap_err().to_string();
+    let e = residual_model(true, 5).validate().unwrap_err().chain_text();
     assert!(e.contains("input_size is 5") && e.contains("6"), "{e}");
-    let e = residual_model(false, 6).validate().unwrap_err().to_string();
+    let e = residual_model(false, 6)
+        .validate()
+        .unwrap_err()
+        .chain_text();
     assert!(e.contains("input_size is 6"), "{e}");
 
     // An older file (no `lstm_reads_base` key) loads as features-only.

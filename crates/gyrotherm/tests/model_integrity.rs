@@ -5,6 +5,17 @@
 use gyrotherm::model::{ModelFile, CHECKSUM_KEY};
 use serde_json::{json, Value};
 
+/// An error as the user reads it: its message and its causes (`gyrotherm::error_chain`).
+trait ChainText {
+    fn chain_text(&self) -> String;
+}
+
+impl<E: std::error::Error + 'static> ChainText for E {
+    fn chain_text(&self) -> String {
+        gyrotherm::error_chain(self)
+    }
+}
+
 /// A linear model as `gyrotherm train --method linear` writes one (fast-cycle profile):
 /// B ≈ 2.8e-3 °/s, K ≈ 1.0003 over -29.8 to 70.4 °C.
 fn linear() -> Value {
@@ -32,7 +43,7 @@ fn write(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
 
 fn load_err(dir: &std::path::Path, v: &Value) -> String {
     let p = write(dir, "m.json", &v.to_string());
-    let e = ModelFile::load(&p).unwrap_err().to_string();
+    let e = ModelFile::load(&p).unwrap_err().chain_text();
     assert!(e.contains(&p.display().to_string()), "no file named in {e}");
     e
 }
@@ -56,7 +67,7 @@ fn a_saved_model_is_sealed_and_an_edit_is_caught_until_resealed() {
     let edited = text.replace("1.0002578767007753", "1.0102578767007753");
     assert_ne!(edited, text);
     write(dir.path(), "m.json", &edited);
-    let e = ModelFile::load(&p).unwrap_err().to_string();
+    let e = ModelFile::load(&p).unwrap_err().chain_text();
     assert!(e.contains(&p.display().to_string()), "{e}");
     assert!(
         e.contains(CHECKSUM_KEY) && e.contains("gyrotherm model seal"),

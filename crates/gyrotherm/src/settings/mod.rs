@@ -16,7 +16,7 @@
 //!   ([`EvaluateSettings`]).
 //! - [`compensate`]: the temperature-sensor limits a compensator believes
 //!   ([`TempSensorDef`](crate::model::TempSensorDef)).
-//! - [`describe`]: every setting of every job with its default and accepted values, as the
+//! - [`describe`](mod@describe): every setting of every job with its default and accepted values, as the
 //!   hidden `gyrotherm settings --json` prints it and the Python package exposes it, so
 //!   their equality can be tested.
 
