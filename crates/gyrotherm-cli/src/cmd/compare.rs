@@ -117,10 +117,9 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     } else {
         print_table(&mut out, &cmp, &cfg)?;
     }
-    for t in &cmp.tests {
-        for w in &t.warnings {
-            eprintln!("gyrotherm: warning: {w}");
-        }
+    // Each finding once, naming the models it concerns (as the report page says it).
+    for w in gyrotherm::report::grouped_warnings(&test_named, &cmp) {
+        eprintln!("gyrotherm: warning: {w}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -58,10 +58,9 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let mut out = std::io::stdout().lock();
     print_table(&mut out, &cmp, &cfg)?;
     writeln!(out, "report: {}", index.display())?;
-    for t in &cmp.tests {
-        for w in &t.warnings {
-            eprintln!("gyrotherm: warning: {w}");
-        }
+    // Each finding once, naming the models it concerns (as the report page says it).
+    for w in gyrotherm::report::grouped_warnings(&test_named, &cmp) {
+        eprintln!("gyrotherm: warning: {w}");
     }
     Ok(ExitCode::SUCCESS)
 }
