@@ -57,8 +57,10 @@ pub mod metrics;
 pub mod model;
 pub mod moving_average;
 pub mod nn;
+pub mod lot;
 pub mod report;
 pub mod sim;
+pub mod spec;
 pub mod table_segments;
 pub mod targets;
 
