@@ -1,6 +1,8 @@
 //! `gyrotherm`: thin command-line front end. Parses arguments, calls the library, prints.
 //!
-//! Exit codes: 0 success; 2 error (the message names the file, line and column, and what to do).
+//! Exit codes: 0 success (and, with `--spec`, every limit met); 1 ran fine but a `--spec` limit
+//! was missed (`evaluate`, `compare`, `report`, `lot add`); 2 error (the message names the
+//! file, line and column, and what to do).
 
 use std::process::ExitCode;
 
@@ -16,7 +18,7 @@ mod signals;
     version,
     about,
     long_about = None,
-    after_help = "Exit status: 0 success, 2 error (the message names the file, line and column).\nStart with `gyrotherm demo`; every command has --help."
+    after_help = "Exit status: 0 success (with --spec: every limit met), 1 a --spec limit missed, 2 error (the message names the file, line and column).\nStart with `gyrotherm demo`; every command has --help."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -45,6 +47,8 @@ enum Command {
     Model(cmd::model::ModelArgs),
     /// Write a model as flight code: C99 or a Rust module for gyrotherm-core.
     Export(cmd::export::ExportArgs),
+    /// Record units judged against a spec in a lot database; list it; report its yield.
+    Lot(cmd::lot::LotArgs),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Report(a) => cmd::report::run(a),
         Command::Model(a) => cmd::model::run(a),
         Command::Export(a) => cmd::export::run(a),
+        Command::Lot(a) => cmd::lot::run(a),
     };
     match result {
         Ok(code) => code,

@@ -501,3 +501,14 @@ pub fn synthetic_run(unit: &str, seed: u64, tested_at_unix_ms: i64) -> Run {
         figures,
     }
 }
+
+/// This machine's host name (the default station name), or `unknown`.
+pub fn default_station() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| std::fs::read_to_string("/etc/hostname"))
+        .ok()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .or_else(|| std::env::var("HOSTNAME").ok().filter(|s| !s.is_empty()))
+        .unwrap_or_else(|| "unknown".into())
+}

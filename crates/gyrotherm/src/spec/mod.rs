@@ -19,9 +19,11 @@
 //! the run gives (a scale-factor limit on a static log) is an error, never a silent pass.
 //! The definitions each figure follows are tabulated in docs/method.md §7.
 
+mod columns;
 mod figures;
 mod verdict;
 
+pub use columns::{judge_comparison, ColumnVerdict};
 pub use figures::{figure, measure, FigureDef, Figures, LogKind, MeasureOptions, FIGURES};
 pub use verdict::{judge, FigureVerdict, Verdict};
 
@@ -104,6 +106,11 @@ pub enum SpecError {
     },
     /// No `[limits]` table, or an empty one.
     NoLimits { path: PathBuf },
+    /// The figures of held-out log `log` could not be computed.
+    Measure {
+        log: String,
+        source: crate::metrics::EvaluationError,
+    },
     /// A limited figure that no log of the run gives.
     NotMeasured {
         key: &'static str,
@@ -169,6 +176,13 @@ impl fmt::Display for SpecError {
                 "{}: no limits; add a [limits] table, e.g. `bias_stability_dph = {{ max = 0.02 }}`",
                 path.display()
             ),
+            SpecError::Measure { log, source } => {
+                write!(f, "{log}: {source}")?;
+                if let Some(inner) = std::error::Error::source(source) {
+                    write!(f, ": {inner}")?;
+                }
+                Ok(())
+            }
             SpecError::NotMeasured { key, from, logs } => {
                 let need = match from {
                     LogKind::Static => "a static log",
