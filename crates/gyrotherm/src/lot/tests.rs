@@ -207,3 +207,146 @@ fn report_of_a_synthetic_lot() {
     let csv = std::fs::read_to_string(dir.path().join("lot.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 40 * 4);
 }
+
+/// A throwaway PostgreSQL server from the Debian package (`initdb`, `pg_ctl`), on a free
+/// loopback port, data in a temp dir; stopped on drop. None (and a note) when the package is
+/// missing, unless `CI=true`, where that is a failure.
+struct PgServer {
+    dir: tempfile::TempDir,
+    bin: std::path::PathBuf,
+    port: u16,
+}
+
+impl PgServer {
+    fn start() -> Option<PgServer> {
+        let bin = std::fs::read_dir("/usr/lib/postgresql")
+            .ok()
+            .and_then(|d| {
+                d.filter_map(|e| e.ok())
+                    .map(|e| e.path().join("bin"))
+                    .find(|b| b.join("initdb").is_file())
+            });
+        let Some(bin) = bin else {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "CI=true but PostgreSQL is not installed (apt-get install postgresql)"
+            );
+            eprintln!("SKIPPED: PostgreSQL store tests (no /usr/lib/postgresql/*/bin/initdb)");
+            return None;
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let data = dir.path().join("data");
+        let port = std::net::TcpListener::bind("127.0.0.1:0")
+            .unwrap()
+            .local_addr()
+            .unwrap()
+            .port();
+        // The server refuses to run as root: the data dir belongs to `postgres`, and the
+        // commands run as that user when we are root.
+        let as_pg = |prog: &str| {
+            let is_root = std::process::Command::new("id")
+                .arg("-u")
+                .output()
+                .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+                .unwrap_or(false);
+            let mut c = if is_root {
+                let mut c = std::process::Command::new("runuser");
+                c.args(["-u", "postgres", "--"]).arg(bin.join(prog));
+                c
+            } else {
+                std::process::Command::new(bin.join(prog))
+            };
+            c.stdout(std::process::Stdio::null());
+            c
+        };
+        let ok = |mut c: std::process::Command| {
+            let s = c.status().unwrap();
+            assert!(s.success(), "{c:?}: {s}");
+        };
+        ok({
+            let mut c = std::process::Command::new("chown");
+            c.args(["-R", "postgres"]).arg(dir.path());
+            c
+        });
+        ok({
+            let mut c = as_pg("initdb");
+            c.args(["-A", "trust", "-U", "postgres", "-D"]).arg(&data);
+            c
+        });
+        ok({
+            let mut c = as_pg("pg_ctl");
+            c.arg("-D").arg(&data).arg("-o").arg(format!(
+                "-p {port} -k {} -c listen_addresses=127.0.0.1",
+                dir.path().display()
+            ));
+            c.args(["-l"]).arg(dir.path().join("log")).args(["-w", "start"]);
+            c
+        });
+        Some(PgServer { dir, bin, port })
+    }
+
+    fn url(&self, db: &str) -> String {
+        format!("postgres://postgres@127.0.0.1:{}/{db}", self.port)
+    }
+
+    fn create_db(&self, name: &str) -> String {
+        let mut c = postgres::Client::connect(&self.url("postgres"), postgres::NoTls).unwrap();
+        c.batch_execute(&format!("CREATE DATABASE {name}")).unwrap();
+        self.url(name)
+    }
+}
+
+impl Drop for PgServer {
+    fn drop(&mut self) {
+        let _ = std::process::Command::new("runuser")
+            .args(["-u", "postgres", "--"])
+            .arg(self.bin.join("pg_ctl"))
+            .arg("-D")
+            .arg(self.dir.path().join("data"))
+            .args(["-m", "fast", "-w", "stop"])
+            .stdout(std::process::Stdio::null())
+            .status();
+    }
+}
+
+#[test]
+fn postgres_store_same_promises() {
+    let Some(pg) = PgServer::start() else { return };
+    // The same checks as the SQLite store, through the same trait.
+    let url = pg.create_db("lot_a");
+    let mut s = open_store(&url, true, 0).unwrap();
+    exercise_store(s.as_mut());
+    assert_eq!(s.schema_version().unwrap(), schema::SCHEMA_VERSION);
+    drop(s);
+
+    // Stations on separate machines: four clients adding at once lose nothing.
+    let url = pg.create_db("lot_b");
+    let threads: Vec<_> = (0..4)
+        .map(|t| {
+            let url = url.clone();
+            std::thread::spawn(move || {
+                let mut s = open_store(&url, true, 0).unwrap();
+                for i in 0..10 {
+                    s.add(&synthetic_run(&format!("S{t}-{i}"), t * 100 + i, 0)).unwrap();
+                }
+            })
+        })
+        .collect();
+    for t in threads {
+        t.join().unwrap();
+    }
+    assert_eq!(open_store(&url, false, 0).unwrap().runs().unwrap().len(), 40);
+
+    // A newer schema is refused and left as it was.
+    let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
+    c.batch_execute("UPDATE schema_version SET version = 7").unwrap();
+    let e = open_store(&url, true, 0).err().unwrap();
+    assert!(matches!(e, LotError::NewerSchema { found: 7, .. }), "{e:?}");
+    let v: i32 = c.query_one("SELECT version FROM schema_version", &[]).unwrap().get(0);
+    let n: i64 = c.query_one("SELECT count(*) FROM runs", &[]).unwrap().get(0);
+    assert_eq!((v, n), (7, 40));
+    // A database that is not a lot, and a reader on an empty one, are refused.
+    let url = pg.create_db("lot_c");
+    let e = open_store(&url, false, 0).err().unwrap();
+    assert!(matches!(e, LotError::NotALot { .. }), "{e:?}");
+}
