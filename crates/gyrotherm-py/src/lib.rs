@@ -15,6 +15,7 @@ use pyo3::prelude::*;
 mod allan;
 mod figures;
 mod logs;
+mod lot;
 mod model;
 
 create_exception!(
@@ -88,6 +89,7 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     allan::register(m)?;
     figures::register(m)?;
     logs::register(m)?;
+    lot::register(m)?;
     model::register(m)?;
     Ok(())
 }

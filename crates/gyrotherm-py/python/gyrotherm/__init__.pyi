@@ -91,6 +91,8 @@ def read_log(
     sample_period: Optional[float] = None,
 ) -> Any: ...
 
+def read_lot(db: PathLike, *, as_frame: Optional[bool] = None) -> Any: ...
+
 # Models
 class Compensation(NamedTuple):
     bias_dps: FloatArray
