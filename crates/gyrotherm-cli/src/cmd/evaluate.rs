@@ -90,7 +90,13 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     )
     .with_context(|| format!("column {}", args.column))?;
     let verdict = match &spec {
-        Some(s) => Some(super::verdict::judge_log(s, &log, &rate_dps, &opts, &args.input)?),
+        Some(s) => Some(super::verdict::judge_log(
+            s,
+            &log,
+            &rate_dps,
+            &opts,
+            &args.input,
+        )?),
         None => None,
     };
     let code = super::verdict::exit_code(verdict.as_ref().is_none_or(|v| v.pass));

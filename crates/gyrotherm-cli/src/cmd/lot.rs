@@ -23,7 +23,7 @@ pub struct LotArgs {
 #[derive(Debug, clap::Subcommand)]
 pub enum LotCommand {
     /// Judge a unit's model on its held-out logs and record the run.
-    Add(AddArgs),
+    Add(Box<AddArgs>),
     /// List the recorded runs.
     List(ListArgs),
     /// Write the lot's HTML page (yield, distributions, worst units) and CSV.
@@ -96,7 +96,7 @@ pub struct ReportArgs {
 
 pub fn run(args: LotArgs) -> anyhow::Result<ExitCode> {
     match args.command {
-        LotCommand::Add(a) => add(a),
+        LotCommand::Add(a) => add(*a),
         LotCommand::List(a) => list(a),
         LotCommand::Report(a) => report(a),
     }

@@ -51,7 +51,12 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
     let verdicts = match &spec {
-        Some(s) => Some(gyrotherm::spec::judge_comparison(s, &cmp, &test_named, &cfg)?),
+        Some(s) => Some(gyrotherm::spec::judge_comparison(
+            s,
+            &cmp,
+            &test_named,
+            &cfg,
+        )?),
         None => None,
     };
     let index = write_full_report_with(

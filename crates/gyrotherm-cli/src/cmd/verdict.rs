@@ -9,7 +9,8 @@ use std::process::ExitCode;
 use gyrotherm::spec::{ColumnVerdict, Spec, Verdict};
 
 /// What `--help` says about `--spec` and the exit status.
-pub const SPEC_HELP: &str = "Spec sheet (TOML): a [limits] table of `figure = { min = …, max = … }` \
+pub const SPEC_HELP: &str =
+    "Spec sheet (TOML): a [limits] table of `figure = { min = …, max = … }` \
 (keys as in `evaluate --json`, noise terms as in `allan --json`; docs/method.md §7). Prints a \
 verdict per figure and exits 1 when a limit is missed.";
 

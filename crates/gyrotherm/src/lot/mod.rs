@@ -233,10 +233,9 @@ impl fmt::Display for LotError {
                  changed: retry, or raise --busy-timeout"
             ),
             LotError::Database { db, detail } => write!(f, "{db}: {detail}"),
-            LotError::BadRow { db, detail } => write!(
-                f,
-                "{db}: {detail}; the lot was edited outside gyrotherm"
-            ),
+            LotError::BadRow { db, detail } => {
+                write!(f, "{db}: {detail}; the lot was edited outside gyrotherm")
+            }
         }
     }
 }
@@ -353,12 +352,11 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
             },
         });
         let comp = compensate_log(&model, log).map_err(|e| model_err(e.into()))?;
-        let f = spec::measure(log, &comp.gyro_comp_dps, &opts).map_err(|source| {
-            LotError::Measure {
+        let f =
+            spec::measure(log, &comp.gyro_comp_dps, &opts).map_err(|source| LotError::Measure {
                 log: name.clone(),
                 source,
-            }
-        })?;
+            })?;
         measured.push((name, f));
     }
     let verdict = match u.spec {
@@ -412,8 +410,10 @@ pub(crate) fn mark_latest(runs: &mut [Run]) {
         let e = newest.entry(r.unit.as_str()).or_insert(r.id);
         *e = (*e).max(r.id);
     }
-    let newest: std::collections::HashMap<String, i64> =
-        newest.into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+    let newest: std::collections::HashMap<String, i64> = newest
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
     for r in runs.iter_mut() {
         r.latest = newest.get(&r.unit) == Some(&r.id);
     }

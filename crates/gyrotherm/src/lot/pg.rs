@@ -56,10 +56,7 @@ impl PgStore {
         tx.execute("SELECT pg_advisory_xact_lock($1)", &[&SCHEMA_LOCK])
             .map_err(e)?;
         let has: bool = tx
-            .query_one(
-                "SELECT to_regclass('schema_version') IS NOT NULL",
-                &[],
-            )
+            .query_one("SELECT to_regclass('schema_version') IS NOT NULL", &[])
             .map_err(e)?
             .get(0);
         let from = if has {

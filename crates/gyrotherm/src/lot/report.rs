@@ -192,13 +192,14 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
                 .iter()
                 .filter(|f| f.margin.is_some())
                 .min_by(|a, b| a.margin.unwrap_or(0.0).total_cmp(&b.margin.unwrap_or(0.0)));
-            let (fig, val, mar) = worst.map_or((String::new(), String::new(), String::new()), |f| {
-                (
-                    f.figure.clone(),
-                    format!("{:.4e}", f.value),
-                    format!("{:+.3e}", f.margin.unwrap_or(f64::NAN)),
-                )
-            });
+            let (fig, val, mar) =
+                worst.map_or((String::new(), String::new(), String::new()), |f| {
+                    (
+                        f.figure.clone(),
+                        format!("{:.4e}", f.value),
+                        format!("{:+.3e}", f.margin.unwrap_or(f64::NAN)),
+                    )
+                });
             let _ = writeln!(
                 h,
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
@@ -214,9 +215,11 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
     }
 
     // One distribution and one over-date figure per figure any unit has.
-    h.push_str("<h2>Figures</h2>\n<table id=\"figures\">\n<thead><tr><th>figure</th><th>unit</th>\
+    h.push_str(
+        "<h2>Figures</h2>\n<table id=\"figures\">\n<thead><tr><th>figure</th><th>unit</th>\
                 <th>units</th><th>min</th><th>median</th><th>max</th><th>limit min</th>\
-                <th>limit max</th><th>failed</th></tr></thead>\n<tbody>\n");
+                <th>limit max</th><th>failed</th></tr></thead>\n<tbody>\n",
+    );
     let mut figs = Vec::new();
     for def in FIGURES {
         let mut pts: Vec<(f64, f64, Option<bool>)> = Vec::new();
@@ -269,7 +272,8 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
             s
         };
         let ranks: Vec<f64> = (1..=sorted.len()).map(|i| i as f64).collect();
-        let mut series = vec![Series::line("units", &ranks, &sorted).with_style(SeriesStyle::Points)];
+        let mut series =
+            vec![Series::line("units", &ranks, &sorted).with_style(SeriesStyle::Points)];
         series.extend(limit_series(1.0, sorted.len().max(2) as f64));
         let y_label = format!("{} ({})", def.key, def.unit);
         let dist = Figure {
@@ -304,7 +308,13 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
         };
         let time_files = write_figure(&dir.join(format!("date_{}", def.key)), &time)?;
         for (files, what) in [(dist_files, "distribution"), (time_files, "over test date")] {
-            let name = |p: &Path| escape(&p.file_name().map(|n| n.to_string_lossy()).unwrap_or_default());
+            let name = |p: &Path| {
+                escape(
+                    &p.file_name()
+                        .map(|n| n.to_string_lossy())
+                        .unwrap_or_default(),
+                )
+            };
             let _ = writeln!(
                 h,
                 "<figure>\n<img src=\"{}\" alt=\"{k} {what}\" width=\"{}\" height=\"{}\">\n\

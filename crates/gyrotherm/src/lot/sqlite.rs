@@ -265,8 +265,9 @@ impl LotStore for SqliteStore {
                 runs.push(Run {
                     id,
                     unit: r.get(1).map_err(e)?,
-                    tested_at_unix_ms: parse_rfc3339_utc(&at)
-                        .ok_or_else(|| bad(format!("run {id}: tested_at {at:?} is not RFC 3339")))?,
+                    tested_at_unix_ms: parse_rfc3339_utc(&at).ok_or_else(|| {
+                        bad(format!("run {id}: tested_at {at:?} is not RFC 3339"))
+                    })?,
                     gyrotherm_version: r.get(3).map_err(e)?,
                     station: r.get(4).map_err(e)?,
                     model_path: r.get(5).map_err(e)?,
@@ -299,7 +300,11 @@ impl LotStore for SqliteStore {
                     position: r.get(1).map_err(e)?,
                     path: r.get(2).map_err(e)?,
                     sha256: r.get(3).map_err(e)?,
-                    kind: if kind == "static" { "static" } else { "rate_table" },
+                    kind: if kind == "static" {
+                        "static"
+                    } else {
+                        "rate_table"
+                    },
                 });
             }
         }

@@ -56,7 +56,8 @@ fn parallel_writers_lose_nothing() {
                 let mut s = SqliteStore::open(&db, true, 30_000).unwrap();
                 for i in 0..25 {
                     let unit = format!("S{t}-{i:03}");
-                    s.add(&synthetic_run(&unit, (t * 100 + i) as u64, 0)).unwrap();
+                    s.add(&synthetic_run(&unit, (t * 100 + i) as u64, 0))
+                        .unwrap();
                 }
             })
         })
@@ -69,7 +70,9 @@ fn parallel_writers_lose_nothing() {
     let mut ids: Vec<i64> = runs.iter().map(|r| r.id).collect();
     ids.dedup();
     assert_eq!(ids.len(), 100);
-    assert!(runs.iter().all(|r| r.figures.len() == 4 && r.inputs.len() == 2));
+    assert!(runs
+        .iter()
+        .all(|r| r.figures.len() == 4 && r.inputs.len() == 2));
 }
 
 #[test]
@@ -102,7 +105,10 @@ fn locked_file_is_an_error_and_changes_nothing() {
     let other = rusqlite::Connection::open(&db).unwrap();
     other.execute_batch("BEGIN EXCLUSIVE").unwrap();
     let e = s.add(&synthetic_run("B", 2, 0)).unwrap_err();
-    assert!(matches!(e, LotError::Locked { waited_ms: 100, .. }), "{e:?}");
+    assert!(
+        matches!(e, LotError::Locked { waited_ms: 100, .. }),
+        "{e:?}"
+    );
     assert!(e.to_string().contains("nothing was changed"), "{e}");
     other.execute_batch("ROLLBACK").unwrap();
     assert_eq!(s.runs().unwrap().len(), 1);
@@ -151,7 +157,14 @@ fn newer_schema_and_foreign_database_are_refused_unchanged() {
     let before = bytes(&db);
     let e = SqliteStore::open(&db, true, 100).err().unwrap();
     assert!(
-        matches!(e, LotError::NewerSchema { found: 99, supported: 1, .. }),
+        matches!(
+            e,
+            LotError::NewerSchema {
+                found: 99,
+                supported: 1,
+                ..
+            }
+        ),
         "{e:?}"
     );
     assert!(e.to_string().contains("use a newer gyrotherm"), "{e}");
@@ -183,7 +196,8 @@ fn report_of_a_synthetic_lot() {
     let runs: Vec<Run> = {
         let mut v: Vec<Run> = (0..40)
             .map(|i| {
-                let mut r = synthetic_run(&format!("<U{i}>"), i, 1_700_000_000_000 + i as i64 * 60_000);
+                let mut r =
+                    synthetic_run(&format!("<U{i}>"), i, 1_700_000_000_000 + i as i64 * 60_000);
                 r.id = i as i64 + 1;
                 r
             })
@@ -192,17 +206,34 @@ fn report_of_a_synthetic_lot() {
         v
     };
     let y = report::lot_yield(&runs);
-    let passed = runs.iter().filter(|r| r.verdict == RunVerdict::Pass).count();
+    let passed = runs
+        .iter()
+        .filter(|r| r.verdict == RunVerdict::Pass)
+        .count();
     assert_eq!((y.units, y.passed), (40, passed));
     let dir = tempfile::tempdir().unwrap();
     let page = report::write_lot_report(dir.path(), "lot <1>", &runs).unwrap();
     let html = std::fs::read_to_string(&page).unwrap();
     // Serials come from the database: escaped on the page.
-    assert!(html.contains("&lt;U") && !html.contains("<U"), "unescaped serial");
+    assert!(
+        html.contains("&lt;U") && !html.contains("<U"),
+        "unescaped serial"
+    );
     assert!(html.contains("lot &lt;1&gt;"));
-    for key in ["bias_stability_dph", "arw_deg_rt_h", "sf_thermal_error_ppm", "bias_dph"] {
-        assert!(dir.path().join(format!("dist_{key}.png")).is_file(), "{key}");
-        assert!(dir.path().join(format!("date_{key}.svg")).is_file(), "{key}");
+    for key in [
+        "bias_stability_dph",
+        "arw_deg_rt_h",
+        "sf_thermal_error_ppm",
+        "bias_dph",
+    ] {
+        assert!(
+            dir.path().join(format!("dist_{key}.png")).is_file(),
+            "{key}"
+        );
+        assert!(
+            dir.path().join(format!("date_{key}.svg")).is_file(),
+            "{key}"
+        );
     }
     let csv = std::fs::read_to_string(dir.path().join("lot.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 40 * 4);
@@ -219,13 +250,11 @@ struct PgServer {
 
 impl PgServer {
     fn start() -> Option<PgServer> {
-        let bin = std::fs::read_dir("/usr/lib/postgresql")
-            .ok()
-            .and_then(|d| {
-                d.filter_map(|e| e.ok())
-                    .map(|e| e.path().join("bin"))
-                    .find(|b| b.join("initdb").is_file())
-            });
+        let bin = std::fs::read_dir("/usr/lib/postgresql").ok().and_then(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.path().join("bin"))
+                .find(|b| b.join("initdb").is_file())
+        });
         let Some(bin) = bin else {
             assert!(
                 std::env::var("CI").as_deref() != Ok("true"),
@@ -279,7 +308,9 @@ impl PgServer {
                 "-p {port} -k {} -c listen_addresses=127.0.0.1",
                 dir.path().display()
             ));
-            c.args(["-l"]).arg(dir.path().join("log")).args(["-w", "start"]);
+            c.args(["-l"])
+                .arg(dir.path().join("log"))
+                .args(["-w", "start"]);
             c
         });
         Some(PgServer { dir, bin, port })
@@ -327,7 +358,8 @@ fn postgres_store_same_promises() {
             std::thread::spawn(move || {
                 let mut s = open_store(&url, true, 0).unwrap();
                 for i in 0..10 {
-                    s.add(&synthetic_run(&format!("S{t}-{i}"), t * 100 + i, 0)).unwrap();
+                    s.add(&synthetic_run(&format!("S{t}-{i}"), t * 100 + i, 0))
+                        .unwrap();
                 }
             })
         })
@@ -335,15 +367,25 @@ fn postgres_store_same_promises() {
     for t in threads {
         t.join().unwrap();
     }
-    assert_eq!(open_store(&url, false, 0).unwrap().runs().unwrap().len(), 40);
+    assert_eq!(
+        open_store(&url, false, 0).unwrap().runs().unwrap().len(),
+        40
+    );
 
     // A newer schema is refused and left as it was.
     let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
-    c.batch_execute("UPDATE schema_version SET version = 7").unwrap();
+    c.batch_execute("UPDATE schema_version SET version = 7")
+        .unwrap();
     let e = open_store(&url, true, 0).err().unwrap();
     assert!(matches!(e, LotError::NewerSchema { found: 7, .. }), "{e:?}");
-    let v: i32 = c.query_one("SELECT version FROM schema_version", &[]).unwrap().get(0);
-    let n: i64 = c.query_one("SELECT count(*) FROM runs", &[]).unwrap().get(0);
+    let v: i32 = c
+        .query_one("SELECT version FROM schema_version", &[])
+        .unwrap()
+        .get(0);
+    let n: i64 = c
+        .query_one("SELECT count(*) FROM runs", &[])
+        .unwrap()
+        .get(0);
     assert_eq!((v, n), (7, 40));
     // A database that is not a lot, and a reader on an empty one, are refused.
     let url = pg.create_db("lot_c");

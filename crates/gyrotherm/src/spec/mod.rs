@@ -123,7 +123,11 @@ impl fmt::Display for SpecError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             SpecError::Read { path, source } => {
-                write!(f, "{}: cannot read the spec sheet: {source}", path.display())
+                write!(
+                    f,
+                    "{}: cannot read the spec sheet: {source}",
+                    path.display()
+                )
             }
             SpecError::Syntax {
                 path,
@@ -367,8 +371,10 @@ impl Spec {
             );
         }
         let name = raw.name.unwrap_or_else(|| {
-            path.file_name()
-                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into())
+            path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into(),
+            )
         });
         Ok(Spec {
             name,

@@ -34,7 +34,9 @@ fn unknown_figure_names_place_and_nearest_names() {
     );
     assert!(msg.contains("did you mean `bias_stability_dph`"), "{msg}");
     // A name near nothing lists every known figure instead.
-    let msg = parse("[limits]\nzzz = { max = 1 }\n").unwrap_err().to_string();
+    let msg = parse("[limits]\nzzz = { max = 1 }\n")
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("known figures: bias_dph,"), "{msg}");
 }
 
@@ -42,14 +44,23 @@ fn unknown_figure_names_place_and_nearest_names() {
 fn malformed_limits_are_refused_with_place() {
     let cases = [
         // (text, what the message must contain)
-        ("[limits]\nbias_dph = { }\n", "spec.toml:2:12: limit on `bias_dph`: give `min`"),
+        (
+            "[limits]\nbias_dph = { }\n",
+            "spec.toml:2:12: limit on `bias_dph`: give `min`",
+        ),
         (
             "[limits]\nbias_dph = { min = 2, max = 1 }\n",
             "min = 2 is above max = 1",
         ),
-        ("[limits]\nbias_dph = { max = nan }\n", "is not a finite number"),
+        (
+            "[limits]\nbias_dph = { max = nan }\n",
+            "is not a finite number",
+        ),
         ("[limits]\nbias_dph = { max = \"0.1\" }\n", "spec.toml:2:"),
-        ("[limits]\nbias_dph = { maximum = 1 }\n", "unknown field `maximum`"),
+        (
+            "[limits]\nbias_dph = { maximum = 1 }\n",
+            "unknown field `maximum`",
+        ),
         ("[limit]\nbias_dph = { max = 1 }\n", "unknown field `limit`"),
         ("name = \"x\"\n", "no limits"),
         ("[limits\n", "spec.toml:1:"),
@@ -62,8 +73,8 @@ fn malformed_limits_are_refused_with_place() {
 
 #[test]
 fn judge_gives_value_limit_margin_and_verdict() {
-    let s = parse("[limits]\nbias_stability_dph = { max = 0.02 }\nbias_dph = { min = -1 }\n")
-        .unwrap();
+    let s =
+        parse("[limits]\nbias_stability_dph = { max = 0.02 }\nbias_dph = { min = -1 }\n").unwrap();
     let mut a = Figures::new();
     a.insert("bias_stability_dph", 0.015);
     a.insert("bias_dph", 0.3);
