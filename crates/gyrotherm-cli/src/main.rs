@@ -1,6 +1,8 @@
 //! `gyrotherm`: thin command-line front end. Parses arguments, calls the library, prints.
 //!
-//! Exit codes: 0 success; 2 error (the message names the file, line and column, and what to do).
+//! Exit codes: 0 success (and, with `--spec`, every limit met); 1 ran fine but a `--spec` limit
+//! was missed (`evaluate`, `compare`, `report`, `lot add`); 2 error (the message names the
+//! file, line and column, and what to do).
 
 use std::process::ExitCode;
 
@@ -16,7 +18,7 @@ mod signals;
     version,
     about,
     long_about = None,
-    after_help = "Exit status: 0 success, 2 error (the message names the file, line and column).\nStart with `gyrotherm demo`; every command has --help."
+    after_help = "Exit status: 0 success (with --spec: every limit met), 1 a --spec limit missed, 2 error (the message names the file, line and column).\nStart with `gyrotherm demo`; every command has --help."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -49,6 +51,8 @@ enum Command {
     /// values, as JSON (the library's own description; for tests and tools).
     #[command(hide = true)]
     Settings(cmd::settings::SettingsArgs),
+    /// Record units judged against a spec in a lot database; list it; report its yield.
+    Lot(cmd::lot::LotArgs),
 }
 
 fn main() -> ExitCode {
@@ -66,6 +70,7 @@ fn main() -> ExitCode {
         Command::Model(a) => cmd::model::run(a),
         Command::Export(a) => cmd::export::run(a),
         Command::Settings(a) => cmd::settings::run(a),
+        Command::Lot(a) => cmd::lot::run(a),
     };
     match result {
         Ok(code) => code,

@@ -16,6 +16,7 @@ use pyo3::prelude::*;
 mod allan;
 mod figures;
 mod logs;
+mod lot;
 mod model;
 
 // The base class has two bases (`ValueError`, `RuntimeError`), which `create_exception!`
@@ -102,6 +103,7 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     allan::register(m)?;
     figures::register(m)?;
     logs::register(m)?;
+    lot::register(m)?;
     model::register(m)?;
     Ok(())
 }

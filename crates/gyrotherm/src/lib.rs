@@ -56,6 +56,7 @@ pub mod export;
 pub mod features;
 pub mod fit;
 pub mod json_keys;
+pub mod lot;
 pub mod metrics;
 pub mod model;
 pub mod moving_average;
@@ -63,6 +64,7 @@ pub mod nn;
 pub mod report;
 pub mod settings;
 pub mod sim;
+pub mod spec;
 pub mod table_segments;
 pub mod targets;
 

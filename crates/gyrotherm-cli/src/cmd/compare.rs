@@ -31,6 +31,9 @@ pub struct CompareArgs {
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,
+    #[doc = "Spec sheet (TOML) to judge every model column against; exit 1 when a column misses a limit."]
+    #[arg(long, value_name = "SPEC.toml", long_help = super::verdict::SPEC_HELP)]
+    pub spec: Option<PathBuf>,
     #[command(flatten)]
     pub columns: ColumnArgs,
     #[command(flatten)]
@@ -103,6 +106,7 @@ pub fn run_comparison(
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
+    let spec = super::verdict::load(args.spec.as_deref())?;
     let mut warnings = Vec::new();
     let train = read_logs(&args.train, &args.log, &mut warnings)?;
     let test = read_logs(&args.test, &args.log, &mut warnings)?;
@@ -111,17 +115,35 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let tau_s = resolve_tau(args.tau_s, &test_named);
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
+    let verdicts = match &spec {
+        Some(s) => Some(gyrotherm::spec::judge_comparison(
+            s,
+            &cmp,
+            &test_named,
+            &cfg,
+        )?),
+        None => None,
+    };
     let mut out = std::io::stdout().lock();
     if args.json {
-        writeln!(out, "{}", serde_json::to_string_pretty(&cmp.summary(&cfg))?)?;
+        let mut j = serde_json::to_value(cmp.summary(&cfg))?;
+        if let (Some(v), Some(o)) = (&verdicts, j.as_object_mut()) {
+            o.insert("verdicts".into(), serde_json::to_value(v)?);
+        }
+        writeln!(out, "{}", serde_json::to_string_pretty(&j)?)?;
     } else {
         print_table(&mut out, &cmp, &cfg)?;
+        if let Some(v) = &verdicts {
+            super::verdict::print_columns(&mut out, v)?;
+        }
     }
     // Each finding once, naming the models it concerns (as the report page says it).
     for w in gyrotherm::report::grouped_warnings(&test_named, &cmp) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(super::verdict::exit_code(
+        verdicts.iter().flatten().all(|c| c.verdict.pass),
+    ))
 }
 
 /// The human table: the models fitted, then one block per held-out log.

@@ -34,10 +34,14 @@ pub struct EvaluateArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    #[doc = "Spec sheet (TOML) to judge the figures against; exit 1 when a limit is missed."]
+    #[arg(long, value_name = "SPEC.toml", long_help = super::verdict::SPEC_HELP)]
+    pub spec: Option<std::path::PathBuf>,
 }
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     let mut w = std::io::stdout().lock();
+    let spec = super::verdict::load(args.spec.as_deref())?;
     let (log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
     let settings = EvaluateSettings {
         column: args.column.clone(),
@@ -49,9 +53,27 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     if let Some(note) = tau.note(tau0_s) {
         eprintln!("gyrotherm: {note}");
     }
+    let verdict = match &spec {
+        Some(s) => {
+            let (rate_dps, opts, _) = settings.prepare(&values, tau0_s)?;
+            Some(super::verdict::judge_log(
+                s,
+                &log,
+                &rate_dps,
+                &opts,
+                &args.input,
+            )?)
+        }
+        None => None,
+    };
+    let code = super::verdict::exit_code(verdict.as_ref().is_none_or(|v| v.pass));
     if args.json {
-        writeln!(w, "{}", serde_json::to_string_pretty(&e)?)?;
-        return Ok(ExitCode::SUCCESS);
+        let mut j = serde_json::to_value(&e)?;
+        if let (Some(v), Some(o)) = (&verdict, j.as_object_mut()) {
+            o.insert("verdict".into(), serde_json::to_value(v)?);
+        }
+        writeln!(w, "{}", serde_json::to_string_pretty(&j)?)?;
+        return Ok(code);
     }
     writeln!(
         w,
@@ -88,7 +110,11 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
             r.scale_over_time.len()
         )?;
     }
-    Ok(ExitCode::SUCCESS)
+    if let Some(v) = &verdict {
+        writeln!(w)?;
+        super::verdict::print(&mut w, v)?;
+    }
+    Ok(code)
 }
 
 /// Fixed-point with `prec` decimals for ordinary magnitudes, scientific beyond (a figure of

@@ -29,6 +29,9 @@ pub struct ReportArgs {
     /// sample period nearest to it when 100 s is not one; said on stderr).
     #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
     pub tau_s: Option<f64>,
+    #[doc = "Spec sheet (TOML) to judge every model column against; exit 1 when a column misses a limit."]
+    #[arg(long, value_name = "SPEC.toml", long_help = super::verdict::SPEC_HELP)]
+    pub spec: Option<PathBuf>,
     #[command(flatten)]
     pub columns: ColumnArgs,
     #[command(flatten)]
@@ -38,6 +41,7 @@ pub struct ReportArgs {
 }
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
+    let spec = super::verdict::load(args.spec.as_deref())?;
     let mut gap_warnings = Vec::new();
     let train = read_logs(&args.train, &args.log, &mut gap_warnings)?;
     let test = read_logs(&args.test, &args.log, &mut gap_warnings)?;
@@ -46,6 +50,15 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let tau_s = resolve_tau(args.tau_s, &test_named);
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
+    let verdicts = match &spec {
+        Some(s) => Some(gyrotherm::spec::judge_comparison(
+            s,
+            &cmp,
+            &test_named,
+            &cfg,
+        )?),
+        None => None,
+    };
     let index = write_full_report_with(
         &args.out,
         &train_named,
@@ -57,10 +70,15 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     .with_context(|| format!("cannot write the report in {}", args.out.display()))?;
     let mut out = std::io::stdout().lock();
     print_table(&mut out, &cmp, &cfg)?;
+    if let Some(v) = &verdicts {
+        super::verdict::print_columns(&mut out, v)?;
+    }
     writeln!(out, "report: {}", index.display())?;
     // Each finding once, naming the models it concerns (as the report page says it).
     for w in gyrotherm::report::grouped_warnings(&test_named, &cmp) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(super::verdict::exit_code(
+        verdicts.iter().flatten().all(|c| c.verdict.pass),
+    ))
 }

@@ -5,7 +5,7 @@
   ``(taus, devs, errs, ns)`` on allantools' τ set; ``deviation`` adds Greenhall EDF
   confidence bounds; ``edf_greenhall`` and ``confidence_interval`` as in allantools.
 - Gyro figures: ``bias_stability``, ``noise_terms``, ``scale_factor``.
-- Logs and models: ``read_log``, ``fit`` → ``Model`` (``save``, ``Model.load``,
+- Logs and models: ``read_log``, ``read_lot`` (a lot database of ``gyrotherm lot``), ``fit`` → ``Model`` (``save``, ``Model.load``,
   ``compensate``, ``summary``); model files are the CLI's JSON.
 
 Errors derive from ``GyrothermError`` (a ``ValueError`` and, as allantools raises for the
@@ -42,7 +42,7 @@ from ._allan import (
     tdev,
 )
 from ._figures import bias_stability, noise_terms, scale_factor
-from ._logs import read_log
+from ._logs import read_log, read_lot
 from ._model import STATUS_NAMES, Compensation, GyrothermWarning, Model, fit
 
 
@@ -88,6 +88,7 @@ __all__ = [
     "oadev",
     "ohdev",
     "read_log",
+    "read_lot",
     "scale_factor",
     "tdev",
 ]

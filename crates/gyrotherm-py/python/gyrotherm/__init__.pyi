@@ -100,6 +100,8 @@ def read_log(
     delimiter: str = ...,
 ) -> Any: ...
 
+def read_lot(db: PathLike, *, as_frame: Optional[bool] = None) -> Any: ...
+
 # Models
 class Compensation(NamedTuple):
     bias_dps: FloatArray

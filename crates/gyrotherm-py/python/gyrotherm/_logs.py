@@ -90,3 +90,25 @@ def columns(log, names):
             raise KeyError(f"the log has no column {n!r}") from None
         out.append(np.ascontiguousarray(v, dtype=np.float64))
     return out
+
+
+def read_lot(db: PathLike, *, as_frame: Optional[bool] = None):
+    """Read a lot database (``gyrotherm lot``): an SQLite file or a ``postgres://`` URL.
+
+    One row per figure measured on one held-out log of one run, the rows of ``lot.csv``:
+    ``run_id``, ``unit``, ``tested_at`` (RFC 3339 UTC), ``latest`` (the unit's newest run),
+    ``run_verdict``, ``station``, ``model_content_sha256``, ``log``, ``figure``, ``value``,
+    ``limit_min``, ``limit_max`` (NaN when not limited), ``verdict`` (``"pass"``, ``"fail"``
+    or None) and ``margin``. A DataFrame when pandas is installed (``as_frame=None``) or
+    ``as_frame=True``, else a dict of arrays and lists. Raises ``gyrotherm.GyrothermError``
+    (a missing, damaged or newer-schema lot, with the message the CLI prints).
+    """
+    cols = _g.read_lot(os.fspath(db))
+    pd = _pandas()
+    if as_frame is None:
+        as_frame = pd is not None
+    if not as_frame:
+        return cols
+    if pd is None:
+        raise ImportError("read_lot(as_frame=True) needs pandas; pip install pandas")
+    return pd.DataFrame(cols)

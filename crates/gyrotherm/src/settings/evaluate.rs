@@ -160,19 +160,7 @@ impl EvaluateSettings {
         values: &[f64],
         tau0_s: f64,
     ) -> Result<(Evaluation, ResolvedTau), EvaluateError> {
-        self.validate().map_err(EvaluateError::Setting)?;
-        let to_dph = rate_column_to_dph(&self.column).ok_or_else(|| EvaluateError::NoRateUnit {
-            column: self.column.clone(),
-        })?;
-        let tau = self.resolve_tau(tau0_s, values.len())?;
-        // Factor first: v·to_dph could overflow where v·(to_dph/3600) does not.
-        let to_dps = to_dph / 3600.0;
-        let rate_dps: Vec<f64> = values.iter().map(|v| v * to_dps).collect();
-        let opts = EvaluationOptions {
-            tau_s: tau.tau_s,
-            settle_s: self.settle_s,
-            reference_scale: self.reference_scale,
-        };
+        let (rate_dps, opts, tau) = self.prepare(values, tau0_s)?;
         let e = metrics::evaluate(
             &self.column,
             &log.time_s,
@@ -186,5 +174,28 @@ impl EvaluateSettings {
             source,
         })?;
         Ok((e, tau))
+    }
+
+    /// What [`evaluate`](Self::evaluate) judges, before it judges it: the column's values in
+    /// °/s, the figures' options and the τ used (also what a spec sheet is judged on).
+    pub fn prepare(
+        &self,
+        values: &[f64],
+        tau0_s: f64,
+    ) -> Result<(Vec<f64>, EvaluationOptions, ResolvedTau), EvaluateError> {
+        self.validate().map_err(EvaluateError::Setting)?;
+        let to_dph = rate_column_to_dph(&self.column).ok_or_else(|| EvaluateError::NoRateUnit {
+            column: self.column.clone(),
+        })?;
+        let tau = self.resolve_tau(tau0_s, values.len())?;
+        // Factor first: v·to_dph could overflow where v·(to_dph/3600) does not.
+        let to_dps = to_dph / 3600.0;
+        let rate_dps: Vec<f64> = values.iter().map(|v| v * to_dps).collect();
+        let opts = EvaluationOptions {
+            tau_s: tau.tau_s,
+            settle_s: self.settle_s,
+            reference_scale: self.reference_scale,
+        };
+        Ok((rate_dps, opts, tau))
     }
 }

@@ -1,0 +1,58 @@
+"""read_lot: a lot filled by the CLI (`gyrotherm lot add`) read back as columns."""
+
+import numpy as np
+import pytest
+
+import gyrotherm as gt
+
+
+@pytest.fixture(scope="module")
+def lot(cli, logs, tmp_path_factory):
+    d = tmp_path_factory.mktemp("lot")
+    model = d / "model.json"
+    cli("train", "--method", "linear", "--input", logs["static"], "--input", logs["table"],
+        "--out", model)
+    spec = d / "spec.toml"
+    # The held-out log's bias stability after a linear fit is far below 1 °/h (gyrotherm
+    # evaluate on it), so U1 passes; 1e-9 °/h is out of reach, so U2 fails.
+    spec.write_text("[limits]\nbias_stability_dph = { max = 1.0 }\n")
+    strict = d / "strict.toml"
+    strict.write_text("[limits]\nbias_stability_dph = { max = 1e-9 }\n")
+    db = d / "lot.sqlite"
+    for unit, sheet, code in [("U1", spec, 0), ("U2", strict, 1), ("U1", spec, 0)]:
+        p = cli("lot", "add", "--db", db, "--unit", unit, "--model", model,
+                "--test", logs["heldout"], "--spec", sheet, check=False)
+        assert p.returncode == code, p.stderr
+    return db
+
+
+def test_read_lot_columns(lot):
+    cols = gt.read_lot(lot, as_frame=False)
+    n = len(cols["figure"])
+    assert all(len(v) == n for v in cols.values())
+    bs = [i for i, f in enumerate(cols["figure"]) if f == "bias_stability_dph"]
+    assert [cols["unit"][i] for i in bs] == ["U1", "U2", "U1"]
+    assert [cols["verdict"][i] for i in bs] == ["pass", "fail", "pass"]
+    assert list(cols["latest"][bs]) == [False, True, True]
+    assert np.all(cols["limit_max"][bs] > 0)
+    # Unlimited figures carry NaN limits and no verdict.
+    other = [i for i, f in enumerate(cols["figure"]) if f == "bias_dph"]
+    assert np.all(np.isnan(cols["limit_max"][other]))
+    assert all(cols["verdict"][i] is None for i in other)
+
+
+def test_read_lot_frame(lot):
+    pd = pytest.importorskip("pandas")
+    df = gt.read_lot(lot)
+    assert isinstance(df, pd.DataFrame)
+    latest = df[df.latest & (df.figure == "bias_stability_dph")]
+    assert sorted(latest.unit) == ["U1", "U2"]
+
+
+def test_read_lot_errors(tmp_path):
+    with pytest.raises(gt.GyrothermError, match="no such lot database"):
+        gt.read_lot(tmp_path / "none.sqlite")
+    junk = tmp_path / "junk.sqlite"
+    junk.write_bytes(b"x" * 4096)
+    with pytest.raises(gt.GyrothermError, match="not an SQLite database"):
+        gt.read_lot(junk)

@@ -1,0 +1,514 @@
+//! A lot: the test station's record of units judged against their spec sheet.
+//!
+//! [`judge_unit`] compensates a unit's held-out logs with its model (the flight compensator,
+//! as `gyrotherm compare` does for one model), measures every figure of
+//! [`crate::spec::FIGURES`] on each, judges them against the spec sheet when
+//! one is given, and returns a [`Run`]: the unit, the time, the gyrotherm version, the
+//! SHA-256 of every input and the model's `content_sha256`, each figure and verdict, and
+//! the spec. A [`LotStore`] keeps runs: [`SqliteStore`] (one file, the default) or
+//! [`PgStore`] (PostgreSQL, for several stations on separate machines), with the same schema
+//! ([`schema`], docs/lot-schema.md). [`report`] writes the lot's HTML page and CSV.
+//!
+//! Nothing is lost: each run is written in one transaction; a unit added again keeps both
+//! runs, and the `latest_runs` view (and [`Run::latest`]) marks the newer one.
+
+mod pg;
+pub mod report;
+pub mod schema;
+mod sqlite;
+mod time;
+
+pub use pg::PgStore;
+pub use sqlite::SqliteStore;
+pub use time::{now_unix_ms, rfc3339_utc};
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+
+use crate::compensate::compensate_log;
+use crate::csvlog::TestLog;
+use crate::fit::NamedLog;
+use crate::metrics::EvaluationOptions;
+use crate::model::ModelFile;
+use crate::spec::{self, MeasureOptions, Spec};
+
+/// One input file of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Input {
+    /// Position among the run's held-out logs, from 0.
+    pub position: u32,
+    /// The path as given.
+    pub path: String,
+    /// SHA-256 of the file's bytes, hex.
+    pub sha256: String,
+    /// `static` or `rate_table`.
+    pub kind: &'static str,
+}
+
+/// One measured figure of one held-out log of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FigureRow {
+    /// The [`Input::position`] of the log it was measured on.
+    pub position: u32,
+    /// The figure's key ([`spec::FIGURES`]).
+    pub figure: String,
+    pub value: f64,
+    /// The spec's limits on it, if any.
+    pub limit_min: Option<f64>,
+    pub limit_max: Option<f64>,
+    /// `Some(true)` pass, `Some(false)` fail, `None` not limited.
+    pub pass: Option<bool>,
+    /// Distance to the nearest limit (positive inside), when limited.
+    pub margin: Option<f64>,
+}
+
+/// The verdict of a run: `pass`, `fail`, or `none` (judged without a spec).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunVerdict {
+    Pass,
+    Fail,
+    None,
+}
+
+impl RunVerdict {
+    /// The word stored in the database.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RunVerdict::Pass => "pass",
+            RunVerdict::Fail => "fail",
+            RunVerdict::None => "none",
+        }
+    }
+
+    fn parse(s: &str) -> Option<RunVerdict> {
+        match s {
+            "pass" => Some(RunVerdict::Pass),
+            "fail" => Some(RunVerdict::Fail),
+            "none" => Some(RunVerdict::None),
+            _ => None,
+        }
+    }
+}
+
+/// One unit judged once: what a lot records.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Run {
+    /// Its id in the store (0 before it is stored); ids grow in the order runs are added.
+    pub id: i64,
+    /// The unit's serial number.
+    pub unit: String,
+    /// When it was judged, ms since 1970-01-01 UTC.
+    pub tested_at_unix_ms: i64,
+    /// The gyrotherm version that judged it.
+    pub gyrotherm_version: String,
+    /// Which station judged it (host name unless given).
+    pub station: String,
+    pub model_path: String,
+    /// SHA-256 of the model file's bytes.
+    pub model_sha256: String,
+    /// The model's own `content_sha256` (its content, however it is formatted).
+    pub model_content_sha256: String,
+    pub model_method: String,
+    /// The spec sheet's name, SHA-256 and text, when judged against one.
+    pub spec_name: Option<String>,
+    pub spec_sha256: Option<String>,
+    pub spec_toml: Option<String>,
+    pub verdict: RunVerdict,
+    /// True for the newest run of its unit (set when read back).
+    pub latest: bool,
+    pub inputs: Vec<Input>,
+    pub figures: Vec<FigureRow>,
+}
+
+impl Run {
+    /// The figure's value on the log where it is worst: the smallest margin when limited,
+    /// else the largest magnitude. None when no log of the run gives it.
+    pub fn worst(&self, figure: &str) -> Option<&FigureRow> {
+        self.figures
+            .iter()
+            .filter(|f| f.figure == figure)
+            .min_by(|a, b| match (a.margin, b.margin) {
+                (Some(x), Some(y)) => x.total_cmp(&y),
+                _ => b.value.abs().total_cmp(&a.value.abs()),
+            })
+    }
+
+    /// The test date as RFC 3339 UTC.
+    pub fn tested_at(&self) -> String {
+        rfc3339_utc(self.tested_at_unix_ms)
+    }
+}
+
+/// Why a lot could not be read or written, or a unit judged.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum LotError {
+    /// An input file could not be read.
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The model could not be loaded or applied.
+    Model {
+        path: PathBuf,
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// The figures of a held-out log could not be computed.
+    Measure {
+        log: String,
+        source: crate::metrics::EvaluationError,
+    },
+    /// The spec could not be applied (a limited figure no log gives).
+    Spec(spec::SpecError),
+    /// The database file does not exist (`lot list`/`lot report` never create one).
+    Missing { db: String },
+    /// The file is not an SQLite database (or is damaged).
+    NotADatabase { db: String, detail: String },
+    /// A database without the lot schema (other tables, no `schema_version`).
+    NotALot { db: String },
+    /// The lot was written by a newer gyrotherm (schema `found` > `supported`).
+    NewerSchema {
+        db: String,
+        found: i64,
+        supported: i64,
+    },
+    /// Another writer held the database for longer than the busy timeout.
+    Locked { db: String, waited_ms: u64 },
+    /// Any other database error.
+    Database { db: String, detail: String },
+    /// A stored value the schema does not allow (edited by hand?).
+    BadRow { db: String, detail: String },
+}
+
+impl fmt::Display for LotError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LotError::Read { path, source } => write!(f, "{}: {source}", path.display()),
+            LotError::Model { path, source } => write!(f, "{}: {source}", path.display()),
+            LotError::Measure { log, source } => {
+                write!(f, "{log}: ")?;
+                let mut e: Option<&dyn std::error::Error> = Some(source);
+                let mut first = true;
+                while let Some(x) = e {
+                    if !first {
+                        write!(f, ": ")?;
+                    }
+                    write!(f, "{x}")?;
+                    first = false;
+                    e = x.source();
+                }
+                Ok(())
+            }
+            LotError::Spec(e) => write!(f, "{e}"),
+            LotError::Missing { db } => write!(
+                f,
+                "{db}: no such lot database; `gyrotherm lot add --db {db} …` creates it"
+            ),
+            LotError::NotADatabase { db, detail } => write!(
+                f,
+                "{db}: not an SQLite database, or damaged ({detail}); nothing was changed: \
+                 check the path, or restore the file from a backup"
+            ),
+            LotError::NotALot { db } => write!(
+                f,
+                "{db}: a database without the gyrotherm lot schema (no schema_version table); \
+                 nothing was changed: give a lot's path or a new file"
+            ),
+            LotError::NewerSchema {
+                db,
+                found,
+                supported,
+            } => write!(
+                f,
+                "{db}: lot schema version {found} is newer than this gyrotherm reads \
+                 ({supported}); nothing was changed: use a newer gyrotherm"
+            ),
+            LotError::Locked { db, waited_ms } => write!(
+                f,
+                "{db}: locked by another writer for more than {waited_ms} ms; nothing was \
+                 changed: retry, or raise --busy-timeout"
+            ),
+            LotError::Database { db, detail } => write!(f, "{db}: {detail}"),
+            LotError::BadRow { db, detail } => {
+                write!(f, "{db}: {detail}; the lot was edited outside gyrotherm")
+            }
+        }
+    }
+}
+
+impl std::error::Error for LotError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            LotError::Read { source, .. } => Some(source),
+            LotError::Model { source, .. } => Some(source.as_ref()),
+            LotError::Spec(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// A place runs are kept: the same schema in SQLite or PostgreSQL.
+pub trait LotStore {
+    /// Record `run` (its `id` and `latest` are ignored) in one transaction; returns its id.
+    fn add(&mut self, run: &Run) -> Result<i64, LotError>;
+    /// Every run, oldest first, with [`Run::latest`] set.
+    fn runs(&mut self) -> Result<Vec<Run>, LotError>;
+    /// The schema version the store holds.
+    fn schema_version(&mut self) -> Result<i64, LotError>;
+}
+
+/// Open the lot at `db`: a `postgres://` or `postgresql://` URL, else an SQLite file path.
+/// `create`: make the file and the schema if missing (`lot add`); otherwise a missing file is
+/// [`LotError::Missing`]. `busy_timeout_ms`: how long a writer waits for another (SQLite).
+pub fn open_store(
+    db: &str,
+    create: bool,
+    busy_timeout_ms: u64,
+) -> Result<Box<dyn LotStore>, LotError> {
+    if db.starts_with("postgres://") || db.starts_with("postgresql://") {
+        Ok(Box::new(PgStore::open(db, create)?))
+    } else {
+        Ok(Box::new(SqliteStore::open(
+            Path::new(db),
+            create,
+            busy_timeout_ms,
+        )?))
+    }
+}
+
+/// What [`judge_unit`] needs besides the logs.
+#[derive(Debug, Clone)]
+pub struct UnitInputs<'a> {
+    pub unit: &'a str,
+    pub station: &'a str,
+    pub model_path: &'a Path,
+    /// The held-out logs, already read, with the paths they were read from.
+    pub tests: &'a [(PathBuf, TestLog)],
+    pub spec: Option<&'a Spec>,
+    /// Bias-stability τ, s (None: `compare`'s default for these logs).
+    pub tau_s: Option<f64>,
+    /// Settle time at each table segment start, s.
+    pub settle_s: f64,
+}
+
+/// SHA-256 of a file's bytes, hex.
+pub fn file_sha256(path: &Path) -> Result<String, LotError> {
+    let bytes = std::fs::read(path).map_err(|source| LotError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok(format!("{:x}", Sha256::digest(&bytes)))
+}
+
+/// Judge one unit: compensate each held-out log with its model, measure every figure, judge
+/// against the spec; the [`Run`] to record (dated now), and the spec's verdict when given.
+pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotError> {
+    let model_err = |source: Box<dyn std::error::Error + Send + Sync>| LotError::Model {
+        path: u.model_path.to_path_buf(),
+        source,
+    };
+    let text = std::fs::read_to_string(u.model_path).map_err(|source| LotError::Read {
+        path: u.model_path.to_path_buf(),
+        source,
+    })?;
+    let model_sha256 = format!("{:x}", Sha256::digest(text.as_bytes()));
+    let (model, _) = ModelFile::from_json_sealed(&text).map_err(|e| model_err(e.into()))?;
+    let content = model.content_digest().map_err(|e| model_err(e.into()))?;
+    let named: Vec<NamedLog> = u
+        .tests
+        .iter()
+        .map(|(p, l)| NamedLog {
+            name: p.to_str().unwrap_or("?"),
+            log: l,
+        })
+        .collect();
+    let tau_s = u
+        .tau_s
+        .unwrap_or_else(|| crate::compare::default_tau_s(&named).0);
+    let opts = MeasureOptions {
+        evaluation: EvaluationOptions {
+            tau_s,
+            settle_s: u.settle_s,
+            reference_scale: None,
+        },
+        noise_terms: true,
+    };
+    let mut inputs = Vec::new();
+    let mut measured = Vec::new();
+    for (i, (path, log)) in u.tests.iter().enumerate() {
+        let name = path.display().to_string();
+        inputs.push(Input {
+            position: i as u32,
+            path: name.clone(),
+            sha256: file_sha256(path)?,
+            kind: if log.is_static() {
+                "static"
+            } else {
+                "rate_table"
+            },
+        });
+        let comp = compensate_log(&model, log).map_err(|e| model_err(e.into()))?;
+        let f =
+            spec::measure(log, &comp.gyro_comp_dps, &opts).map_err(|source| LotError::Measure {
+                log: name.clone(),
+                source,
+            })?;
+        measured.push((name, f));
+    }
+    let verdict = match u.spec {
+        Some(s) => Some(spec::judge(s, &measured).map_err(LotError::Spec)?),
+        None => None,
+    };
+    let mut figures = Vec::new();
+    for (i, (_, f)) in measured.iter().enumerate() {
+        for (&key, &value) in f {
+            let limit = u.spec.and_then(|s| s.limit(key));
+            figures.push(FigureRow {
+                position: i as u32,
+                figure: key.to_string(),
+                value,
+                limit_min: limit.and_then(|l| l.min),
+                limit_max: limit.and_then(|l| l.max),
+                pass: limit.map(|l| l.passes(value)),
+                margin: limit.map(|l| l.margin(value)),
+            });
+        }
+    }
+    let run = Run {
+        id: 0,
+        unit: u.unit.to_string(),
+        tested_at_unix_ms: now_unix_ms(),
+        gyrotherm_version: env!("CARGO_PKG_VERSION").to_string(),
+        station: u.station.to_string(),
+        model_path: u.model_path.display().to_string(),
+        model_sha256,
+        model_content_sha256: content,
+        model_method: model.method.as_str().to_string(),
+        spec_name: u.spec.map(|s| s.name.clone()),
+        spec_sha256: u.spec.map(|s| s.sha256.clone()),
+        spec_toml: u.spec.map(|s| s.text.clone()),
+        verdict: match &verdict {
+            Some(v) if v.pass => RunVerdict::Pass,
+            Some(_) => RunVerdict::Fail,
+            None => RunVerdict::None,
+        },
+        latest: false,
+        inputs,
+        figures,
+    };
+    Ok((run, verdict))
+}
+
+/// Mark the newest run of each unit (highest id) as [`Run::latest`].
+pub(crate) fn mark_latest(runs: &mut [Run]) {
+    let mut newest: std::collections::HashMap<&str, i64> = Default::default();
+    for r in runs.iter() {
+        let e = newest.entry(r.unit.as_str()).or_insert(r.id);
+        *e = (*e).max(r.id);
+    }
+    let newest: std::collections::HashMap<String, i64> = newest
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
+    for r in runs.iter_mut() {
+        r.latest = newest.get(&r.unit) == Some(&r.id);
+    }
+}
+
+#[cfg(test)]
+mod tests;
+
+/// A run with made-up figures, for benchmarks and tests of the stores and the report (no
+/// log is read): unit `unit`, dated `tested_at_unix_ms`, a static and a rate-table input, and
+/// the bias stability, ARW and thermal scale-factor error drawn from `seed` around typical
+/// values, judged against `bias_stability_dph <= 0.02`, `arw_deg_rt_h <= 0.005` and
+/// `sf_thermal_error_ppm <= 30`.
+pub fn synthetic_run(unit: &str, seed: u64, tested_at_unix_ms: i64) -> Run {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let limits = [
+        (0u32, "bias_stability_dph", 0.012, 0.005, 0.02),
+        (0, "arw_deg_rt_h", 0.003, 0.001, 0.005),
+        (1, "sf_thermal_error_ppm", 18.0, 8.0, 30.0),
+    ];
+    let mut figures = Vec::new();
+    for (position, key, mean, sd, max) in limits {
+        let value: f64 = (mean + sd * (rng.gen::<f64>() * 2.0 - 1.0) * 1.7).max(0.0);
+        let limit = crate::spec::Limit {
+            min: None,
+            max: Some(max),
+        };
+        figures.push(FigureRow {
+            position,
+            figure: key.to_string(),
+            value,
+            limit_min: None,
+            limit_max: Some(max),
+            pass: Some(limit.passes(value)),
+            margin: Some(limit.margin(value)),
+        });
+    }
+    figures.push(FigureRow {
+        position: 0,
+        figure: "bias_dph".into(),
+        value: rng.gen::<f64>() * 0.2 - 0.1,
+        limit_min: None,
+        limit_max: None,
+        pass: None,
+        margin: None,
+    });
+    // The order the stores read back: by log, then by figure key.
+    figures.sort_by(|a, b| (a.position, &a.figure).cmp(&(b.position, &b.figure)));
+    let pass = figures.iter().all(|f| f.pass != Some(false));
+    let digest = |s: &str| format!("{:x}", Sha256::digest(s.as_bytes()));
+    Run {
+        id: 0,
+        unit: unit.to_string(),
+        tested_at_unix_ms,
+        gyrotherm_version: env!("CARGO_PKG_VERSION").to_string(),
+        station: "synthetic".into(),
+        model_path: format!("{unit}/model.json"),
+        model_sha256: digest(&format!("{unit}/model")),
+        model_content_sha256: digest(&format!("{unit}/content")),
+        model_method: "lstm".into(),
+        spec_name: Some("synthetic".into()),
+        spec_sha256: Some(digest("synthetic spec")),
+        spec_toml: Some("[limits]\nbias_stability_dph = { max = 0.02 }\n".into()),
+        verdict: if pass {
+            RunVerdict::Pass
+        } else {
+            RunVerdict::Fail
+        },
+        latest: false,
+        inputs: vec![
+            Input {
+                position: 0,
+                path: format!("{unit}/static.csv"),
+                sha256: digest(&format!("{unit}/static")),
+                kind: "static",
+            },
+            Input {
+                position: 1,
+                path: format!("{unit}/table.csv"),
+                sha256: digest(&format!("{unit}/table")),
+                kind: "rate_table",
+            },
+        ],
+        figures,
+    }
+}
+
+/// This machine's host name (the default station name), or `unknown`.
+pub fn default_station() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| std::fs::read_to_string("/etc/hostname"))
+        .ok()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .or_else(|| std::env::var("HOSTNAME").ok().filter(|s| !s.is_empty()))
+        .unwrap_or_else(|| "unknown".into())
+}

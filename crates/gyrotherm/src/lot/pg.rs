@@ -1,0 +1,284 @@
+//! The lot in PostgreSQL: several stations on separate machines write one lot. The schema is
+//! [`PG_V1`] (the SQLite one with an identity column); each run is one transaction, and the
+//! schema is created or upgraded under an advisory lock so two stations starting at once do
+//! not both create it.
+
+use postgres::{Client, NoTls};
+
+use super::schema::{PG_MIGRATIONS, PG_V1, RUN_COLUMNS, SCHEMA_VERSION};
+use super::time::{parse_rfc3339_utc, rfc3339_utc};
+use super::{mark_latest, FigureRow, Input, LotError, LotStore, Run, RunVerdict};
+
+/// The advisory-lock key that serialises schema changes (an arbitrary constant, "gyro" in
+/// ASCII).
+const SCHEMA_LOCK: i64 = 0x6779_726f;
+
+/// A lot in a PostgreSQL database.
+pub struct PgStore {
+    client: Client,
+    /// The URL without its password, for messages.
+    db: String,
+}
+
+/// `url` with any password replaced by `***` (messages must not print secrets).
+fn redact(url: &str) -> String {
+    if let Some((scheme, rest)) = url.split_once("://") {
+        if let Some((auth, host)) = rest.split_once('@') {
+            if let Some((user, _)) = auth.split_once(':') {
+                return format!("{scheme}://{user}:***@{host}");
+            }
+        }
+    }
+    url.to_string()
+}
+
+impl PgStore {
+    /// Connect to `url` and, with `create`, make the schema if missing.
+    pub fn open(url: &str, create: bool) -> Result<Self, LotError> {
+        let db = redact(url);
+        let client = Client::connect(url, NoTls).map_err(|e| LotError::Database {
+            db: db.clone(),
+            detail: format!("cannot connect: {e}"),
+        })?;
+        let mut s = PgStore { client, db };
+        s.prepare_schema(create)?;
+        Ok(s)
+    }
+
+    fn err(&self, e: postgres::Error) -> LotError {
+        pg_error(&self.db, e)
+    }
+
+    fn prepare_schema(&mut self, create: bool) -> Result<(), LotError> {
+        let db = self.db.clone();
+        let e = |x| pg_error(&db, x);
+        let mut tx = self.client.transaction().map_err(e)?;
+        tx.execute("SELECT pg_advisory_xact_lock($1)", &[&SCHEMA_LOCK])
+            .map_err(e)?;
+        let has: bool = tx
+            .query_one("SELECT to_regclass('schema_version') IS NOT NULL", &[])
+            .map_err(e)?
+            .get(0);
+        let from = if has {
+            let v: Option<i32> = tx
+                .query_one("SELECT max(version) FROM schema_version", &[])
+                .map_err(e)?
+                .get(0);
+            let v = i64::from(v.ok_or(LotError::NotALot { db: db.clone() })?);
+            if v > SCHEMA_VERSION {
+                return Err(LotError::NewerSchema {
+                    db,
+                    found: v,
+                    supported: SCHEMA_VERSION,
+                });
+            }
+            if v == SCHEMA_VERSION {
+                return tx.commit().map_err(e);
+            }
+            v
+        } else {
+            let tables: i64 = tx
+                .query_one(
+                    "SELECT count(*) FROM information_schema.tables \
+                     WHERE table_schema = current_schema() AND table_name IN ('runs', 'figures', 'run_inputs')",
+                    &[],
+                )
+                .map_err(e)?
+                .get(0);
+            if tables > 0 || !create {
+                return Err(LotError::NotALot { db });
+            }
+            tx.batch_execute(PG_V1).map_err(e)?;
+            1
+        };
+        for step in PG_MIGRATIONS.iter().skip(from as usize - 1) {
+            tx.batch_execute(step).map_err(e)?;
+        }
+        tx.execute(
+            "UPDATE schema_version SET version = $1",
+            &[&(SCHEMA_VERSION as i32)],
+        )
+        .map_err(e)?;
+        tx.commit().map_err(e)
+    }
+}
+
+fn pg_error(db: &str, e: postgres::Error) -> LotError {
+    LotError::Database {
+        db: db.to_string(),
+        detail: match e.as_db_error() {
+            Some(d) => format!("{}: {}", d.severity(), d.message()),
+            None => e.to_string(),
+        },
+    }
+}
+
+impl LotStore for PgStore {
+    fn add(&mut self, run: &Run) -> Result<i64, LotError> {
+        let db = self.db.clone();
+        let e = |x| pg_error(&db, x);
+        let mut tx = self.client.transaction().map_err(e)?;
+        let id: i64 = tx
+            .query_one(
+                "INSERT INTO runs (unit, tested_at, gyrotherm_version, station, model_path, \
+                 model_sha256, model_content_sha256, model_method, spec_name, spec_sha256, \
+                 spec_toml, verdict) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) \
+                 RETURNING id",
+                &[
+                    &run.unit,
+                    &rfc3339_utc(run.tested_at_unix_ms),
+                    &run.gyrotherm_version,
+                    &run.station,
+                    &run.model_path,
+                    &run.model_sha256,
+                    &run.model_content_sha256,
+                    &run.model_method,
+                    &run.spec_name,
+                    &run.spec_sha256,
+                    &run.spec_toml,
+                    &run.verdict.as_str(),
+                ],
+            )
+            .map_err(e)?
+            .get(0);
+        let ins = tx
+            .prepare(
+                "INSERT INTO run_inputs (run_id, position, path, sha256, kind) \
+                 VALUES ($1, $2, $3, $4, $5)",
+            )
+            .map_err(e)?;
+        for i in &run.inputs {
+            tx.execute(
+                &ins,
+                &[&id, &(i.position as i32), &i.path, &i.sha256, &i.kind],
+            )
+            .map_err(e)?;
+        }
+        let fig = tx
+            .prepare(
+                "INSERT INTO figures (run_id, position, figure, value, limit_min, limit_max, \
+                 verdict, margin) VALUES ($1, $2, $3, $4, $5, $6, $7, $8)",
+            )
+            .map_err(e)?;
+        for f in &run.figures {
+            let v = f.pass.map(|p| if p { "pass" } else { "fail" });
+            tx.execute(
+                &fig,
+                &[
+                    &id,
+                    &(f.position as i32),
+                    &f.figure,
+                    &f.value,
+                    &f.limit_min,
+                    &f.limit_max,
+                    &v,
+                    &f.margin,
+                ],
+            )
+            .map_err(e)?;
+        }
+        tx.commit().map_err(e)?;
+        Ok(id)
+    }
+
+    fn runs(&mut self) -> Result<Vec<Run>, LotError> {
+        let db = self.db.clone();
+        let e = |x| pg_error(&db, x);
+        let bad = |detail: String| LotError::BadRow {
+            db: db.clone(),
+            detail,
+        };
+        // REPEATABLE READ: the three queries see one snapshot, so a run added meanwhile is
+        // wholly in or out.
+        let mut tx = self
+            .client
+            .build_transaction()
+            .isolation_level(postgres::IsolationLevel::RepeatableRead)
+            .read_only(true)
+            .start()
+            .map_err(e)?;
+        let mut runs = Vec::new();
+        for r in tx
+            .query(&format!("SELECT {RUN_COLUMNS} FROM runs ORDER BY id"), &[])
+            .map_err(e)?
+        {
+            let id: i64 = r.get(0);
+            let at: String = r.get(2);
+            let verdict: String = r.get(12);
+            runs.push(Run {
+                id,
+                unit: r.get(1),
+                tested_at_unix_ms: parse_rfc3339_utc(&at)
+                    .ok_or_else(|| bad(format!("run {id}: tested_at {at:?} is not RFC 3339")))?,
+                gyrotherm_version: r.get(3),
+                station: r.get(4),
+                model_path: r.get(5),
+                model_sha256: r.get(6),
+                model_content_sha256: r.get(7),
+                model_method: r.get(8),
+                spec_name: r.get(9),
+                spec_sha256: r.get(10),
+                spec_toml: r.get(11),
+                verdict: RunVerdict::parse(&verdict)
+                    .ok_or_else(|| bad(format!("run {id}: verdict {verdict:?}")))?,
+                latest: false,
+                inputs: Vec::new(),
+                figures: Vec::new(),
+            });
+        }
+        let index: std::collections::HashMap<i64, usize> =
+            runs.iter().enumerate().map(|(i, r)| (r.id, i)).collect();
+        for r in tx
+            .query(
+                "SELECT run_id, position, path, sha256, kind FROM run_inputs ORDER BY run_id, position",
+                &[],
+            )
+            .map_err(e)?
+        {
+            let Some(&i) = index.get(&r.get::<_, i64>(0)) else {
+                continue;
+            };
+            let kind: String = r.get(4);
+            runs[i].inputs.push(Input {
+                position: r.get::<_, i32>(1) as u32,
+                path: r.get(2),
+                sha256: r.get(3),
+                kind: if kind == "static" { "static" } else { "rate_table" },
+            });
+        }
+        for r in tx
+            .query(
+                "SELECT run_id, position, figure, value, limit_min, limit_max, verdict, margin \
+                 FROM figures ORDER BY run_id, position, figure",
+                &[],
+            )
+            .map_err(e)?
+        {
+            let Some(&i) = index.get(&r.get::<_, i64>(0)) else {
+                continue;
+            };
+            let v: Option<String> = r.get(6);
+            runs[i].figures.push(FigureRow {
+                position: r.get::<_, i32>(1) as u32,
+                figure: r.get(2),
+                value: r.get(3),
+                limit_min: r.get(4),
+                limit_max: r.get(5),
+                pass: v.map(|v| v == "pass"),
+                margin: r.get(7),
+            });
+        }
+        tx.commit().map_err(e)?;
+        mark_latest(&mut runs);
+        Ok(runs)
+    }
+
+    fn schema_version(&mut self) -> Result<i64, LotError> {
+        let v: Option<i32> = self
+            .client
+            .query_one("SELECT max(version) FROM schema_version", &[])
+            .map_err(|e| self.err(e))?
+            .get(0);
+        Ok(v.map_or(0, i64::from))
+    }
+}
