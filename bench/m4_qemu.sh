@@ -3,7 +3,7 @@
 # its output with the host's `gyrotherm compensate --stream`, line by line, bit for bit.
 # Needs: apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
 # Usage: bench/m4_qemu.sh
-# Models as bench/m4_size.sh (linear, poly, default lstm recipe, the published-recipe LSTM of
+# Models as bench/m4_size.sh (linear, poly, the default thermal method, the published-recipe LSTM of
 # the flight_loop example); runs: 30,000-line seed-shock static run without and with injected
 # temperature faults (spikes, NaN bursts, stuck readings, dropouts).
 set -euo pipefail
@@ -22,7 +22,7 @@ M4=(-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard)
 CFLAGS=("${M4[@]}" -Os -std=c99 -ffp-contract=off -Wall -Wextra -Werror -pedantic)
 $bin simulate --profile fast-cycle --seed 1 --out "$work/s.csv" 2>/dev/null
 $bin simulate --profile fast-cycle --seed 2 --table-rate 20 --out "$work/t.csv" 2>/dev/null
-for m in linear poly lstm; do
+for m in linear poly thermal; do
     $bin train --method $m --input "$work/s.csv" --input "$work/t.csv" --out "$work/$m.json" 2>/dev/null
 done
 cp crates/gyrotherm-core/examples/flight_loop/model.json "$work/published.json"
@@ -33,7 +33,7 @@ $bin simulate --profile seed-shock --seed 3 --spikes-per-hour 4 --nan-bursts-per
 arm-none-eabi-gcc "${M4[@]}" -Os -c bench/m4/startup.c -o "$work/startup.o"
 echo "qemu: $(qemu-system-arm --version | head -1); machine mps2-an386 (Cortex-M4F)"
 fail=0
-for m in linear poly lstm published; do
+for m in linear poly thermal published; do
     dir="$work/$m"
     $bin export --model "$work/$m.json" --lang c --out "$dir" 2>/dev/null
     arm-none-eabi-gcc "${CFLAGS[@]}" -I "$dir" crates/gyrotherm-cli/tests/export_c/driver.c \

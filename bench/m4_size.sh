@@ -2,7 +2,7 @@
 # Flash and RAM of `gyrotherm export --lang c` models on a Cortex-M4F, with Debian's
 # gcc-arm-none-eabi (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi).
 # Usage: bench/m4_size.sh
-# Models: linear, poly and the default `lstm` recipe (residual on thermal-state inputs)
+# Models: linear, poly and the default `thermal` method (ridge on identified thermal states)
 # trained here on simulated fast-cycle runs, and the `published`-recipe LSTM of
 # crates/gyrotherm-core/examples/flight_loop/model.json (bias and scale-factor LSTMs).
 # Per model: the object file's text, data and bss; flash = text + data; RAM = data + bss +
@@ -25,7 +25,7 @@ CFLAGS=(-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os -std=c99
 LDFLAGS=(--specs=nano.specs --specs=nosys.specs -Wl,--gc-sections)
 $bin simulate --profile fast-cycle --seed 1 --out "$work/s.csv" 2>/dev/null
 $bin simulate --profile fast-cycle --seed 2 --table-rate 20 --out "$work/t.csv" 2>/dev/null
-for m in linear poly lstm; do
+for m in linear poly thermal; do
     $bin train --method $m --input "$work/s.csv" --input "$work/t.csv" --out "$work/$m.json" 2>/dev/null
 done
 cp crates/gyrotherm-core/examples/flight_loop/model.json "$work/published.json"
@@ -33,7 +33,7 @@ arm-none-eabi-gcc "${CFLAGS[@]}" bench/m4/size_main.c "${LDFLAGS[@]}" -o "$work/
 empty=$(arm-none-eabi-size "$work/empty.elf" | awk 'NR==2 {print $1 + $2}')
 echo "arm-none-eabi-gcc $(arm-none-eabi-gcc -dumpversion); flags: ${CFLAGS[*]}"
 printf '%-10s %-20s %6s %6s %6s %8s %8s %7s %14s\n' model parts text data bss flash RAM stack "linked +flash"
-for m in linear poly lstm published; do
+for m in linear poly thermal published; do
     dir="$work/$m"
     $bin export --model "$work/$m.json" --lang c --out "$dir" 2>/dev/null
     arm-none-eabi-gcc "${CFLAGS[@]}" -c "$dir/gyrotherm_model.c" -o "$dir/model.o"
