@@ -6,31 +6,10 @@
 use std::process::Stdio;
 
 mod cli;
+use cli::{bias_stability_dph, column};
 use cli::{gyrotherm, run_ok};
 
 use cli::simulate_args as simulate;
-
-/// Columns of a CSV text by header name.
-fn column(text: &str, name: &str) -> Vec<String> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = header.iter().position(|h| *h == name).unwrap();
-    lines
-        .map(|l| l.split(',').nth(k).unwrap().to_owned())
-        .collect()
-}
-
-/// Bias stability, °/h: sample std (n − 1) of consecutive non-overlapping 100 s means of a
-/// 1 Hz rate in °/s (GJB 2426A / IEEE Std 952; computed here independently of the library).
-fn bias_stability_dph(x: &[f64]) -> f64 {
-    let means: Vec<f64> = x
-        .chunks_exact(100)
-        .map(|c| c.iter().sum::<f64>() / 100.0)
-        .collect();
-    let mu = means.iter().sum::<f64>() / means.len() as f64;
-    let var = means.iter().map(|m| (m - mu).powi(2)).sum::<f64>() / (means.len() - 1) as f64;
-    var.sqrt() * 3600.0
-}
 
 #[test]
 fn faulted_run_keeps_its_bias_stability() {

@@ -50,15 +50,10 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let tau_s = resolve_tau(args.tau_s, &test_named);
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
     let cmp = run_comparison(&train_named, &test_named, &cfg)?;
-    let verdicts = match &spec {
-        Some(s) => Some(gyrotherm::spec::judge_comparison(
-            s,
-            &cmp,
-            &test_named,
-            &cfg,
-        )?),
-        None => None,
-    };
+    let verdicts = spec
+        .as_ref()
+        .map(|s| gyrotherm::spec::judge_comparison(s, &cmp, &test_named, &cfg))
+        .transpose()?;
     let index = write_full_report_with(
         &args.out,
         &train_named,
