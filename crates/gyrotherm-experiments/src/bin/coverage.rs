@@ -171,7 +171,11 @@ fn run() -> Result<(), String> {
         get("--units").map_or(Ok(30), |v| v.parse().map_err(|e| format!("--units: {e}")))?;
     let threads: usize =
         get("--threads").map_or(Ok(2), |v| v.parse().map_err(|e| format!("--threads: {e}")))?;
-    let scales = list(get("--scales"), "1")?;
+    // Defaults: the settings `train` uses.
+    let scales = list(
+        get("--scales"),
+        &gyrotherm::settings::coverage::SIGMA_SCALE.to_string(),
+    )?;
     let growths = list(
         get("--growths"),
         &gyrotherm::settings::coverage::GROWTH_PER_CELL.to_string(),
