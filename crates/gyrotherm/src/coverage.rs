@@ -320,3 +320,25 @@ pub fn missing_note(model: &crate::model::ModelFile) -> Option<String> {
             .to_owned()
     })
 }
+
+/// Shares of the samples of `log` whose verdict is inside, edge and outside (in that order,
+/// of the samples with a verdict) under `model`'s map, stepped by the flight compensator as
+/// `compensate` steps it; None when the model has no map or no sample got a verdict.
+pub fn shares(
+    model: &crate::model::ModelFile,
+    log: &crate::csvlog::TestLog,
+) -> Result<Option<[f64; 3]>, crate::compensate::CompensateError> {
+    let Some(map) = model.coverage.as_ref().and_then(|c| c.to_core().ok()) else {
+        return Ok(None);
+    };
+    let mut comp = crate::compensate::compensator(model)?;
+    let mut n = [0u64; 3];
+    for i in 0..log.len() {
+        comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
+        if let Some(v) = map.verdict_of(comp.features()) {
+            n[v.coverage as usize] += 1;
+        }
+    }
+    let total: u64 = n.iter().sum();
+    Ok((total > 0).then(|| n.map(|k| k as f64 / total as f64)))
+}
