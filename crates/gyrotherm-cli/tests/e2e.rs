@@ -103,14 +103,19 @@ fn train_compensate_evaluate_and_stream_equals_batch() {
             row.starts_with(in_row),
             "input columns not passed through: {row}"
         );
-        // Every field but the last (status) is a number.
-        let f: Vec<f64> = row
-            .rsplit_once(',')
-            .unwrap()
-            .0
-            .split(',')
-            .map(|v| v.parse().unwrap())
-            .collect();
+        // Every field up to gyro_comp_dps is a number; then status, coverage, sigma_dph.
+        let fields: Vec<&str> = row.split(',').collect();
+        let f: Vec<f64> = fields[..=oi].iter().map(|v| v.parse().unwrap()).collect();
+        let tail = &fields[oi + 1..];
+        assert_eq!(tail.len(), 3, "{row}");
+        assert!(
+            tail[1].is_empty() || gyrotherm_core::coverage::Coverage::parse(tail[1]).is_some(),
+            "{row}"
+        );
+        assert!(
+            tail[2].is_empty() || tail[2].parse::<f64>().is_ok_and(|s| s > 0.0),
+            "{row}"
+        );
         let want = (f[gi] - f[bi]) / f[ki];
         assert!(
             (f[oi] - want).abs() <= 1e-15 * want.abs().max(1e-3),

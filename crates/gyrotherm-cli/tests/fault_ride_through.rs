@@ -295,17 +295,18 @@ fn stream_rides_through_bad_lines_and_batch_stays_strict() {
     assert_eq!(lines.len(), 201, "header + one line per data line");
     assert_eq!(
         lines[0],
-        "time_s,gyro_dps,temp_c,note,bias_dps,scale,gyro_comp_dps,status"
+        "time_s,gyro_dps,temp_c,note,bias_dps,scale,gyro_comp_dps,status,coverage,sigma_dph"
     );
-    let status = |i: usize| lines[i + 1].rsplit(',').next().unwrap();
+    // status, then coverage and sigma_dph.
+    let status = |i: usize| lines[i + 1].rsplit(',').nth(2).unwrap();
     for i in [50, 60, 70] {
         assert_eq!(status(i), "held", "{}", lines[i + 1]);
     }
     assert_eq!(status(80), "invalid");
-    assert!(lines[81].ends_with(",,invalid"), "{}", lines[81]);
+    assert!(lines[81].contains(",,invalid,"), "{}", lines[81]);
     // Wrong field count: empty fields (the first quoted, so the line is not blank).
-    assert_eq!(lines[91], "\"\",,,,,,,invalid");
-    assert_eq!(lines[101], "abc,0.003,21,x,,,,invalid");
+    assert_eq!(lines[91], "\"\",,,,,,,invalid,,");
+    assert_eq!(lines[101], "abc,0.003,21,x,,,,invalid,,");
     assert_eq!(status(0), "ok");
     assert_eq!(status(199), "ok");
     assert!(

@@ -541,13 +541,13 @@ fn a_100_mb_stream_line_is_one_invalid_line_in_bounded_memory() {
     drop(stdin);
     let status = child.wait().unwrap();
     assert!(status.success());
-    assert!(lines[1].ends_with(",ok\n"), "{lines:?}");
+    assert!(lines[1].contains(",ok,"), "{lines:?}");
     assert_eq!(
         lines[2],
-        ",,,,,,invalid\n".replacen(",", "\"\",", 1),
+        ",,,,,,invalid,,\n".replacen(",", "\"\",", 1),
         "{lines:?}"
     );
-    assert!(lines[3].ends_with(",ok\n"), "{lines:?}");
+    assert!(lines[3].contains(",ok,"), "{lines:?}");
     if let Some(kb) = rss {
         eprintln!("peak RSS with a 100 MB line: {kb} kB");
         assert!(kb < 50 * 1024, "peak RSS {kb} kB");

@@ -12,6 +12,8 @@
 //! - [`baseline`]: evaluation of fitted linear/polynomial baseline models (f64).
 //! - [`compensator`]: bias and scale factor to corrected rate, G = (Ĝ − B)/K (eq. 4 of the
 //!   paper), riding through temperature-sensor faults with a [`Status`] per sample.
+//! - [`coverage`]: the training region in (T, dT) and a per-sample verdict (inside, edge,
+//!   outside) with a 1σ estimate of the residual bias error.
 //! - [`static_model`]: a model as plain static data (`gyrotherm export --lang rust`).
 //! - [`error`]: what the core refuses instead of panicking.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
@@ -29,6 +31,7 @@
 
 pub mod baseline;
 pub mod compensator;
+pub mod coverage;
 pub mod error;
 pub mod features;
 pub mod lstm;

@@ -100,6 +100,13 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
             .into_iter()
             .collect::<std::collections::BTreeMap<_, _>>(),
     )?;
+    m.add(
+        "COVERAGE_NAMES",
+        model::coverage_names()
+            .into_iter()
+            .collect::<std::collections::BTreeMap<_, _>>(),
+    )?;
+    m.add("NO_COVERAGE", model::NO_COVERAGE)?;
     allan::register(m)?;
     figures::register(m)?;
     logs::register(m)?;

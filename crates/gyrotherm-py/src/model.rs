@@ -171,6 +171,39 @@ impl RawModel {
         ))
     }
 
+    /// Per-sample coverage verdict (code: `Coverage as u8`, 255 where there is none) and σ
+    /// (°/h, NaN where there is none), as the `coverage` and `sigma_dph` columns of
+    /// `gyrotherm compensate`; and the note when the model file has no coverage map.
+    fn coverage<'py>(
+        &self,
+        py: Python<'py>,
+        time_s: PyReadonlyArray1<'py, f64>,
+        gyro_dps: PyReadonlyArray1<'py, f64>,
+        temp_c: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<CoverageColumns<'py>> {
+        let (t, g, c) = (
+            slice(&time_s, "time_s")?,
+            slice(&gyro_dps, "gyro_dps")?,
+            slice(&temp_c, "temp_c")?,
+        );
+        if t.len() != g.len() || t.len() != c.len() {
+            return Err(CompensationError::new_err(format!(
+                "time_s, gyro_dps and temp_c differ in length ({}, {}, {}); give one value per sample in each",
+                t.len(),
+                g.len(),
+                c.len()
+            )));
+        }
+        let (codes, sigma) = py
+            .detach(|| coverage_columns(&self.file, t, g, c))
+            .map_err(py_err::<CompensationError>)?;
+        Ok((
+            codes.into_pyarray(py),
+            sigma.into_pyarray(py),
+            gyrotherm::coverage::missing_note(&self.file),
+        ))
+    }
+
     /// Compensate a CSV log into a CSV file exactly as `gyrotherm compensate --input --out`
     /// does (same code, same bytes); returns (rows, ok, held, degraded, invalid, warnings).
     fn compensate_csv(
@@ -267,6 +300,53 @@ fn compensate_with_status(model: &ModelFile, log: &TestLog) -> Result<Columns, C
         out.3.push(c.status as u8);
     }
     Ok(out)
+}
+
+type CoverageColumns<'py> = (
+    Bound<'py, PyArray1<u8>>,
+    Bound<'py, PyArray1<f64>>,
+    Option<String>,
+);
+
+/// Code of "no verdict" in [`coverage_columns`].
+pub const NO_COVERAGE: u8 = 255;
+
+/// The flight compensator stepped over the samples with the model's coverage map: the
+/// verdict of each sample's latest step, as `compensate_lines` writes it.
+fn coverage_columns(
+    model: &ModelFile,
+    t: &[f64],
+    g: &[f64],
+    c: &[f64],
+) -> Result<(Vec<u8>, Vec<f64>), CompensateError> {
+    let mut comp = compensator(model)?;
+    // The file's map was checked when it was loaded.
+    let map = model.coverage.as_ref().and_then(|m| m.to_core().ok());
+    let mut codes = Vec::with_capacity(t.len());
+    let mut sigma = Vec::with_capacity(t.len());
+    for i in 0..t.len() {
+        comp.step(t[i], g[i], c[i]);
+        match map.as_ref().and_then(|m| m.verdict_of(comp.features())) {
+            Some(v) => {
+                codes.push(v.coverage as u8);
+                sigma.push(v.sigma_dph);
+            }
+            None => {
+                codes.push(NO_COVERAGE);
+                sigma.push(f64::NAN);
+            }
+        }
+    }
+    Ok((codes, sigma))
+}
+
+/// Coverage code → name, as in the `coverage` column of `gyrotherm compensate`.
+pub fn coverage_names() -> Vec<(u8, &'static str)> {
+    use gyrotherm_core::coverage::Coverage;
+    [Coverage::Inside, Coverage::Edge, Coverage::Outside]
+        .into_iter()
+        .map(|c| (c as u8, c.as_str()))
+        .collect()
 }
 
 /// Status code → name, as in the `status` column of the CLI's streaming output.

@@ -70,6 +70,17 @@ def test_round_trip_equals_cli_compensate_to_the_last_bit(cli, logs, tmp_path, m
         assert status.dtype == np.uint8
         if "status" in want:  # the CLI's status column, by name
             assert [gt.STATUS_NAMES[int(s)] for s in status] == want["status"], name
+        # The coverage verdict, as the CLI's coverage and sigma_dph columns (empty: none).
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", gt.GyrothermWarning)
+            cov = loaded.coverage(log["time_s"], log["gyro_dps"], log["temp_c"])
+        assert cov.coverage.dtype == np.uint8
+        assert [gt.COVERAGE_NAMES.get(int(c), "") for c in cov.coverage] == want["coverage"], name
+        np.testing.assert_array_equal(
+            cov.sigma_dph,
+            np.array([float(v) if v else np.nan for v in want["sigma_dph"]]),
+            err_msg=f"{name} sigma_dph",
+        )
 
 
 def test_compensate_csv_writes_the_cli_bytes(cli, logs, tmp_path):

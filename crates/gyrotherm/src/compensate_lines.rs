@@ -3,8 +3,11 @@
 //!
 //! One output line per input data line (comment lines starting with `#` and blank lines are
 //! not data lines and are dropped): every input field as it was, then `bias_dps`, `scale`,
-//! `gyro_comp_dps` (°/s) and `status` (`ok`, `held`, `degraded`, `invalid`; see
-//! [`gyrotherm_core::compensator`]). The flight [`Compensator`](gyrotherm_core::Compensator)
+//! `gyro_comp_dps` (°/s), `status` (`ok`, `held`, `degraded`, `invalid`; see
+//! [`gyrotherm_core::compensator`]), `coverage` (`inside`, `edge`, `outside`) and `sigma_dph`
+//! (the verdict of the latest step's T and dT against the model's coverage map, see
+//! [`crate::coverage`]; both empty before the first step, on a malformed line, and when the
+//! model file has no map). The flight [`Compensator`](gyrotherm_core::Compensator)
 //! runs sample by sample, so the numbers are those of flight code.
 //!
 //! Temperature faults never stop the run: an empty, non-numeric, NaN or implausible temperature
@@ -38,7 +41,14 @@ use crate::model::ModelFile;
 pub const MAX_LINE_BYTES: usize = 64 * 1024;
 
 /// Columns appended to every row, in order.
-pub const OUTPUT_COLUMNS: [&str; 4] = ["bias_dps", "scale", "gyro_comp_dps", "status"];
+pub const OUTPUT_COLUMNS: [&str; 6] = [
+    "bias_dps",
+    "scale",
+    "gyro_comp_dps",
+    "status",
+    "coverage",
+    "sigma_dph",
+];
 
 /// What to do with a malformed line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,6 +73,8 @@ pub struct LinesSummary {
     pub malformed: u64,
     /// Extrapolation warnings (temperature or its rate outside the training range).
     pub warnings: Vec<String>,
+    /// Lines per coverage verdict: inside, edge, outside (all 0 without a coverage map).
+    pub coverage: [u64; 3],
 }
 
 impl LinesSummary {
@@ -83,6 +95,10 @@ impl LinesSummary {
         );
         if self.malformed > 0 {
             s.push_str(&format!(" ({} malformed)", self.malformed));
+        }
+        if self.coverage.iter().any(|c| *c > 0) {
+            let [i, e, o] = self.coverage;
+            s.push_str(&format!("; coverage: inside {i}, edge {e}, outside {o}"));
         }
         s
     }
@@ -361,6 +377,8 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     flush_each_row: bool,
 ) -> Result<LinesSummary, LinesError> {
     let mut comp = crate::compensate::compensator(model).map_err(LinesError::Model)?;
+    // The file's map was checked when it was loaded.
+    let cover = model.coverage.as_ref().and_then(|c| c.to_core().ok());
     // Header: everything up to the first line that is neither blank nor a comment, checked by
     // the log reader (column mapping and its messages).
     let mut head = Vec::new();
@@ -450,6 +468,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                 writer.push_raw(b"");
             }
             writer.push_raw(Status::Invalid.as_str().as_bytes());
+            crate::coverage::push_verdict(&mut writer, None);
             summary.count(Status::Invalid);
             summary.malformed += 1;
             writer.end_row()?;
@@ -552,6 +571,11 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                 }
                 writer.push_raw(c.status.as_str().as_bytes());
                 summary.count(c.status);
+                let verdict = cover.as_ref().and_then(|m| m.verdict_of(comp.features()));
+                if let Some(v) = verdict {
+                    summary.coverage[v.coverage as usize] += 1;
+                }
+                crate::coverage::push_verdict(&mut writer, verdict);
                 if c.status == Status::Ok {
                     if let Some([t, r, ..]) = comp.features().map(|f| f.as_slice()) {
                         temp_seen = (temp_seen.0.min(*t), temp_seen.1.max(*t));
@@ -568,6 +592,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                     writer.push_raw(b"");
                 }
                 writer.push_raw(Status::Invalid.as_str().as_bytes());
+                crate::coverage::push_verdict(&mut writer, None);
                 summary.count(Status::Invalid);
                 summary.malformed += 1;
             }

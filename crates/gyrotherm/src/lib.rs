@@ -51,6 +51,7 @@ pub mod baseline;
 pub mod compare;
 pub mod compensate;
 pub mod compensate_lines;
+pub mod coverage;
 pub mod csvlog;
 pub mod export;
 pub mod features;

@@ -79,6 +79,7 @@ fn lstm_model() -> ModelFile {
         bias: Some(lstm_sub(&mut rng, 2, 8)),
         scale: Some(lstm_sub(&mut rng, 2, 8)),
         training: training(),
+        coverage: None,
     }
 }
 
@@ -100,6 +101,7 @@ fn poly_model() -> ModelFile {
             seed: None,
             ..training()
         },
+        coverage: None,
     }
 }
 
@@ -386,6 +388,7 @@ fn fitted_baseline_saves_and_flies() {
             created_by: gyrotherm::model::created_by(),
             inputs: vec!["synthetic".into()],
         },
+        coverage: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("linear.json");
@@ -430,6 +433,7 @@ fn residual_model(reads_base: bool, lstm_inputs: usize) -> ModelFile {
         }),
         scale: None,
         training: training(),
+        coverage: None,
     }
 }
 

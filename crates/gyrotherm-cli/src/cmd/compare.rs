@@ -136,9 +136,35 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     for w in gyrotherm::report::grouped_warnings(&test_named, &cmp) {
         eprintln!("gyrotherm: warning: {w}");
     }
+    for line in coverage_lines(&test_named, &cmp)? {
+        eprintln!("gyrotherm: {line}");
+    }
     Ok(super::verdict::exit_code(
         verdicts.iter().flatten().all(|c| c.verdict.pass),
     ))
+}
+
+/// Per held-out log, the share of its samples outside (and at the edge of) each model's
+/// training region; models without a coverage map are left out.
+fn coverage_lines(test: &[NamedLog], cmp: &Comparison) -> anyhow::Result<Vec<String>> {
+    let mut out = Vec::new();
+    for t in test {
+        let mut parts = Vec::new();
+        for (fit, col) in cmp.fits.iter().zip(&cmp.columns) {
+            if let Some([_, edge, outside]) = gyrotherm::coverage::shares(&fit.model, t.log)? {
+                parts.push(format!(
+                    "{} outside {:.1} % (edge {:.1} %)",
+                    col.label,
+                    100.0 * outside,
+                    100.0 * edge
+                ));
+            }
+        }
+        if !parts.is_empty() {
+            out.push(format!("coverage of {}: {}", t.name, parts.join("; ")));
+        }
+    }
+    Ok(out)
 }
 
 /// The human table: the models fitted, then one block per held-out log.

@@ -23,8 +23,9 @@ pub struct CompensateArgs {
     /// Log to compensate (CSV). Not with --stream.
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub input: Option<PathBuf>,
-    /// Output CSV: every input column, then bias_dps, scale, gyro_comp_dps (°/s) and status
-    /// (ok, held, degraded, invalid).
+    /// Output CSV: every input column, then bias_dps, scale, gyro_comp_dps (°/s), status
+    /// (ok, held, degraded, invalid), coverage (inside, edge, outside the training region)
+    /// and sigma_dph (1σ estimate of the residual bias error, °/h).
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub out: Option<PathBuf>,
     /// Read CSV on stdin and write one output line per input line on stdout, flushed as it
@@ -39,6 +40,9 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
     let (model, seal) = ModelFile::load_sealed(&args.model)?;
     if let Some(w) = seal.warning(&args.model) {
         eprintln!("gyrotherm: warning: {w}");
+    }
+    if let Some(n) = gyrotherm::coverage::missing_note(&model) {
+        eprintln!("gyrotherm: note: {}: {n}", args.model.display());
     }
     anyhow::ensure!(
         args.log.fill_gaps_max_s.is_none(),

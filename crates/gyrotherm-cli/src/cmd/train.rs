@@ -212,5 +212,19 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             }
         }
     }
+    match (&m.coverage, &outcome.coverage_note) {
+        (Some(c), _) => eprintln!(
+            "  coverage: {} of {} (T, dT) cells covered ({:.2} °C × {:.3} °C/min cells), \
+             cross-validated bias residual {:.4} °/h RMS over {} folds",
+            c.covered_cells(),
+            c.n_temp * c.n_rate,
+            c.temp_cell_c,
+            c.rate_cell_c_per_s * 60.0,
+            c.pooled_rms_dph(),
+            c.folds
+        ),
+        (None, Some(note)) => eprintln!("  coverage: none: {note}"),
+        (None, None) => {}
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -43,7 +43,16 @@ from ._allan import (
 )
 from ._figures import bias_stability, noise_terms, scale_factor
 from ._logs import read_log, read_lot
-from ._model import STATUS_NAMES, Compensation, GyrothermWarning, Model, fit
+from ._model import (
+    COVERAGE_NAMES,
+    NO_COVERAGE,
+    STATUS_NAMES,
+    Compensation,
+    CoverageVerdicts,
+    GyrothermWarning,
+    Model,
+    fit,
+)
 
 
 
@@ -64,6 +73,8 @@ __all__ = [
     "settings",
     "AllanError",
     "Compensation",
+    "COVERAGE_NAMES",
+    "CoverageVerdicts",
     "CompensationError",
     "Deviation",
     "FitError",
@@ -74,6 +85,7 @@ __all__ = [
     "Model",
     "ModelError",
     "ONE_SIGMA_CI",
+    "NO_COVERAGE",
     "STATUS_NAMES",
     "__version__",
     "adev",

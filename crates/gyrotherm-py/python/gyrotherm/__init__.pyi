@@ -17,6 +17,8 @@ AllanResult = Tuple[FloatArray, FloatArray, FloatArray, FloatArray]
 
 ONE_SIGMA_CI: float
 STATUS_NAMES: Dict[int, str]
+COVERAGE_NAMES: Dict[int, str]
+NO_COVERAGE: int
 
 class GyrothermError(ValueError, RuntimeError): ...
 class LogError(GyrothermError): ...
@@ -109,6 +111,10 @@ class Compensation(NamedTuple):
     rate_dps: FloatArray
     status: npt.NDArray[np.uint8]
 
+class CoverageVerdicts(NamedTuple):
+    coverage: npt.NDArray[np.uint8]
+    sigma_dph: FloatArray
+
 class Model:
     def __init__(self, raw: Any) -> None: ...
     @classmethod
@@ -126,6 +132,7 @@ class Model:
     @property
     def training(self) -> Dict[str, Any]: ...
     def compensate(self, time_s: ArrayLike, gyro_dps: ArrayLike, temp_c: ArrayLike) -> Compensation: ...
+    def coverage(self, time_s: ArrayLike, gyro_dps: ArrayLike, temp_c: ArrayLike) -> CoverageVerdicts: ...
     def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]: ...
     def summary(self) -> str: ...
 

@@ -22,6 +22,12 @@ Progress = Union[bool, Callable[[str, int, float], Any], None]
 STATUS_NAMES: Dict[int, str] = dict(_g.STATUS_NAMES)
 
 
+#: Per-sample coverage codes of :meth:`Model.coverage`: inside the (T, dT) region training
+#: covered, at its edge (within one cell), or outside; ``NO_COVERAGE`` (255) where there is
+#: no verdict (before the first step, or a model file without a coverage map).
+COVERAGE_NAMES: Dict[int, str] = dict(_g.COVERAGE_NAMES)
+NO_COVERAGE: int = _g.NO_COVERAGE
+
 class GyrothermWarning(UserWarning):
     """The model extrapolates (temperature or its rate leaves the training range), or a
     loaded model file has no content checksum."""
@@ -39,6 +45,17 @@ class Compensation(NamedTuple):
     status: np.ndarray
     """Status code per sample (uint8, see ``STATUS_NAMES``; 0 is ok)."""
 
+
+
+class CoverageVerdicts(NamedTuple):
+    """What the model knows at each sample: the ``coverage`` and ``sigma_dph`` columns of
+    ``gyrotherm compensate``."""
+
+    coverage: np.ndarray
+    """Coverage code per sample (uint8, see ``COVERAGE_NAMES``; 255 is no verdict)."""
+    sigma_dph: np.ndarray
+    """1σ estimate of the residual bias error of the compensated output, °/h (NaN where there
+    is no verdict)."""
 
 def _warn(messages: Iterable[str]) -> None:
     for m in messages:
@@ -109,9 +126,25 @@ class Model:
         _warn(warns)
         return Compensation(bias, scale, rate, status)
 
+    def coverage(self, time_s, gyro_dps, temp_c) -> CoverageVerdicts:
+        """Per sample, whether the temperature and its rate lie inside, at the edge of or
+        outside the region the training logs covered, and the 1σ residual bias error there
+        (°/h): the ``coverage`` and ``sigma_dph`` columns ``gyrotherm compensate`` writes for
+        the same samples. Warns (``GyrothermWarning``) when the model file has no coverage
+        map (every code is then ``NO_COVERAGE``)."""
+        arrays = [np.ascontiguousarray(a, dtype=np.float64) for a in (time_s, gyro_dps, temp_c)]
+        for name, a in zip(("time_s", "gyro_dps", "temp_c"), arrays):
+            if a.ndim != 1:
+                raise _g.CompensationError(f"{name}: need a 1-D array, got shape {a.shape}")
+        codes, sigma, note = self._raw.coverage(*arrays)
+        if note is not None:
+            _warn([note])
+        return CoverageVerdicts(codes, sigma)
+
     def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]:
         """``gyrotherm compensate --input INPUT --out OUT`` with the same log options: every
-        input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps`` and ``status``. Returns
+        input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps``, ``status``, ``coverage`` and
+        ``sigma_dph``. Returns
         the rows written, the count per status and the extrapolation warnings (also issued as
         warnings)."""
         if options.get("fill_gaps_max_s", options.get("fill_gaps")) is not None:

@@ -104,6 +104,8 @@ pub struct FitOutcome {
     /// LSTM training summaries (None for least-squares fits or an absent target).
     pub bias_training: Option<TrainSummary>,
     pub scale_training: Option<TrainSummary>,
+    /// Why the model carries no coverage map (None when it does).
+    pub coverage_note: Option<String>,
 }
 
 /// The feature specification a method reads.
@@ -367,12 +369,28 @@ pub fn fit_model(
         bias: bias_model,
         scale: scale_model,
         training,
+        coverage: None,
     };
+    // What training covered, and the bias model's cross-validated error there.
+    let coverage = model.bias.as_ref().map(|b| {
+        crate::coverage::cross_validated(
+            b,
+            &bias_sets,
+            &crate::coverage::CoverageSettings::default(),
+        )
+    });
+    let (coverage, coverage_note) = match coverage {
+        Some(Ok(c)) => (Some(c), None),
+        Some(Err(e)) => (None, Some(crate::error_chain(&e))),
+        None => (None, Some("no bias model: no coverage map".to_owned())),
+    };
+    let model = ModelFile { coverage, ..model };
     model.validate()?;
     Ok(FitOutcome {
         model,
         bias_training,
         scale_training,
+        coverage_note,
     })
 }
 

@@ -284,6 +284,10 @@ impl ModelFile {
                 });
             }
         }
+        if let Some(c) = &self.coverage {
+            c.to_core()
+                .map_err(|e| ModelFileError::invalid("coverage", e.to_string()))?;
+        }
         self.check_outputs_in_training_range(&spec)
     }
 

@@ -308,6 +308,10 @@ pub struct ModelFile {
     pub scale: Option<SubModel>,
     /// Training facts.
     pub training: TrainingInfo,
+    /// The (T, dT) region training covered and the cross-validated bias error there (absent
+    /// in older files and for LSTM bias models; see [`crate::coverage`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<crate::coverage::CoverageDef>,
 }
 
 /// A model that cannot be read, checked or written: the file, the field and the value at

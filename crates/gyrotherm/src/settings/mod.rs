@@ -16,12 +16,15 @@
 //!   ([`EvaluateSettings`]).
 //! - [`compensate`]: the temperature-sensor limits a compensator believes
 //!   ([`TempSensorDef`](crate::model::TempSensorDef)).
+//! - [`coverage`]: the training-region map and the 1σ estimate `train` stores
+//!   ([`CoverageSettings`](coverage::CoverageSettings)).
 //! - [`describe`](mod@describe): every setting of every job with its default and accepted values, as the
 //!   hidden `gyrotherm settings --json` prints it and the Python package exposes it, so
 //!   their equality can be tested.
 
 pub mod allan;
 pub mod compensate;
+pub mod coverage;
 pub mod describe;
 pub mod evaluate;
 pub mod fit;

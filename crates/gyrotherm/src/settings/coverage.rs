@@ -1,0 +1,68 @@
+//! Coverage settings: how `train` maps the region of (temperature, temperature rate) its logs
+//! covered and the cross-validated error there, and how fast the 1σ estimate grows outside it
+//! (see [`crate::coverage`] and [`gyrotherm_core::coverage`]).
+//!
+//! [`SIGMA_SCALE`] and [`GROWTH_PER_CELL`] were chosen on the design family of simulated
+//! units (unit seeds 1000-1029) and measured once on the confirmation family (5000-5029):
+//! `docs/experiments/coverage.md`.
+
+/// Temperature cells of the grid (the core's maximum).
+pub const TEMP_CELLS: usize = gyrotherm_core::coverage::MAX_TEMP_CELLS;
+/// Temperature-rate cells of the grid (the core's maximum).
+pub const RATE_CELLS: usize = gyrotherm_core::coverage::MAX_RATE_CELLS;
+/// Narrowest temperature cell, °C: twice the DS18B20's ±0.5 °C accuracy (He et al. 2024,
+/// DOI 10.19452/j.issn1007-5453.2024.02.004, §3), so a log that barely moved covers a cell
+/// or two, not sixteen slivers of noise.
+pub const MIN_TEMP_CELL_C: f64 = 1.0;
+/// Narrowest rate cell, °C/s: 0.06 °C/min, about the rate noise of a 0.0625 °C sensor step
+/// over the 20 s rate window (0.0625 / 20 ≈ 0.003 °C/s) divided by thirty.
+pub const MIN_RATE_CELL_C_PER_S: f64 = 1e-3;
+/// Cross-validation folds: contiguous time blocks of each static log, as the `thermal`
+/// method's own cross-validation uses (README, "The method").
+pub const FOLDS: usize = 5;
+/// Held-out steps a cell needs to count as covered: one 100 s bias window (He et al. 2024,
+/// §3), so a cell's residual is at least one independent smoothed value.
+pub const MIN_CELL_STEPS: u64 = 100;
+/// Steps of pooled residual mixed into each cell's RMS (shrinkage towards the pooled RMS):
+/// residuals of a 100 s smoothed target are correlated over about 100 steps, so a cell of a
+/// few hundred steps holds only a few independent values.
+pub const SHRINK_STEPS: f64 = 300.0;
+/// σ = SIGMA_SCALE × the cell's shrunk cross-validated RMS (design family,
+/// docs/experiments/coverage.md).
+pub const SIGMA_SCALE: f64 = 0.9;
+/// Growth of σ per cell of distance outside the training region (design family,
+/// docs/experiments/coverage.md).
+pub const GROWTH_PER_CELL: f64 = 0.5;
+
+/// The coverage settings of one fit (defaults: the constants above).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoverageSettings {
+    /// Temperature cells, 1..=16.
+    pub temp_cells: usize,
+    /// Rate cells, 1..=12.
+    pub rate_cells: usize,
+    /// Cross-validation folds, ≥ 2.
+    pub folds: usize,
+    /// Held-out steps a cell needs to count as covered.
+    pub min_cell_steps: u64,
+    /// Shrinkage of each cell's RMS towards the pooled one, steps.
+    pub shrink_steps: f64,
+    /// σ over the cell's shrunk RMS.
+    pub sigma_scale: f64,
+    /// Growth of σ per cell of distance outside the region.
+    pub growth_per_cell: f64,
+}
+
+impl Default for CoverageSettings {
+    fn default() -> Self {
+        CoverageSettings {
+            temp_cells: TEMP_CELLS,
+            rate_cells: RATE_CELLS,
+            folds: FOLDS,
+            min_cell_steps: MIN_CELL_STEPS,
+            shrink_steps: SHRINK_STEPS,
+            sigma_scale: SIGMA_SCALE,
+            growth_per_cell: GROWTH_PER_CELL,
+        }
+    }
+}
