@@ -18,6 +18,8 @@ GYRO_UNIT_NAMES: List[str]
 DELIMITER_NAMES: List[str]
 SETTINGS_JSON: str
 STATUS_NAMES: Dict[int, str]
+COVERAGE_NAMES: Dict[int, str]
+NO_COVERAGE: int
 
 class GyrothermError(ValueError, RuntimeError): ...
 class LogError(GyrothermError): ...
