@@ -1,7 +1,9 @@
 //! `gyrotherm export --lang c`: the generated C, built with gcc `-std=c99 -O2
 //! -ffp-contract=off -Wall -Wextra -Werror -pedantic` together with a small driver
 //! (tests/export_c/driver.c), gives the same rate, bias, scale factor and status as
-//! `gyrotherm compensate --stream`, to the last bit (parsed doubles compared), on a 30,000-line
+//! `gyrotherm compensate --stream`, to the last bit (parsed doubles compared), and the same
+//! coverage verdict and sigma_dph (`gt_coverage_of`, for models trained with a coverage map;
+//! both columns empty alike otherwise), on a 30,000-line
 //! seed-shock run with and without injected faults (spikes, NaN bursts, stuck readings, gyro
 //! NaN, repeated time stamps), and on the faulty run with dropouts, for every method and recipe (linear, poly, each LSTM recipe, bias-only) and for
 //! constructed models that are sure to hold every part (residual LSTM on a baseline, with and
@@ -124,8 +126,9 @@ fn constructed_models(dir: &Path, template: &Path) -> Vec<(String, PathBuf)> {
     out
 }
 
-/// Compare the driver's output with the stream's: (lines compared, lines differing).
-fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
+/// Compare the driver's output with the stream's: (lines compared, lines differing, lines
+/// per status, lines per coverage verdict inside, edge, outside).
+fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4], [usize; 3]) {
     let mut s_lines = stream_out.lines();
     let header: Vec<&str> = s_lines.next().unwrap().split(',').collect();
     let idx = |n: &str| header.iter().position(|h| *h == n).unwrap();
@@ -135,9 +138,10 @@ fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
         idx("scale"),
         idx("status"),
     );
+    let (ci, gi) = (idx("coverage"), idx("sigma_dph"));
     let mut c_lines = c_out.lines();
     c_lines.next();
-    let (mut n, mut bad, mut statuses) = (0, 0, [0usize; 4]);
+    let (mut n, mut bad, mut statuses, mut cover) = (0, 0, [0usize; 4], [0usize; 3]);
     let num =
         |s: &str| -> Option<u64> { (!s.is_empty()).then(|| s.parse::<f64>().unwrap().to_bits()) };
     for (c, s) in c_lines.zip(s_lines) {
@@ -147,12 +151,14 @@ fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
         let same = c[0] == s[si]
             && num(c[1]) == num(s[ri])
             && num(c[2]) == num(s[bi])
-            && num(c[3]) == num(s[ki]);
+            && num(c[3]) == num(s[ki])
+            && c[4] == s[ci]
+            && num(c[5]) == num(s[gi]);
         if !same {
             if bad < 3 {
                 eprintln!(
                     "differs: C {c:?} vs stream {:?}",
-                    [s[si], s[ri], s[bi], s[ki]]
+                    [s[si], s[ri], s[bi], s[ki], s[ci], s[gi]]
                 );
             }
             bad += 1;
@@ -162,8 +168,14 @@ fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
             .position(|v| *v == c[0])
             .unwrap();
         statuses[k] += 1;
+        if let Some(v) = ["inside", "edge", "outside"]
+            .iter()
+            .position(|v| *v == c[4])
+        {
+            cover[v] += 1;
+        }
     }
-    (n, bad, statuses)
+    (n, bad, statuses, cover)
 }
 
 #[test]
@@ -263,6 +275,7 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
 
     let driver = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c/driver.c");
     let mut failures = Vec::new();
+    let mut covered_lines = 0usize;
     for (name, model) in &models {
         let m: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(model).unwrap()).unwrap();
@@ -308,21 +321,25 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
                     .arg(model)
                     .stdin(Stdio::from(std::fs::File::open(input).unwrap())),
             );
-            let (n, bad, st) = compare(
+            let (n, bad, st, cv) = compare(
                 &String::from_utf8_lossy(&c_out.stdout),
                 &String::from_utf8_lossy(&stream.stdout),
             );
             let lines = std::fs::read_to_string(input).unwrap().lines().count() - 1;
             println!(
                 "{name:28} bias {:9} scale {:9} {run:6}: {n} lines, {bad} differ \
-                 (ok {}, held {}, degraded {}, invalid {})",
+                 (ok {}, held {}, degraded {}, invalid {}; inside {}, edge {}, outside {})",
                 kind("bias"),
                 kind("scale"),
                 st[0],
                 st[1],
                 st[2],
-                st[3]
+                st[3],
+                cv[0],
+                cv[1],
+                cv[2]
             );
+            covered_lines += cv.iter().sum::<usize>();
             if bad > 0 || n != lines {
                 failures.push(format!(
                     "{name} {run}: {bad} of {n} lines differ ({lines} input)"
@@ -331,6 +348,11 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+    // The trained least-squares models carry a coverage map: the verdict was compared.
+    assert!(
+        covered_lines > 100_000,
+        "only {covered_lines} lines had a coverage verdict"
+    );
 }
 
 // The differential test: many generated models, C against the stream, line by line.
