@@ -500,7 +500,43 @@ fn generated_model(i: usize) -> serde_json::Value {
             (method, bias, None)
         }
     };
-    model_json(method, features, bias, scale)
+    let mut m = model_json(method, features, bias, scale);
+    if i % 3 != 0 {
+        m["coverage"] = coverage_json(&mut rng);
+    }
+    m
+}
+
+/// A random coverage map (two models in three carry one): 1 to 16 by 1 to 12 cells placed
+/// around the streams' temperatures (−5 to 35 °C) and rates, about half the cells covered,
+/// growth 0 to 1 per cell (0 in one map in four).
+fn coverage_json(rng: &mut Lcg) -> serde_json::Value {
+    let mut u = || rng.next() + 0.5;
+    let n_temp = 1 + (u() * 16.0) as usize % 16;
+    let n_rate = 1 + (u() * 12.0) as usize % 12;
+    let temp_cell_c = 1.0 + 6.0 * u();
+    let rate_cell_c_per_s = 0.002 + 0.02 * u();
+    let temp_min_c = -10.0 + 20.0 * u() - 0.5 * n_temp as f64 * temp_cell_c + 15.0;
+    let rate_min_c_per_s = -0.5 * n_rate as f64 * rate_cell_c_per_s + 0.01 * (u() - 0.5);
+    let growth = if u() < 0.25 { 0.0 } else { u() };
+    let n = n_temp * n_rate;
+    let mut sigma: Vec<f64> = (0..n)
+        .map(|_| if u() < 0.5 { 0.0 } else { 0.01 + 0.1 * u() })
+        .collect();
+    let k = (u() * n as f64) as usize % n;
+    if sigma[k] == 0.0 {
+        sigma[k] = 0.05;
+    }
+    let count: Vec<u64> = sigma
+        .iter()
+        .map(|s| if *s > 0.0 { 200 } else { 0 })
+        .collect();
+    serde_json::json!({
+        "temp_min_c": temp_min_c, "temp_cell_c": temp_cell_c, "n_temp": n_temp,
+        "rate_min_c_per_s": rate_min_c_per_s, "rate_cell_c_per_s": rate_cell_c_per_s,
+        "n_rate": n_rate, "folds": 5, "count": count, "rms_dph": sigma.clone(),
+        "sigma_dph": sigma, "growth_per_cell": growth,
+    })
 }
 
 /// Largest finite gyro sample the tester used: with K < 1, (Ĝ − B) / K overflows.
@@ -597,11 +633,12 @@ fn random_stream(seed: u64) -> Vec<(f64, f64, f64)> {
     out
 }
 
-/// `compensate --stream`, in process: (status, rate or NaN when empty, bias, scale) per line.
-fn stream_in_process(
-    model: &gyrotherm::ModelFile,
-    samples: &[(f64, f64, f64)],
-) -> Vec<(usize, f64, f64, f64)> {
+/// `compensate --stream`, in process: (status, rate or NaN when empty, bias, scale, coverage
+/// verdict (0 inside, 1 edge, 2 outside; None when empty), sigma_dph or NaN when empty) per
+/// line.
+type StreamLine = (usize, f64, f64, f64, Option<usize>, f64);
+
+fn stream_in_process(model: &gyrotherm::ModelFile, samples: &[(f64, f64, f64)]) -> Vec<StreamLine> {
     let mut text = String::from("time_s,gyro_dps,temp_c\n");
     for (t, g, c) in samples {
         text.push_str(&format!("{t:?},{g:?},{c:?}\n"));
@@ -627,7 +664,10 @@ fn stream_in_process(
                 .position(|s| *s == f[6])
                 .unwrap();
             let num = |s: &str| s.parse::<f64>().unwrap_or(f64::NAN);
-            (status, num(f[5]), num(f[3]), num(f[4]))
+            let cover = ["inside", "edge", "outside"]
+                .iter()
+                .position(|s| *s == f[7]);
+            (status, num(f[5]), num(f[3]), num(f[4]), cover, num(f[8]))
         })
         .collect()
 }
@@ -656,7 +696,9 @@ fn gcc(opt: &str, args: &[&str], files: &[&Path], out: &Path) {
 /// 1,000 generated models (every method; scale factor above and below 1), each exported to
 /// C, built with the same flags as above (at -O0) and run over two faulted streams (the
 /// fixed one and a random one per model, both with time faults and overflow gyro samples):
-/// every line's status, rate, bias and scale equal `compensate --stream`'s to the last bit.
+/// every line's status, rate, bias and scale equal `compensate --stream`'s to the last bit, and
+/// so do the coverage verdict and sigma_dph of `gt_coverage_of` (two models in three carry a
+/// random coverage map; the rest must answer GT_NO_MAP).
 #[test]
 fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
     if !have_gcc() {
@@ -673,6 +715,7 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
     let fixed = fixed_stream();
     let (mut lines, mut differ, mut statuses) = (0usize, 0usize, [0usize; 4]);
+    let mut verdicts = [0usize; 3];
     let mut failures = Vec::new();
     let workers = std::thread::available_parallelism().map_or(2, |n| n.get().min(4));
     for batch in 0..DIFF_MODELS.div_ceil(BATCH) {
@@ -712,6 +755,7 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
                                         &format!("-DGT_RUN=run_{i}"),
                                         &format!("-Dgt_init=gt_init_{i}"),
                                         &format!("-Dgt_step=gt_step_{i}"),
+                                        &format!("-Dgt_coverage_of=gt_coverage_of_{i}"),
                                         "-I",
                                         mdir.to_str().unwrap(),
                                     ],
@@ -782,21 +826,32 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
                 assert_eq!(want.len(), s.len(), "model {i}: one line out per line in");
                 let st: Vec<u8> = out[at..at + s.len()].to_vec();
                 at += s.len();
+                // Without a verdict the C says why: no map in the model, or none yet.
+                let no_verdict = if m.coverage.is_some() { 3 } else { 4 };
                 for (line, (w, c_status)) in want.iter().zip(st).enumerate() {
                     let (r, b, sc) = (f64_at(&mut at), f64_at(&mut at), f64_at(&mut at));
+                    let (cv, sigma) = (f64_at(&mut at) as usize, f64_at(&mut at));
                     let c_status = c_status as usize;
+                    let same_cover = match w.4 {
+                        Some(v) => cv == v && sigma.to_bits() == w.5.to_bits(),
+                        None => cv == no_verdict && sigma.is_nan(),
+                    };
                     let same = c_status == w.0
                         && b.to_bits() == w.2.to_bits()
                         && sc.to_bits() == w.3.to_bits()
-                        && (c_status == 3 || r.to_bits() == w.1.to_bits());
+                        && (c_status == 3 || r.to_bits() == w.1.to_bits())
+                        && same_cover;
                     lines += 1;
                     statuses[c_status.min(3)] += 1;
+                    if let Some(v) = w.4 {
+                        verdicts[v] += 1;
+                    }
                     if !same {
                         differ += 1;
                         if failures.len() < 5 {
                             failures.push(format!(
                                 "model {i} stream {k} line {line} {:?}: C ({c_status}, {r:e}, \
-                                 {b:e}, {sc:e}) vs stream {w:?}",
+                                 {b:e}, {sc:e}, {cv}, {sigma:e}) vs stream {w:?}",
                                 s[line]
                             ));
                         }
@@ -808,15 +863,21 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
     }
     println!(
         "differential: {DIFF_MODELS} models × 2 streams: {lines} lines compared, {differ} differ \
-         (ok {}, held {}, degraded {}, invalid {}); {:.1} s",
+         (ok {}, held {}, degraded {}, invalid {}; coverage inside {}, edge {}, outside {}); \
+         {:.1} s",
         statuses[0],
         statuses[1],
         statuses[2],
         statuses[3],
+        verdicts[0],
+        verdicts[1],
+        verdicts[2],
         start.elapsed().as_secs_f64()
     );
     assert!(
         failures.is_empty() && differ == 0,
         "{differ} lines differ: {failures:#?}"
     );
+    // Every verdict occurred, so each branch of the port was compared.
+    assert!(verdicts.iter().all(|v| *v > 1000), "verdicts {verdicts:?}");
 }
