@@ -1,7 +1,9 @@
 //! `gyrotherm export --lang c`: the generated C, built with gcc `-std=c99 -O2
 //! -ffp-contract=off -Wall -Wextra -Werror -pedantic` together with a small driver
 //! (tests/export_c/driver.c), gives the same rate, bias, scale factor and status as
-//! `gyrotherm compensate --stream`, to the last bit (parsed doubles compared), on a 30,000-line
+//! `gyrotherm compensate --stream`, to the last bit (parsed doubles compared), and the same
+//! coverage verdict and sigma_dph (`gt_coverage_of`, for models trained with a coverage map;
+//! both columns empty alike otherwise), on a 30,000-line
 //! seed-shock run with and without injected faults (spikes, NaN bursts, stuck readings, gyro
 //! NaN, repeated time stamps), and on the faulty run with dropouts, for every method and recipe (linear, poly, each LSTM recipe, bias-only) and for
 //! constructed models that are sure to hold every part (residual LSTM on a baseline, with and
@@ -124,8 +126,9 @@ fn constructed_models(dir: &Path, template: &Path) -> Vec<(String, PathBuf)> {
     out
 }
 
-/// Compare the driver's output with the stream's: (lines compared, lines differing).
-fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
+/// Compare the driver's output with the stream's: (lines compared, lines differing, lines
+/// per status, lines per coverage verdict inside, edge, outside).
+fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4], [usize; 3]) {
     let mut s_lines = stream_out.lines();
     let header: Vec<&str> = s_lines.next().unwrap().split(',').collect();
     let idx = |n: &str| header.iter().position(|h| *h == n).unwrap();
@@ -135,9 +138,10 @@ fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
         idx("scale"),
         idx("status"),
     );
+    let (ci, gi) = (idx("coverage"), idx("sigma_dph"));
     let mut c_lines = c_out.lines();
     c_lines.next();
-    let (mut n, mut bad, mut statuses) = (0, 0, [0usize; 4]);
+    let (mut n, mut bad, mut statuses, mut cover) = (0, 0, [0usize; 4], [0usize; 3]);
     let num =
         |s: &str| -> Option<u64> { (!s.is_empty()).then(|| s.parse::<f64>().unwrap().to_bits()) };
     for (c, s) in c_lines.zip(s_lines) {
@@ -147,12 +151,14 @@ fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
         let same = c[0] == s[si]
             && num(c[1]) == num(s[ri])
             && num(c[2]) == num(s[bi])
-            && num(c[3]) == num(s[ki]);
+            && num(c[3]) == num(s[ki])
+            && c[4] == s[ci]
+            && num(c[5]) == num(s[gi]);
         if !same {
             if bad < 3 {
                 eprintln!(
                     "differs: C {c:?} vs stream {:?}",
-                    [s[si], s[ri], s[bi], s[ki]]
+                    [s[si], s[ri], s[bi], s[ki], s[ci], s[gi]]
                 );
             }
             bad += 1;
@@ -162,8 +168,14 @@ fn compare(c_out: &str, stream_out: &str) -> (usize, usize, [usize; 4]) {
             .position(|v| *v == c[0])
             .unwrap();
         statuses[k] += 1;
+        if let Some(v) = ["inside", "edge", "outside"]
+            .iter()
+            .position(|v| *v == c[4])
+        {
+            cover[v] += 1;
+        }
     }
-    (n, bad, statuses)
+    (n, bad, statuses, cover)
 }
 
 #[test]
@@ -263,6 +275,7 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
 
     let driver = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c/driver.c");
     let mut failures = Vec::new();
+    let mut covered_lines = 0usize;
     for (name, model) in &models {
         let m: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(model).unwrap()).unwrap();
@@ -308,21 +321,25 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
                     .arg(model)
                     .stdin(Stdio::from(std::fs::File::open(input).unwrap())),
             );
-            let (n, bad, st) = compare(
+            let (n, bad, st, cv) = compare(
                 &String::from_utf8_lossy(&c_out.stdout),
                 &String::from_utf8_lossy(&stream.stdout),
             );
             let lines = std::fs::read_to_string(input).unwrap().lines().count() - 1;
             println!(
                 "{name:28} bias {:9} scale {:9} {run:6}: {n} lines, {bad} differ \
-                 (ok {}, held {}, degraded {}, invalid {})",
+                 (ok {}, held {}, degraded {}, invalid {}; inside {}, edge {}, outside {})",
                 kind("bias"),
                 kind("scale"),
                 st[0],
                 st[1],
                 st[2],
-                st[3]
+                st[3],
+                cv[0],
+                cv[1],
+                cv[2]
             );
+            covered_lines += cv.iter().sum::<usize>();
             if bad > 0 || n != lines {
                 failures.push(format!(
                     "{name} {run}: {bad} of {n} lines differ ({lines} input)"
@@ -331,6 +348,11 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+    // The trained least-squares models carry a coverage map: the verdict was compared.
+    assert!(
+        covered_lines > 100_000,
+        "only {covered_lines} lines had a coverage verdict"
+    );
 }
 
 // The differential test: many generated models, C against the stream, line by line.
@@ -478,7 +500,43 @@ fn generated_model(i: usize) -> serde_json::Value {
             (method, bias, None)
         }
     };
-    model_json(method, features, bias, scale)
+    let mut m = model_json(method, features, bias, scale);
+    if i % 3 != 0 {
+        m["coverage"] = coverage_json(&mut rng);
+    }
+    m
+}
+
+/// A random coverage map (two models in three carry one): 1 to 16 by 1 to 12 cells placed
+/// around the streams' temperatures (−5 to 35 °C) and rates, about half the cells covered,
+/// growth 0 to 1 per cell (0 in one map in four).
+fn coverage_json(rng: &mut Lcg) -> serde_json::Value {
+    let mut u = || rng.next() + 0.5;
+    let n_temp = 1 + (u() * 16.0) as usize % 16;
+    let n_rate = 1 + (u() * 12.0) as usize % 12;
+    let temp_cell_c = 1.0 + 6.0 * u();
+    let rate_cell_c_per_s = 0.002 + 0.02 * u();
+    let temp_min_c = -10.0 + 20.0 * u() - 0.5 * n_temp as f64 * temp_cell_c + 15.0;
+    let rate_min_c_per_s = -0.5 * n_rate as f64 * rate_cell_c_per_s + 0.01 * (u() - 0.5);
+    let growth = if u() < 0.25 { 0.0 } else { u() };
+    let n = n_temp * n_rate;
+    let mut sigma: Vec<f64> = (0..n)
+        .map(|_| if u() < 0.5 { 0.0 } else { 0.01 + 0.1 * u() })
+        .collect();
+    let k = (u() * n as f64) as usize % n;
+    if sigma[k] == 0.0 {
+        sigma[k] = 0.05;
+    }
+    let count: Vec<u64> = sigma
+        .iter()
+        .map(|s| if *s > 0.0 { 200 } else { 0 })
+        .collect();
+    serde_json::json!({
+        "temp_min_c": temp_min_c, "temp_cell_c": temp_cell_c, "n_temp": n_temp,
+        "rate_min_c_per_s": rate_min_c_per_s, "rate_cell_c_per_s": rate_cell_c_per_s,
+        "n_rate": n_rate, "folds": 5, "count": count, "rms_dph": sigma.clone(),
+        "sigma_dph": sigma, "growth_per_cell": growth,
+    })
 }
 
 /// Largest finite gyro sample the tester used: with K < 1, (Ĝ − B) / K overflows.
@@ -575,11 +633,12 @@ fn random_stream(seed: u64) -> Vec<(f64, f64, f64)> {
     out
 }
 
-/// `compensate --stream`, in process: (status, rate or NaN when empty, bias, scale) per line.
-fn stream_in_process(
-    model: &gyrotherm::ModelFile,
-    samples: &[(f64, f64, f64)],
-) -> Vec<(usize, f64, f64, f64)> {
+/// `compensate --stream`, in process: (status, rate or NaN when empty, bias, scale, coverage
+/// verdict (0 inside, 1 edge, 2 outside; None when empty), sigma_dph or NaN when empty) per
+/// line.
+type StreamLine = (usize, f64, f64, f64, Option<usize>, f64);
+
+fn stream_in_process(model: &gyrotherm::ModelFile, samples: &[(f64, f64, f64)]) -> Vec<StreamLine> {
     let mut text = String::from("time_s,gyro_dps,temp_c\n");
     for (t, g, c) in samples {
         text.push_str(&format!("{t:?},{g:?},{c:?}\n"));
@@ -605,7 +664,10 @@ fn stream_in_process(
                 .position(|s| *s == f[6])
                 .unwrap();
             let num = |s: &str| s.parse::<f64>().unwrap_or(f64::NAN);
-            (status, num(f[5]), num(f[3]), num(f[4]))
+            let cover = ["inside", "edge", "outside"]
+                .iter()
+                .position(|s| *s == f[7]);
+            (status, num(f[5]), num(f[3]), num(f[4]), cover, num(f[8]))
         })
         .collect()
 }
@@ -634,7 +696,9 @@ fn gcc(opt: &str, args: &[&str], files: &[&Path], out: &Path) {
 /// 1,000 generated models (every method; scale factor above and below 1), each exported to
 /// C, built with the same flags as above (at -O0) and run over two faulted streams (the
 /// fixed one and a random one per model, both with time faults and overflow gyro samples):
-/// every line's status, rate, bias and scale equal `compensate --stream`'s to the last bit.
+/// every line's status, rate, bias and scale equal `compensate --stream`'s to the last bit, and
+/// so do the coverage verdict and sigma_dph of `gt_coverage_of` (two models in three carry a
+/// random coverage map; the rest must answer GT_NO_MAP).
 #[test]
 fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
     if !have_gcc() {
@@ -651,6 +715,7 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
     let fixed = fixed_stream();
     let (mut lines, mut differ, mut statuses) = (0usize, 0usize, [0usize; 4]);
+    let mut verdicts = [0usize; 3];
     let mut failures = Vec::new();
     let workers = std::thread::available_parallelism().map_or(2, |n| n.get().min(4));
     for batch in 0..DIFF_MODELS.div_ceil(BATCH) {
@@ -690,6 +755,7 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
                                         &format!("-DGT_RUN=run_{i}"),
                                         &format!("-Dgt_init=gt_init_{i}"),
                                         &format!("-Dgt_step=gt_step_{i}"),
+                                        &format!("-Dgt_coverage_of=gt_coverage_of_{i}"),
                                         "-I",
                                         mdir.to_str().unwrap(),
                                     ],
@@ -760,21 +826,32 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
                 assert_eq!(want.len(), s.len(), "model {i}: one line out per line in");
                 let st: Vec<u8> = out[at..at + s.len()].to_vec();
                 at += s.len();
+                // Without a verdict the C says why: no map in the model, or none yet.
+                let no_verdict = if m.coverage.is_some() { 3 } else { 4 };
                 for (line, (w, c_status)) in want.iter().zip(st).enumerate() {
                     let (r, b, sc) = (f64_at(&mut at), f64_at(&mut at), f64_at(&mut at));
+                    let (cv, sigma) = (f64_at(&mut at) as usize, f64_at(&mut at));
                     let c_status = c_status as usize;
+                    let same_cover = match w.4 {
+                        Some(v) => cv == v && sigma.to_bits() == w.5.to_bits(),
+                        None => cv == no_verdict && sigma.is_nan(),
+                    };
                     let same = c_status == w.0
                         && b.to_bits() == w.2.to_bits()
                         && sc.to_bits() == w.3.to_bits()
-                        && (c_status == 3 || r.to_bits() == w.1.to_bits());
+                        && (c_status == 3 || r.to_bits() == w.1.to_bits())
+                        && same_cover;
                     lines += 1;
                     statuses[c_status.min(3)] += 1;
+                    if let Some(v) = w.4 {
+                        verdicts[v] += 1;
+                    }
                     if !same {
                         differ += 1;
                         if failures.len() < 5 {
                             failures.push(format!(
                                 "model {i} stream {k} line {line} {:?}: C ({c_status}, {r:e}, \
-                                 {b:e}, {sc:e}) vs stream {w:?}",
+                                 {b:e}, {sc:e}, {cv}, {sigma:e}) vs stream {w:?}",
                                 s[line]
                             ));
                         }
@@ -786,15 +863,21 @@ fn generated_c_equals_the_stream_for_a_thousand_generated_models() {
     }
     println!(
         "differential: {DIFF_MODELS} models × 2 streams: {lines} lines compared, {differ} differ \
-         (ok {}, held {}, degraded {}, invalid {}); {:.1} s",
+         (ok {}, held {}, degraded {}, invalid {}; coverage inside {}, edge {}, outside {}); \
+         {:.1} s",
         statuses[0],
         statuses[1],
         statuses[2],
         statuses[3],
+        verdicts[0],
+        verdicts[1],
+        verdicts[2],
         start.elapsed().as_secs_f64()
     );
     assert!(
         failures.is_empty() && differ == 0,
         "{differ} lines differ: {failures:#?}"
     );
+    // Every verdict occurred, so each branch of the port was compared.
+    assert!(verdicts.iter().all(|v| *v > 1000), "verdicts {verdicts:?}");
 }

@@ -120,7 +120,10 @@ fn a_training_file_name_never_reaches_the_generated_source() {
             .arg(&obj),
     );
     // The header's API and nothing else: everything else in the source is `static`.
-    assert_eq!(defined_symbols(&obj), ["gt_init", "gt_step"]);
+    assert_eq!(
+        defined_symbols(&obj),
+        ["gt_coverage_of", "gt_init", "gt_step"]
+    );
 }
 
 #[test]

@@ -28,16 +28,23 @@
 //!         lstm_reads_base: false,
 //!     },
 //!     scale: StaticTarget::constant(1.0),
+//!     coverage: None,
 //! };
 //! let mut c = Compensator::from_static(&MODEL).unwrap();
 //! let out = c.step(0.0, 0.01, 20.0);
 //! assert!((out.bias_dps - (1e-3 + 2e-5 * 20.0)).abs() < 1e-15);
+//! // No coverage map in this model: no verdict.
+//! assert!(MODEL.coverage_map().is_none());
 //! ```
+//!
+//! With a map ([`StaticCoverage`]), the verdict of each sample is
+//! `map.verdict_of(c.features())`, `map` built once by [`StaticModel::coverage_map`].
 
 use crate::baseline::{BaselineModel, MAX_TERMS};
 use crate::compensator::{
     Compensator, ModelError, NormalisedLstm, TargetModel, TempLimits, HIDDEN, LSTM_INPUTS,
 };
+use crate::coverage::{CoverageError, CoverageMap, Grid, MAX_RATE_CELLS, MAX_TEMP_CELLS};
 use crate::features::{FeatureSpec, MAX_FEATURES};
 use crate::lstm::LstmWeights;
 
@@ -52,6 +59,38 @@ pub struct StaticModel {
     pub bias: StaticTarget,
     /// Scale-factor model (dimensionless, ≈ 1).
     pub scale: StaticTarget,
+    /// The training region and its error (None: the model file has no coverage map).
+    pub coverage: Option<StaticCoverage>,
+}
+
+/// A coverage map as plain data (see [`crate::coverage`]): `sigma_dph[i · n_rate + j]` is
+/// the σ (°/h) of temperature cell i and rate cell j, 0 where training did not cover the cell;
+/// the slots after the first `n_temp · n_rate` are unused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticCoverage {
+    /// The geometry.
+    pub grid: Grid,
+    /// σ per cell, row-major by temperature.
+    pub sigma_dph: [f64; MAX_TEMP_CELLS * MAX_RATE_CELLS],
+    /// Growth of σ per cell of distance outside the covered cells.
+    pub growth_per_cell: f64,
+}
+
+impl StaticCoverage {
+    /// The checked map, as [`CoverageMap::new`] checks it.
+    pub fn to_map(&self) -> Result<CoverageMap, CoverageError> {
+        let n = self.grid.n_temp.saturating_mul(self.grid.n_rate);
+        // More cells than the slots hold is a cell count the map refuses anyway.
+        let sigma = self.sigma_dph.get(..n).ok_or(CoverageError::CellCount)?;
+        CoverageMap::new(self.grid, sigma, self.growth_per_cell)
+    }
+}
+
+impl StaticModel {
+    /// The model's coverage map, checked (None: the model has none).
+    pub fn coverage_map(&self) -> Option<Result<CoverageMap, CoverageError>> {
+        self.coverage.as_ref().map(StaticCoverage::to_map)
+    }
 }
 
 /// One target: `offset + baseline(features) + lstm(features)` (see [`TargetModel`]).

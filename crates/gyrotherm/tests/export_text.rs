@@ -3,7 +3,7 @@
 //! bidirectional overrides, quotes, backslashes, inner attributes) in every free-text field
 //! of a model, the generated files equal those of the same model with plain strings except
 //! for the content hash, hold only printable ASCII and newlines, and compile: the C with the
-//! strict flags of the C export test (defining exactly `gt_init` and `gt_step`), the Rust
+//! strict flags of the C export test (defining exactly `gt_coverage_of`, `gt_init` and `gt_step`), the Rust
 //! module against gyrotherm-core.
 
 use std::cell::RefCell;
@@ -57,7 +57,7 @@ fn hostile_string() -> impl Strategy<Value = String> {
         4 => any::<char>().prop_map(String::from),
         1 => prop::sample::select(vec![
             "*/", "/*", "//", "\n", "\r", "\r\n", "??/", "??=", "\u{202e}", "\u{2066}",
-            "\u{2028}", "\u{feff}", "\0", "\t", "\"", "'", "\\", "#![", "@ABOUT@", "@DATA@",
+            "\u{2028}", "\u{feff}", "\0", "\t", "\"", "'", "\\", "#![", "@ABOUT@", "@DATA@", "@COVERAGE@",
             "*/ #undef isfinite\n#define isfinite(x) 1\n/*",
             "*/ int gt_pwned; /*",
             "#![doc = include_str!(\"/etc/hostname\")]",
@@ -208,7 +208,12 @@ fn compile_c(dir: &Path, models: &[ModelFile]) {
             .filter_map(|l| l.split_whitespace().next().map(str::to_owned))
             .collect();
         names.sort();
-        assert_eq!(names, ["gt_init", "gt_step"], "case {i}: {:?}", m.training);
+        assert_eq!(
+            names,
+            ["gt_coverage_of", "gt_init", "gt_step"],
+            "case {i}: {:?}",
+            m.training
+        );
     }
 }
 

@@ -1,8 +1,10 @@
 /* Test driver for the generated C model: reads a gyrotherm CSV log (the file named by the
  * first argument, else stdin; header with
  * time_s, gyro_dps, temp_c), calls gt_step per data line and prints
- * `status,rate_dps,bias_dps,scale` per line (%.17g, so the doubles round-trip; rate empty when
- * the status is invalid). A field that is not a number is read as NaN. */
+ * `status,rate_dps,bias_dps,scale,coverage,sigma_dph` per line (%.17g, so the doubles
+ * round-trip; rate empty when the status is invalid; coverage and sigma_dph from
+ * gt_coverage_of, both empty without a verdict or a map, as the stream writes them). A field
+ * that is not a number is read as NaN. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,6 +47,7 @@ int main(int argc, char **argv)
     int ti = -1, gi = -1, ci = -1, n, i;
     gt_state s;
     static const char *names[] = {"ok", "held", "degraded", "invalid"};
+    static const char *cover[] = {"inside", "edge", "outside"};
     if (argc > 1 && (in = fopen(argv[1], "r")) == NULL) {
         fprintf(stderr, "driver: cannot open %s\n", argv[1]);
         return 2;
@@ -68,10 +71,11 @@ int main(int argc, char **argv)
         return 2;
     }
     gt_init(&s);
-    printf("status,gyro_comp_dps,bias_dps,scale\n");
+    printf("status,gyro_comp_dps,bias_dps,scale,coverage,sigma_dph\n");
     while (fgets(line, sizeof line, in) != NULL) {
-        double rate, bias, scale;
+        double rate, bias, scale, sigma;
         gt_status st;
+        gt_coverage cv;
         line[strcspn(line, "\r\n")] = '\0';
         if (line[0] == '\0' || line[0] == '#') {
             continue;
@@ -84,9 +88,15 @@ int main(int argc, char **argv)
         st = gt_step(&s, number(fields[ti]), number(fields[gi]), number(fields[ci]), &rate,
                      &bias, &scale);
         if (st == GT_INVALID) {
-            printf("%s,,%.17g,%.17g\n", names[st], bias, scale);
+            printf("%s,,%.17g,%.17g", names[st], bias, scale);
         } else {
-            printf("%s,%.17g,%.17g,%.17g\n", names[st], rate, bias, scale);
+            printf("%s,%.17g,%.17g,%.17g", names[st], rate, bias, scale);
+        }
+        cv = gt_coverage_of(&s, &sigma);
+        if (cv == GT_INSIDE || cv == GT_EDGE || cv == GT_OUTSIDE) {
+            printf(",%s,%.17g\n", cover[cv], sigma);
+        } else {
+            printf(",,\n");
         }
     }
     return 0;

@@ -10,6 +10,7 @@
 
 mod gyrotherm_model;
 
+use gyrotherm_core::coverage::Coverage;
 use gyrotherm_core::{Compensator, Status};
 
 /// What the flight code reads each cycle (an ADC/UART frame on the target).
@@ -56,6 +57,9 @@ fn main() {
     let Ok(mut comp) = Compensator::from_static(&gyrotherm_model::MODEL) else {
         std::process::exit(2);
     };
+    // The training region, when the model file carried one (checked once, like the model).
+    let cover = gyrotherm_model::MODEL.coverage_map().and_then(Result::ok);
+    let mut outside = 0u32;
     let mut sensors = MockSensors { k: 0 };
     let mut counts = [0u32; 4];
     let mut last_rate = 0.0;
@@ -72,9 +76,17 @@ fn main() {
             // No gyro sample: keep the navigation filter's prediction instead.
             Status::Invalid => {}
         }
+        // Outside the training region the model extrapolates: flag it in telemetry.
+        let verdict = cover.as_ref().and_then(|m| m.verdict_of(comp.features()));
+        if verdict.is_some_and(|v| v.coverage == Coverage::Outside) {
+            outside += 1;
+        }
     }
     println!(
         "3600 samples: ok {}, held {}, degraded {}, invalid {}; last rate {last_rate:.3e} °/s",
         counts[0], counts[1], counts[2], counts[3]
     );
+    if cover.is_some() {
+        println!("outside the training region: {outside} samples");
+    }
 }

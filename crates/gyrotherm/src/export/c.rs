@@ -7,10 +7,16 @@
 //! void gt_init(gt_state *s);
 //! gt_status gt_step(gt_state *s, double time_s, double gyro_dps, double temp_c,
 //!                   double *rate_dps, double *bias_dps, double *scale);
+//! typedef enum { GT_INSIDE = 0, GT_EDGE = 1, GT_OUTSIDE = 2, GT_NO_VERDICT = 3,
+//!                GT_NO_MAP = 4 } gt_coverage;
+//! gt_coverage gt_coverage_of(const gt_state *s, double *sigma_dph);
 //! ```
 //!
 //! `gt_step` is a line-by-line port of `gyrotherm_core::Compensator::step` (see the parent
 //! module for what makes the numbers equal). On `GT_INVALID` `*rate_dps` is 0.
+//! `gt_coverage_of` is a port of `gyrotherm_core::coverage::CoverageMap::verdict_of` on the
+//! compensator's latest features, the model's coverage map held as `static const` data;
+//! `GT_NO_MAP` for a model without one.
 
 use std::fmt::Write as _;
 
@@ -149,6 +155,40 @@ fn target(out: &mut String, name: &str, t: &StaticTarget, nf: usize) {
     );
 }
 
+/// The C source of the coverage map's static data (empty without a map).
+fn coverage(m: &StaticModel) -> String {
+    let Some(c) = &m.coverage else {
+        return String::new();
+    };
+    let g = &c.grid;
+    let rows: Vec<String> = (0..g.n_temp)
+        .map(|i| {
+            format!(
+                "{{{}}}",
+                join((0..g.n_rate).map(|j| d(c.sigma_dph[i * g.n_rate + j])))
+            )
+        })
+        .collect();
+    format!(
+        "static const double COV_TEMP_MIN = {};\n\
+         static const double COV_TEMP_CELL = {};\n\
+         static const double COV_RATE_MIN = {};\n\
+         static const double COV_RATE_CELL = {};\n\
+         static const double COV_GROWTH = {};\n\
+         #define COV_N_TEMP {}\n\
+         #define COV_N_RATE {}\n\
+         static const double COV_SIGMA[COV_N_TEMP][COV_N_RATE] = {{\n    {}\n}};\n\n",
+        d(g.temp_min_c),
+        d(g.temp_cell_c),
+        d(g.rate_min_c_per_s),
+        d(g.rate_cell_c_per_s),
+        d(c.growth_per_cell),
+        g.n_temp,
+        g.n_rate,
+        rows.join(",\n    ")
+    )
+}
+
 /// `(header, source)`.
 pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
     let spec = &m.spec;
@@ -181,7 +221,14 @@ pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
         .replace("@STEP_S@", &p.to_string())
         .replace("@NF@", &nf.to_string())
         .replace("@LAGS@", &lag_slots.to_string())
-        .replace("@HIST@", &HISTORY_STEPS.to_string());
+        .replace("@HIST@", &HISTORY_STEPS.to_string())
+        .replace(
+            "@COVERAGE_NOTE@",
+            &match &m.coverage {
+                Some(c) => format!("a map of {} x {} cells", c.grid.n_temp, c.grid.n_rate),
+                None => "none, so always GT_NO_MAP".to_owned(),
+            },
+        );
     let mut data = String::new();
     target(&mut data, "bias", &m.bias, nf);
     target(&mut data, "scale", &m.scale, nf);
@@ -224,7 +271,12 @@ pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
         .replace("@SHIFT@", &f(12_582_912.0))
         .replace("@P7@", &f(p7))
         .replace("@POLY@", &join(poly.iter().map(|v| f(*v))))
-        .replace("@DATA@", &data);
+        .replace(
+            "@HAS_COVERAGE@",
+            &u8::from(m.coverage.is_some()).to_string(),
+        )
+        .replace("@DATA@", &data)
+        .replace("@COVERAGE@", &coverage(m));
     (header, source)
 }
 

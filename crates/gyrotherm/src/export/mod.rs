@@ -16,8 +16,11 @@ pub mod rust;
 use std::path::{Path, PathBuf};
 
 use gyrotherm_core::compensator::{HIDDEN, LSTM_INPUTS};
+use gyrotherm_core::coverage::{MAX_RATE_CELLS, MAX_TEMP_CELLS};
 use gyrotherm_core::features::MAX_FEATURES;
-use gyrotherm_core::static_model::{StaticBaseline, StaticLstm, StaticModel, StaticTarget};
+use gyrotherm_core::static_model::{
+    StaticBaseline, StaticCoverage, StaticLstm, StaticModel, StaticTarget,
+};
 
 use crate::compensate::CompensateError;
 use crate::model::{ModelFile, ModelFileError, SubModel, Target, CHECKSUM_KEY};
@@ -127,7 +130,31 @@ pub fn static_model(model: &ModelFile) -> Result<StaticModel, ExportError> {
         limits,
         bias: target(model.bias.as_ref(), 0.0, Target::Bias)?,
         scale: target(model.scale.as_ref(), 1.0, Target::Scale)?,
+        coverage: static_coverage(model)?,
     })
+}
+
+/// The model's coverage map as static data, checked as `compensate` checks it (the core map
+/// is built from it, so a map the core refuses is refused here rather than in flight).
+fn static_coverage(model: &ModelFile) -> Result<Option<StaticCoverage>, ExportError> {
+    let Some(def) = &model.coverage else {
+        return Ok(None);
+    };
+    let map = def
+        .to_core()
+        .map_err(|e| ExportError::Model(ModelFileError::invalid("coverage", e.to_string())))?;
+    let grid = *map.grid();
+    let mut sigma_dph = [0.0; MAX_TEMP_CELLS * MAX_RATE_CELLS];
+    for i in 0..grid.n_temp {
+        for j in 0..grid.n_rate {
+            sigma_dph[i * grid.n_rate + j] = map.sigma_dph(i, j).unwrap_or(0.0);
+        }
+    }
+    Ok(Some(StaticCoverage {
+        grid,
+        sigma_dph,
+        growth_per_cell: map.growth_per_cell(),
+    }))
 }
 
 fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, CompensateError> {

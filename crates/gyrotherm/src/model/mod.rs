@@ -362,7 +362,7 @@ pub enum ModelFileError {
 }
 
 impl ModelFileError {
-    fn invalid(field: &str, problem: String) -> Self {
+    pub(crate) fn invalid(field: &str, problem: String) -> Self {
         ModelFileError::Invalid {
             field: field.to_owned(),
             problem,
