@@ -52,6 +52,7 @@ pub mod compare;
 pub mod compensate;
 pub mod compensate_lines;
 pub mod coverage;
+pub mod coverage_track;
 pub mod csvlog;
 pub mod export;
 pub mod features;
