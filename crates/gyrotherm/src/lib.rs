@@ -63,6 +63,7 @@ pub mod metrics;
 pub mod model;
 pub mod moving_average;
 pub mod nn;
+pub mod plan;
 pub mod report;
 pub mod settings;
 pub mod sim;
