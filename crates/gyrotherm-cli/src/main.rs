@@ -43,11 +43,14 @@ enum Command {
     Compare(cmd::compare::CompareArgs),
     /// Write an HTML report with figures for a held-out comparison.
     Report(cmd::report::ReportArgs),
+    /// What the training logs cover of a flight's (T, dT) envelope; a chamber profile that
+    /// covers it.
+    Plan(cmd::plan::PlanArgs),
     /// Check a model file, or re-seal one after a deliberate hand edit.
     Model(cmd::model::ModelArgs),
     /// Write a model as flight code: C99 or a Rust module for gyrotherm-core.
     Export(cmd::export::ExportArgs),
-    /// Every setting of train, compensate, allan and evaluate with its default and accepted
+    /// Every setting of train, compensate, allan, evaluate and plan with its default and accepted
     /// values, as JSON (the library's own description; for tests and tools).
     #[command(hide = true)]
     Settings(cmd::settings::SettingsArgs),
@@ -67,6 +70,7 @@ fn main() -> ExitCode {
         Command::Compensate(a) => cmd::compensate::run(a),
         Command::Compare(a) => cmd::compare::run(a),
         Command::Report(a) => cmd::report::run(a),
+        Command::Plan(a) => cmd::plan::run(a),
         Command::Model(a) => cmd::model::run(a),
         Command::Export(a) => cmd::export::run(a),
         Command::Settings(a) => cmd::settings::run(a),

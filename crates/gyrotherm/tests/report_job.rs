@@ -81,7 +81,7 @@ fn sim_profile(profile: Profile, seed: u64, table: bool) -> TestLog {
 
 /// Figure sizes stated in `report::figures` (1000 wide; 600 high for one panel, 800 for two;
 /// figure 6 is 400 per panel, two panels for ±20 °/s).
-const STATED_SIZE: [(u32, u32); 8] = [
+const STATED_SIZE: [(u32, u32); 10] = [
     (1000, 800),
     (1000, 600),
     (1000, 600),
@@ -90,6 +90,8 @@ const STATED_SIZE: [(u32, u32); 8] = [
     (1000, 800),
     (1000, 600),
     (1000, 600),
+    (1000, 600),
+    (1000, 800),
 ];
 
 fn check_png(path: &Path, want: (u32, u32)) {
@@ -288,7 +290,8 @@ fn figures_that_cannot_apply_are_noted_not_errors() {
     let dir = tempfile::tempdir().unwrap();
     let index = write_full_report(dir.path(), &train_n, &test_n, &cmp, &cfg).expect("report");
     let html = std::fs::read_to_string(&index).unwrap();
-    let drawn = [0usize, 1, 6, 7];
+    // The coverage figures need only a model with a least-squares bias: both have maps.
+    let drawn = [0usize, 1, 6, 7, 8, 9];
     for (k, (stem, size)) in FIGURE_STEMS.iter().zip(STATED_SIZE).enumerate() {
         let png = dir.path().join(format!("{stem}.png"));
         if drawn.contains(&k) {
@@ -445,6 +448,46 @@ fn extrapolation_is_said_once_naming_the_models() {
         );
     }
     check_input_names(&table_row(&models, "inputs")[1..]);
+
+    // The coverage figure marks the hotter, faster run's excursions outside the training
+    // region in their own colour, and its caption gives the share the track counts.
+    let t = gyrotherm::coverage_track::track(&cmp.fits[1].model, &test[0].1)
+        .unwrap()
+        .expect("poly has a coverage map");
+    let outside = t.shares().unwrap()[2];
+    assert!(outside > 0.05, "the wide run leaves the region: {outside}");
+    assert!(
+        html.contains(&format!("{:.1} % outside", 100.0 * outside)),
+        "caption lacks the outside share {outside}"
+    );
+    let red = count_colour(
+        &dir.path().join("fig9_coverage.png"),
+        gyrotherm::report::coverage_figures::OUTSIDE,
+    );
+    assert!(red > 100, "outside stretch not drawn: {red} px");
+    // Tested on the training cycle (another run): less of it outside. Not none: a 3900 s log
+    // fills only a few of the 16 × 12 cells with the 100 steps a covered cell needs.
+    let same = vec![("same.csv".to_owned(), sim(12, false))];
+    let same_n = named(&same);
+    let cmp = run_compare(&train_n, &same_n, &cfg);
+    let dir = tempfile::tempdir().unwrap();
+    write_full_report(dir.path(), &train_n, &same_n, &cmp, &cfg).expect("report");
+    let t = gyrotherm::coverage_track::track(&cmp.fits[1].model, &same[0].1)
+        .unwrap()
+        .unwrap();
+    let same_outside = t.shares().unwrap()[2];
+    assert!(
+        same_outside + 0.2 < outside,
+        "same cycle {same_outside} against the wide one {outside}"
+    );
+}
+
+/// Pixels of exactly `rgb` in the PNG at `path`.
+fn count_colour(path: &Path, rgb: (u8, u8, u8)) -> usize {
+    let img = image::open(path).unwrap().to_rgb8();
+    img.pixels()
+        .filter(|p| p.0 == [rgb.0, rgb.1, rgb.2])
+        .count()
 }
 
 #[test]

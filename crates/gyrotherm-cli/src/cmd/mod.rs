@@ -10,6 +10,7 @@ pub mod evaluate;
 pub mod export;
 pub mod lot;
 pub mod model;
+pub mod plan;
 pub mod progress;
 pub mod report;
 pub mod settings;

@@ -5,14 +5,17 @@
 //! - `plot`: the generic plot writer ([`write_figure`]: time series, x-y, log-log; one or
 //!   more stacked panels, each legend below its panel so it hides no data), written as PNG
 //!   and SVG of a stated size, atomically.
-//! - [`figures`]: the eight named figures of the report and the Allan figure that
+//! - [`figures`]: the eight figures of the report after He et al. and the Allan figure that
 //!   `gyrotherm allan --plot` reuses, each a function over plain data.
+//! - [`coverage_figures`]: the training region with a held-out run over it, and the 1σ
+//!   estimate beside the residual.
 //! - [`html`]: `DIR/index.html`, self-contained (inline CSS, no script, no network).
 //! - `job`: the full report of a held-out comparison ([`write_full_report`], used by
 //!   `gyrotherm report`), from the logs and a [`crate::compare::Comparison`].
 //! - `decimate`: min/max per pixel column, so long runs draw fast without losing extremes.
 //! - `font`: the embedded DejaVu Sans font; no system font or graphics library is used.
 
+pub mod coverage_figures;
 pub(crate) mod decimate;
 pub mod figures;
 pub(crate) mod font;

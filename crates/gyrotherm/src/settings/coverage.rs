@@ -5,6 +5,16 @@
 //! [`SIGMA_SCALE`] and [`GROWTH_PER_CELL`] were chosen on the design family of simulated
 //! units (unit seeds 1000-1029) and measured once on the confirmation family (5000-5029):
 //! `docs/experiments/coverage.md`.
+//!
+//! None of these is a user option, so none is listed in [`super::describe`]: `train` always
+//! maps with [`CoverageSettings::default`]. The σ scale and the growth were calibrated on
+//! held-out runs *with this grid, these folds, this cell minimum and this shrinkage*; a user
+//! changing any one of them would get a σ whose ±1σ share nobody has measured, and a map a
+//! flight reader cannot compare with another model's. The struct keeps them together for
+//! [`crate::coverage::cross_validated`] and its tests; the calibration harness
+//! (`crates/gyrotherm-experiments/src/bin/coverage.rs`) varies scale and growth on the
+//! design family only, through [`crate::coverage::CoverageDef::rescaled`]. A change of any
+//! constant here needs that record re-run (`bench/coverage.sh design`, then `confirm` once).
 
 /// Temperature cells of the grid (the core's maximum).
 pub const TEMP_CELLS: usize = gyrotherm_core::coverage::MAX_TEMP_CELLS;

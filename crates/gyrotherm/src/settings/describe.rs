@@ -128,8 +128,27 @@ pub fn evaluate_options() -> Vec<OptionSpec> {
     ]
 }
 
+/// The settings of `plan` (the flight log is a setting: the envelope comes from it).
+pub fn plan_options() -> Vec<OptionSpec> {
+    let d = super::plan::PlanSettings::default();
+    let num = |v: Option<f64>| v.map(|v| v.to_string());
+    vec![
+        opt("flight", None),
+        opt("temp_min_c", num(d.temp_min_c)),
+        opt("temp_max_c", num(d.temp_max_c)),
+        opt("max_rate_c_per_min", num(d.max_rate_c_per_min)),
+        opt("chamber_min_c", num(Some(d.chamber_min_c))),
+        opt("chamber_max_c", num(Some(d.chamber_max_c))),
+        opt(
+            "chamber_max_rate_c_per_min",
+            num(Some(d.chamber_max_rate_c_per_min)),
+        ),
+    ]
+}
+
 /// Every job's settings: `train` (fit, sensor limits and log options), `compensate` (log
-/// options; the sensor limits come from the model), `allan` and `evaluate` (theirs and the log options).
+/// options; the sensor limits come from the model), `allan`, `evaluate` and `plan` (theirs and the
+/// log options).
 pub fn describe() -> Vec<(&'static str, Vec<OptionSpec>)> {
     let with_log = |mut v: Vec<OptionSpec>| {
         v.extend(log_options());
@@ -143,6 +162,7 @@ pub fn describe() -> Vec<(&'static str, Vec<OptionSpec>)> {
         ("compensate", log_options()),
         ("allan", with_log(allan_options())),
         ("evaluate", with_log(evaluate_options())),
+        ("plan", with_log(plan_options())),
     ]
 }
 

@@ -18,6 +18,8 @@
 //!   ([`TempSensorDef`](crate::model::TempSensorDef)).
 //! - [`coverage`]: the training-region map and the 1σ estimate `train` stores
 //!   ([`CoverageSettings`](coverage::CoverageSettings)).
+//! - [`plan`]: the flight envelope and the chamber's limits of `gyrotherm plan`
+//!   ([`PlanSettings`](plan::PlanSettings)).
 //! - [`describe`](mod@describe): every setting of every job with its default and accepted values, as the
 //!   hidden `gyrotherm settings --json` prints it and the Python package exposes it, so
 //!   their equality can be tested.
@@ -29,6 +31,7 @@ pub mod describe;
 pub mod evaluate;
 pub mod fit;
 pub mod method;
+pub mod plan;
 pub mod read;
 
 pub use allan::{AllanAnalysis, AllanSettings};
@@ -55,6 +58,10 @@ pub enum Rule {
     NoiseAlpha,
     /// A number at all.
     Number,
+    /// Finite and > 0 (a rate, °C/min).
+    PositiveRate,
+    /// Finite (a temperature, °C).
+    Finite,
 }
 
 impl Rule {
@@ -73,6 +80,8 @@ impl Rule {
                  Hadamard only)"
             }
             Rule::Number => "is not a number",
+            Rule::PositiveRate => "is not a positive rate (°C/min)",
+            Rule::Finite => "is not a finite number",
         }
     }
 
@@ -84,6 +93,8 @@ impl Rule {
             Rule::AtLeastOne => v >= 1.0,
             Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
             Rule::Number => true,
+            Rule::PositiveRate => v.is_finite() && v > 0.0,
+            Rule::Finite => v.is_finite(),
         }
     }
 }

@@ -1,4 +1,4 @@
-//! The full report of a held-out comparison (`gyrotherm report`): the eight figures
+//! The full report of a held-out comparison (`gyrotherm report`): the ten figures
 //! ([`FIGURE_STEMS`]) computed from the logs and the [`Comparison`], the comparison table, the model
 //! metadata and the warnings, written as `DIR/index.html` beside one PNG and SVG per figure.
 //!
@@ -7,10 +7,13 @@
 //!
 //! Which log each figure shows: figures 1, 2 and 7 the first static held-out log (else the
 //! first held-out log), figures 4 and 8 the first static held-out log, figures 5 and 6 the
-//! first rate-table held-out log. "Compensated" means the LSTM model's output through the
-//! flight compensator (`MethodResult::compensated`).
+//! first rate-table held-out log, figure 9 the main log (as figure 1) and figure 10 the
+//! first static held-out log, both under the coverage map of the model the report is about.
+//! "Compensated" means the LSTM model's output through the flight compensator
+//! (`MethodResult::compensated`).
 
 mod allan_figure;
+mod coverage;
 mod rate_table;
 mod tables;
 mod warnings;
@@ -47,7 +50,7 @@ const TEMP_RATE_SMOOTHING_S: f64 = 100.0;
 const TEMP_RATE_HALF_SPAN_S: f64 = 5.0;
 
 /// File stems of the figures, in report order.
-pub const FIGURE_STEMS: [&str; 8] = [
+pub const FIGURE_STEMS: [&str; 10] = [
     "fig1_temperature",
     "fig2_raw_output",
     "fig3_training_loss",
@@ -56,6 +59,8 @@ pub const FIGURE_STEMS: [&str; 8] = [
     "fig6_rate_table",
     "fig7_compensation",
     "fig8_allan",
+    "fig9_coverage",
+    "fig10_sigma",
 ];
 
 /// [`write_full_report_with`] without extra warnings.
@@ -113,6 +118,7 @@ pub fn write_full_report_with(
     fig_rate_table(&mut b, table_pair, cfg)?;
     fig_before_after(&mut b, main_pair)?;
     fig_allan(&mut b, static_pair)?;
+    coverage::coverage_figures(&mut b, main_pair, static_pair, cmp)?;
 
     let mut warnings = grouped_warnings(test, cmp);
     warnings.extend(extra_warnings.iter().cloned());
@@ -409,6 +415,8 @@ impl Builder<'_> {
             "output at the table rates",
             "output before and after compensation",
             "Allan deviation",
+            "coverage of the training region",
+            "residual and its 1σ estimate",
         ];
         self.notes.push(format!(
             "Figure {number} ({}) not drawn: {why}.",

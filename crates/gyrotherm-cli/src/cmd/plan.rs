@@ -1,0 +1,149 @@
+//! `gyrotherm plan`: what the training logs cover of a flight's envelope and a chamber
+//! profile that covers it (`gyrotherm::plan`; this file only translates).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use gyrotherm::plan::{propose, resolve_envelope, training_coverage, Step};
+use gyrotherm::settings::plan::{self as defaults, PlanSettings};
+
+use super::common::{named, read_log_reporting, read_logs, LogArgs};
+
+#[derive(Debug, clap::Args)]
+pub struct PlanArgs {
+    /// Flight log (CSV): its sensor temperature's extremes and largest |dT| are the envelope.
+    #[arg(long, value_name = "FLIGHT.csv")]
+    pub flight: Option<PathBuf>,
+    /// Envelope's coldest temperature, °C (instead of the flight log's).
+    #[arg(long, value_name = "C", allow_hyphen_values = true)]
+    pub temp_min_c: Option<f64>,
+    /// Envelope's hottest temperature, °C (instead of the flight log's).
+    #[arg(long, value_name = "C", allow_hyphen_values = true)]
+    pub temp_max_c: Option<f64>,
+    /// Envelope's largest |dT|, °C/min (instead of the flight log's).
+    #[arg(long, value_name = "C_PER_MIN")]
+    pub max_rate_c_per_min: Option<f64>,
+    /// The chamber's coldest set point, °C.
+    #[arg(long, value_name = "C", allow_hyphen_values = true, default_value_t = defaults::CHAMBER_MIN_C)]
+    pub chamber_min_c: f64,
+    /// The chamber's hottest set point, °C.
+    #[arg(long, value_name = "C", allow_hyphen_values = true, default_value_t = defaults::CHAMBER_MAX_C)]
+    pub chamber_max_c: f64,
+    /// The chamber's fastest ramp, °C/min.
+    #[arg(long, value_name = "C_PER_MIN", default_value_t = defaults::CHAMBER_MAX_RATE_C_PER_MIN)]
+    pub chamber_max_rate_c_per_min: f64,
+    /// Training log so far (CSV); repeat for several. Without one, only the profile.
+    #[arg(long)]
+    pub input: Vec<PathBuf>,
+    /// Write the proposed profile here, as `simulate --profile-file` reads it.
+    #[arg(long, value_name = "PROFILE.txt")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub log: LogArgs,
+}
+
+pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
+    let s = PlanSettings {
+        temp_min_c: args.temp_min_c,
+        temp_max_c: args.temp_max_c,
+        max_rate_c_per_min: args.max_rate_c_per_min,
+        chamber_min_c: args.chamber_min_c,
+        chamber_max_c: args.chamber_max_c,
+        chamber_max_rate_c_per_min: args.chamber_max_rate_c_per_min,
+    };
+    let flight = args
+        .flight
+        .as_deref()
+        .map(|p| read_log_reporting(p, &args.log))
+        .transpose()?;
+    let env = resolve_envelope(flight.as_ref(), &s)?;
+    println!(
+        "envelope: {:.1} to {:.1} °C, |dT| up to {:.2} °C/min{}",
+        env.temp_min_c,
+        env.temp_max_c,
+        env.max_rate_c_per_min,
+        if flight.is_some() {
+            " (flight log)"
+        } else {
+            ""
+        }
+    );
+    println!(
+        "chamber: {} to {} °C, ramps up to {} °C/min",
+        s.chamber_min_c, s.chamber_max_c, s.chamber_max_rate_c_per_min
+    );
+    if !args.input.is_empty() {
+        let mut warnings = Vec::new();
+        let train = read_logs(&args.input, &args.log, &mut warnings)?;
+        match training_coverage(&named(&train), flight.as_ref(), &env)? {
+            Err(why) => println!("training coverage: none: {why}"),
+            Ok(c) => {
+                println!(
+                    "training covers {} of {} (T, dT) cells: {:.1} to {:.1} °C, {:.2} to {:.2} \
+                     °C/min",
+                    c.covered_cells,
+                    c.cells,
+                    c.temp_span_c.0,
+                    c.temp_span_c.1,
+                    c.rate_span_c_per_min.0,
+                    c.rate_span_c_per_min.1
+                );
+                if let Some([inside, edge, outside]) = c.flight_shares {
+                    println!(
+                        "flight: {:.1} % of samples inside, {:.1} % at the edge, {:.1} % outside",
+                        100.0 * inside,
+                        100.0 * edge,
+                        100.0 * outside
+                    );
+                }
+                println!(
+                    "envelope (temperature × ±rate): {:.1} % outside",
+                    100.0 * c.envelope_outside
+                );
+            }
+        }
+    }
+    let plan = propose(&env, &s)?;
+    for n in &plan.notes {
+        eprintln!("gyrotherm: warning: {n}");
+    }
+    println!(
+        "proposed profile: {:.1} to {:.1} °C; ramps at {}; {:.0} s ({:.1} h)",
+        plan.temp_lo_c,
+        plan.temp_hi_c,
+        plan.rates_c_per_min
+            .iter()
+            .map(|(r, n)| format!("{r:.2} °C/min ×{n}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        plan.duration_s(),
+        plan.duration_s() / 3600.0
+    );
+    println!(
+        "{:>4}  {:<5} {:>8} {:>8} {:>10} {:>10}",
+        "#", "step", "from °C", "to °C", "°C/min", "s"
+    );
+    for (i, seg) in plan.segments.iter().enumerate() {
+        let step = match seg.step {
+            Step::Hold => "hold",
+            Step::Ramp => "ramp",
+            Step::Soak => "soak",
+        };
+        println!(
+            "{:>4}  {:<5} {:>8.1} {:>8.1} {:>10.2} {:>10.0}",
+            i + 1,
+            step,
+            seg.from_c,
+            seg.to_c,
+            seg.rate_c_per_min,
+            seg.duration_s
+        );
+    }
+    if let Some(out) = &args.out {
+        gyrotherm::atomic_file::write_bytes_atomically(out, plan.profile_text().as_bytes())
+            .with_context(|| format!("cannot write {}", out.display()))?;
+        println!("wrote {}", out.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}

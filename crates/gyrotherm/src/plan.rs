@@ -1,0 +1,349 @@
+//! `gyrotherm plan`: what the training logs so far cover of a flight's (T, dT) envelope, and
+//! a chamber profile that covers the rest.
+//!
+//! **Coverage.** The training logs are fitted as `train` fits them by default
+//! ([`crate::settings::DEFAULT_METHOD`]); the fit's coverage map
+//! ([`crate::coverage`]) is the region they cover. Against it: the flight log's samples,
+//! stepped as `compensate` steps them ([`crate::coverage_track`]), and a 41 × 41 lattice
+//! over the envelope's rectangle (temperature × ±rate).
+//!
+//! **Profile.** A deliberately simple design (constants in [`crate::settings::plan`]):
+//! from room temperature, ramp to the envelope's hot end and soak; then at each of
+//! [`RATE_LEVELS`](crate::settings::plan::RATE_LEVELS) rates `R·k/levels` (slowest first, R
+//! the flight's largest |dT| with a margin, at most the chamber's), ramp cold, soak, ramp
+//! hot, soak, repeated until every temperature cell of the coverage grid holds
+//! [`MIN_CELL_S`](crate::settings::plan::MIN_CELL_S) seconds of each ramp direction; back to
+//! room. The envelope is the flight's temperature extremes widened by
+//! [`TEMP_MARGIN_C`](crate::settings::plan::TEMP_MARGIN_C), clipped to the chamber's range.
+//! Down- and up-ramps give −r and +r, the soaks 0: the rate rows of the grid between levels
+//! are at most one cell from a covered one.
+
+use std::fmt;
+
+use crate::coverage_track::track;
+use crate::csvlog::TestLog;
+use crate::fit::{fit_model, FitConfig, FitError, NamedLog};
+use crate::settings::coverage::TEMP_CELLS;
+use crate::settings::plan::{
+    PlanSettings, MIN_CELL_S, RATE_LEVELS, RATE_MARGIN, ROOM_C, SOAK_S, TEMP_MARGIN_C,
+};
+use crate::settings::SettingError;
+use crate::sim::{Profile, Segment};
+
+/// The flight's envelope: temperature extremes (°C) and largest |dT| (°C/min).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Envelope {
+    pub temp_min_c: f64,
+    pub temp_max_c: f64,
+    pub max_rate_c_per_min: f64,
+}
+
+/// Why no plan was made.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum PlanError {
+    /// A setting breaks its rule.
+    Setting(SettingError),
+    /// No flight log and an incomplete envelope.
+    NoEnvelope,
+    /// The flight log has no finite temperature.
+    EmptyFlight,
+    /// Fitting the training logs failed.
+    Fit(FitError),
+    /// Stepping a log through the fitted model failed.
+    Compensate(crate::compensate::CompensateError),
+    /// The fit's coverage map is refused by the flight crate.
+    Coverage(gyrotherm_core::coverage::CoverageError),
+}
+
+impl fmt::Display for PlanError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PlanError::Setting(e) => e.fmt(f),
+            PlanError::NoEnvelope => f.write_str(
+                "no envelope: give a flight log (--flight) or all of --temp-min-c, --temp-max-c \
+                 and --max-rate-c-per-min",
+            ),
+            PlanError::EmptyFlight => f.write_str("the flight log has no finite temperature"),
+            PlanError::Fit(_) => f.write_str("fitting the training logs"),
+            PlanError::Compensate(_) => f.write_str("stepping the flight through the fit"),
+            PlanError::Coverage(e) => write!(f, "the fit's coverage map: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for PlanError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            PlanError::Setting(e) => Some(e),
+            PlanError::Fit(e) => Some(e),
+            PlanError::Compensate(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// The envelope of a flight log: its sensor temperature's extremes and the largest |rate|
+/// of the report's temperature rate (100 s smoothing, so the sensor's 0.0625 °C steps do not
+/// read as rates; [`crate::report::temperature_rate_c_per_min`]).
+pub fn envelope_of(log: &TestLog) -> Result<Envelope, PlanError> {
+    let finite = || log.temp_c.iter().copied().filter(|t| t.is_finite());
+    let lo = finite().fold(f64::INFINITY, f64::min);
+    let hi = finite().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(PlanError::EmptyFlight);
+    }
+    let rate = crate::report::temperature_rate_c_per_min(&log.time_s, &log.temp_c)
+        .into_iter()
+        .filter(|r| r.is_finite())
+        .fold(0.0f64, |m, r| m.max(r.abs()));
+    Ok(Envelope {
+        temp_min_c: lo,
+        temp_max_c: hi,
+        max_rate_c_per_min: rate,
+    })
+}
+
+/// The envelope to plan for: the settings' values where given, else the flight's.
+pub fn resolve_envelope(flight: Option<&TestLog>, s: &PlanSettings) -> Result<Envelope, PlanError> {
+    s.validate().map_err(PlanError::Setting)?;
+    let from_flight = flight.map(envelope_of).transpose()?;
+    let pick = |given: Option<f64>, f: fn(&Envelope) -> f64| {
+        given
+            .or(from_flight.as_ref().map(f))
+            .ok_or(PlanError::NoEnvelope)
+    };
+    Ok(Envelope {
+        temp_min_c: pick(s.temp_min_c, |e| e.temp_min_c)?,
+        temp_max_c: pick(s.temp_max_c, |e| e.temp_max_c)?,
+        max_rate_c_per_min: pick(s.max_rate_c_per_min, |e| e.max_rate_c_per_min)?,
+    })
+}
+
+/// What the training logs cover.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoverageSummary {
+    /// Covered cells and all cells of the grid.
+    pub covered_cells: usize,
+    pub cells: usize,
+    /// The covered cells' span: temperature (°C) and rate (°C/min).
+    pub temp_span_c: (f64, f64),
+    pub rate_span_c_per_min: (f64, f64),
+    /// The flight's samples inside, at the edge and outside (None without a flight log).
+    pub flight_shares: Option<[f64; 3]>,
+    /// Share of the envelope's rectangle (41 × 41 lattice) outside.
+    pub envelope_outside: f64,
+}
+
+/// The coverage of `train` against the flight and the envelope; None when the fit carries no
+/// coverage map (the reason is `FitOutcome::coverage_note`'s, returned as the error text).
+pub fn training_coverage(
+    train: &[NamedLog],
+    flight: Option<&TestLog>,
+    env: &Envelope,
+) -> Result<Result<CoverageSummary, String>, PlanError> {
+    let fit = fit_model(
+        train,
+        &FitConfig::new(crate::settings::DEFAULT_METHOD),
+        &|_, _, _| {},
+    )
+    .map_err(PlanError::Fit)?;
+    let Some(def) = fit.model.coverage.as_ref() else {
+        return Ok(Err(fit
+            .coverage_note
+            .unwrap_or_else(|| "the fit has no coverage map".to_owned())));
+    };
+    let cells = crate::coverage_track::covered_cells(def);
+    let span = |f: fn(&crate::coverage_track::CoveredCell) -> (f64, f64)| {
+        cells
+            .iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (l, h)| {
+                (a.min(l), b.max(h))
+            })
+    };
+    let (r0, r1) = span(|c| c.rate_c_per_s);
+    let flight_shares = match flight {
+        Some(log) => track(&fit.model, log)
+            .map_err(PlanError::Compensate)?
+            .and_then(|t| t.shares()),
+        None => None,
+    };
+    let map = def.to_core().map_err(PlanError::Coverage)?;
+    const N: usize = 41;
+    let mut outside = 0usize;
+    for i in 0..N {
+        let t = env.temp_min_c + (env.temp_max_c - env.temp_min_c) * i as f64 / (N - 1) as f64;
+        for j in 0..N {
+            let r = env.max_rate_c_per_min * (2.0 * j as f64 / (N - 1) as f64 - 1.0) / 60.0;
+            if map.verdict(t, r).coverage == gyrotherm_core::coverage::Coverage::Outside {
+                outside += 1;
+            }
+        }
+    }
+    Ok(Ok(CoverageSummary {
+        covered_cells: cells.len(),
+        cells: def.n_temp * def.n_rate,
+        temp_span_c: span(|c| c.temp_c),
+        rate_span_c_per_min: (60.0 * r0, 60.0 * r1),
+        flight_shares,
+        envelope_outside: outside as f64 / (N * N) as f64,
+    }))
+}
+
+/// What a segment of the proposed profile does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Step {
+    Hold,
+    Ramp,
+    Soak,
+}
+
+/// One row of the proposed profile, for the table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlannedSegment {
+    pub step: Step,
+    pub from_c: f64,
+    pub to_c: f64,
+    /// Set-point rate, °C/min (0 for holds and soaks).
+    pub rate_c_per_min: f64,
+    pub duration_s: f64,
+}
+
+/// The proposed profile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// The temperatures and the rate the profile spans (the envelope widened, clipped).
+    pub temp_lo_c: f64,
+    pub temp_hi_c: f64,
+    pub max_rate_c_per_min: f64,
+    /// Rates of the ramps, °C/min, slowest first, and each one's repetitions.
+    pub rates_c_per_min: Vec<(f64, usize)>,
+    pub segments: Vec<PlannedSegment>,
+    /// What the chamber's limits cut from the envelope.
+    pub notes: Vec<String>,
+}
+
+impl Plan {
+    /// Total duration, s.
+    pub fn duration_s(&self) -> f64 {
+        self.segments.iter().map(|s| s.duration_s).sum()
+    }
+
+    /// The profile as `simulate --profile-file` reads it ([`Profile::parse`]).
+    pub fn profile_text(&self) -> String {
+        let mut out = String::from(
+            "# gyrotherm plan: chamber set point, one segment per row (see gyrotherm::plan)\n\
+             duration_s,target_c\n",
+        );
+        for s in &self.segments {
+            out.push_str(&format!("{},{}\n", round3(s.duration_s), round3(s.to_c)));
+        }
+        out
+    }
+
+    /// The profile as the simulator's.
+    pub fn profile(&self) -> Profile {
+        Profile {
+            name: "plan".into(),
+            start_c: self.segments.first().map_or(ROOM_C, |s| s.to_c),
+            segments: self
+                .segments
+                .iter()
+                .map(|s| Segment {
+                    duration_s: round3(s.duration_s),
+                    target_c: round3(s.to_c),
+                })
+                .collect(),
+        }
+    }
+}
+
+fn round3(v: f64) -> f64 {
+    (v * 1000.0).round() / 1000.0
+}
+
+/// The chamber profile for `env` under the chamber limits of `s` (see the module doc).
+pub fn propose(env: &Envelope, s: &PlanSettings) -> Result<Plan, PlanError> {
+    s.validate().map_err(PlanError::Setting)?;
+    let mut notes = Vec::new();
+    let want_lo = env.temp_min_c - TEMP_MARGIN_C;
+    let want_hi = env.temp_max_c + TEMP_MARGIN_C;
+    let want_rate = env.max_rate_c_per_min * RATE_MARGIN;
+    let lo = want_lo.max(s.chamber_min_c);
+    let hi = want_hi.min(s.chamber_max_c);
+    let rate = want_rate.min(s.chamber_max_rate_c_per_min);
+    if lo > want_lo {
+        notes.push(format!(
+            "the chamber's coldest set point {} °C is above the envelope's {want_lo:.1} °C: \
+             the coldest part stays outside coverage",
+            s.chamber_min_c
+        ));
+    }
+    if hi < want_hi {
+        notes.push(format!(
+            "the chamber's hottest set point {} °C is below the envelope's {want_hi:.1} °C: \
+             the hottest part stays outside coverage",
+            s.chamber_max_c
+        ));
+    }
+    if rate < want_rate {
+        notes.push(format!(
+            "the chamber's fastest ramp {} °C/min is below the envelope's {want_rate:.2} \
+             °C/min: the fastest rates stay outside coverage",
+            s.chamber_max_rate_c_per_min
+        ));
+    }
+    let (lo, hi) = if lo < hi { (lo, hi) } else { (hi - 1.0, hi) };
+    let span = hi - lo;
+    let mut segments = vec![PlannedSegment {
+        step: Step::Hold,
+        from_c: ROOM_C,
+        to_c: ROOM_C,
+        rate_c_per_min: 0.0,
+        duration_s: SOAK_S,
+    }];
+    let mut at = ROOM_C;
+    let mut go = |to: f64, r: f64, segments: &mut Vec<PlannedSegment>| {
+        if (to - at).abs() > 0.0 {
+            segments.push(PlannedSegment {
+                step: Step::Ramp,
+                from_c: at,
+                to_c: to,
+                rate_c_per_min: r,
+                duration_s: (to - at).abs() / r * 60.0,
+            });
+        }
+        segments.push(PlannedSegment {
+            step: Step::Soak,
+            from_c: to,
+            to_c: to,
+            rate_c_per_min: 0.0,
+            duration_s: SOAK_S,
+        });
+        at = to;
+    };
+    let slowest = rate / RATE_LEVELS as f64;
+    go(hi, slowest, &mut segments);
+    let mut rates = Vec::new();
+    for k in 1..=RATE_LEVELS {
+        let r = rate * k as f64 / RATE_LEVELS as f64;
+        // Seconds a ramp at r spends in one temperature cell of the grid.
+        let cell_s = span / TEMP_CELLS as f64 / r * 60.0;
+        let reps = ((MIN_CELL_S / cell_s).ceil() as usize).max(1);
+        rates.push((r, reps));
+        for _ in 0..reps {
+            go(lo, r, &mut segments);
+            go(hi, r, &mut segments);
+        }
+    }
+    go(ROOM_C.clamp(lo, hi), slowest, &mut segments);
+    Ok(Plan {
+        temp_lo_c: lo,
+        temp_hi_c: hi,
+        max_rate_c_per_min: rate,
+        rates_c_per_min: rates,
+        segments,
+        notes,
+    })
+}

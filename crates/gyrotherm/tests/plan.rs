@@ -1,0 +1,91 @@
+//! `gyrotherm::plan` on simulated logs: trained on the published shock test alone, the
+//! airborne flight (a built-in profile: a 9.5 °C/min climb to −45 °C) leaves the training
+//! region; the profile `plan` proposes, simulated as `simulate --profile-file` simulates it,
+//! brings the flight inside. The numbers of the run (same seeds, CLI) are in
+//! docs/experiments/plan.md.
+
+use gyrotherm::csvlog::TestLog;
+use gyrotherm::fit::NamedLog;
+use gyrotherm::plan::{propose, resolve_envelope, training_coverage, CoverageSummary};
+use gyrotherm::settings::plan::PlanSettings;
+use gyrotherm::sim::{simulate, Profile, SimConfig};
+
+fn sim(profile: Profile, seed: u64) -> TestLog {
+    let mut cfg = SimConfig::new(profile);
+    cfg.seed = seed;
+    simulate(&cfg).expect("simulate")
+}
+
+fn coverage(train: &[(&str, &TestLog)], flight: &TestLog, s: &PlanSettings) -> CoverageSummary {
+    let named: Vec<NamedLog> = train
+        .iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect();
+    let env = resolve_envelope(Some(flight), s).unwrap();
+    training_coverage(&named, Some(flight), &env)
+        .unwrap()
+        .expect("a thermal fit has a coverage map")
+}
+
+#[test]
+fn the_planned_profile_brings_the_flight_inside_coverage() {
+    let shock = sim(Profile::builtin("seed-shock").unwrap(), 1);
+    let flight = sim(Profile::builtin("airborne").unwrap(), 3);
+    let s = PlanSettings::default();
+    let before = coverage(&[("shock", &shock)], &flight, &s);
+    let [_, _, out_before] = before.flight_shares.unwrap();
+
+    let env = resolve_envelope(Some(&flight), &s).unwrap();
+    let plan = propose(&env, &s).unwrap();
+    // The file `plan --out` writes reads back as the profile simulated here.
+    let text = plan.profile_text();
+    let parsed = Profile::parse(&text, "plan.txt").unwrap();
+    assert_eq!(parsed.segments, plan.profile().segments);
+    let planned = sim(parsed, 4);
+
+    let after = coverage(&[("shock", &shock), ("plan", &planned)], &flight, &s);
+    let [inside_after, _, out_after] = after.flight_shares.unwrap();
+    assert!(
+        out_before > 0.03,
+        "the shock test alone leaves the climb outside: {out_before}"
+    );
+    assert!(
+        out_after < 0.2 * out_before,
+        "outside {out_before} → {out_after}"
+    );
+    assert!(inside_after > 0.5, "inside after the plan: {inside_after}");
+    assert!(
+        after.envelope_outside < 0.5 * before.envelope_outside,
+        "envelope outside {} → {}",
+        before.envelope_outside,
+        after.envelope_outside
+    );
+    // The covered rates reach the flight's.
+    assert!(after.rate_span_c_per_min.0 <= -env.max_rate_c_per_min);
+    assert!(after.rate_span_c_per_min.1 >= env.max_rate_c_per_min);
+}
+
+#[test]
+fn the_chamber_limits_bound_the_profile_and_are_said() {
+    let s = PlanSettings {
+        temp_min_c: Some(-70.0),
+        temp_max_c: Some(60.0),
+        max_rate_c_per_min: Some(20.0),
+        ..PlanSettings::default()
+    };
+    let env = resolve_envelope(None, &s).unwrap();
+    let plan = propose(&env, &s).unwrap();
+    assert_eq!(plan.temp_lo_c, s.chamber_min_c);
+    assert_eq!(plan.max_rate_c_per_min, s.chamber_max_rate_c_per_min);
+    assert_eq!(plan.notes.len(), 2, "{:?}", plan.notes);
+    for seg in &plan.segments {
+        assert!(seg.rate_c_per_min <= s.chamber_max_rate_c_per_min + 1e-9);
+        assert!(seg.to_c >= s.chamber_min_c && seg.to_c <= s.chamber_max_c);
+    }
+    // Neither a flight log nor a full envelope: refused.
+    let partial = PlanSettings {
+        max_rate_c_per_min: None,
+        ..s
+    };
+    assert!(resolve_envelope(None, &partial).is_err());
+}
