@@ -21,6 +21,7 @@
 //!   their equality can be tested.
 
 pub mod allan;
+pub mod columns;
 pub mod compensate;
 pub mod describe;
 pub mod evaluate;
@@ -52,6 +53,8 @@ pub enum Rule {
     NoiseAlpha,
     /// A number at all.
     Number,
+    /// A list of column names (one, or several separated by commas).
+    ColumnList,
 }
 
 impl Rule {
@@ -70,6 +73,10 @@ impl Rule {
                  Hadamard only)"
             }
             Rule::Number => "is not a number",
+            Rule::ColumnList => {
+                "is not a list of column names: give one name, or distinct names separated by \
+                 commas"
+            }
         }
     }
 
@@ -80,7 +87,7 @@ impl Rule {
             Rule::NonNegativeSeconds => v.is_finite() && v >= 0.0,
             Rule::AtLeastOne => v >= 1.0,
             Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
-            Rule::Number => true,
+            Rule::Number | Rule::ColumnList => true,
         }
     }
 }
