@@ -55,6 +55,7 @@ pub mod csvlog;
 pub mod export;
 pub mod features;
 pub mod fit;
+pub mod imu_model;
 pub mod json_keys;
 pub mod metrics;
 pub mod model;

@@ -54,6 +54,20 @@ impl ImuLog {
         self.gyro.iter().position(|g| g.name == a)
     }
 
+    /// One axis as a single-axis log without pass-through columns (what a fit reads): gyro
+    /// `axis`, temperature `temp`, the table rate only when the table turns this axis.
+    pub fn axis_data(&self, axis: usize, temp: usize) -> TestLog {
+        TestLog {
+            time_s: self.time_s.clone(),
+            gyro_dps: self.gyro[axis].values.clone(),
+            temp_c: self.temp[temp].values.clone(),
+            table_dps: (self.table_axis_index() == Some(axis))
+                .then(|| self.table.as_ref().map(|t| t.values.clone()))
+                .flatten(),
+            extra: Vec::new(),
+        }
+    }
+
     /// One axis as a single-axis log: gyro `axis` with temperature `temp`; the table rate only
     /// when the table turns this axis (for the others the run is static); the other gyro and
     /// temperature columns and the pass-through ones as pass-through text.
