@@ -17,12 +17,18 @@ pub struct LogArgs {
     /// Header of the time column (seconds).
     #[arg(long, value_name = "NAME", default_value = csvlog::TIME_COL)]
     pub time_col: String,
-    /// Header of the gyro-output column (unit: --gyro-unit).
-    #[arg(long, value_name = "NAME", default_value = csvlog::GYRO_COL)]
+    /// Header of the gyro-output column (unit: --gyro-unit); for an inertial unit, the gyro
+    /// columns separated by commas (`gyro_x_dps,gyro_y_dps,gyro_z_dps`).
+    #[arg(long, value_name = "NAME[,NAME...]", default_value = csvlog::GYRO_COL)]
     pub gyro_col: String,
-    /// Header of the temperature column (°C).
-    #[arg(long, value_name = "NAME", default_value = csvlog::TEMP_COL)]
+    /// Header of the temperature column (°C); for several sensors, their columns separated by
+    /// commas (`temp_case_c,temp_x_c,temp_y_c,temp_z_c`).
+    #[arg(long, value_name = "NAME[,NAME...]", default_value = csvlog::TEMP_COL)]
     pub temp_col: String,
+    /// With several gyro columns: the one the table column drives in every table log read
+    /// (default: the gyro whose output follows the table rate, found per log).
+    #[arg(long, value_name = "GYRO_COL")]
+    pub table_axis: Option<String>,
     /// Header of the rate-table column (°/s); optional unless renamed here.
     #[arg(long, value_name = "NAME", default_value = csvlog::DEFAULT_TABLE_COL)]
     pub table_col: String,

@@ -37,6 +37,9 @@ pub struct CompensateArgs {
 }
 
 pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
+    if super::imu::is_imu_model(&args.model)? {
+        return super::imu::compensate(args);
+    }
     let (model, seal) = ModelFile::load_sealed(&args.model)?;
     if let Some(w) = seal.warning(&args.model) {
         eprintln!("gyrotherm: warning: {w}");

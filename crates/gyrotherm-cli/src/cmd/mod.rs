@@ -8,6 +8,7 @@ pub mod compensate;
 pub mod demo;
 pub mod evaluate;
 pub mod export;
+pub mod imu;
 pub mod lot;
 pub mod model;
 pub mod plan;

@@ -78,6 +78,14 @@ pub struct SimulateArgs {
         allow_negative_numbers = true
     )]
     stuck_value: f64,
+    /// An inertial unit: three gyros in one housing, a sensor on the case and one beside each
+    /// coil (`time_s,gyro_x_dps,gyro_y_dps,gyro_z_dps,temp_case_c,temp_x_c,temp_y_c,temp_z_c`);
+    /// needs `--unit random --unit-seed N` (or no --unit: unit seed 0).
+    #[arg(long)]
+    imu: bool,
+    /// With --imu and --table-rate: the axis the table turns.
+    #[arg(long, default_value = "x", value_parser = ["x", "y", "z"], requires = "imu")]
+    table_axis: String,
     /// Output CSV file.
     #[arg(long, value_name = "FILE", required_unless_present_any = ["list_profiles", "print_unit"])]
     out: Option<PathBuf>,
@@ -142,7 +150,10 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         },
         ..SimConfig::new(profile)
     };
-    let out = args.out.context("--out is required")?;
+    let out = args.out.clone().context("--out is required")?;
+    if args.imu {
+        return run_imu(&args, cfg, &out);
+    }
     let log = sim::simulate(&cfg)?;
     gyrotherm::sim::fault::write_log(&out, &log)?;
     let sidecar = random.then(|| {
@@ -188,5 +199,62 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = sidecar {
         eprintln!("the drawn unit's parameters: {}", path.display());
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `simulate --imu`: the inertial unit of the unit seed (see `gyrotherm::sim::imu`).
+fn run_imu(args: &SimulateArgs, run: SimConfig, out: &std::path::Path) -> anyhow::Result<ExitCode> {
+    use gyrotherm::sim::imu;
+    let random = args.unit.as_deref() == Some(std::path::Path::new("random"));
+    anyhow::ensure!(
+        args.unit.is_none() || random,
+        "--imu draws its unit from the family: give `--unit random --unit-seed N`"
+    );
+    let unit_seed = args.unit_seed.unwrap_or(0);
+    let cfg = imu::ImuConfig {
+        unit: imu::imu_from_family(unit_seed),
+        table_axis: imu::AXIS_NAMES
+            .iter()
+            .position(|a| *a == args.table_axis)
+            .unwrap_or(0),
+        run,
+    };
+    let log = imu::simulate_imu(&cfg)?;
+    gyrotherm::csvlog::write_imu_log(out, &log)?;
+    let mut sidecar = out.to_path_buf().into_os_string();
+    sidecar.push(".unit.json");
+    let sidecar = PathBuf::from(sidecar);
+    let json = serde_json::to_string_pretty(&serde_json::json!({
+        "gyros": cfg.unit.gyros,
+        "case_sensor": {
+            "tau_s": cfg.unit.case_sensor.tau_s,
+            "offset_c": cfg.unit.case_sensor.offset_c,
+            "noise_c": cfg.unit.case_sensor.noise_c,
+            "resolution_c": cfg.unit.case_sensor.resolution_c,
+        },
+    }))? + "\n";
+    gyrotherm::atomic_file::write_bytes_atomically(&sidecar, json.as_bytes()).with_context(
+        || {
+            format!(
+                "cannot write the unit's parameters to {}",
+                sidecar.display()
+            )
+        },
+    )?;
+    let table = match cfg.run.table_rate_dps {
+        Some(r) => format!("rate table ±{r} °/s on axis {}", args.table_axis),
+        None => "static".to_owned(),
+    };
+    eprintln!(
+        "simulated {} samples ({:.0} s at {} Hz) of `{}` with inertial unit {unit_seed} (3 gyros, \
+         4 sensors), seed {}, {table}; wrote {}; the unit's parameters: {}",
+        log.len(),
+        cfg.run.profile.duration_s(),
+        cfg.run.sample_rate_hz,
+        cfg.run.profile.name,
+        cfg.run.seed,
+        out.display(),
+        sidecar.display()
+    );
     Ok(ExitCode::SUCCESS)
 }

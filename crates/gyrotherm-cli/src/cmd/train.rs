@@ -125,6 +125,9 @@ pub struct TrainArgs {
 }
 
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
+    if args.log.read_options().is_multi_column() {
+        return super::imu::train(args);
+    }
     let logs = read_logs(&args.input, &args.log, &mut Vec::new())?;
     let named = named(&logs);
     let cfg = args.fit.fit_config(args.method)?;

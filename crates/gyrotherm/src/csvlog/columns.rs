@@ -28,6 +28,21 @@ pub(super) fn check_options(path: &Path, opts: &ReadOptions) -> Result<(), LogEr
             format!("{what} must be a positive number of seconds, got {v}"),
         )
     };
+    if opts.is_multi_column() {
+        // Column lists are read by `read_imu_log`; this reader holds one gyro and one
+        // temperature, and a list is no column name.
+        return Err(LogError::new(
+            Kind::BadOptions,
+            path,
+            None,
+            None,
+            format!(
+                "this reads one gyro and one temperature column, not the lists {:?} and {:?}; \
+                 name one of each (lists are for train and compensate of an inertial unit)",
+                opts.gyro_col, opts.temp_col
+            ),
+        ));
+    }
     if let Some(v) = opts.fill_gaps_max_s {
         if !(v.is_finite() && v > 0.0) {
             return Err(bad("--fill-gaps", v));

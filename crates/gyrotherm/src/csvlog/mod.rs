@@ -20,12 +20,14 @@ mod chunk;
 mod columns;
 mod error;
 mod gaps;
+mod imu;
 mod number;
 mod reader;
 mod writer;
 
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
+pub use imu::{read_imu_log, write_imu_log, ImuLog, NamedSeries};
 pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
@@ -190,6 +192,19 @@ pub enum GyroUnit {
     RadPerS,
 }
 
+impl GyroUnit {
+    /// °/s per unit of the file: the factor a gyro field is multiplied by on reading.
+    pub fn dps_per_unit(self) -> f64 {
+        match self {
+            GyroUnit::Dps => 1.0,
+            // 1 °/h = 1/3600 °/s.
+            GyroUnit::Dph => 1.0 / 3600.0,
+            // 1 rad = 180/π °.
+            GyroUnit::RadPerS => 180.0 / std::f64::consts::PI,
+        }
+    }
+}
+
 impl std::str::FromStr for GyroUnit {
     type Err = String;
     /// `dps`, `dph` or `rad/s`.
@@ -210,9 +225,10 @@ impl std::str::FromStr for GyroUnit {
 pub struct ReadOptions {
     /// Header of the time column (s).
     pub time_col: String,
-    /// Header of the gyro column (unit: `gyro_unit`).
+    /// Header of the gyro column (unit: `gyro_unit`), or of several, comma-separated (an
+    /// inertial unit's log: [`read_imu_log`]; see [`crate::settings::columns`]).
     pub gyro_col: String,
-    /// Header of the temperature column (°C).
+    /// Header of the temperature column (°C), or of several, comma-separated.
     pub temp_col: String,
     /// Header of the table-rate column (°/s). Optional when left at `table_dps`; a column
     /// mapped to another name must exist.

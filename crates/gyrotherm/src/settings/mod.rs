@@ -25,6 +25,7 @@
 //!   their equality can be tested.
 
 pub mod allan;
+pub mod columns;
 pub mod compensate;
 pub mod coverage;
 pub mod describe;
@@ -62,6 +63,8 @@ pub enum Rule {
     PositiveRate,
     /// Finite (a temperature, °C).
     Finite,
+    /// A list of column names (one, or several separated by commas).
+    ColumnList,
 }
 
 impl Rule {
@@ -82,6 +85,10 @@ impl Rule {
             Rule::Number => "is not a number",
             Rule::PositiveRate => "is not a positive rate (°C/min)",
             Rule::Finite => "is not a finite number",
+            Rule::ColumnList => {
+                "is not a list of column names: give one name, or distinct names separated by \
+                 commas"
+            }
         }
     }
 
@@ -92,7 +99,7 @@ impl Rule {
             Rule::NonNegativeSeconds => v.is_finite() && v >= 0.0,
             Rule::AtLeastOne => v >= 1.0,
             Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
-            Rule::Number => true,
+            Rule::Number | Rule::ColumnList => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
         }

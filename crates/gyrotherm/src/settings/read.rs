@@ -50,6 +50,7 @@ pub fn delimiter_name(d: u8) -> &'static str {
 impl ReadOptions {
     /// Check every value; the error names the setting and the rule.
     pub fn validate(&self) -> Result<(), SettingError> {
+        self.validate_columns()?;
         check_opt(
             "fill_gaps_max_s",
             self.fill_gaps_max_s,

@@ -34,6 +34,9 @@
 use super::fog::{FogUnit, SensorNode};
 use super::noise::Gauss;
 
+/// The ChaCha8 stream a unit is drawn from (apart from the run's noise streams, 1 to 31).
+pub const UNIT_STREAM: u64 = 40;
+
 /// A closed interval `(lo, hi)`.
 pub type Interval = (f64, f64);
 
@@ -140,7 +143,14 @@ impl Draw {
 impl UnitRanges {
     /// The unit of seed `unit_seed` (same seed, same unit), named `random unit <seed>`.
     pub fn draw(&self, unit_seed: u64) -> FogUnit {
-        let mut d = Draw(Gauss::new(unit_seed, 40));
+        self.draw_on_stream(unit_seed, UNIT_STREAM)
+    }
+
+    /// [`UnitRanges::draw`] from another ChaCha8 stream of the same seed: the further gyros of
+    /// an inertial unit ([`super::imu`]) are drawn from streams after [`UNIT_STREAM`], so the
+    /// first gyro of unit N is single-axis unit N's gyro.
+    pub fn draw_on_stream(&self, unit_seed: u64, stream: u64) -> FogUnit {
+        let mut d = Draw(Gauss::new(unit_seed, stream));
         let has_mount = d.0.uniform() < self.mount_probability;
         let mount_tau_s = d.log_uniform(self.node_tau_s);
         let case_tau_s = d.log_uniform(self.node_tau_s);

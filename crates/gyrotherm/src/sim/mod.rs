@@ -28,6 +28,7 @@ pub mod chamber;
 pub mod family;
 pub mod fault;
 pub mod fog;
+pub mod imu;
 pub mod noise;
 pub mod profile;
 pub mod table;

@@ -28,7 +28,7 @@ use super::columns::{check_options, map_columns, Columns};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::gaps::{gap_verdict, Fill, GapVerdict, Sample};
 use super::number::{parse_f64, parse_f64_decimal_comma};
-use super::{GyroUnit, ReadOptions, ReadReport};
+use super::{ReadOptions, ReadReport};
 
 /// Number of leading time steps whose median is the nominal sample period.
 pub const PERIOD_ESTIMATE_STEPS: usize = 100;
@@ -195,13 +195,7 @@ impl<R: Read> LogReader<R> {
             headers.push(name.trim().to_owned());
         }
         let cols = map_columns(&path, header_line, &headers, opts)?;
-        let gyro_scale = match opts.gyro_unit {
-            GyroUnit::Dps => 1.0,
-            // 1 °/h = 1/3600 °/s.
-            GyroUnit::Dph => 1.0 / 3600.0,
-            // 1 rad = 180/π °.
-            GyroUnit::RadPerS => 180.0 / std::f64::consts::PI,
-        };
+        let gyro_scale = opts.gyro_unit.dps_per_unit();
         let ncols = headers.len();
         let lay = Layout {
             delimiter: opts.delimiter,

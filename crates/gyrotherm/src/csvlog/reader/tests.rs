@@ -1,6 +1,7 @@
 //! Tests of the streaming reader.
 
 use super::*;
+use crate::csvlog::GyroUnit;
 use proptest::prelude::*;
 
 /// One sample as handed out: the bits of time, gyro, temperature, table rate; line;

@@ -1,0 +1,198 @@
+//! An inertial unit through the real binary: `simulate --imu`, `train` with column lists
+//! (one model file for the unit), `compensate` with per-axis columns, a missing column named,
+//! and a fault in one sensor reaching only the axis that reads it.
+
+use std::path::Path;
+
+mod cli;
+use cli::{gyrotherm, outcome, run_ok, simulate_args};
+
+const GYROS: &str = "gyro_x_dps,gyro_y_dps,gyro_z_dps";
+
+/// Columns of a CSV text by header name.
+fn column(text: &str, name: &str) -> Vec<String> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    lines
+        .map(|l| l.split(',').nth(k).unwrap().to_owned())
+        .collect()
+}
+
+/// Unit 1000 (design family): a static run and one table run per axis on `fast-cycle`, a
+/// linear model with the case sensor and the x coil sensor.
+fn train_linear(dir: &Path) -> std::path::PathBuf {
+    let unit = ["--imu", "--unit", "random", "--unit-seed", "1000"];
+    let prof = ["--profile", "fast-cycle"];
+    let mut inputs = vec![simulate_args(
+        dir,
+        "s.csv",
+        &[&unit[..], &prof[..], &["--seed", "1"]].concat(),
+    )];
+    for ax in ["x", "y", "z"] {
+        inputs.push(simulate_args(
+            dir,
+            &format!("t{ax}.csv"),
+            &[
+                &unit[..],
+                &prof[..],
+                &["--seed", "2", "--table-rate", "20", "--table-axis", ax],
+            ]
+            .concat(),
+        ));
+    }
+    let model = dir.join("imu.json");
+    let mut cmd = gyrotherm();
+    cmd.args(["train", "--method", "linear", "--gyro-col", GYROS]);
+    cmd.args(["--temp-col", "temp_case_c,temp_x_c", "--out"])
+        .arg(&model);
+    for i in &inputs {
+        cmd.arg("--input").arg(i);
+    }
+    let out = run_ok(&mut cmd);
+    let err = String::from_utf8_lossy(&out.stderr);
+    for ax in ["x", "y", "z"] {
+        assert!(
+            err.contains(&format!("t{ax}.csv: rate table on gyro_{ax}_dps")),
+            "{err}"
+        );
+    }
+    model
+}
+
+#[test]
+fn one_model_for_the_unit_compensates_each_axis() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = train_linear(dir.path());
+    let text = std::fs::read_to_string(&model).unwrap();
+    assert!(text.contains("\"imu_format_version\": 1"), "{text}");
+    let run = simulate_args(
+        dir.path(),
+        "run.csv",
+        &[
+            "--imu",
+            "--unit",
+            "random",
+            "--unit-seed",
+            "1000",
+            "--seed",
+            "3",
+        ],
+    );
+    let comp = dir.path().join("comp.csv");
+    run_ok(
+        gyrotherm()
+            .args(["compensate", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&run)
+            .arg("--out")
+            .arg(&comp),
+    );
+    let out = std::fs::read_to_string(&comp).unwrap();
+    for g in GYROS.split(',') {
+        let raw: Vec<f64> = column(&out, g).iter().map(|v| v.parse().unwrap()).collect();
+        let bias: Vec<f64> = column(&out, &format!("{g}_bias"))
+            .iter()
+            .map(|v| v.parse().unwrap())
+            .collect();
+        let scale: Vec<f64> = column(&out, &format!("{g}_scale"))
+            .iter()
+            .map(|v| v.parse().unwrap())
+            .collect();
+        let rate: Vec<f64> = column(&out, &format!("{g}_comp"))
+            .iter()
+            .map(|v| v.parse().unwrap())
+            .collect();
+        // G = (Ĝ − B)/K (He et al. 2024 eq. 4), computed the same way: exact.
+        for i in 0..raw.len() {
+            assert_eq!(rate[i], (raw[i] - bias[i]) / scale[i], "{g} line {}", i + 2);
+        }
+        assert!(column(&out, &format!("{g}_status"))
+            .iter()
+            .all(|s| s == "ok"));
+    }
+}
+
+#[test]
+fn a_missing_column_is_named_and_a_sensor_fault_stays_on_its_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = train_linear(dir.path());
+    let json = std::fs::read_to_string(&model).unwrap();
+    // The linear method has no cross-validation: every axis reads the first sensor.
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    for a in v["axes"].as_array().unwrap() {
+        assert_eq!(a["temps"], serde_json::json!(["temp_case_c"]));
+    }
+    let run = simulate_args(
+        dir.path(),
+        "run.csv",
+        &[
+            "--imu",
+            "--unit",
+            "random",
+            "--unit-seed",
+            "1000",
+            "--seed",
+            "3",
+        ],
+    );
+    let text = std::fs::read_to_string(&run).unwrap();
+    // Without the case sensor's column.
+    let no_case: String = text
+        .lines()
+        .map(|l| {
+            let mut f: Vec<&str> = l.split(',').collect();
+            f.remove(4);
+            f.join(",") + "\n"
+        })
+        .collect();
+    let cut = dir.path().join("cut.csv");
+    std::fs::write(&cut, no_case).unwrap();
+    let m = model.to_str().unwrap();
+    let (code, _, err) = outcome(&[
+        "compensate",
+        "--model",
+        m,
+        "--input",
+        cut.to_str().unwrap(),
+        "--out",
+        dir.path().join("x.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("column temp_case_c"), "{err}");
+    // The x coil sensor reads -127 °C (a DS18B20 bus error) for 200 s: no axis reads it, so
+    // every axis stays ok.
+    let faulty: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut f: Vec<String> = l.split(',').map(str::to_owned).collect();
+            if (5001..5201).contains(&i) {
+                f[5] = "-127".into();
+            }
+            f.join(",") + "\n"
+        })
+        .collect();
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, faulty).unwrap();
+    let (code, _, err) = outcome(&[
+        "compensate",
+        "--model",
+        m,
+        "--input",
+        bad.to_str().unwrap(),
+        "--out",
+        dir.path().join("y.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    for g in GYROS.split(',') {
+        assert!(
+            err.contains(&format!("{g}: 30000 ok, 0 held, 0 degraded")),
+            "{err}"
+        );
+    }
+}

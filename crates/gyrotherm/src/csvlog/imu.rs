@@ -1,0 +1,347 @@
+//! An inertial unit's log: several gyro and temperature columns in one file
+//! ([`crate::settings::columns`] says how they are named).
+//!
+//! Reading goes through [`read_log`](super::read_log) with the first gyro and the first
+//! temperature column, so time, gaps, separators and those two columns get every check of a
+//! single-axis log; the further columns are then parsed as strictly (a number, finite; the
+//! gyro unit converted; a decimal comma with `;` or tab separators) and named in their errors.
+//! Rows made by gap filling get the further columns interpolated linearly in time, as the
+//! reader interpolates the first ones.
+
+use std::path::Path;
+
+use super::error::{LogError, LogErrorKind as Kind};
+use super::number::{parse_f64, parse_f64_decimal_comma};
+use super::{ExtraColumn, LogWriter, ReadOptions, ReadReport, TestLog, TIME_COL};
+use crate::settings::columns::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
+
+/// A named column of numbers.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NamedSeries {
+    pub name: String,
+    pub values: Vec<f64>,
+}
+
+/// An inertial unit's log in memory: gyro outputs in °/s, temperatures in °C, in the order of
+/// the column lists.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ImuLog {
+    /// Time, s, strictly increasing.
+    pub time_s: Vec<f64>,
+    /// Gyro outputs, °/s.
+    pub gyro: Vec<NamedSeries>,
+    /// Temperatures, °C (a sensor fault may leave NaN in a simulated log being written).
+    pub temp: Vec<NamedSeries>,
+    /// Table rate, °/s, and its column name (None: static run).
+    pub table: Option<NamedSeries>,
+    /// The gyro column the table turns (None: static run).
+    pub table_axis: Option<String>,
+    /// Other columns, passed through.
+    pub extra: Vec<ExtraColumn>,
+}
+
+impl ImuLog {
+    pub fn len(&self) -> usize {
+        self.time_s.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.time_s.is_empty()
+    }
+
+    /// Index of the gyro column the table turns.
+    pub fn table_axis_index(&self) -> Option<usize> {
+        let a = self.table_axis.as_deref()?;
+        self.gyro.iter().position(|g| g.name == a)
+    }
+
+    /// One axis as a single-axis log without pass-through columns (what a fit reads): gyro
+    /// `axis`, temperature `temp`, the table rate only when the table turns this axis.
+    pub fn axis_data(&self, axis: usize, temp: usize) -> TestLog {
+        TestLog {
+            time_s: self.time_s.clone(),
+            gyro_dps: self.gyro[axis].values.clone(),
+            temp_c: self.temp[temp].values.clone(),
+            table_dps: (self.table_axis_index() == Some(axis))
+                .then(|| self.table.as_ref().map(|t| t.values.clone()))
+                .flatten(),
+            extra: Vec::new(),
+        }
+    }
+
+    /// One axis as a single-axis log: gyro `axis` with temperature `temp`; the table rate only
+    /// when the table turns this axis (for the others the run is static); the other gyro and
+    /// temperature columns and the pass-through ones as pass-through text.
+    pub fn axis_log(&self, axis: usize, temp: usize) -> TestLog {
+        let text = |s: &NamedSeries| ExtraColumn {
+            name: s.name.clone(),
+            values: s.values.iter().map(|v| format!("{v}")).collect(),
+        };
+        let extra = self
+            .gyro
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| *k != axis)
+            .map(|(_, s)| text(s))
+            .chain(
+                self.temp
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != temp)
+                    .map(|(_, s)| text(s)),
+            )
+            .chain(self.extra.iter().cloned())
+            .collect();
+        TestLog {
+            time_s: self.time_s.clone(),
+            gyro_dps: self.gyro[axis].values.clone(),
+            temp_c: self.temp[temp].values.clone(),
+            table_dps: (self.table_axis_index() == Some(axis))
+                .then(|| self.table.as_ref().map(|t| t.values.clone()))
+                .flatten(),
+            extra,
+        }
+    }
+}
+
+/// The gyro the table turns: the one whose output has a slope on the table rate within
+/// [`TABLE_AXIS_SLOPE_RANGE`] (least squares over the samples, table rate and output
+/// centred); None when none or several do.
+pub fn detect_table_axis(gyro: &[NamedSeries], table_dps: &[f64]) -> Option<usize> {
+    let n = table_dps.len() as f64;
+    let mt = table_dps.iter().sum::<f64>() / n;
+    let stt: f64 = table_dps.iter().map(|t| (t - mt) * (t - mt)).sum();
+    if stt <= 0.0 || !stt.is_finite() {
+        return None;
+    }
+    let (lo, hi) = TABLE_AXIS_SLOPE_RANGE;
+    let mut hits = gyro.iter().enumerate().filter(|(_, g)| {
+        let mg = g.values.iter().sum::<f64>() / n;
+        let sgt: f64 = g
+            .values
+            .iter()
+            .zip(table_dps)
+            .map(|(y, t)| (y - mg) * (t - mt))
+            .sum();
+        let slope = sgt / stt;
+        slope.abs() >= lo && slope.abs() <= hi
+    });
+    match (hits.next(), hits.next()) {
+        (Some((k, _)), None) => Some(k),
+        _ => None,
+    }
+}
+
+/// Read an inertial unit's log: the gyro and temperature columns of `opts` (lists, or one
+/// name each), the table column, and the axis it turns (`table_axis`, a gyro column, or
+/// found by [`detect_table_axis`]; a table log where no single axis follows the table is an
+/// error that says to name it).
+pub fn read_imu_log(
+    path: &Path,
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+) -> Result<(ImuLog, ReadReport), LogError> {
+    let options =
+        |e: crate::SettingError| LogError::new(Kind::BadOptions, path, None, None, e.to_string());
+    let gyro_cols = opts.gyro_cols().map_err(options)?;
+    let temp_cols = opts.temp_cols().map_err(options)?;
+    opts.validate_columns().map_err(options)?;
+    let first = ReadOptions {
+        gyro_col: gyro_cols[0].clone(),
+        temp_col: temp_cols[0].clone(),
+        ..opts.clone()
+    };
+    let (mut log, report) = super::read_log(path, &first)?;
+    let gyro_scale = opts.gyro_unit.dps_per_unit();
+    let mut take = |name: &str, scale: f64, what: &str| -> Result<Vec<f64>, LogError> {
+        let k = log
+            .extra
+            .iter()
+            .position(|c| c.name == name)
+            .ok_or_else(|| {
+                let mut found = vec![
+                    TIME_COL.to_owned(),
+                    first.gyro_col.clone(),
+                    first.temp_col.clone(),
+                ];
+                found.extend(log.extra.iter().map(|c| c.name.clone()));
+                LogError::new(
+                    Kind::MissingColumn,
+                    path,
+                    None,
+                    Some(name),
+                    format!(
+                        "{what} column not found; the header has: {}",
+                        found.join(", ")
+                    ),
+                )
+            })?;
+        let col = log.extra.remove(k);
+        parse_column(path, &col, &log.time_s, scale, opts.delimiter != b',')
+    };
+    let mut gyro = Vec::with_capacity(gyro_cols.len());
+    gyro.push(NamedSeries {
+        name: gyro_cols[0].clone(),
+        values: std::mem::take(&mut log.gyro_dps),
+    });
+    for g in &gyro_cols[1..] {
+        gyro.push(NamedSeries {
+            name: g.clone(),
+            values: take(g, gyro_scale, "gyro")?,
+        });
+    }
+    let mut temp = Vec::with_capacity(temp_cols.len());
+    temp.push(NamedSeries {
+        name: temp_cols[0].clone(),
+        values: std::mem::take(&mut log.temp_c),
+    });
+    for t in &temp_cols[1..] {
+        temp.push(NamedSeries {
+            name: t.clone(),
+            values: take(t, 1.0, "temperature")?,
+        });
+    }
+    let table = log.table_dps.take().map(|values| NamedSeries {
+        name: opts.table_col.clone(),
+        values,
+    });
+    let table_axis = match (&table, table_axis) {
+        (None, _) => None,
+        (Some(_), Some(a)) => Some(parse_table_axis(a, &gyro_cols).map_err(options)?),
+        (Some(t), None) if gyro.len() == 1 => {
+            let _ = t;
+            Some(0)
+        }
+        (Some(t), None) => Some(detect_table_axis(&gyro, &t.values).ok_or_else(|| {
+            LogError::new(
+                Kind::BadOptions,
+                path,
+                None,
+                Some(&t.name),
+                format!(
+                    "no single gyro column follows the table rate (slope {} to {}); name the \
+                     axis the table turns with --table-axis GYRO_COL",
+                    TABLE_AXIS_SLOPE_RANGE.0, TABLE_AXIS_SLOPE_RANGE.1
+                ),
+            )
+        })?),
+    };
+    Ok((
+        ImuLog {
+            time_s: log.time_s,
+            table_axis: table_axis.map(|k| gyro[k].name.clone()),
+            gyro,
+            temp,
+            table,
+            extra: log.extra,
+        },
+        report,
+    ))
+}
+
+/// Parse a further column: every field a finite number (times `scale`); empty fields, which
+/// only gap filling makes, interpolated linearly in time between the real rows around them.
+fn parse_column(
+    path: &Path,
+    col: &ExtraColumn,
+    time_s: &[f64],
+    scale: f64,
+    decimal_comma: bool,
+) -> Result<Vec<f64>, LogError> {
+    let mut out = Vec::with_capacity(col.values.len());
+    let mut filled = Vec::new();
+    for (row, text) in col.values.iter().enumerate() {
+        if text.is_empty() {
+            filled.push(row);
+            out.push(f64::NAN);
+            continue;
+        }
+        let raw = text.as_bytes();
+        let v = parse_f64(raw)
+            .or_else(|| {
+                decimal_comma
+                    .then(|| parse_f64_decimal_comma(raw))
+                    .flatten()
+            })
+            .ok_or_else(|| {
+                LogError::new(
+                    Kind::NotANumber,
+                    path,
+                    None,
+                    Some(&col.name),
+                    format!("data row {}: {text:?} is not a number", row + 1),
+                )
+            })?;
+        if !v.is_finite() {
+            return Err(LogError::new(
+                Kind::NonFinite,
+                path,
+                None,
+                Some(&col.name),
+                format!("data row {}: {text:?} is not a finite number", row + 1),
+            ));
+        }
+        out.push(v * scale);
+    }
+    for row in filled {
+        let before = (0..row).rev().find(|&i| out[i].is_finite());
+        let after = (row + 1..out.len()).find(|&i| out[i].is_finite());
+        out[row] = match (before, after) {
+            (Some(a), Some(b)) => {
+                let w = (time_s[row] - time_s[a]) / (time_s[b] - time_s[a]);
+                out[a] + w * (out[b] - out[a])
+            }
+            _ => {
+                return Err(LogError::new(
+                    Kind::NotANumber,
+                    path,
+                    None,
+                    Some(&col.name),
+                    format!("data row {}: the field is empty", row + 1),
+                ))
+            }
+        };
+    }
+    Ok(out)
+}
+
+/// Write an inertial unit's log (`time_s`, the gyro columns, the temperature columns, the
+/// table column, the pass-through columns), atomically; numbers round-trip exactly, a
+/// non-finite temperature is written as `NaN` (a simulated sensor fault).
+pub fn write_imu_log(path: &Path, log: &ImuLog) -> Result<(), LogError> {
+    let bad = |column: &str, message: String| {
+        LogError::new(Kind::BadLog, path, None, Some(column), message)
+    };
+    let n = log.len();
+    let numeric = log.gyro.iter().chain(&log.temp).chain(&log.table);
+    for s in numeric.clone() {
+        if s.values.len() != n {
+            return Err(bad(
+                &s.name,
+                format!("{} values but {n} timestamps", s.values.len()),
+            ));
+        }
+    }
+    for s in log.gyro.iter().chain(&log.table) {
+        if let Some(i) = s.values.iter().position(|v| !v.is_finite()) {
+            return Err(bad(&s.name, format!("row {} is not finite", i + 1)));
+        }
+    }
+    crate::atomic_file::write_atomically(path, |w| -> std::io::Result<()> {
+        let header = std::iter::once(TIME_COL)
+            .chain(numeric.clone().map(|s| s.name.as_str()))
+            .chain(log.extra.iter().map(|c| c.name.as_str()));
+        let mut out = LogWriter::new(w, header)?;
+        for i in 0..n {
+            out.push_f64(log.time_s[i]);
+            for s in numeric.clone() {
+                out.push_f64(s.values[i]);
+            }
+            for c in &log.extra {
+                out.push_raw(c.values[i].as_bytes());
+            }
+            out.end_row()?;
+        }
+        out.flush()
+    })
+    .map_err(|e| LogError::new(Kind::Io, path, None, None, format!("cannot write: {e}")))
+}

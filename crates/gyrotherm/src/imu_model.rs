@@ -1,0 +1,433 @@
+//! One model file for an inertial unit: per gyro axis a bias and a scale-factor model, the
+//! gyro columns and the temperature sensors the unit's log must hold, and which sensor each
+//! axis reads.
+//!
+//! What this stage does: each axis is fitted once per listed sensor (the axes on their own
+//! threads), and keeps the sensor whose fit has the lowest cross-validated RMS on the bias
+//! target (`thermal`'s 5-fold time-segment cross-validation; on the scale factor when the
+//! axis has no static log). Methods without cross-validation keep each axis on the first
+//! sensor. Each axis's model is an ordinary single-sensor [`ModelFile`], so the flight
+//! [`Compensator`] runs it unchanged; a fault in one sensor reaches only the axes that read it.
+//! What it does not do yet: one axis model reading several sensors at once (lags per sensor,
+//! differences between sensors).
+//!
+//! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
+//! format is unchanged), sealed with `content_sha256` like a single-axis file.
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+use gyrotherm_core::compensator::{Compensator, Status};
+
+use crate::compensate::compensator;
+use crate::csvlog::{ImuLog, ReadOptions, TestLog};
+use crate::fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog};
+use crate::model::{sha256_hex, ModelFile, ModelFileError, TempSensorDef, CHECKSUM_KEY};
+use crate::CompensateError;
+
+/// Version of the inertial-unit file layout.
+pub const IMU_FORMAT_VERSION: u32 = 1;
+/// The key that marks an inertial-unit model file.
+pub const IMU_VERSION_KEY: &str = "imu_format_version";
+
+/// A sensor tried for an axis and its score.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorScore {
+    /// The temperature column.
+    pub temp: String,
+    /// Cross-validated RMS of the fit on this sensor (bias °/s, or K for a scale-only
+    /// axis); None when the method has no cross-validation.
+    pub cv_rms: Option<f64>,
+}
+
+/// One gyro axis of the unit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuAxis {
+    /// The gyro column.
+    pub gyro: String,
+    /// The temperature columns this axis's model reads (one at this stage).
+    pub temps: Vec<String>,
+    /// Every sensor tried, in column order, with its score.
+    pub scores: Vec<SensorScore>,
+    /// The axis's bias and scale-factor model.
+    pub model: ModelFile,
+}
+
+/// An inertial unit's model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuModel {
+    /// [`IMU_FORMAT_VERSION`].
+    pub imu_format_version: u32,
+    /// The gyro columns, in the order of the axes (and of the exported `gyro[]`).
+    pub gyro_cols: Vec<String>,
+    /// The temperature columns, in the order of the exported `temp[]`.
+    pub temp_cols: Vec<String>,
+    /// One entry per gyro column, same order.
+    pub axes: Vec<ImuAxis>,
+}
+
+/// Why an inertial-unit model cannot be fitted, read, written or applied.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum ImuError {
+    /// Fitting axis `gyro` on sensor `temp` failed.
+    Fit {
+        gyro: String,
+        temp: String,
+        source: Box<FitError>,
+    },
+    /// The model of axis `gyro` is not valid.
+    Axis {
+        gyro: String,
+        source: Box<ModelFileError>,
+    },
+    /// The file's structure is inconsistent (the message says what).
+    Layout(String),
+    /// The text is not an inertial-unit model (JSON error, or a field).
+    Json(serde_json::Error),
+    /// `content_sha256` does not match the content.
+    Checksum { found: String, computed: String },
+    /// The log lacks a column the model needs.
+    MissingColumn { column: String, role: &'static str },
+    /// The compensator of axis `gyro` could not be built.
+    Compensate {
+        gyro: String,
+        source: Box<CompensateError>,
+    },
+    /// A file could not be read or written.
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl std::fmt::Display for ImuError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ImuError::Fit { gyro, temp, .. } => {
+                write!(f, "fitting axis {gyro} on sensor {temp} failed")
+            }
+            ImuError::Axis { gyro, .. } => write!(f, "the model of axis {gyro}"),
+            ImuError::Layout(m) => write!(f, "{m}"),
+            ImuError::Json(_) => write!(f, "not an inertial-unit model file"),
+            ImuError::Checksum { found, computed } => write!(
+                f,
+                "{CHECKSUM_KEY} {found} does not match the content ({computed}): the file was \
+                 changed after it was written"
+            ),
+            ImuError::MissingColumn { column, role } => write!(
+                f,
+                "the log has no {role} column {column:?}, which the model needs (name the \
+                 columns with --gyro-col/--temp-col as at training)"
+            ),
+            ImuError::Compensate { gyro, .. } => write!(f, "axis {gyro}"),
+            ImuError::Io { path, .. } => write!(f, "{}", path.display()),
+        }
+    }
+}
+
+impl std::error::Error for ImuError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ImuError::Fit { source, .. } => Some(source.as_ref()),
+            ImuError::Axis { source, .. } => Some(source.as_ref()),
+            ImuError::Json(e) => Some(e),
+            ImuError::Compensate { source, .. } => Some(source.as_ref()),
+            ImuError::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
+
+/// Whether model-file text is an inertial unit's (it has [`IMU_VERSION_KEY`]).
+pub fn is_imu_model_text(text: &str) -> bool {
+    serde_json::from_str::<serde_json::Value>(text.strip_prefix('\u{feff}').unwrap_or(text))
+        .ok()
+        .and_then(|v| v.get(IMU_VERSION_KEY).cloned())
+        .is_some()
+}
+
+/// Progress of an inertial-unit fit: axis index, sensor index, and the fit's own progress
+/// (target, epoch, loss), as [`fit_model`] reports it.
+pub type ImuProgress<'a> = dyn Fn(usize, usize, crate::fit::Target, usize, f64) + Sync + 'a;
+
+/// Fit every axis of the unit (see the module doc): logs read with the column lists; each
+/// axis on its own thread; `temp_sensor` the limits every axis's compensator believes.
+pub fn fit_imu(
+    logs: &[(String, ImuLog)],
+    cfg: &FitConfig,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+) -> Result<ImuModel, ImuError> {
+    let first = logs
+        .first()
+        .map(|(_, l)| l)
+        .ok_or_else(|| ImuError::Layout("no training logs".into()))?;
+    let gyro_cols: Vec<String> = first.gyro.iter().map(|s| s.name.clone()).collect();
+    let temp_cols: Vec<String> = first.temp.iter().map(|s| s.name.clone()).collect();
+    for (name, l) in logs {
+        let g: Vec<&String> = l.gyro.iter().map(|s| &s.name).collect();
+        let t: Vec<&String> = l.temp.iter().map(|s| &s.name).collect();
+        if g != gyro_cols.iter().collect::<Vec<_>>() || t != temp_cols.iter().collect::<Vec<_>>() {
+            return Err(ImuError::Layout(format!(
+                "{name}: the training logs must be read with the same gyro and temperature columns"
+            )));
+        }
+    }
+    let axes: Vec<Result<ImuAxis, ImuError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..gyro_cols.len())
+            .map(|k| {
+                let (gyro_cols, temp_cols) = (&gyro_cols, &temp_cols);
+                scope.spawn(move || {
+                    fit_axis(logs, k, gyro_cols, temp_cols, cfg, temp_sensor, progress)
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| match h.join() {
+                Ok(r) => r,
+                Err(p) => std::panic::resume_unwind(p),
+            })
+            .collect()
+    });
+    let axes = axes.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let model = ImuModel {
+        imu_format_version: IMU_FORMAT_VERSION,
+        gyro_cols,
+        temp_cols,
+        axes,
+    };
+    model.validate()?;
+    Ok(model)
+}
+
+fn fit_axis(
+    logs: &[(String, ImuLog)],
+    k: usize,
+    gyro_cols: &[String],
+    temp_cols: &[String],
+    cfg: &FitConfig,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+) -> Result<ImuAxis, ImuError> {
+    let mut best: Option<(usize, FitOutcome)> = None;
+    let mut scores = Vec::with_capacity(temp_cols.len());
+    for (j, temp) in temp_cols.iter().enumerate() {
+        let axis_logs: Vec<(String, TestLog)> = logs
+            .iter()
+            .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
+            .collect();
+        let named: Vec<NamedLog> = axis_logs
+            .iter()
+            .map(|(n, l)| NamedLog { name: n, log: l })
+            .collect();
+        let outcome =
+            fit_model(&named, cfg, &|t, e, loss| progress(k, j, t, e, loss)).map_err(|source| {
+                ImuError::Fit {
+                    gyro: gyro_cols[k].clone(),
+                    temp: temp.clone(),
+                    source: Box::new(source),
+                }
+            })?;
+        let cv = |t: &Option<crate::fit::TrainSummary>| {
+            t.as_ref()
+                .and_then(|s| s.thermal.as_ref())
+                .and_then(|r| r.cv_rms)
+        };
+        let cv_rms = if outcome.model.bias.is_some() {
+            cv(&outcome.bias_training)
+        } else {
+            cv(&outcome.scale_training)
+        };
+        scores.push(SensorScore {
+            temp: temp.clone(),
+            cv_rms,
+        });
+        let better = match &best {
+            None => true,
+            Some((b, _)) => match (cv_rms, scores[*b].cv_rms) {
+                (Some(new), Some(old)) => new < old,
+                _ => false,
+            },
+        };
+        if better {
+            best = Some((j, outcome));
+        }
+    }
+    let (j, mut outcome) = best.ok_or_else(|| ImuError::Layout("no temperature columns".into()))?;
+    outcome.model.features.temp_sensor = *temp_sensor;
+    Ok(ImuAxis {
+        gyro: gyro_cols[k].clone(),
+        temps: vec![temp_cols[j].clone()],
+        scores,
+        model: outcome.model,
+    })
+}
+
+impl ImuModel {
+    /// Checks the layout (one axis per gyro column, in order; each axis's sensors among the
+    /// temperature columns) and every axis's model.
+    pub fn validate(&self) -> Result<(), ImuError> {
+        if self.imu_format_version != IMU_FORMAT_VERSION {
+            return Err(ImuError::Layout(format!(
+                "{IMU_VERSION_KEY} {} is not supported (this build reads {IMU_FORMAT_VERSION})",
+                self.imu_format_version
+            )));
+        }
+        let gyros: Vec<&String> = self.axes.iter().map(|a| &a.gyro).collect();
+        if gyros != self.gyro_cols.iter().collect::<Vec<_>>() || gyros.is_empty() {
+            return Err(ImuError::Layout(
+                "the axes must list the gyro columns, in order".into(),
+            ));
+        }
+        for a in &self.axes {
+            if a.temps.len() != 1 || !a.temps.iter().all(|t| self.temp_cols.contains(t)) {
+                return Err(ImuError::Layout(format!(
+                    "axis {} must read one of the temperature columns ({})",
+                    a.gyro,
+                    self.temp_cols.join(", ")
+                )));
+            }
+            a.model.validate().map_err(|source| ImuError::Axis {
+                gyro: a.gyro.clone(),
+                source: Box::new(source),
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The sealed JSON text (pretty; `content_sha256` of the compact content last).
+    pub fn to_json(&self) -> Result<String, ImuError> {
+        self.validate()?;
+        let compact = serde_json::to_string(self).map_err(ImuError::Json)?;
+        let text = serde_json::to_string_pretty(self).map_err(ImuError::Json)?;
+        let body = text.strip_suffix("\n}").unwrap_or(&text);
+        Ok(format!(
+            "{body},\n  \"{CHECKSUM_KEY}\": \"{}\"\n}}\n",
+            sha256_hex(compact.as_bytes())
+        ))
+    }
+
+    /// Parse and check the text (the checksum, when present, must match).
+    pub fn from_json(text: &str) -> Result<ImuModel, ImuError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut v: serde_json::Value = serde_json::from_str(text).map_err(ImuError::Json)?;
+        let sealed = v.as_object_mut().and_then(|o| o.remove(CHECKSUM_KEY));
+        let m: ImuModel = serde_json::from_value(v).map_err(ImuError::Json)?;
+        if let Some(found) = sealed {
+            let compact = serde_json::to_string(&m).map_err(ImuError::Json)?;
+            let computed = sha256_hex(compact.as_bytes());
+            let found = found.as_str().map_or(found.to_string(), str::to_owned);
+            if !found.eq_ignore_ascii_case(&computed) {
+                return Err(ImuError::Checksum { found, computed });
+            }
+        }
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Write atomically.
+    pub fn save(&self, path: &Path) -> Result<(), ImuError> {
+        let text = self.to_json()?;
+        crate::atomic_file::write_bytes_atomically(path, text.as_bytes()).map_err(|source| {
+            ImuError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })
+    }
+
+    /// Read and check a file.
+    pub fn load(path: &Path) -> Result<ImuModel, ImuError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ImuError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json(&text)
+    }
+
+    /// Read options naming the model's columns (the rest of `base` kept).
+    pub fn read_options(&self, base: &ReadOptions) -> ReadOptions {
+        ReadOptions {
+            gyro_col: self.gyro_cols.join(","),
+            temp_col: self.temp_cols.join(","),
+            ..base.clone()
+        }
+    }
+
+    /// Index of each axis's sensor in the temperature columns.
+    pub fn sensor_index(&self) -> Vec<usize> {
+        self.axes
+            .iter()
+            .map(|a| {
+                self.temp_cols
+                    .iter()
+                    .position(|t| *t == a.temps[0])
+                    .unwrap_or(0)
+            })
+            .collect()
+    }
+}
+
+/// The compensated series of one axis.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AxisCompensated {
+    pub bias_dps: Vec<f64>,
+    pub scale: Vec<f64>,
+    pub gyro_comp_dps: Vec<f64>,
+    pub status: Vec<Status>,
+}
+
+/// The flight compensators of every axis, in axis order.
+pub fn imu_compensators(model: &ImuModel) -> Result<Vec<Compensator>, ImuError> {
+    model
+        .axes
+        .iter()
+        .map(|a| {
+            compensator(&a.model).map_err(|source| ImuError::Compensate {
+                gyro: a.gyro.clone(),
+                source: Box::new(source),
+            })
+        })
+        .collect()
+}
+
+/// Compensate an inertial unit's log: each axis's flight compensator fed with its gyro
+/// column and its sensor's column. The log must hold the model's columns (the error names
+/// the first one missing).
+pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensated>, ImuError> {
+    let find = |list: &[crate::csvlog::NamedSeries], name: &str, role| {
+        list.iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| ImuError::MissingColumn {
+                column: name.to_owned(),
+                role,
+            })
+    };
+    let mut comps = imu_compensators(model)?;
+    let mut out = Vec::with_capacity(model.axes.len());
+    for (a, comp) in model.axes.iter().zip(&mut comps) {
+        let g = &log.gyro[find(&log.gyro, &a.gyro, "gyro")?].values;
+        let t = &log.temp[find(&log.temp, &a.temps[0], "temperature")?].values;
+        let n = log.len();
+        let mut r = AxisCompensated {
+            bias_dps: Vec::with_capacity(n),
+            scale: Vec::with_capacity(n),
+            gyro_comp_dps: Vec::with_capacity(n),
+            status: Vec::with_capacity(n),
+        };
+        for i in 0..n {
+            let c = comp.step(log.time_s[i], g[i], t[i]);
+            r.bias_dps.push(c.bias_dps);
+            r.scale.push(c.scale);
+            r.gyro_comp_dps.push(c.rate_dps);
+            r.status.push(c.status);
+        }
+        out.push(r);
+    }
+    Ok(out)
+}
