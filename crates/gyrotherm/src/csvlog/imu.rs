@@ -133,7 +133,7 @@ pub fn detect_table_axis(gyro: &[NamedSeries], table_dps: &[f64]) -> Option<usiz
 
 /// Read an inertial unit's log: the gyro and temperature columns of `opts` (lists, or one
 /// name each), the table column, and the axis it turns (`table_axis`, a gyro column, or
-/// found by [`detect_table_axis`]; a table log where no single axis follows the table is an
+/// found by `detect_table_axis`; a table log where no single axis follows the table is an
 /// error that says to name it).
 pub fn read_imu_log(
     path: &Path,

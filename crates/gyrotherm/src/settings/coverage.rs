@@ -6,7 +6,7 @@
 //! units (unit seeds 1000-1029) and measured once on the confirmation family (5000-5029):
 //! `docs/experiments/coverage.md`.
 //!
-//! None of these is a user option, so none is listed in [`super::describe`]: `train` always
+//! None of these is a user option, so none is listed in [`super::describe`](mod@super::describe): `train` always
 //! maps with [`CoverageSettings::default`]. The σ scale and the growth were calibrated on
 //! held-out runs *with this grid, these folds, this cell minimum and this shrinkage*; a user
 //! changing any one of them would get a σ whose ±1σ share nobody has measured, and a map a
