@@ -71,6 +71,9 @@ pub fn log_options() -> Vec<OptionSpec> {
             open: true,
             ..choice("delimiter", delimiter_name(d.delimiter), &DELIMITER_NAMES)
         },
+        // Which listed gyro column a rate-table log drives (default: the one that follows
+        // the table, `settings::columns`); a column name, so no list of values.
+        opt("table_axis", None),
     ]
 }
 
