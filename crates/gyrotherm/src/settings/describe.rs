@@ -59,6 +59,10 @@ fn switch(name: &'static str, default: bool) -> OptionSpec {
 pub fn log_options() -> Vec<OptionSpec> {
     let d = ReadOptions::default();
     vec![
+        // Which listed gyro column a rate-table log drives (default: the one that follows
+        // the table, `settings::columns`); a column name, so no list of values. First: it
+        // reads IMU logs, which Python's log options (the rest, in this order) do not yet.
+        opt("table_axis", None),
         opt("time_col", Some(d.time_col)),
         opt("gyro_col", Some(d.gyro_col)),
         opt("temp_col", Some(d.temp_col)),
@@ -71,9 +75,6 @@ pub fn log_options() -> Vec<OptionSpec> {
             open: true,
             ..choice("delimiter", delimiter_name(d.delimiter), &DELIMITER_NAMES)
         },
-        // Which listed gyro column a rate-table log drives (default: the one that follows
-        // the table, `settings::columns`); a column name, so no list of values.
-        opt("table_axis", None),
     ]
 }
 
