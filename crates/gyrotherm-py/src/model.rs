@@ -34,6 +34,28 @@ pub struct RawModel {
     load_warnings: Vec<String>,
 }
 
+/// The time, gyro and temperature arrays of one log, checked to hold one value per sample.
+fn samples<'a>(
+    time_s: &'a PyReadonlyArray1<'_, f64>,
+    gyro_dps: &'a PyReadonlyArray1<'_, f64>,
+    temp_c: &'a PyReadonlyArray1<'_, f64>,
+) -> PyResult<(&'a [f64], &'a [f64], &'a [f64])> {
+    let (t, g, c) = (
+        slice(time_s, "time_s")?,
+        slice(gyro_dps, "gyro_dps")?,
+        slice(temp_c, "temp_c")?,
+    );
+    if t.len() != g.len() || t.len() != c.len() {
+        return Err(CompensationError::new_err(format!(
+            "time_s, gyro_dps and temp_c differ in length ({}, {}, {}); give one value per sample in each",
+            t.len(),
+            g.len(),
+            c.len()
+        )));
+    }
+    Ok((t, g, c))
+}
+
 fn model_err(e: impl std::error::Error + 'static) -> PyErr {
     ModelError::new_err(gyrotherm::error_chain(&e))
 }
@@ -136,19 +158,7 @@ impl RawModel {
         gyro_dps: PyReadonlyArray1<'py, f64>,
         temp_c: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Compensated<'py>> {
-        let (t, g, c) = (
-            slice(&time_s, "time_s")?,
-            slice(&gyro_dps, "gyro_dps")?,
-            slice(&temp_c, "temp_c")?,
-        );
-        if t.len() != g.len() || t.len() != c.len() {
-            return Err(CompensationError::new_err(format!(
-                "time_s, gyro_dps and temp_c differ in length ({}, {}, {}); give one value per sample in each",
-                t.len(),
-                g.len(),
-                c.len()
-            )));
-        }
+        let (t, g, c) = samples(&time_s, &gyro_dps, &temp_c)?;
         let log = TestLog {
             time_s: t.to_vec(),
             gyro_dps: g.to_vec(),
@@ -181,19 +191,7 @@ impl RawModel {
         gyro_dps: PyReadonlyArray1<'py, f64>,
         temp_c: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<CoverageColumns<'py>> {
-        let (t, g, c) = (
-            slice(&time_s, "time_s")?,
-            slice(&gyro_dps, "gyro_dps")?,
-            slice(&temp_c, "temp_c")?,
-        );
-        if t.len() != g.len() || t.len() != c.len() {
-            return Err(CompensationError::new_err(format!(
-                "time_s, gyro_dps and temp_c differ in length ({}, {}, {}); give one value per sample in each",
-                t.len(),
-                g.len(),
-                c.len()
-            )));
-        }
+        let (t, g, c) = samples(&time_s, &gyro_dps, &temp_c)?;
         let (codes, sigma) = py
             .detach(|| coverage_columns(&self.file, t, g, c))
             .map_err(py_err::<CompensationError>)?;
