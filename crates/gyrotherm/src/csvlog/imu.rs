@@ -207,10 +207,7 @@ pub fn read_imu_log(
     let table_axis = match (&table, table_axis) {
         (None, _) => None,
         (Some(_), Some(a)) => Some(parse_table_axis(a, &gyro_cols).map_err(options)?),
-        (Some(t), None) if gyro.len() == 1 => {
-            let _ = t;
-            Some(0)
-        }
+        (Some(_), None) if gyro.len() == 1 => Some(0),
         (Some(t), None) => Some(detect_table_axis(&gyro, &t.values).ok_or_else(|| {
             LogError::new(
                 Kind::BadOptions,
