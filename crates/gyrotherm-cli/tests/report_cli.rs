@@ -105,8 +105,9 @@ fn report_writes_the_page_and_every_figure() {
     );
     let html = std::fs::read_to_string(&index).unwrap();
     let refs = references(&html);
-    // Eight figures, a PNG and an SVG each, all present.
-    assert_eq!(refs.len(), 16, "{refs:?}");
+    // Ten figures (the coverage map and σ over time included), a PNG and an SVG each, all
+    // present.
+    assert_eq!(refs.len(), 20, "{refs:?}");
     for r in &refs {
         let p = out.join(r);
         assert!(p.is_file(), "index.html references missing {r}");
