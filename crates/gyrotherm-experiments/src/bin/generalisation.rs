@@ -5,7 +5,10 @@
 //! judges it on three held-out profiles through the flight compensator:
 //!
 //! - training, setting `one`: `seed-shock` static + ±20 °/s rate table; setting `two`: the same
-//!   plus `fast-cycle` static + table (two chamber runs);
+//!   plus `fast-cycle` static + table (two chamber runs); setting `planned`: `seed-shock`
+//!   static + table plus static + table on the chamber profile `gyrotherm plan` proposes for
+//!   the unit (`gyrotherm::plan::propose`, envelope from the unit's own airborne run with a
+//!   seed other than the held-out one's), methods `linear` and `thermal` only;
 //! - held out: `slow-ramp`, `shock-5` (5 °C/min) and `airborne`, static + table each.
 //!
 //! Per setting and method it prints the median and worst bias stability (τ = 100 s) as a
@@ -14,7 +17,7 @@
 //! thermal error (ppm) and the worst ±20 °/s output error (°/s).
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin generalisation -- [--family
-//! design|confirm] [--units 30] [--settings one,two] [--methods linear,poly,...]
+//! design|confirm] [--units 30] [--settings one,two,planned] [--methods linear,poly,...]
 //! [--threads 2] [--cases FILE]`; `bench/generalisation.sh` runs it as recorded in
 //! `docs/experiments/generalisation.md`. Settings are chosen on the design family only; the
 //! confirmation family is run once at the end.
@@ -30,7 +33,9 @@ use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, RecipeSettings}
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::Method;
-use gyrotherm::sim::{random_unit, simulate_series, FogUnit, SimConfig};
+use gyrotherm::plan::{envelope_of, propose};
+use gyrotherm::settings::plan::PlanSettings;
+use gyrotherm::sim::{random_unit, simulate_series, FogUnit, Profile, SimConfig};
 
 const TABLE_RATE_DPS: f64 = 20.0;
 const TAU_S: f64 = 100.0;
@@ -123,7 +128,16 @@ struct Run {
 }
 
 fn sim(unit: &FogUnit, profile: &str, seed: u64, table: bool) -> Result<Run, String> {
-    let mut c = SimConfig::builtin(profile).map_err(|e| e.to_string())?;
+    sim_profile(
+        unit,
+        Profile::builtin(profile).map_err(|e| e.to_string())?,
+        seed,
+        table,
+    )
+}
+
+fn sim_profile(unit: &FogUnit, profile: Profile, seed: u64, table: bool) -> Result<Run, String> {
+    let mut c = SimConfig::new(profile);
     c.unit = unit.clone();
     c.seed = seed;
     c.table_rate_dps = table.then_some(TABLE_RATE_DPS);
@@ -208,14 +222,45 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             sim(&unit, p, seed + 2, true)?,
         ));
     }
+    if job.settings.iter().any(|s| s == "planned") {
+        // The flight input is an airborne run of this unit with its own seed, so the plan
+        // never sees the held-out airborne runs it is judged on. The profile depends on the
+        // flight's envelope and the chamber limits only; the training logs so far
+        // (`seed-shock`) enter `gyrotherm plan`'s coverage report, not the profile.
+        let flight = sim(&unit, "airborne", s0 + 31, false)?.log;
+        let env = envelope_of(&flight).map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
+        let plan = propose(&env, &PlanSettings::default())
+            .map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
+        let profile = plan.profile();
+        train_all.push((
+            "planned-static".into(),
+            sim_profile(&unit, profile.clone(), s0 + 41, false)?.log,
+        ));
+        train_all.push((
+            "planned-table".into(),
+            sim_profile(&unit, profile, s0 + 42, true)?.log,
+        ));
+    }
     let mut out = Vec::new();
     for setting in job.settings {
-        let n_train = if setting == "two" { 4 } else { 2 };
-        let named: Vec<NamedLog> = train_all[..n_train]
+        let picked: &[usize] = match setting.as_str() {
+            "two" => &[0, 1, 2, 3],
+            "planned" => &[0, 1, 4, 5],
+            _ => &[0, 1],
+        };
+        let named: Vec<NamedLog> = picked
             .iter()
-            .map(|(name, log)| NamedLog { name, log })
+            .map(|&i| NamedLog {
+                name: &train_all[i].0,
+                log: &train_all[i].1,
+            })
             .collect();
         for m in job.methods {
+            if setting == "planned" && m != "linear" && m != "thermal" {
+                // The planned setting asks whether the chamber profile helps the default
+                // method; linear stays for the 0.7 × linear share.
+                continue;
+            }
             if m == "published" && setting == "two" {
                 // The paper's recipe on the paper's setting only: 1000 full-BPTT epochs over
                 // two runs would double the benchmark's time for a method that is not in the
@@ -328,12 +373,15 @@ fn run() -> Result<(), String> {
         method_config(m)?;
     }
     let settings: Vec<String> = get("--settings")
-        .unwrap_or_else(|| "one,two".into())
+        .unwrap_or_else(|| "one,two,planned".into())
         .split(',')
         .map(str::to_owned)
         .collect();
-    if let Some(s) = settings.iter().find(|s| *s != "one" && *s != "two") {
-        return Err(format!("--settings: unknown {s:?}; use one, two"));
+    if let Some(s) = settings
+        .iter()
+        .find(|s| !["one", "two", "planned"].contains(&s.as_str()))
+    {
+        return Err(format!("--settings: unknown {s:?}; use one, two, planned"));
     }
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     let job = Job {
@@ -422,10 +470,10 @@ fn print_table(family: &str, cases: &[Case], methods: &[String], settings: &[Str
         println!();
         println!(
             "{family} family, training `{}`; held out: slow-ramp, shock-5, airborne",
-            if setting == "two" {
-                "seed-shock + fast-cycle"
-            } else {
-                "seed-shock"
+            match setting.as_str() {
+                "two" => "seed-shock + fast-cycle",
+                "planned" => "seed-shock + planned profile",
+                _ => "seed-shock",
             }
         );
         println!(
@@ -484,6 +532,32 @@ fn print_table(family: &str, cases: &[Case], methods: &[String], settings: &[Str
                 out20,
                 fit_s
             );
+        }
+    }
+    println!();
+    println!("{family} family, bias stability × floor per held-out profile, median / worst");
+    println!("| setting | method | slow-ramp | shock-5 | airborne |");
+    println!("|---|---|---|---|---|");
+    for setting in settings {
+        for m in methods {
+            let cells: Vec<String> = TEST_PROFILES
+                .iter()
+                .map(|p| {
+                    let mut v: Vec<f64> = cases
+                        .iter()
+                        .filter(|c| &c.setting == setting && &c.method == m && c.profile == *p)
+                        .map(|c| c.x_floor)
+                        .collect();
+                    let worst = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    format!("{:.2} / {worst:.2}", median(&mut v))
+                })
+                .collect();
+            if cases
+                .iter()
+                .any(|c| &c.setting == setting && &c.method == m)
+            {
+                println!("| {setting} | {m} | {} |", cells.join(" | "));
+            }
         }
     }
 }
