@@ -22,7 +22,7 @@
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin imu_family -- [--family
 //! design|confirm] [--units 30] [--first 0] [--settings case,chosen,all] [--threads 2]
-//! [--cases FILE]`; `bench/imu_family.sh` runs it as recorded in `docs/experiments/imu.md`.
+//! [--min-gain 0.02] [--cases FILE]`; `bench/imu_family.sh` runs it as recorded in `docs/experiments/imu.md`.
 //! Settings are chosen on the design family only; the confirmation family is run once.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -31,7 +31,7 @@ use std::time::Instant;
 
 use gyrotherm::csvlog::{ImuLog, NamedSeries};
 use gyrotherm::fit::{FitConfig, RecipeKind, RecipeSettings};
-use gyrotherm::imu_model::{compensate_imu, fit_imu, ImuModel};
+use gyrotherm::imu_model::{compensate_imu, fit_imu_with, ImuFitSettings, ImuModel, ImuSensors};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::{Method, TempSensorDef};
@@ -44,7 +44,7 @@ const TABLE_RATE_DPS: f64 = 20.0;
 const TAU_S: f64 = 100.0;
 const TEST_PROFILES: [&str; 2] = ["airborne", "shock-5"];
 const SETTINGS: [&str; 3] = ["case", "chosen", "all"];
-const DEFAULT_SETTINGS: &str = "case,chosen";
+const DEFAULT_SETTINGS: &str = "case,chosen,all";
 const DESIGN_BASE_SEED: u64 = 1000;
 const CONFIRM_BASE_SEED: u64 = 5000;
 
@@ -101,7 +101,13 @@ struct Case {
     temps: String,
 }
 
-fn run_unit(unit_seed: u64, settings: &[String]) -> Result<Vec<Case>, String> {
+struct Job<'a> {
+    settings: &'a [String],
+    min_gain: f64,
+}
+
+fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
+    let settings = job.settings;
     let unit = imu_from_family(unit_seed);
     let s0 = unit_seed * 100;
     let mut train = vec![("seed-shock-static".to_owned(), sim(&unit, "seed-shock", s0 + 1, None)?)];
@@ -136,6 +142,14 @@ fn run_unit(unit_seed: u64, settings: &[String]) -> Result<Vec<Case>, String> {
     cfg.recipe = RecipeSettings::of_kind(RecipeKind::Thermal);
     cfg.seed = 1;
     let sensor = TempSensorDef::default();
+    let one = ImuFitSettings {
+        sensors: ImuSensors::ChooseOne,
+        ..ImuFitSettings::default()
+    };
+    let all = ImuFitSettings {
+        min_gain: job.min_gain,
+        ..ImuFitSettings::default()
+    };
     let mut out = Vec::new();
     for setting in settings {
         let t0 = Instant::now();
@@ -143,10 +157,10 @@ fn run_unit(unit_seed: u64, settings: &[String]) -> Result<Vec<Case>, String> {
             "case" => {
                 let logs: Vec<(String, ImuLog)> =
                     train.iter().map(|(n, l)| (n.clone(), case_only(l))).collect();
-                fit_imu(&logs, &cfg, &sensor, &|_, _, _, _, _| {})
+                fit_imu_with(&logs, &cfg, &one, &sensor, &|_, _, _, _, _| {})
             }
-            "chosen" => fit_imu(&train, &cfg, &sensor, &|_, _, _, _, _| {}),
-            _ => return Err("setting `all` needs the multi-sensor fit".into()),
+            "chosen" => fit_imu_with(&train, &cfg, &one, &sensor, &|_, _, _, _, _| {}),
+            _ => fit_imu_with(&train, &cfg, &all, &sensor, &|_, _, _, _, _| {}),
         }
         .map_err(|e| format!("unit {unit_seed} {setting}: {e}: {:?}", std::error::Error::source(&e).map(|s| s.to_string())))?;
         let fit_s = t0.elapsed().as_secs_f64();
@@ -228,6 +242,14 @@ fn run() -> Result<(), String> {
     if let Some(s) = settings.iter().find(|s| !SETTINGS.contains(&s.as_str())) {
         return Err(format!("--settings: unknown {s:?}; use {}", SETTINGS.join(", ")));
     }
+    let min_gain: f64 = get("--min-gain").map_or(
+        Ok(ImuFitSettings::default().min_gain),
+        |v| v.parse().map_err(|e| format!("--min-gain: {e}")),
+    )?;
+    let job = Job {
+        settings: &settings,
+        min_gain,
+    };
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     eprintln!(
         "{family} family: {} units (seeds {}..{}), settings {settings:?}, {threads} threads",
@@ -245,7 +267,7 @@ fn run() -> Result<(), String> {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(&seed) = seeds.get(i) else { break };
-                match run_unit(seed, &settings) {
+                match run_unit(seed, &job) {
                     Ok(c) => results.lock().unwrap_or_else(|p| p.into_inner()).extend(c),
                     Err(e) => errors.lock().unwrap_or_else(|p| p.into_inner()).push(e),
                 }
