@@ -21,9 +21,10 @@ pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 pub const RECIPE_NAMES: [&str; 5] = ["thermal", "residual", "generic", "direct", "published"];
 
 /// Default least relative drop of an inertial-unit axis's cross-validated RMS for a further
-/// temperature sensor to join its model (chosen on the design family,
-/// docs/experiments/imu.md).
-pub const DEFAULT_IMU_MIN_GAIN: f64 = 0.02;
+/// temperature sensor to join its model: −1, a sensor joins unless it doubles the
+/// cross-validated RMS (chosen on the design family against +0.02, which kept one sensor
+/// per axis: docs/experiments/imu.md).
+pub const DEFAULT_IMU_MIN_GAIN: f64 = -1.0;
 
 /// Which temperature sensors each axis of an inertial unit may read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -40,7 +41,8 @@ pub enum ImuSensors {
 pub struct ImuFitSettings {
     /// Which sensors an axis may read.
     pub sensors: ImuSensors,
-    /// Least relative drop of the cross-validated RMS for a further sensor to join.
+    /// Least relative drop of the cross-validated RMS for a further sensor to join
+    /// (negative: the rise it may cause, −1 allowing up to double).
     pub min_gain: f64,
 }
 

@@ -7,10 +7,17 @@
 //! ridge fit over all columns, strength chosen by the same blocked cross-validation.
 //!
 //! Which sensors stay: the sensor whose one-sensor fit has the lowest cross-validated RMS
-//! comes first; each other sensor, best first, joins when it lowers the cross-validated RMS
-//! of the bias by more than [`MultiConfig::min_gain`] (on the scale factor when the axis has
-//! no static run). The scale-factor model reads the further sensors only when they lower its
-//! own cross-validated RMS by that margin too.
+//! comes first; each other sensor, best first, joins when the cross-validated RMS of the
+//! bias (of the scale factor when the axis has no static run) drops below
+//! `(1 − min_gain)` times the best so far ([`MultiConfig::min_gain`]). The scale-factor model
+//! reads the further sensors only when its own cross-validated RMS passes the same test.
+//!
+//! The default `min_gain` is −1: a sensor joins unless it doubles the cross-validated RMS.
+//! On the design family the blocked cross-validation within the chamber runs scores further
+//! sensors 2–20 % worse, while on held-out profiles they lower the error (median 1.41 →
+//! 1.26 × the noise floor, worst 7.85 → 5.91; docs/experiments/imu.md): the chamber runs do
+//! not move the gradients independently enough for the folds to see what they carry, so the
+//! test is kept as a guard against a sensor that ruins the fit, not as a filter.
 
 use super::*;
 use crate::targets::TargetSet;
@@ -41,11 +48,7 @@ pub struct SensorData<'a> {
 /// The further sensor's terms: `T` and each lag difference, linearly, no constant.
 pub fn extra_terms(lags: usize) -> Terms {
     let n = 2 + lags;
-    let v = std::env::var("GT_EXTRA").unwrap_or_default();
-    let mut powers = if v.contains("not") { vec![] } else { vec![term(n, &[(0, 1)])] };
-    if v.contains("tonly") {
-        return Terms { n_features: n, powers };
-    }
+    let mut powers = vec![term(n, &[(0, 1)])];
     for j in 0..lags {
         powers.push(term(n, &[(2 + j, 1)]));
     }
@@ -196,11 +199,7 @@ pub fn select(
         }
         let mut trial = order.clone();
         trial.push(j);
-        let got = cv_rms(sensors, &trial, cfg, scale);
-        if std::env::var_os("GT_DEBUG_MULTI").is_some() {
-            eprintln!("DEBUG multi: single {single:?} trial {trial:?} -> {got:?} (best {best})");
-        }
-        if let Some(s) = got {
+        if let Some(s) = cv_rms(sensors, &trial, cfg, scale) {
             if s < best * (1.0 - multi.min_gain) {
                 best = s;
                 order = trial;
