@@ -143,13 +143,13 @@ pub fn evaluate_imu(
             ));
         }
         let judge = |values: &[f64], output: &'static str, name: String| {
-            let (mut e, t) = settings.evaluate(&axis_log, values, tau0_s).map_err(|source| {
-                ImuJudgeError::Evaluate {
+            let (mut e, t) = settings
+                .evaluate(&axis_log, values, tau0_s)
+                .map_err(|source| ImuJudgeError::Evaluate {
                     gyro: g.name.clone(),
                     output,
                     source,
-                }
-            })?;
+                })?;
             e.column = name;
             Ok::<_, ImuJudgeError>((e, t))
         };
@@ -158,10 +158,18 @@ pub fn evaluate_imu(
         let (compensated, temps) = match (&comp, model) {
             (Some(c), Some(m)) => {
                 // compensate_imu returns the model's axes in order; find this column's.
-                let i = m.axes.iter().position(|a| a.gyro == g.name).ok_or_else(|| {
-                    ImuJudgeError::Layout(format!("the model has no axis {}", g.name))
-                })?;
-                let (e, _) = judge(&c[i].gyro_comp_dps, "compensated", format!("{}_comp", g.name))?;
+                let i = m
+                    .axes
+                    .iter()
+                    .position(|a| a.gyro == g.name)
+                    .ok_or_else(|| {
+                        ImuJudgeError::Layout(format!("the model has no axis {}", g.name))
+                    })?;
+                let (e, _) = judge(
+                    &c[i].gyro_comp_dps,
+                    "compensated",
+                    format!("{}_comp", g.name),
+                )?;
                 (Some(e), m.axes[i].temps.clone())
             }
             _ => (None, Vec::new()),
@@ -276,11 +284,12 @@ pub fn compare_imu(
                             .iter()
                             .map(|(n, l)| NamedLog { name: n, log: l })
                             .collect();
-                        compare(&tr, &te, cfg, &|key, t, e, l| progress(k, key, t, e, l))
-                            .map_err(|source| ImuJudgeError::Compare {
+                        compare(&tr, &te, cfg, &|key, t, e, l| progress(k, key, t, e, l)).map_err(
+                            |source| ImuJudgeError::Compare {
                                 gyro: gyro_cols[k].clone(),
                                 source,
-                            })?
+                            },
+                        )?
                     };
                     Ok(AxisComparison {
                         gyro: gyro_cols[k].clone(),
@@ -363,11 +372,7 @@ impl ImuComparison {
         let keys: Vec<&'static str> = cfg.candidates.iter().map(|c| c.key(&cfg.fit)).collect();
         headers.extend(keys.iter().map(|k| (*k).to_owned()));
         headers.push("noise floor".to_owned());
-        let tables: Vec<_> = self
-            .axes
-            .iter()
-            .map(|a| a.comparison.table(cfg))
-            .collect();
+        let tables: Vec<_> = self.axes.iter().map(|a| a.comparison.table(cfg)).collect();
         let mut rows = Vec::new();
         let n_tests = tables.iter().map(|t| t.blocks.len()).max().unwrap_or(0);
         for b in 0..n_tests {
@@ -398,8 +403,16 @@ impl ImuComparison {
                         continue;
                     };
                     let mut cells = vec![
-                        if first_row { log.clone() } else { String::new() },
-                        if first_axis { figure.label() } else { String::new() },
+                        if first_row {
+                            log.clone()
+                        } else {
+                            String::new()
+                        },
+                        if first_axis {
+                            figure.label()
+                        } else {
+                            String::new()
+                        },
                         a.gyro.clone(),
                     ];
                     first_row = false;
@@ -441,7 +454,11 @@ pub fn write_text_table(w: &mut dyn std::io::Write, t: &Table) -> std::io::Resul
         writeln!(w, "{}", cells.join("  ").trim_end())
     };
     line(w, &t.headers)?;
-    writeln!(w, "{}", "-".repeat(width.iter().sum::<usize>() + 2 * n.saturating_sub(1)))?;
+    writeln!(
+        w,
+        "{}",
+        "-".repeat(width.iter().sum::<usize>() + 2 * n.saturating_sub(1))
+    )?;
     for r in &t.rows {
         line(w, r)?;
     }

@@ -259,10 +259,7 @@ fn fit_axis(
     let mut best: Option<(usize, FitOutcome)> = None;
     let mut scores = Vec::with_capacity(temp_cols.len());
     for (j, temp) in temp_cols.iter().enumerate() {
-        events(ImuFitEvent::SensorStarted {
-            axis: k,
-            sensor: j,
-        });
+        events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
         let axis_logs: Vec<(String, TestLog)> = logs
             .iter()
             .map(|(n, l)| (n.clone(), l.axis_data(k, j)))

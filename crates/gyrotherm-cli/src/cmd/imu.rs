@@ -231,7 +231,11 @@ pub fn fit_event_printer(
                 cv_rms.map_or("-".to_owned(), |r| format!("{r:.3e}"))
             ),
             ImuFitEvent::AxisFinished { axis, sensor } => {
-                eprintln!("gyrotherm: [{at:6.1} s] {}: axis done, reads {}", g(axis), t(sensor))
+                eprintln!(
+                    "gyrotherm: [{at:6.1} s] {}: axis done, reads {}",
+                    g(axis),
+                    t(sensor)
+                )
             }
             _ => {}
         }

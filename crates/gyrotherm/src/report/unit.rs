@@ -20,8 +20,14 @@ pub const UNIT_PAGE_FIGURES: [(&str, &str); 2] = [
         "fig7_compensation",
         "raw and compensated output of the main held-out log",
     ),
-    ("fig4_bias", "bias against temperature"),
+    (
+        "fig6_rate_table",
+        "output at the table rates (an axis with a rate-table held-out log)",
+    ),
 ];
+
+/// The across-axes table names the log, the figure and the axis in its first three columns.
+const UNIT_CSS: &str = "table.across-axes td:nth-child(-n+3){text-align:left}";
 
 /// The folder of axis `k` (0-based) inside the report folder.
 pub fn axis_folder(k: usize) -> String {
@@ -64,7 +70,7 @@ pub fn write_unit_report(
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
-         <title>{title}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<h1>{title}</h1>\n"
+         <title>{title}</title>\n<style>{CSS}{UNIT_CSS}</style>\n</head>\n<body>\n<h1>{title}</h1>\n"
     );
     h.push_str("<h2>Across axes</h2>\n");
     push_table(&mut h, &cmp.across_axes(cfg), "across-axes");
