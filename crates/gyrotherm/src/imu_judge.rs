@@ -464,3 +464,98 @@ pub fn write_text_table(w: &mut dyn std::io::Write, t: &Table) -> std::io::Resul
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::csvlog::NamedSeries;
+
+    fn series(name: &str, v: &[f64]) -> NamedSeries {
+        NamedSeries {
+            name: name.into(),
+            values: v.to_vec(),
+        }
+    }
+
+    fn text(name: &str, v: &[&str]) -> ExtraColumn {
+        ExtraColumn {
+            name: name.into(),
+            values: v.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn an_axis_sees_its_own_truth_under_the_single_axis_names() {
+        let log = ImuLog {
+            time_s: vec![0.0, 1.0],
+            gyro: vec![
+                series("gyro_x_dps", &[1.0, 2.0]),
+                series("gyro_y_dps", &[3.0, 4.0]),
+            ],
+            temp: vec![series("temp_case_c", &[20.0, 21.0])],
+            table: Some(series("table_dps", &[0.0, 20.0])),
+            table_axis: Some("gyro_y_dps".into()),
+            extra: vec![
+                text("noise_dps_x", &["0.1", "0.2"]),
+                text("noise_dps_y", &["0.3", "0.4"]),
+                text("chamber_temp_c", &["22", "23"]),
+            ],
+        };
+        let y = axis_test_log(&log, 1, 0);
+        assert_eq!(y.gyro_dps, [3.0, 4.0]);
+        assert_eq!(y.extra_f64("noise_dps"), Some(vec![0.3, 0.4]));
+        assert_eq!(y.extra_f64("noise_dps_x"), Some(vec![0.1, 0.2]));
+        assert_eq!(y.extra_f64("chamber_temp_c"), Some(vec![22.0, 23.0]));
+        assert_eq!(y.table_dps.as_deref(), Some(&[0.0, 20.0][..]));
+        let x = axis_test_log(&log, 0, 0);
+        assert_eq!(x.extra_f64("noise_dps"), Some(vec![0.1, 0.2]));
+        // The table turns y: for x the run is static.
+        assert!(x.table_dps.is_none());
+        // Gyro names the simulator did not write get no renaming.
+        let mut other = log.clone();
+        other.gyro[1].name = "gy".into();
+        other.table_axis = Some("gy".into());
+        assert!(axis_test_log(&other, 1, 0).extra_f64("noise_dps").is_none());
+    }
+
+    #[test]
+    fn the_table_across_axes_aligns_its_columns() {
+        let t = Table {
+            headers: vec![
+                "held-out log".into(),
+                "figure".into(),
+                "axis".into(),
+                "raw".into(),
+            ],
+            rows: vec![vec![
+                "a.csv".into(),
+                "bias".into(),
+                "gx".into(),
+                "0.5".into(),
+            ]],
+        };
+        let mut out = Vec::new();
+        write_text_table(&mut out, &t).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "held-out log  figure  axis  raw");
+        assert_eq!(lines[1], "-".repeat(31));
+        assert_eq!(lines[2], "a.csv         bias    gx    0.5");
+    }
+
+    #[test]
+    fn evaluate_refuses_a_column_other_than_the_gyros() {
+        let log = ImuLog {
+            time_s: vec![0.0, 1.0],
+            gyro: vec![series("gx", &[1.0, 2.0])],
+            temp: vec![series("t", &[20.0, 21.0])],
+            ..Default::default()
+        };
+        let s = EvaluateSettings {
+            column: "other_dps".into(),
+            ..Default::default()
+        };
+        let e = evaluate_imu(&log, None, &s).unwrap_err().to_string();
+        assert!(e.contains("judged per gyro column"), "{e}");
+    }
+}

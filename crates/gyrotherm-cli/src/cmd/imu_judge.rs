@@ -30,6 +30,15 @@ pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         .model
         .as_ref()
         .map(|p| {
+            // A readable file that is not a unit's model: say what to do instead.
+            if p.is_file() && !super::imu::is_imu_model(p)? {
+                anyhow::bail!(
+                    "{}: evaluate --model takes an inertial unit's model (train with column \
+                     lists); for a single-axis model run compensate, then evaluate --column \
+                     gyro_comp_dps",
+                    p.display()
+                );
+            }
             ImuModel::load(p)
                 .map_err(anyhow::Error::new)
                 .with_context(|| format!("cannot use model {}", p.display()))

@@ -12,7 +12,7 @@
 //! - [`html`]: `DIR/index.html`, self-contained (inline CSS, no script, no network).
 //! - `job`: the full report of a held-out comparison ([`write_full_report`], used by
 //!   `gyrotherm report`), from the logs and a [`crate::compare::Comparison`].
-//! - [`unit`]: the report of an inertial unit: the table across axes, a section per axis,
+//! - [`unit`](mod@unit): the report of an inertial unit: the table across axes, a section per axis,
 //!   and each axis's full report in its own folder.
 //! - `decimate`: min/max per pixel column, so long runs draw fast without losing extremes.
 //! - `font`: the embedded DejaVu Sans font; no system font or graphics library is used.
