@@ -55,6 +55,8 @@ fn train_says_when_each_axis_and_sensor_starts_and_finishes() {
     let dir = tempfile::tempdir().unwrap();
     let (_, err) = train(dir.path());
     for g in ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"] {
+        let starts = format!("{g}: axis starts (2 sensor(s) to try)");
+        assert!(err.contains(&starts), "{starts:?} missing:\n{err}");
         for (k, t) in ["temp_case_c", "temp_x_c"].iter().enumerate() {
             let start = format!("{g}: fitting on {t} (sensor {} of 2)", k + 1);
             let done = format!("{g}: {t} done (cross-validated RMS");

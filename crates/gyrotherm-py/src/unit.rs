@@ -321,6 +321,7 @@ fn fit_unit(
         let events = |e: ImuFitEvent| {
             let Some(cb) = &progress else { return };
             let (what, axis, sensor, cv) = match e {
+                ImuFitEvent::AxisStarted { axis } => ("axis_start", axis, usize::MAX, None),
                 ImuFitEvent::SensorStarted { axis, sensor } => ("start", axis, sensor, None),
                 ImuFitEvent::SensorFinished {
                     axis,
@@ -331,7 +332,9 @@ fn fit_unit(
                 _ => return,
             };
             Python::attach(|py| {
-                let args = (what, gyro[axis].clone(), temp[sensor].clone(), cv);
+                // An axis's start names no sensor yet.
+                let sensor = temp.get(sensor).cloned();
+                let args = (what, gyro[axis].clone(), sensor, cv);
                 if let Err(e) = cb.call1(py, args) {
                     let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
                     slot.get_or_insert(e);

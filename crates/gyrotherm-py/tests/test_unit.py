@@ -157,16 +157,18 @@ def test_unit_fit_reports_each_axis_and_sensor(unit_logs, capfd):
     )
     for g in GYROS:
         mine = [e for e in events if e[1] == g]
-        # Per sensor a start then its finish, then the axis with the sensor it reads.
+        # The axis starts, per sensor a start then its finish, then the axis with the sensor
+        # it reads.
         assert [(e[0], e[2]) for e in mine] == [
-            ("start", TEMPS[0]), ("done", TEMPS[0]), ("start", TEMPS[1]), ("done", TEMPS[1]),
+            ("axis_start", None), ("start", TEMPS[0]), ("done", TEMPS[0]), ("start", TEMPS[1]), ("done", TEMPS[1]),
             ("axis", mine[-1][2]),
         ]
     capfd.readouterr()
     gt.fit(static=unit_logs["static"], method="linear", gyro_col=GYROS, temp_col=TEMPS, progress=True)
     err = capfd.readouterr().err
     for g in GYROS:
-        assert f"{g}: fitting on temp_case_c" in err and f"{g}: axis done, reads" in err, err
+        for line in (f"{g}: axis starts", f"{g}: fitting on temp_case_c", f"{g}: axis done, reads"):
+            assert line in err, err
 
 
 def test_unit_progress_callback_error_is_raised(unit_logs):

@@ -159,6 +159,8 @@ pub type ImuProgress<'a> = dyn Fn(usize, usize, crate::fit::Target, usize, f64) 
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum ImuFitEvent {
+    /// Axis `axis` starts (its sensors are then tried in column order).
+    AxisStarted { axis: usize },
     /// Axis `axis` starts its fit on sensor `sensor` (indices into the column lists).
     SensorStarted { axis: usize, sensor: usize },
     /// Axis `axis` finished its fit on sensor `sensor`, with its cross-validated RMS.
@@ -256,6 +258,7 @@ fn fit_axis(
     progress: &ImuProgress,
     events: &ImuEvents,
 ) -> Result<ImuAxis, ImuError> {
+    events(ImuFitEvent::AxisStarted { axis: k });
     let mut best: Option<(usize, FitOutcome)> = None;
     let mut scores = Vec::with_capacity(temp_cols.len());
     for (j, temp) in temp_cols.iter().enumerate() {

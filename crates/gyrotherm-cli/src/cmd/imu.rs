@@ -213,6 +213,11 @@ pub fn fit_event_printer(
         let g = |k: usize| gyro.get(k).map_or("?", String::as_str);
         let t = |j: usize| temp.get(j).map_or("?", String::as_str);
         match e {
+            ImuFitEvent::AxisStarted { axis } => eprintln!(
+                "gyrotherm: [{at:6.1} s] {}: axis starts ({} sensor(s) to try)",
+                g(axis),
+                temp.len()
+            ),
             ImuFitEvent::SensorStarted { axis, sensor } => eprintln!(
                 "gyrotherm: [{at:6.1} s] {}: fitting on {} (sensor {} of {})",
                 g(axis),

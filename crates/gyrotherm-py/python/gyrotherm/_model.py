@@ -271,9 +271,11 @@ class _PrintUnitProgress:
     def __init__(self) -> None:
         self.started = time.monotonic()
 
-    def __call__(self, event: str, gyro: str, temp: str, cv_rms: Optional[float]) -> None:
+    def __call__(self, event: str, gyro: str, temp: Optional[str], cv_rms: Optional[float]) -> None:
         at = time.monotonic() - self.started
-        if event == "start":
+        if event == "axis_start":
+            text = f"{gyro}: axis starts"
+        elif event == "start":
             text = f"{gyro}: fitting on {temp}"
         elif event == "done":
             score = "-" if cv_rms is None else f"{cv_rms:.3e}"
@@ -358,7 +360,8 @@ def fit(
     :class:`UnitModel` (the same file). Table logs go in ``table`` (one per axis; the axis is
     found, or named by ``table_axis=``). ``progress``: True prints a line as each axis and
     sensor starts and finishes; a callable gets ``(event, gyro, temp, cv_rms)``, event
-    ``"start"``, ``"done"`` or ``"axis"`` (the axis is done and reads ``temp``).
+    ``"axis_start"`` (``temp`` None), ``"start"``, ``"done"`` (with the sensor's
+    cross-validated RMS) or ``"axis"`` (the axis is done and reads ``temp``).
     """
     for old, new in _FIT_RENAMED.items():
         if old in log_options:
