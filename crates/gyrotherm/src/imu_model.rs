@@ -154,6 +154,28 @@ pub fn is_imu_model_text(text: &str) -> bool {
 /// (target, epoch, loss), as [`fit_model`] reports it.
 pub type ImuProgress<'a> = dyn Fn(usize, usize, crate::fit::Target, usize, f64) + Sync + 'a;
 
+/// A step of an inertial-unit fit, as it happens (from the axes' threads): what a caller
+/// needs to say which axis and sensor are being fitted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum ImuFitEvent {
+    /// Axis `axis` starts (its sensors are then tried in column order).
+    AxisStarted { axis: usize },
+    /// Axis `axis` starts its fit on sensor `sensor` (indices into the column lists).
+    SensorStarted { axis: usize, sensor: usize },
+    /// Axis `axis` finished its fit on sensor `sensor`, with its cross-validated RMS.
+    SensorFinished {
+        axis: usize,
+        sensor: usize,
+        cv_rms: Option<f64>,
+    },
+    /// Axis `axis` is done and reads sensor `sensor`.
+    AxisFinished { axis: usize, sensor: usize },
+}
+
+/// Receiver of [`ImuFitEvent`]s.
+pub type ImuEvents<'a> = dyn Fn(ImuFitEvent) + Sync + 'a;
+
 /// Fit every axis of the unit (see the module doc): logs read with the column lists; each
 /// axis on its own thread; `temp_sensor` the limits every axis's compensator believes.
 pub fn fit_imu(
@@ -161,6 +183,17 @@ pub fn fit_imu(
     cfg: &FitConfig,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
+) -> Result<ImuModel, ImuError> {
+    fit_imu_with_events(logs, cfg, temp_sensor, progress, &|_| {})
+}
+
+/// [`fit_imu`], telling `events` as each axis and each sensor tried starts and finishes.
+pub fn fit_imu_with_events(
+    logs: &[(String, ImuLog)],
+    cfg: &FitConfig,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
 ) -> Result<ImuModel, ImuError> {
     let first = logs
         .first()
@@ -182,7 +215,16 @@ pub fn fit_imu(
             .map(|k| {
                 let (gyro_cols, temp_cols) = (&gyro_cols, &temp_cols);
                 scope.spawn(move || {
-                    fit_axis(logs, k, gyro_cols, temp_cols, cfg, temp_sensor, progress)
+                    fit_axis(
+                        logs,
+                        k,
+                        gyro_cols,
+                        temp_cols,
+                        cfg,
+                        temp_sensor,
+                        progress,
+                        events,
+                    )
                 })
             })
             .collect();
@@ -205,6 +247,7 @@ pub fn fit_imu(
     Ok(model)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fit_axis(
     logs: &[(String, ImuLog)],
     k: usize,
@@ -213,10 +256,13 @@ fn fit_axis(
     cfg: &FitConfig,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
+    events: &ImuEvents,
 ) -> Result<ImuAxis, ImuError> {
+    events(ImuFitEvent::AxisStarted { axis: k });
     let mut best: Option<(usize, FitOutcome)> = None;
     let mut scores = Vec::with_capacity(temp_cols.len());
     for (j, temp) in temp_cols.iter().enumerate() {
+        events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
         let axis_logs: Vec<(String, TestLog)> = logs
             .iter()
             .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
@@ -243,6 +289,11 @@ fn fit_axis(
         } else {
             cv(&outcome.scale_training)
         };
+        events(ImuFitEvent::SensorFinished {
+            axis: k,
+            sensor: j,
+            cv_rms,
+        });
         scores.push(SensorScore {
             temp: temp.clone(),
             cv_rms,
@@ -259,6 +310,7 @@ fn fit_axis(
         }
     }
     let (j, mut outcome) = best.ok_or_else(|| ImuError::Layout("no temperature columns".into()))?;
+    events(ImuFitEvent::AxisFinished { axis: k, sensor: j });
     outcome.model.features.temp_sensor = *temp_sensor;
     Ok(ImuAxis {
         gyro: gyro_cols[k].clone(),

@@ -57,6 +57,7 @@ pub mod csvlog;
 pub mod export;
 pub mod features;
 pub mod fit;
+pub mod imu_judge;
 pub mod imu_model;
 pub mod json_keys;
 pub mod lot;

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use gyrotherm::csvlog::{self, ImuLog, LogWriter};
-use gyrotherm::imu_model::{self, ImuModel};
+use gyrotherm::imu_model::{self, ImuFitEvent, ImuModel};
 
 use super::common::{error_message, LogArgs};
 use super::compensate::CompensateArgs;
@@ -19,7 +19,7 @@ pub fn is_imu_model(path: &Path) -> anyhow::Result<bool> {
 }
 
 /// Read every log with the column lists, reporting each failure, then stop if any failed.
-fn read_imu_logs(paths: &[PathBuf], args: &LogArgs) -> anyhow::Result<Vec<(String, ImuLog)>> {
+pub fn read_imu_logs(paths: &[PathBuf], args: &LogArgs) -> anyhow::Result<Vec<(String, ImuLog)>> {
     let opts = args.read_options();
     let mut out = Vec::new();
     let mut failed = 0;
@@ -71,9 +71,11 @@ pub fn train(args: TrainArgs) -> anyhow::Result<ExitCode> {
     eprintln!(
         "gyrotherm: fitting {axes} axes on their own threads, each on {sensors} sensor(s) in turn"
     );
-    let model = imu_model::fit_imu(&logs, &cfg, &temp_sensor, &|_, _, _, _, _| {})
-        .map_err(anyhow::Error::new)
-        .context("training failed")?;
+    let events = fit_event_printer(started, &logs);
+    let model =
+        imu_model::fit_imu_with_events(&logs, &cfg, &temp_sensor, &|_, _, _, _, _| {}, &events)
+            .map_err(anyhow::Error::new)
+            .context("training failed")?;
     model
         .save(&args.out)
         .map_err(anyhow::Error::new)
@@ -189,4 +191,58 @@ fn write_compensated(
         }
         out.flush()
     })
+}
+
+/// Live lines on stderr for each step of a unit fit ([`ImuFitEvent`]): the axis and sensor
+/// with the seconds since `started` (the axes run on threads, so lines of several axes
+/// interleave; each line names its axis).
+pub fn fit_event_printer(
+    started: std::time::Instant,
+    logs: &[(String, ImuLog)],
+) -> impl Fn(ImuFitEvent) + Sync {
+    let gyro: Vec<String> = logs
+        .first()
+        .map(|(_, l)| l.gyro.iter().map(|s| s.name.clone()).collect())
+        .unwrap_or_default();
+    let temp: Vec<String> = logs
+        .first()
+        .map(|(_, l)| l.temp.iter().map(|s| s.name.clone()).collect())
+        .unwrap_or_default();
+    move |e: ImuFitEvent| {
+        let at = started.elapsed().as_secs_f64();
+        let g = |k: usize| gyro.get(k).map_or("?", String::as_str);
+        let t = |j: usize| temp.get(j).map_or("?", String::as_str);
+        match e {
+            ImuFitEvent::AxisStarted { axis } => eprintln!(
+                "gyrotherm: [{at:6.1} s] {}: axis starts ({} sensor(s) to try)",
+                g(axis),
+                temp.len()
+            ),
+            ImuFitEvent::SensorStarted { axis, sensor } => eprintln!(
+                "gyrotherm: [{at:6.1} s] {}: fitting on {} (sensor {} of {})",
+                g(axis),
+                t(sensor),
+                sensor + 1,
+                temp.len()
+            ),
+            ImuFitEvent::SensorFinished {
+                axis,
+                sensor,
+                cv_rms,
+            } => eprintln!(
+                "gyrotherm: [{at:6.1} s] {}: {} done (cross-validated RMS {})",
+                g(axis),
+                t(sensor),
+                cv_rms.map_or("-".to_owned(), |r| format!("{r:.3e}"))
+            ),
+            ImuFitEvent::AxisFinished { axis, sensor } => {
+                eprintln!(
+                    "gyrotherm: [{at:6.1} s] {}: axis done, reads {}",
+                    g(axis),
+                    t(sensor)
+                )
+            }
+            _ => {}
+        }
+    }
 }
