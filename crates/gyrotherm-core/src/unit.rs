@@ -156,8 +156,8 @@ impl<const N: usize> Unit<N> {
         }
         let mut unit = Unit::new(n_temps);
         for (axis, (m, ch)) in models.iter().zip(channels).enumerate() {
-            let c = Compensator::from_static(m)
-                .map_err(|source| UnitError::Model { axis, source })?;
+            let c =
+                Compensator::from_static(m).map_err(|source| UnitError::Model { axis, source })?;
             unit.push_axis(c.with_channel(usize::from(*ch)))?;
         }
         Ok(unit)
@@ -231,7 +231,11 @@ mod tests {
                 150 => x - 40.0,
                 _ => x,
             };
-            let s3 = if (50..80).contains(&i) { f64::NAN } else { 25.0 };
+            let s3 = if (50..80).contains(&i) {
+                f64::NAN
+            } else {
+                25.0
+            };
             let temps = [20.0, 21.0 + 0.01 * x, 22.0, s3];
             let gyro = [0.01, if i == 7 { f64::NAN } else { 0.02 }, 0.03];
             let out = unit.step(t, &gyro, &temps);
