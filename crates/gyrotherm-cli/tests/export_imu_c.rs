@@ -216,12 +216,8 @@ fn generated_unit_c_equals_the_unit_stream() {
             let m = gyrotherm::imu_model::ImuModel::from_json(&json.to_string())
                 .unwrap_or_else(|e| panic!("generated unit {u}: {e}"));
             let mdir = bdir.join(format!("u{u}"));
-            let files = gyrotherm::export::unit::export_imu(
-                &m,
-                gyrotherm::export::Lang::C,
-                &mdir,
-            )
-            .unwrap();
+            let files =
+                gyrotherm::export::unit::export_imu(&m, gyrotherm::export::Lang::C, &mdir).unwrap();
             for f in files {
                 let text = std::fs::read_to_string(f).unwrap();
                 assert!(gyrotherm::export::is_generated_text(&text), "unit {u}");
@@ -249,9 +245,7 @@ fn generated_unit_c_equals_the_unit_stream() {
                                         &format!("-Dgt_init=gt_init_{u}"),
                                         &format!("-Dgt_step_imu=gt_step_imu_{u}"),
                                         &format!("-Dgt_step_imu_bk=gt_step_imu_bk_{u}"),
-                                        &format!(
-                                            "-Dgt_coverage_of_axis=gt_coverage_of_axis_{u}"
-                                        ),
+                                        &format!("-Dgt_coverage_of_axis=gt_coverage_of_axis_{u}"),
                                         "-I",
                                         mdir.to_str().unwrap(),
                                     ],

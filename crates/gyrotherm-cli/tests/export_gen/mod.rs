@@ -227,4 +227,3 @@ pub fn coverage_json(rng: &mut Lcg) -> serde_json::Value {
 
 /// Largest finite gyro sample the tester used: with K < 1, (Ĝ − B) / K overflows.
 pub const HUGE: f64 = 1.797e308;
-

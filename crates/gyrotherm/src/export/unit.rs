@@ -149,16 +149,21 @@ impl Layout<'_> {
     /// The comment lines (without comment markers) on the model and the column order.
     fn about(&self, axes: &[(StaticModel, String)], gyro: &str, temp: &str) -> Vec<String> {
         let n = axes.len();
-        let mut out = vec![format!(
-            "Unit model: {n} gyro axes, {} temperature columns; {CHECKSUM_KEY} {}.",
-            self.n_temps, self.digest
-        )];
+        let mut out = vec![
+            format!(
+                "Unit model: {n} gyro axes, {} temperature columns;",
+                self.n_temps
+            ),
+            format!("{CHECKSUM_KEY} {}.", self.digest),
+        ];
         for (i, (_, about)) in axes.iter().enumerate() {
             out.push(format!("Axis {i}: {about}."));
         }
         out.push(
-            "Column order. The model's column names are not copied into generated source; \
-             `gyrotherm export` prints them on stderr and the model file lists them \
+            "Column order. The model's column names are not copied into generated source;".into(),
+        );
+        out.push(
+            "`gyrotherm export` prints them on stderr, and the model file lists them \
              (gyro_cols, temp_cols):"
                 .into(),
         );
