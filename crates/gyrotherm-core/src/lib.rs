@@ -15,7 +15,7 @@
 //! - [`coverage`]: the training region in (T, dT) and a per-sample verdict (inside, edge,
 //!   outside) with a 1σ estimate of the residual bias error.
 //! - [`static_model`]: a model as plain static data (`gyrotherm export --lang rust`).
-//! - [`unit`]: an inertial unit, one compensator per gyro axis, each on its own temperature
+//! - [`unit`](mod@unit): an inertial unit, one compensator per gyro axis, each on its own temperature
 //!   sensor, stepped together.
 //! - [`error`]: what the core refuses instead of panicking.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]

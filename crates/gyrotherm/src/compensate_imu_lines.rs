@@ -1,7 +1,7 @@
 //! Compensate an inertial unit's CSV log line by line: what `gyrotherm compensate --stream`
 //! runs with a unit model ([`crate::imu_model`]).
 //!
-//! The line handling is the single-axis stream's ([`crate::compensate_lines`]): the header
+//! The line handling is the single-axis stream's ([`compensate_lines`](mod@crate::compensate_lines)): the header
 //! (comments and blank lines before it), the line cap [`MAX_LINE_BYTES`], the separator and
 //! decimal comma, comment and blank lines dropped, one output line per data line, and
 //! [`Mode::Strict`] (stop on a malformed line, naming file, line and column) or

@@ -21,7 +21,7 @@
 //! [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last bit.
 //!
 //! **Rust.** `gyrotherm_model.rs` holds `AXES`, `TEMPS`, `CHANNELS` (the sensor each axis
-//! reads) and `MODELS` (one [`StaticModel`](gyrotherm_core::static_model::StaticModel) per
+//! reads) and `MODELS` (one [`StaticModel`] per
 //! axis), for [`Unit::from_static`](gyrotherm_core::unit::Unit::from_static).
 //!
 //! **Column names.** Generated source holds only generator text and numbers: the column
