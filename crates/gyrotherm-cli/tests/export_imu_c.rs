@@ -2,7 +2,9 @@
 //! and `gt_step_imu` beside it), built with gcc `-std=c99 -ffp-contract=off -Wall -Wextra
 //! -Werror -pedantic`, gives every axis the same status, rate, bias and scale factor as
 //! `compensate --stream` with the unit model (in process: `compensate_imu_lines`), to the last
-//! bit, on generated units (one to three axes, each axis one of the generated single-axis
+//! bit, and `gt_coverage_of_axis` the verdict and sigma_dph of the core's coverage map on that
+//! axis's compensator (the core `Unit` stepped alongside; two axis models in three carry a
+//! map), on generated units (one to three axes, each axis one of the generated single-axis
 //! models of every method, one to five temperature sensors, each axis on a drawn sensor)
 //! under faulted streams: one sensor NaN for a minute and out of range, time glitches and
 //! lasting clock resets and jumps, huge and non-finite gyro samples. The units' column names
@@ -204,6 +206,7 @@ fn generated_unit_c_equals_the_unit_stream() {
     let d = dir.path();
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
     let (mut lines, mut axis_lines, mut differ, mut statuses) = (0usize, 0, 0, [0usize; 4]);
+    let mut verdicts = [0usize; 5];
     let mut failures = Vec::new();
     let workers = std::thread::available_parallelism().map_or(2, |n| n.get().min(4));
     for batch in 0..UNITS.div_ceil(BATCH) {
@@ -306,13 +309,37 @@ fn generated_unit_c_equals_the_unit_stream() {
         for ((u, m, _, axes, _), s) in units.iter().zip(&streams) {
             let want = stream_in_process(m, s);
             assert_eq!(want.len(), s.len(), "unit {u}: one line out per line in");
+            // The coverage verdicts: the core unit stepped here, each axis's map on its
+            // features (C: 0 inside, 1 edge, 2 outside, 3 no verdict yet, 4 no map).
+            let mut unit = gyrotherm::compensate_imu_lines::flight_unit(m).unwrap();
+            let maps: Vec<_> = m
+                .axes
+                .iter()
+                .map(|a| a.model.coverage.as_ref().map(|c| c.to_core().unwrap()))
+                .collect();
+            let cover: Vec<Vec<(usize, f64)>> = s
+                .iter()
+                .map(|r| {
+                    unit.step(r[0], &r[1..1 + axes], &r[1 + axes..]);
+                    maps.iter()
+                        .enumerate()
+                        .map(|(k, map)| match map {
+                            None => (4, f64::NAN),
+                            Some(map) => match map.verdict_of(unit.axis(k).unwrap().features()) {
+                                Some(v) => (v.coverage as usize, v.sigma_dph),
+                                None => (3, f64::NAN),
+                            },
+                        })
+                        .collect()
+                })
+                .collect();
             let st: Vec<u8> = out[at..at + s.len() * axes].to_vec();
             at += s.len() * axes;
-            let vals: Vec<f64> = out[at..at + s.len() * axes * 24]
+            let vals: Vec<f64> = out[at..at + s.len() * axes * 40]
                 .chunks_exact(8)
                 .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
                 .collect();
-            at += s.len() * axes * 24;
+            at += s.len() * axes * 40;
             for (line, w) in want.iter().enumerate() {
                 lines += 1;
                 let mut same_line = true;
@@ -320,22 +347,28 @@ fn generated_unit_c_equals_the_unit_stream() {
                     let j = line * axes + k;
                     let (cs, r, b, sc) = (
                         st[j] as usize,
-                        vals[3 * j],
-                        vals[3 * j + 1],
-                        vals[3 * j + 2],
+                        vals[5 * j],
+                        vals[5 * j + 1],
+                        vals[5 * j + 2],
                     );
+                    let (cv, sigma) = (vals[5 * j + 3] as usize, vals[5 * j + 4]);
+                    let (wc, wsig) = cover[line][k];
                     axis_lines += 1;
                     statuses[ws] += 1;
+                    verdicts[wc] += 1;
                     let same = cs == ws
                         && b.to_bits() == wb.to_bits()
                         && sc.to_bits() == wk.to_bits()
-                        && (cs == 3 || r.to_bits() == wr.to_bits());
+                        && (cs == 3 || r.to_bits() == wr.to_bits())
+                        && cv == wc
+                        && (sigma.to_bits() == wsig.to_bits() || (sigma.is_nan() && wsig.is_nan()));
                     if !same {
                         same_line = false;
                         if failures.len() < 5 {
                             failures.push(format!(
                                 "unit {u} line {line} axis {k} {:?}: C ({cs}, {r:e}, {b:e}, \
-                                 {sc:e}) vs stream ({ws}, {wr:e}, {wb:e}, {wk:e})",
+                                 {sc:e}, {cv}, {sigma:e}) vs stream ({ws}, {wr:e}, {wb:e}, \
+                                 {wk:e}, {wc}, {wsig:e})",
                                 s[line]
                             ));
                         }
@@ -348,11 +381,17 @@ fn generated_unit_c_equals_the_unit_stream() {
     }
     println!(
         "unit differential: {UNITS} units, {lines} lines ({axis_lines} axis-lines) compared, \
-         {differ} lines differ (axis-lines ok {}, held {}, degraded {}, invalid {}); {:.1} s",
+         {differ} lines differ (axis-lines ok {}, held {}, degraded {}, invalid {}; coverage \
+         inside {}, edge {}, outside {}, no verdict {}, no map {}); {:.1} s",
         statuses[0],
         statuses[1],
         statuses[2],
         statuses[3],
+        verdicts[0],
+        verdicts[1],
+        verdicts[2],
+        verdicts[3],
+        verdicts[4],
         start.elapsed().as_secs_f64()
     );
     assert!(
@@ -361,4 +400,5 @@ fn generated_unit_c_equals_the_unit_stream() {
     );
     // Every status occurred often, so each path was compared.
     assert!(statuses.iter().all(|v| *v > 1000), "statuses {statuses:?}");
+    assert!(verdicts.iter().all(|v| *v > 500), "verdicts {verdicts:?}");
 }

@@ -9,9 +9,10 @@
 size_t GT_RUN(size_t n, const double *in, unsigned char *status, double *out);
 
 /* in: n rows of (t, gyro[GT_AXES], temp[GT_TEMPS]); out: per row and axis (rate, bias,
- * scale), status per row and axis. gt_step_imu runs on a second state beside
- * gt_step_imu_bk: where its rate or status differs from _bk's, the status is 255. Returns
- * GT_AXES. */
+ * scale, coverage, sigma_dph) after the step, coverage the gt_coverage_of_axis value as a
+ * double; status per row and axis. gt_step_imu runs on a second state beside
+ * gt_step_imu_bk: where its rate or status differs from _bk's, the status is 255; where an
+ * axis out of range does not answer GT_NO_VERDICT and NaN, 254. Returns GT_AXES. */
 size_t GT_RUN(size_t n, const double *in, unsigned char *status, double *out)
 {
     gt_state s, s2;
@@ -23,16 +24,25 @@ size_t GT_RUN(size_t n, const double *in, unsigned char *status, double *out)
     for (i = 0; i < n; i++) {
         double rate[GT_AXES], bias[GT_AXES], scale[GT_AXES], rate2[GT_AXES];
         gt_status st[GT_AXES], st2[GT_AXES];
+        double sigma = 0.0;
+        int beyond;
         const double *row = in + w * i;
         gt_step_imu_bk(&s, row[0], row + 1, row + 1 + GT_AXES, rate, st, bias, scale);
         gt_step_imu(&s2, row[0], row + 1, row + 1 + GT_AXES, rate2, st2);
         for (k = 0; k < GT_AXES; k++) {
             size_t j = (size_t)GT_AXES * i + (size_t)k;
             int same = st[k] == st2[k] && memcmp(&rate[k], &rate2[k], sizeof rate[k]) == 0;
+            gt_coverage c = gt_coverage_of_axis(&s, k, &sigma);
             status[j] = same ? (unsigned char)st[k] : 255u;
-            out[3 * j] = rate[k];
-            out[3 * j + 1] = bias[k];
-            out[3 * j + 2] = scale[k];
+            out[5 * j] = rate[k];
+            out[5 * j + 1] = bias[k];
+            out[5 * j + 2] = scale[k];
+            out[5 * j + 3] = (double)c;
+            out[5 * j + 4] = sigma;
+        }
+        beyond = (int)i % 2 == 0 ? GT_AXES : -1;
+        if (gt_coverage_of_axis(&s, beyond, &sigma) != GT_NO_VERDICT || !isnan(sigma)) {
+            status[(size_t)GT_AXES * i] = 254u;
         }
     }
     return GT_AXES;
