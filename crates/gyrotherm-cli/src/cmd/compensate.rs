@@ -25,11 +25,13 @@ pub struct CompensateArgs {
     pub input: Option<PathBuf>,
     /// Output CSV: every input column, then bias_dps, scale, gyro_comp_dps (°/s), status
     /// (ok, held, degraded, invalid), coverage (inside, edge, outside the training region)
-    /// and sigma_dph (1σ estimate of the residual bias error, °/h).
+    /// and sigma_dph (1σ estimate of the residual bias error, °/h). With an inertial-unit
+    /// model: every input column, then G_bias, G_scale, G_comp, G_status per gyro column G.
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub out: Option<PathBuf>,
     /// Read CSV on stdin and write one output line per input line on stdout, flushed as it
-    /// goes (the flight path). A malformed line is written as `invalid` and the stream goes on.
+    /// goes (the flight path), with the columns of --out (single-axis or inertial-unit model).
+    /// A malformed line is written as `invalid` and the stream goes on.
     #[arg(long)]
     pub stream: bool,
     #[command(flatten)]
