@@ -342,3 +342,104 @@ fn with_time_faults_each_axis_equals_its_own_single_axis_stream() {
     );
     assert_eq!(String::from_utf8(out.stdout).unwrap().lines().count(), 9);
 }
+
+/// The single-axis stream's line handling, for a unit: `;` with decimal commas (output with
+/// `;` and decimal points, the same numbers as the comma log), a line over the 64 KiB cap and
+/// a line with a broken quote written as `invalid` on every axis with the stream going on, a
+/// temperature field that is empty or not a number a fault of its sensor's axes only, and a
+/// log without one of the model's columns refused, naming it.
+#[test]
+fn line_handling_is_the_single_axis_streams() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = unit_model(d);
+    let text = unit_run(d);
+    let head: Vec<&str> = text.lines().take(301).collect();
+    let comma = d.join("comma.csv");
+    std::fs::write(&comma, head.join("\n") + "\n").unwrap();
+    let want = stream(&model, &comma, &[]);
+    // `;` and decimal commas.
+    let semi: Vec<String> = head
+        .iter()
+        .map(|l| l.replace(',', ";").replace('.', ","))
+        .collect();
+    let semi_path = d.join("semi.csv");
+    std::fs::write(&semi_path, semi.join("\n") + "\n").unwrap();
+    let got = stream(&model, &semi_path, &["--delimiter", ";"]);
+    let (w, g): (Vec<&str>, Vec<&str>) = (want.lines().collect(), got.lines().collect());
+    assert_eq!(w.len(), g.len());
+    let n_in = head[0].split(',').count();
+    for (a, b) in w.iter().zip(&g).skip(1) {
+        let a: Vec<&str> = a.split(',').collect();
+        let b: Vec<&str> = b.split(';').collect();
+        assert_eq!(a[n_in..], b[n_in..], "the added columns");
+    }
+    // Faults in lines 11 (too long), 21 (broken quote), 31 (y sensor empty), 41 (y sensor
+    // not a number).
+    let header: Vec<&str> = head[0].split(',').collect();
+    let ty = header.iter().position(|h| *h == "temp_y_c").unwrap();
+    let faulty: Vec<String> = head
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut f: Vec<String> = l.split(',').map(str::to_owned).collect();
+            match i {
+                11 => return "9".repeat(70 * 1024),
+                21 => f[1] = "\"0.01".into(),
+                31 => f[ty] = String::new(),
+                41 => f[ty] = "bus error".into(),
+                _ => {}
+            }
+            f.join(",")
+        })
+        .collect();
+    let faulty_path = d.join("faulty.csv");
+    std::fs::write(&faulty_path, faulty.join("\n") + "\n").unwrap();
+    let got = stream(&model, &faulty_path, &[]);
+    let rows: Vec<Vec<&str>> = got
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 300);
+    let out_header: Vec<&str> = got.lines().next().unwrap().split(',').collect();
+    let status = |g: &str| {
+        out_header
+            .iter()
+            .position(|h| *h == format!("{g}_status"))
+            .unwrap()
+    };
+    for line in [11, 21] {
+        for g in GYROS {
+            assert_eq!(rows[line - 1][status(g)], "invalid", "line {line} {g}");
+        }
+    }
+    for line in [31, 41] {
+        assert_eq!(rows[line - 1][status(GYROS[1])], "held", "line {line}");
+        assert_eq!(rows[line - 1][status(GYROS[0])], "ok", "line {line}");
+        assert_eq!(rows[line - 1][status(GYROS[2])], "ok", "line {line}");
+    }
+    assert!(rows[50..]
+        .iter()
+        .all(|r| GYROS.iter().all(|g| r[status(g)] == "ok")));
+    // A log without the y coil sensor's column.
+    let cut: Vec<String> = head
+        .iter()
+        .map(|l| {
+            let mut f: Vec<&str> = l.split(',').collect();
+            f.remove(ty);
+            f.join(",")
+        })
+        .collect();
+    let cut_path = d.join("cut.csv");
+    std::fs::write(&cut_path, cut.join("\n") + "\n").unwrap();
+    let out = gyrotherm()
+        .args(["compensate", "--stream", "--model"])
+        .arg(&model)
+        .stdin(Stdio::from(std::fs::File::open(&cut_path).unwrap()))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("column temp_y_c"), "{err}");
+}
