@@ -50,6 +50,7 @@ pub mod atomic_file;
 pub mod baseline;
 pub mod compare;
 pub mod compensate;
+pub mod compensate_imu_lines;
 pub mod compensate_lines;
 pub mod coverage;
 pub mod coverage_track;
