@@ -5,8 +5,11 @@
 # Models: linear, poly and the default `thermal` method (ridge on identified thermal states)
 # trained here on simulated fast-cycle runs, and the `published`-recipe LSTM of
 # crates/gyrotherm-core/examples/flight_loop/model.json (bias and scale-factor LSTMs).
+# Then an inertial unit: 3 gyros and 4 temperature sensors (case + one per coil), `thermal`
+# trained on simulated runs of unit 1000 of the design family (`simulate --imu`: a static
+# run and a rate-table run per axis), exported with gt_step_imu.
 # Per model: the object file's text, data and bss; flash = text + data; RAM = data + bss +
-# sizeof(gt_state) (one gyro axis); stack: an upper bound for one gt_step call; and the flash a linked image grows by against an empty
+# sizeof(gt_state) (one gyro axis; the whole unit for the unit); stack: an upper bound for one gt_step (gt_step_imu) call; and the flash a linked image grows by against an empty
 # main (--specs=nano.specs, -Wl,--gc-sections): the model plus the soft-float double
 # routines and libm's floor that it pulls in (the M4F FPU is single precision).
 set -euo pipefail
@@ -52,3 +55,30 @@ for m in linear poly thermal published; do
 done
 echo "state: sizeof(gt_state) = $state bytes per axis (RAM includes it); stack: sum of the"
 echo "frames of every function in gyrotherm_model.c (-fstack-usage), an upper bound for gt_step"
+
+# The inertial unit.
+unit=(--imu --unit random --unit-seed 1000 --profile fast-cycle)
+$bin simulate "${unit[@]}" --seed 1 --out "$work/us.csv" 2>/dev/null
+inputs=(--input "$work/us.csv")
+for ax in x y z; do
+    $bin simulate "${unit[@]}" --seed 2 --table-rate 20 --table-axis $ax --out "$work/ut$ax.csv" 2>/dev/null
+    inputs+=(--input "$work/ut$ax.csv")
+done
+$bin train --method thermal --gyro-col gyro_x_dps,gyro_y_dps,gyro_z_dps \
+    --temp-col temp_case_c,temp_x_c,temp_y_c,temp_z_c "${inputs[@]}" --out "$work/imu.json" 2>/dev/null
+dir="$work/imu"
+$bin export --model "$work/imu.json" --lang c --out "$dir" 2>/dev/null
+arm-none-eabi-gcc "${CFLAGS[@]}" -c "$dir/gyrotherm_model.c" -o "$dir/model.o"
+stack=$(awk '{s += $(NF-1)} END {print s}' "$dir/model.su")
+read -r text data bss _ < <(arm-none-eabi-size "$dir/model.o" | awk 'NR==2')
+printf '#include "gyrotherm_model.h"\ngt_state probe;\n' > "$dir/probe.c"
+arm-none-eabi-gcc "${CFLAGS[@]}" -I "$dir" -c "$dir/probe.c" -o "$dir/probe.o"
+state=$(arm-none-eabi-size "$dir/probe.o" | awk 'NR==2 {print $3}')
+arm-none-eabi-gcc "${CFLAGS[@]}" -DWITH_IMU -I "$dir" bench/m4/size_main.c \
+    "$dir/gyrotherm_model.c" "${LDFLAGS[@]}" -o "$dir/image.elf" -lm
+image=$(arm-none-eabi-size "$dir/image.elf" | awk 'NR==2 {print $1 + $2}')
+parts=$(python3 -c "import json,sys; m=json.load(open(sys.argv[1])); print('3x4 reads ' + ','.join(a['temps'][0] for a in m['axes']))" "$work/imu.json")
+printf '%-10s %-20s %6d %6d %6d %8d %8d %7d %14d\n' "imu" "3 axes, 4 sensors" "$text" "$data" "$bss" \
+    $((text + data)) $((data + bss + state)) "$stack" $((image - empty))
+echo "imu: $parts; sizeof(gt_state) = $state bytes for the unit (RAM includes it); stack: sum"
+echo "of the frames of every function (an upper bound for gt_step_imu)"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Make a lot report and a comparison report from simulated units with the release binary,
-# then load both pages in headless Chromium (check_pages.mjs). Without chromium or node this
+# Make a lot report, a comparison report and an inertial unit's report (the page across axes
+# and one axis's page) from simulated units with the release binary, then load the pages in
+# headless Chromium (check_pages.mjs). Without chromium or node this
 # says it skipped, except under CI=true, where that is a failure.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -33,4 +34,13 @@ for n in 1 2 3; do
 done
 "$bin" lot report --db lot.sqlite --out lot-report >/dev/null
 "$bin" report --train u1-train1.csv --train u1-train2.csv --test u1-test1.csv --test u1-test2.csv --methods linear,poly --out cmp-report >/dev/null 2>&1
-node "$here/check_pages.mjs" lot-report/index.html cmp-report/index.html
+# An inertial unit's report: the page across axes and one axis's full page.
+imu=(--imu --unit random --unit-seed 1 --profile fast-cycle --truth)
+"$bin" simulate "${imu[@]}" --seed 1 --out imu-s.csv >/dev/null 2>&1
+"$bin" simulate "${imu[@]}" --seed 2 --table-rate 20 --table-axis y --out imu-t.csv >/dev/null 2>&1
+"$bin" simulate "${imu[@]}" --seed 3 --out imu-h.csv >/dev/null 2>&1
+"$bin" simulate "${imu[@]}" --seed 4 --table-rate 20 --table-axis y --out imu-ht.csv >/dev/null 2>&1
+"$bin" report --gyro-col gyro_x_dps,gyro_y_dps,gyro_z_dps --temp-col temp_case_c,temp_x_c \
+    --train imu-s.csv --train imu-t.csv --test imu-h.csv --test imu-ht.csv --methods linear,poly \
+    --out imu-report >/dev/null 2>&1
+node "$here/check_pages.mjs" lot-report/index.html cmp-report/index.html imu-report/index.html imu-report/axis2/index.html

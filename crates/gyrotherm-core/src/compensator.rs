@@ -564,6 +564,8 @@ pub struct Compensator {
     last_good: Option<(f64, f64)>,
     /// Time of the latest sample with fresh B and K on this base.
     last_ok_s: Option<f64>,
+    /// Which of a unit's temperature channels [`Compensator::step_unit`] reads (0 alone).
+    channel: usize,
 }
 
 impl Compensator {
@@ -603,7 +605,29 @@ impl Compensator {
             settle_end_s: None,
             last_good: None,
             last_ok_s: None,
+            channel: 0,
         })
+    }
+
+    /// The same compensator reading temperature channel `channel` of a unit's sensors in
+    /// [`Compensator::step_unit`] (0 by default).
+    pub fn with_channel(mut self, channel: usize) -> Self {
+        self.channel = channel;
+        self
+    }
+
+    /// The unit temperature channel this compensator reads.
+    pub fn channel(&self) -> usize {
+        self.channel
+    }
+
+    /// One sample of a unit with several temperature sensors: `temps` holds every sensor's
+    /// reading and the compensator picks its own (a sensor it does not read cannot fault it).
+    /// A channel missing from `temps` reads as NaN, a sensor fault. Otherwise as
+    /// [`Compensator::step`].
+    pub fn step_unit(&mut self, time_s: f64, gyro_dps: f64, temps: &[f64]) -> Corrected {
+        let temp_c = temps.get(self.channel).copied().unwrap_or(f64::NAN);
+        self.step(time_s, gyro_dps, temp_c)
     }
 
     /// The feature specification.

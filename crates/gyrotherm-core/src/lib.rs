@@ -17,6 +17,8 @@
 //! - [`coverage`]: the training region in (T, dT) and a per-sample verdict (inside, edge,
 //!   outside) with a 1σ estimate of the residual bias error.
 //! - [`static_model`]: a model as plain static data (`gyrotherm export --lang rust`).
+//! - [`unit`](mod@unit): an inertial unit, one compensator per gyro axis, each on its own temperature
+//!   sensor, stepped together.
 //! - [`error`]: what the core refuses instead of panicking.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code)]
@@ -39,7 +41,9 @@ pub mod features;
 pub mod lstm;
 pub mod multi;
 pub mod static_model;
+pub mod unit;
 
 pub use compensator::{Compensator, Corrected, Status, TargetModel, TempLimits};
 pub use error::{Channel, InputError};
 pub use features::FeatureSpec;
+pub use unit::Unit;

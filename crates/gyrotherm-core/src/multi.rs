@@ -116,7 +116,7 @@ impl AxisCompensator {
     /// compensator.
     pub fn new(first: Compensator, first_index: usize) -> Self {
         AxisCompensator {
-            first,
+            first: first.with_channel(first_index),
             first_index,
             more: MoreParts {
                 parts: core::array::from_fn(|_| None),

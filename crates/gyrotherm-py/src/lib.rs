@@ -18,6 +18,7 @@ mod figures;
 mod logs;
 mod lot;
 mod model;
+mod unit;
 
 // The base class has two bases (`ValueError`, `RuntimeError`), which `create_exception!`
 // cannot express: it is defined in `python/gyrotherm/_errors.py` and imported here.
@@ -112,5 +113,6 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     logs::register(m)?;
     lot::register(m)?;
     model::register(m)?;
+    unit::register(m)?;
     Ok(())
 }

@@ -20,6 +20,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[derive(Debug, Clone, FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct LogOptions {
+    /// With several gyro columns, the one a table log's table column drives (None: found).
+    pub table_axis: Option<String>,
     pub time_col: String,
     pub gyro_col: String,
     pub temp_col: String,
@@ -53,6 +55,8 @@ impl LogOptions {
 pub fn read_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = ReadOptions::default();
     let out = PyDict::new(py);
+    // First, as the library lists the log options (`settings::describe::log_options`).
+    out.set_item("table_axis", None::<String>)?;
     out.set_item("time_col", &d.time_col)?;
     out.set_item("gyro_col", &d.gyro_col)?;
     out.set_item("temp_col", &d.temp_col)?;

@@ -375,7 +375,7 @@ pub struct FitArgs {
 
 impl FitArgs {
     /// The library's fit configuration and what a deprecated spelling now means.
-    fn config(&self) -> PyResult<(FitConfig, Option<String>)> {
+    pub(crate) fn config(&self) -> PyResult<(FitConfig, Option<String>)> {
         let settings = FitSettings {
             method: self.method.parse().map_err(py_err::<FitError>)?,
             recipe: self

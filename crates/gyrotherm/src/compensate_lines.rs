@@ -110,6 +110,9 @@ impl LinesSummary {
 pub enum LinesError {
     /// The model cannot be turned into a compensator.
     Model(crate::compensate::CompensateError),
+    /// An inertial-unit model cannot be turned into the flight unit, or the log lacks one of
+    /// its columns.
+    Unit(crate::imu_model::ImuError),
     /// The input (header, or a malformed line in [`Mode::Strict`]): file, line, column, fix.
     Log(LogError),
     /// Reading the input or writing the output failed.
@@ -120,6 +123,7 @@ impl std::fmt::Display for LinesError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             LinesError::Model(_) => f.write_str("model"),
+            LinesError::Unit(e) => write!(f, "inertial-unit model: {e}"),
             LinesError::Log(e) => write!(f, "{e}"),
             LinesError::Io(e) => write!(f, "{e}"),
         }
@@ -133,6 +137,7 @@ impl std::error::Error for LinesError {
             LinesError::Io(e) => e.source(),
             LinesError::Log(e) => e.source(),
             LinesError::Model(e) => Some(e),
+            LinesError::Unit(e) => e.source(),
         }
     }
 }
@@ -147,7 +152,7 @@ impl From<std::io::Error> for LinesError {
 /// (the usual log line: no copy), else into `buf`, which holds the unquoted fields. Reused
 /// from line to line, so a steady stream allocates nothing.
 #[derive(Default)]
-struct Fields {
+pub(crate) struct Fields {
     ranges: Vec<std::ops::Range<usize>>,
     buf: Vec<u8>,
     quoted: bool,
@@ -155,7 +160,7 @@ struct Fields {
 
 impl Fields {
     /// Split `line` at `delimiter`; false on a broken quote.
-    fn split(&mut self, line: &[u8], delimiter: u8) -> bool {
+    pub(crate) fn split(&mut self, line: &[u8], delimiter: u8) -> bool {
         self.ranges.clear();
         self.quoted = line.contains(&b'"');
         if !self.quoted {
@@ -205,12 +210,12 @@ impl Fields {
         !quoted
     }
 
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.ranges.len()
     }
 
     /// Field `k` of `line` (the line last split), empty past the end.
-    fn get<'a>(&'a self, line: &'a [u8], k: usize) -> &'a [u8] {
+    pub(crate) fn get<'a>(&'a self, line: &'a [u8], k: usize) -> &'a [u8] {
         let src = if self.quoted { &self.buf[..] } else { line };
         self.ranges
             .get(k)
@@ -221,7 +226,7 @@ impl Fields {
 
 /// A numeric field (ASCII spaces around it allowed), as the log reader parses it: with a
 /// separator other than the comma, a decimal comma (`0,5`) is accepted too.
-fn parse_number(raw: &[u8], decimal_comma: bool) -> Option<f64> {
+pub(crate) fn parse_number(raw: &[u8], decimal_comma: bool) -> Option<f64> {
     let dotted = std::str::from_utf8(raw.trim_ascii()).ok()?.parse().ok();
     match dotted {
         None if decimal_comma => crate::csvlog::parse_f64_decimal_comma(raw),
@@ -231,7 +236,7 @@ fn parse_number(raw: &[u8], decimal_comma: bool) -> Option<f64> {
 
 /// What [`read_line_capped`] found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum LineRead {
+pub(crate) enum LineRead {
     /// End of input, nothing read.
     Eof,
     /// A line (in the buffer, its line break included when there was one).
@@ -243,7 +248,7 @@ enum LineRead {
 
 /// `read_until(b'\n')` that keeps at most `cap` bytes of a line, so memory stays bounded
 /// whatever the input.
-fn read_line_capped<R: BufRead>(
+pub(crate) fn read_line_capped<R: BufRead>(
     input: &mut R,
     buf: &mut Vec<u8>,
     cap: usize,
@@ -365,6 +370,52 @@ impl std::error::Error for FileError {
     }
 }
 
+/// A line over [`MAX_LINE_BYTES`] at `line` of `source`.
+pub(crate) fn too_long_error(source: &Path, line: u64) -> LinesError {
+    LinesError::Log(LogError::new(
+        LogErrorKind::LineTooLong,
+        source,
+        Some(line),
+        None,
+        format!(
+            "line longer than {MAX_LINE_BYTES} bytes; a log line holds a few numbers: check \
+             that this is a log with one record per line"
+        ),
+    ))
+}
+
+/// The header: everything up to the first line that is neither blank nor a comment, checked
+/// by the log reader with `opts` (column mapping and its messages). Returns the column names
+/// and the number of lines read.
+pub(crate) fn read_header<R: BufRead>(
+    input: &mut R,
+    source: &Path,
+    opts: &ReadOptions,
+) -> Result<(Vec<String>, u64), LinesError> {
+    let mut head = Vec::new();
+    let mut line_no = 0u64;
+    let mut buf = Vec::new();
+    loop {
+        match read_line_capped(input, &mut buf, MAX_LINE_BYTES)? {
+            LineRead::Eof => break,
+            LineRead::TooLong => return Err(too_long_error(source, line_no + 1)),
+            LineRead::Line => {}
+        }
+        line_no += 1;
+        if head.len() + buf.len() > MAX_LINE_BYTES {
+            // Comments before the header count too: they are kept for the header check.
+            return Err(too_long_error(source, line_no));
+        }
+        head.extend_from_slice(&buf);
+        let t = buf.trim_ascii();
+        if !t.is_empty() && !t.starts_with(b"#") {
+            break;
+        }
+    }
+    let r = LogReader::new(&head[..], source, opts).map_err(LinesError::Log)?;
+    Ok((r.headers().to_vec(), line_no))
+}
+
 /// Compensate `input` (CSV with a header) into `output`; see the module doc. `source` names
 /// the input in errors. With `flush_each_row` every line is flushed as soon as it is written.
 pub fn compensate_lines<R: BufRead, W: Write>(
@@ -379,44 +430,9 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     let mut comp = crate::compensate::compensator(model).map_err(LinesError::Model)?;
     // The file's map was checked when it was loaded.
     let cover = model.coverage.as_ref().and_then(|c| c.to_core().ok());
-    // Header: everything up to the first line that is neither blank nor a comment, checked by
-    // the log reader (column mapping and its messages).
-    let mut head = Vec::new();
-    let mut line_no = 0u64;
+    let (headers, mut line_no) = read_header(&mut input, source, opts)?;
     let mut buf = Vec::new();
-    let too_long = |line| {
-        LinesError::Log(LogError::new(
-            LogErrorKind::LineTooLong,
-            source,
-            Some(line),
-            None,
-            format!(
-                "line longer than {MAX_LINE_BYTES} bytes; a log line holds a few numbers: check \
-                 that this is a log with one record per line"
-            ),
-        ))
-    };
-    loop {
-        match read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)? {
-            LineRead::Eof => break,
-            LineRead::TooLong => return Err(too_long(line_no + 1)),
-            LineRead::Line => {}
-        }
-        line_no += 1;
-        if head.len() + buf.len() > MAX_LINE_BYTES {
-            // Comments before the header count too: they are kept for the header check.
-            return Err(too_long(line_no));
-        }
-        head.extend_from_slice(&buf);
-        let t = buf.trim_ascii();
-        if !t.is_empty() && !t.starts_with(b"#") {
-            break;
-        }
-    }
-    let headers: Vec<String> = {
-        let r = LogReader::new(&head[..], source, opts).map_err(LinesError::Log)?;
-        r.headers().to_vec()
-    };
+    let too_long = |line| too_long_error(source, line);
     let col = |name: &str| headers.iter().position(|h| h == name);
     let (Some(ti), Some(gi), Some(ci)) = (
         col(&opts.time_col),

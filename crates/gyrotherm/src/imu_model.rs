@@ -188,6 +188,29 @@ pub fn is_imu_model_text(text: &str) -> bool {
 /// (target, epoch, loss), as [`fit_model`] reports it.
 pub type ImuProgress<'a> = dyn Fn(usize, usize, crate::fit::Target, usize, f64) + Sync + 'a;
 
+/// A step of an inertial-unit fit, as it happens (from the axes' threads): what a caller
+/// needs to say which axis and sensor are being fitted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum ImuFitEvent {
+    /// Axis `axis` starts (its sensors are then tried in column order; with every sensor
+    /// allowed, each sensor's `SensorFinished` comes once all are identified).
+    AxisStarted { axis: usize },
+    /// Axis `axis` starts its fit on sensor `sensor` (indices into the column lists).
+    SensorStarted { axis: usize, sensor: usize },
+    /// Axis `axis` finished its fit on sensor `sensor`, with its cross-validated RMS.
+    SensorFinished {
+        axis: usize,
+        sensor: usize,
+        cv_rms: Option<f64>,
+    },
+    /// Axis `axis` is done and reads sensor `sensor` (its first, when it reads several).
+    AxisFinished { axis: usize, sensor: usize },
+}
+
+/// Receiver of [`ImuFitEvent`]s.
+pub type ImuEvents<'a> = dyn Fn(ImuFitEvent) + Sync + 'a;
+
 /// Fit every axis of the unit with the default [`ImuFitSettings`] (see [`fit_imu_with`]).
 pub fn fit_imu(
     logs: &[(String, ImuLog)],
@@ -198,14 +221,45 @@ pub fn fit_imu(
     fit_imu_with(logs, cfg, &ImuFitSettings::default(), temp_sensor, progress)
 }
 
-/// Fit every axis of the unit (see the module doc): logs read with the column lists; each
-/// axis on its own thread; `temp_sensor` the limits every axis's compensator believes.
+/// [`fit_imu`], telling `events` as each axis and each sensor tried starts and finishes.
+pub fn fit_imu_with_events(
+    logs: &[(String, ImuLog)],
+    cfg: &FitConfig,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
+) -> Result<ImuModel, ImuError> {
+    fit_imu_with_settings(
+        logs,
+        cfg,
+        &ImuFitSettings::default(),
+        temp_sensor,
+        progress,
+        events,
+    )
+}
+
+/// [`fit_imu`] with `settings`.
 pub fn fit_imu_with(
     logs: &[(String, ImuLog)],
     cfg: &FitConfig,
     settings: &ImuFitSettings,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
+) -> Result<ImuModel, ImuError> {
+    fit_imu_with_settings(logs, cfg, settings, temp_sensor, progress, &|_| {})
+}
+
+/// Fit every axis of the unit (see the module doc): logs read with the column lists; each
+/// axis on its own thread; `temp_sensor` the limits every axis's compensator believes;
+/// `events` told as each axis and each sensor starts and finishes.
+pub fn fit_imu_with_settings(
+    logs: &[(String, ImuLog)],
+    cfg: &FitConfig,
+    settings: &ImuFitSettings,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
 ) -> Result<ImuModel, ImuError> {
     let first = logs
         .first()
@@ -237,9 +291,19 @@ pub fn fit_imu_with(
                             settings,
                             temp_sensor,
                             progress,
+                            events,
                         )
                     } else {
-                        fit_axis(logs, k, gyro_cols, temp_cols, cfg, temp_sensor, progress)
+                        fit_axis(
+                            logs,
+                            k,
+                            gyro_cols,
+                            temp_cols,
+                            cfg,
+                            temp_sensor,
+                            progress,
+                            events,
+                        )
                     }
                 })
             })
@@ -268,6 +332,7 @@ pub fn fit_imu_with(
     Ok(model)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fit_axis(
     logs: &[(String, ImuLog)],
     k: usize,
@@ -276,10 +341,13 @@ fn fit_axis(
     cfg: &FitConfig,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
+    events: &ImuEvents,
 ) -> Result<ImuAxis, ImuError> {
+    events(ImuFitEvent::AxisStarted { axis: k });
     let mut best: Option<(usize, FitOutcome)> = None;
     let mut scores = Vec::with_capacity(temp_cols.len());
     for (j, temp) in temp_cols.iter().enumerate() {
+        events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
         let axis_logs: Vec<(String, TestLog)> = logs
             .iter()
             .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
@@ -306,6 +374,11 @@ fn fit_axis(
         } else {
             cv(&outcome.scale_training)
         };
+        events(ImuFitEvent::SensorFinished {
+            axis: k,
+            sensor: j,
+            cv_rms,
+        });
         scores.push(SensorScore {
             temp: temp.clone(),
             cv_rms,
@@ -322,6 +395,7 @@ fn fit_axis(
         }
     }
     let (j, mut outcome) = best.ok_or_else(|| ImuError::Layout("no temperature columns".into()))?;
+    events(ImuFitEvent::AxisFinished { axis: k, sensor: j });
     outcome.model.features.temp_sensor = *temp_sensor;
     Ok(ImuAxis {
         gyro: gyro_cols[k].clone(),
@@ -345,7 +419,9 @@ fn fit_axis_multi(
     settings: &ImuFitSettings,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
+    events: &ImuEvents,
 ) -> Result<ImuAxis, ImuError> {
+    events(ImuFitEvent::AxisStarted { axis: k });
     let fit_err = |j: usize, source: FitError| ImuError::Fit {
         gyro: gyro_cols[k].clone(),
         temp: temp_cols[j].clone(),
@@ -362,6 +438,7 @@ fn fit_axis_multi(
     };
     let mut per_sensor = Vec::with_capacity(temp_cols.len());
     for j in 0..temp_cols.len() {
+        events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
         let axis_logs: Vec<(String, TestLog)> = logs
             .iter()
             .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
@@ -398,6 +475,13 @@ fn fit_axis_multi(
             min_gain: settings.min_gain,
         },
     );
+    for (j, cv_rms) in single.iter().enumerate() {
+        events(ImuFitEvent::SensorFinished {
+            axis: k,
+            sensor: j,
+            cv_rms: *cv_rms,
+        });
+    }
     let scores: Vec<SensorScore> = temp_cols
         .iter()
         .zip(&single)
@@ -455,6 +539,10 @@ fn fit_axis_multi(
             });
         }
     }
+    events(ImuFitEvent::AxisFinished {
+        axis: k,
+        sensor: j0,
+    });
     Ok(ImuAxis {
         gyro: gyro_cols[k].clone(),
         temps: order.iter().map(|&j| temp_cols[j].clone()).collect(),

@@ -106,6 +106,9 @@ pub fn run_comparison(
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
+    if args.log.read_options().is_multi_column() {
+        return super::imu_judge::compare(args);
+    }
     let spec = super::verdict::load(args.spec.as_deref())?;
     let mut warnings = Vec::new();
     let train = read_logs(&args.train, &args.log, &mut warnings)?;

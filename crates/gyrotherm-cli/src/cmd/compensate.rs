@@ -25,11 +25,13 @@ pub struct CompensateArgs {
     pub input: Option<PathBuf>,
     /// Output CSV: every input column, then bias_dps, scale, gyro_comp_dps (°/s), status
     /// (ok, held, degraded, invalid), coverage (inside, edge, outside the training region)
-    /// and sigma_dph (1σ estimate of the residual bias error, °/h).
+    /// and sigma_dph (1σ estimate of the residual bias error, °/h). With an inertial-unit
+    /// model: every input column, then G_bias, G_scale, G_comp, G_status per gyro column G.
     #[arg(long, required_unless_present = "stream", conflicts_with = "stream")]
     pub out: Option<PathBuf>,
     /// Read CSV on stdin and write one output line per input line on stdout, flushed as it
-    /// goes (the flight path). A malformed line is written as `invalid` and the stream goes on.
+    /// goes (the flight path), with the columns of --out (single-axis or inertial-unit model).
+    /// A malformed line is written as `invalid` and the stream goes on.
     #[arg(long)]
     pub stream: bool,
     #[command(flatten)]
@@ -60,37 +62,17 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
     }
     let opts = args.log.read_options();
     let summary = if args.stream {
-        // Rows are handed on as they are made and stdout is flushed whenever the input has
-        // to be read again: a live feed gets each line at once, a file is not written one
-        // system call per line.
-        let out = Rc::new(RefCell::new(BufWriter::with_capacity(
-            64 * 1024,
-            std::io::stdout().lock(),
-        )));
-        let write_error = Rc::new(RefCell::new(None));
-        let input = std::io::BufReader::new(FlushBeforeRead {
-            inner: std::io::stdin().lock(),
-            out: Rc::clone(&out),
-            write_error: Rc::clone(&write_error),
-        });
-        let result = compensate_lines(
-            &model,
-            input,
-            "<stdin>".as_ref(),
-            &opts,
-            DeferredFlush(Rc::clone(&out)),
-            Mode::Stream,
-            true,
-        );
-        // A failed flush ends the input (see FlushBeforeRead): that error, not the input's
-        // state at that moment, is what went wrong.
-        if let Some(e) = write_error.borrow_mut().take() {
-            return Err(anyhow::Error::new(e).context("writing standard output"));
-        }
-        let summary = result?;
-        out.borrow_mut()
-            .flush()
-            .context("writing standard output")?;
+        let summary = stdio_stream(|input, output| {
+            compensate_lines(
+                &model,
+                input,
+                "<stdin>".as_ref(),
+                &opts,
+                output,
+                Mode::Stream,
+                true,
+            )
+        })?;
         eprintln!("gyrotherm: {}", summary.describe());
         summary
     } else {
@@ -123,6 +105,38 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
         eprintln!("gyrotherm: warning: {w}");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Run `f` on stdin and stdout as a live stream. Rows are handed on as they are made and
+/// stdout is flushed whenever the input has to be read again: a live feed gets each line at
+/// once, a file is not written one system call per line.
+pub(super) fn stdio_stream<T, E>(
+    f: impl FnOnce(&mut dyn std::io::BufRead, &mut dyn Write) -> Result<T, E>,
+) -> anyhow::Result<T>
+where
+    E: std::error::Error + Send + Sync + 'static,
+{
+    let out = Rc::new(RefCell::new(BufWriter::with_capacity(
+        64 * 1024,
+        std::io::stdout().lock(),
+    )));
+    let write_error = Rc::new(RefCell::new(None));
+    let mut input = std::io::BufReader::new(FlushBeforeRead {
+        inner: std::io::stdin().lock(),
+        out: Rc::clone(&out),
+        write_error: Rc::clone(&write_error),
+    });
+    let result = f(&mut input, &mut DeferredFlush(Rc::clone(&out)));
+    // A failed flush ends the input (see FlushBeforeRead): that error, not the input's
+    // state at that moment, is what went wrong.
+    if let Some(e) = write_error.borrow_mut().take() {
+        return Err(anyhow::Error::new(e).context("writing standard output"));
+    }
+    let value = result?;
+    out.borrow_mut()
+        .flush()
+        .context("writing standard output")?;
+    Ok(value)
 }
 
 type SharedOut<'a> = Rc<RefCell<BufWriter<std::io::StdoutLock<'a>>>>;

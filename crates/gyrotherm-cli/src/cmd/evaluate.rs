@@ -34,12 +34,19 @@ pub struct EvaluateArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Inertial-unit model (JSON from `train` with column lists): judge each axis's raw and
+    /// compensated output (the log is read with the model's gyro and temperature columns).
+    #[arg(long, value_name = "UNIT.json")]
+    pub model: Option<PathBuf>,
     #[doc = "Spec sheet (TOML) to judge the figures against; exit 1 when a limit is missed."]
     #[arg(long, value_name = "SPEC.toml", long_help = super::verdict::SPEC_HELP)]
     pub spec: Option<std::path::PathBuf>,
 }
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
+    if args.model.is_some() || args.log.read_options().is_multi_column() {
+        return super::imu_judge::evaluate(args);
+    }
     let mut w = std::io::stdout().lock();
     let spec = super::verdict::load(args.spec.as_deref())?;
     let (log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
@@ -75,6 +82,20 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         writeln!(w, "{}", serde_json::to_string_pretty(&j)?)?;
         return Ok(code);
     }
+    print_evaluation(&mut w, &e)?;
+    if let Some(v) = &verdict {
+        writeln!(w)?;
+        super::verdict::print(&mut w, v)?;
+    }
+    Ok(code)
+}
+
+/// The figures of one column as text (the single-axis output, and each axis's block of a
+/// unit log).
+pub fn print_evaluation(
+    w: &mut dyn Write,
+    e: &gyrotherm::metrics::Evaluation,
+) -> std::io::Result<()> {
     writeln!(
         w,
         "{} ({} samples, τ0 = {} s)",
@@ -110,11 +131,7 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
             r.scale_over_time.len()
         )?;
     }
-    if let Some(v) = &verdict {
-        writeln!(w)?;
-        super::verdict::print(&mut w, v)?;
-    }
-    Ok(code)
+    Ok(())
 }
 
 /// Fixed-point with `prec` decimals for ordinary magnitudes, scientific beyond (a figure of

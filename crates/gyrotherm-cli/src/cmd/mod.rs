@@ -9,6 +9,7 @@ pub mod demo;
 pub mod evaluate;
 pub mod export;
 pub mod imu;
+pub mod imu_judge;
 pub mod lot;
 pub mod model;
 pub mod plan;

@@ -41,6 +41,9 @@ pub struct ReportArgs {
 }
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
+    if args.log.read_options().is_multi_column() {
+        return super::imu_judge::report(args);
+    }
     let spec = super::verdict::load(args.spec.as_deref())?;
     let mut gap_warnings = Vec::new();
     let train = read_logs(&args.train, &args.log, &mut gap_warnings)?;

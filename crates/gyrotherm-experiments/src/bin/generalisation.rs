@@ -18,7 +18,7 @@
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin generalisation -- [--family
 //! design|confirm] [--units 30] [--settings one,two,planned] [--methods linear,poly,...]
-//! [--threads 2] [--cases FILE]`; `bench/generalisation.sh` runs it as recorded in
+//! [--threads 2] [--cases FILE] [--temp-source sensor|coil]`; `bench/generalisation.sh` runs it as recorded in
 //! `docs/experiments/generalisation.md`. Settings are chosen on the design family only; the
 //! confirmation family is run once at the end.
 
@@ -41,6 +41,10 @@ const TABLE_RATE_DPS: f64 = 20.0;
 const TAU_S: f64 = 100.0;
 const TEST_PROFILES: [&str; 3] = ["slow-ramp", "shock-5", "airborne"];
 const DESIGN_BASE_SEED: u64 = 1000;
+/// `--temp-source coil`: the logs' temperature column is the simulator's coil temperature
+/// (a noiseless sensor on the coil) instead of the housing sensor, for every run. A
+/// diagnostic: how much of the held-out error a model that saw the coil would remove.
+static TEMP_FROM_COIL: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 const CONFIRM_BASE_SEED: u64 = 5000;
 
 /// The methods the benchmark knows, by name.
@@ -155,7 +159,11 @@ fn sim_profile(unit: &FogUnit, profile: Profile, seed: u64, table: bool) -> Resu
         log: TestLog {
             time_s: s.time_s,
             gyro_dps: s.gyro_dps,
-            temp_c: s.temp_c,
+            temp_c: if TEMP_FROM_COIL.load(Ordering::Relaxed) {
+                s.coil_c
+            } else {
+                s.temp_c
+            },
             table_dps: s.table_dps,
             extra: Vec::new(),
         },
@@ -382,6 +390,11 @@ fn run() -> Result<(), String> {
         .find(|s| !["one", "two", "planned"].contains(&s.as_str()))
     {
         return Err(format!("--settings: unknown {s:?}; use one, two, planned"));
+    }
+    match get("--temp-source").as_deref() {
+        None | Some("sensor") => {}
+        Some("coil") => TEMP_FROM_COIL.store(true, Ordering::Relaxed),
+        Some(v) => return Err(format!("--temp-source {v:?}: use sensor or coil")),
     }
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     let job = Job {

@@ -7,6 +7,8 @@
 - Gyro figures: ``bias_stability``, ``noise_terms``, ``scale_factor``.
 - Logs and models: ``read_log``, ``read_lot`` (a lot database of ``gyrotherm lot``), ``fit`` → ``Model`` (``save``, ``Model.load``,
   ``compensate``, ``summary``); model files are the CLI's JSON.
+- Inertial units: ``gyro_col``/``temp_col`` lists in ``read_log`` and ``fit`` (→ ``UnitModel``:
+  one file for the unit, ``compensate`` per axis), as the CLI's comma-separated lists.
 
 Errors derive from ``GyrothermError`` (a ``ValueError`` and, as allantools raises for the
 same faults, a ``RuntimeError``) and carry the CLI's messages.
@@ -51,6 +53,7 @@ from ._model import (
     CoverageVerdicts,
     GyrothermWarning,
     Model,
+    UnitModel,
     fit,
 )
 
@@ -83,6 +86,7 @@ __all__ = [
     "LogError",
     "MetricsError",
     "Model",
+    "UnitModel",
     "ModelError",
     "ONE_SIGMA_CI",
     "NO_COVERAGE",

@@ -36,12 +36,25 @@ def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
         )
     out = dict(READ_DEFAULTS)
     out.update(options)
+    # A list of gyro or temperature columns is the CLI's comma-separated list.
+    for k in ("gyro_col", "temp_col"):
+        v = out[k]
+        if not isinstance(v, (str, bytes)) and hasattr(v, "__iter__"):
+            out[k] = ",".join(str(n) for n in v)
     for k in ("time_col", "gyro_col", "temp_col", "table_col", "gyro_unit", "delimiter"):
         out[k] = str(out[k])
+    if out["table_axis"] is not None:
+        out["table_axis"] = str(out["table_axis"])
     for k in ("fill_gaps_max_s", "sample_period_s"):
         if out[k] is not None:
             out[k] = float(out[k])
     return out
+
+
+def is_unit(options: Dict[str, Any]) -> bool:
+    """Whether full options (:func:`read_options`) name several gyro or temperature columns:
+    an inertial unit's log."""
+    return "," in options["gyro_col"] or "," in options["temp_col"]
 
 
 def _pandas():
@@ -62,12 +75,20 @@ def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any)
     ``gyro_unit`` (``"dps"``, ``"dph"``, ``"rad/s"``), ``fill_gaps_max_s`` (max gap in s to
     interpolate), ``sample_period_s`` (s), ``delimiter`` (``","``, ``";"`` or ``"tab"``).
 
+    An inertial unit's log: ``gyro_col`` and ``temp_col`` take several columns, as a list or
+    the CLI's comma-separated text (``gyro_col=["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"]``);
+    each gyro (in °/s) and each temperature then keeps its own name, the table rate is
+    ``table_dps``, and the report adds ``gyro_cols``, ``temp_cols`` and ``table_axis`` (the
+    gyro the table turns: ``table_axis=`` names it, else the one whose output follows it).
+
     Returns a pandas DataFrame when pandas is installed (``as_frame=None``, the default) or
     ``as_frame=True``, else a dict of numpy arrays. The DataFrame's ``attrs`` hold the read
     report (rows, filled samples and gaps, sample period).
     Raises ``gyrotherm.LogError`` naming file, line and column.
     """
-    cols, report = _g.read_log(os.fspath(path), read_options(options))
+    opts = read_options(options)
+    reader = _g.read_imu_log if is_unit(opts) else _g.read_log
+    cols, report = reader(os.fspath(path), opts)
     pd = _pandas()
     if as_frame is None:
         as_frame = pd is not None

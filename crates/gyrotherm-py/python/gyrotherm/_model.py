@@ -6,12 +6,12 @@ import os
 import sys
 import time
 import warnings
-from typing import Any, Callable, Dict, Iterable, NamedTuple, Optional, Union
+from typing import Any, Callable, Dict, Iterable, List, NamedTuple, Optional, Union
 
 import numpy as np
 
 from . import _gyrotherm as _g
-from ._logs import read_options
+from ._logs import columns, is_unit, read_options
 
 PathLike = Union[str, "os.PathLike[str]"]
 Progress = Union[bool, Callable[[str, int, float], Any], None]
@@ -72,9 +72,12 @@ class Model:
         self._raw = raw
 
     @classmethod
-    def load(cls, path: PathLike) -> "Model":
+    def load(cls, path: PathLike) -> Union["Model", "UnitModel"]:
         """Read and check a model file (raises ``gyrotherm.ModelError``; warns,
-        ``GyrothermWarning``, when the file has no content checksum)."""
+        ``GyrothermWarning``, when the file has no content checksum). An inertial unit's file
+        (``train`` with column lists) comes back as a :class:`UnitModel`."""
+        if _g.is_unit_model_file(os.fspath(path)):
+            return UnitModel.load(path)
         raw = _g.RawModel.load(os.fspath(path))
         _warn(raw.load_warnings)
         return cls(raw)
@@ -168,6 +171,120 @@ class Model:
         return repr(self._raw)
 
 
+class UnitModel:
+    """An inertial unit's model: the file ``gyrotherm train`` writes with ``--gyro-col`` and
+    ``--temp-col`` lists (per axis a bias and a scale-factor model, the columns it needs).
+    Make one with :func:`fit` (column lists) or :meth:`UnitModel.load`."""
+
+    def __init__(self, raw: "_g.RawUnitModel") -> None:
+        if not isinstance(raw, _g.RawUnitModel):
+            raise TypeError("make a UnitModel with gyrotherm.fit(...) or UnitModel.load(path)")
+        self._raw = raw
+
+    @classmethod
+    def load(cls, path: PathLike) -> "UnitModel":
+        """Read and check a unit model file (raises ``gyrotherm.ModelError``)."""
+        return cls(_g.RawUnitModel.load(os.fspath(path)))
+
+    @classmethod
+    def from_json(cls, text: str) -> "UnitModel":
+        """Parse and check unit model JSON text."""
+        return cls(_g.RawUnitModel.from_json(text))
+
+    def save(self, path: PathLike) -> None:
+        """Write the file (atomically; the same bytes as ``gyrotherm train``)."""
+        self._raw.save(os.fspath(path))
+
+    def to_json(self) -> str:
+        """The file's text."""
+        return self._raw.to_json()
+
+    @property
+    def gyro_cols(self) -> List[str]:
+        """The gyro columns, in the order of the axes."""
+        return self._raw.gyro_cols
+
+    @property
+    def temp_cols(self) -> List[str]:
+        """The temperature columns the unit's log must hold."""
+        return self._raw.temp_cols
+
+    @property
+    def axes(self) -> List[Dict[str, Any]]:
+        """Per axis: ``gyro``, ``temps`` (the sensors its model reads), ``cv_rms`` (the
+        cross-validated RMS of each sensor tried, None without cross-validation),
+        ``method``, ``bias_kind`` and ``scale_kind``."""
+        return self._raw.axes
+
+    def compensate(self, time_s, gyro, temp) -> Dict[str, Compensation]:
+        """Compensate a unit's samples with each axis's flight compensator: ``gyro`` and
+        ``temp`` map each of :attr:`gyro_cols` and :attr:`temp_cols` to its samples (a dict,
+        or sequences in those orders). Returns per gyro column its :class:`Compensation`,
+        the numbers ``gyrotherm compensate`` writes as ``G_bias``, ``G_scale``, ``G_comp``
+        and ``G_status``."""
+        t = np.ascontiguousarray(time_s, dtype=np.float64)
+        g = self._ordered(gyro, self.gyro_cols, "gyro")
+        c = self._ordered(temp, self.temp_cols, "temp")
+        for name, a in [("time_s", t), *zip(self.gyro_cols, g), *zip(self.temp_cols, c)]:
+            if a.ndim != 1:
+                raise _g.CompensationError(f"{name}: need a 1-D array, got shape {a.shape}")
+        out = self._raw.compensate(t, g, c)
+        return {name: Compensation(*cols) for name, cols in zip(self.gyro_cols, out)}
+
+    def compensate_log(self, log) -> Dict[str, Compensation]:
+        """:meth:`compensate` of a log as :func:`read_log` returns it (read with the model's
+        columns: ``gyro_col=model.gyro_cols, temp_col=model.temp_cols``)."""
+        (t,) = columns(log, ["time_s"])
+        return self.compensate(
+            t, columns(log, self.gyro_cols), columns(log, self.temp_cols)
+        )
+
+    @staticmethod
+    def _ordered(values, names: List[str], what: str):
+        if isinstance(values, dict) or hasattr(values, "keys"):
+            missing = [n for n in names if n not in values]
+            if missing:
+                raise _g.CompensationError(
+                    f"{what}: no samples for {', '.join(missing)}, which the model needs"
+                )
+            values = [values[n] for n in names]
+        values = [np.ascontiguousarray(v, dtype=np.float64) for v in values]
+        if len(values) != len(names):
+            raise _g.CompensationError(
+                f"{what}: {len(values)} arrays given, the model needs {len(names)} "
+                f"({', '.join(names)})"
+            )
+        return values
+
+    def summary(self) -> str:
+        """The axes, the sensor each reads and its models."""
+        return self._raw.summary()
+
+    def __repr__(self) -> str:
+        return repr(self._raw)
+
+
+class _PrintUnitProgress:
+    """``progress=True`` for a unit: a line on stderr as each axis and sensor starts and
+    finishes, with the seconds since the fit began (the lines ``gyrotherm train`` prints)."""
+
+    def __init__(self) -> None:
+        self.started = time.monotonic()
+
+    def __call__(self, event: str, gyro: str, temp: Optional[str], cv_rms: Optional[float]) -> None:
+        at = time.monotonic() - self.started
+        if event == "axis_start":
+            text = f"{gyro}: axis starts"
+        elif event == "start":
+            text = f"{gyro}: fitting on {temp}"
+        elif event == "done":
+            score = "-" if cv_rms is None else f"{cv_rms:.3e}"
+            text = f"{gyro}: {temp} done (cross-validated RMS {score})"
+        else:
+            text = f"{gyro}: axis done, reads {temp}"
+        print(f"gyrotherm: [{at:6.1f} s] {text}", file=sys.stderr, flush=True)
+
+
 class _PrintProgress:
     """``progress=True``: one line per target on stderr at most every 2 s, and the last."""
 
@@ -224,7 +341,7 @@ def fit(
     validate_on_runs: bool = _FIT["validate_on_runs"],
     progress: Progress = False,
     **log_options: Any,
-) -> Model:
+) -> Union[Model, "UnitModel"]:
     """Fit a compensation model, as ``gyrotherm train --input S… --input T… --method …``
     (same defaults, same checks, same file).
 
@@ -237,6 +354,14 @@ def fit(
     epochs and loss to stderr; a callable gets ``(target, epoch, loss)``. Log options
     (``time_col``, ``gyro_unit``, ``fill_gaps_max_s``, ``delimiter`` …) apply to every log.
     The GIL is released while reading and training.
+
+    An inertial unit: ``gyro_col`` and ``temp_col`` as lists (or the CLI's comma-separated
+    text) fit every axis as ``gyrotherm train --gyro-col … --temp-col …`` does and return a
+    :class:`UnitModel` (the same file). Table logs go in ``table`` (one per axis; the axis is
+    found, or named by ``table_axis=``). ``progress``: True prints a line as each axis and
+    sensor starts and finishes; a callable gets ``(event, gyro, temp, cv_rms)``, event
+    ``"axis_start"`` (``temp`` None), ``"start"``, ``"done"`` (with the sensor's
+    cross-validated RMS) or ``"axis"`` (the axis is done and reads ``temp``).
     """
     for old, new in _FIT_RENAMED.items():
         if old in log_options:
@@ -262,6 +387,20 @@ def fit(
         "cross": bool(cross),
         "validate_on_runs": bool(validate_on_runs),
     }
+    options = read_options(log_options)
+    if is_unit(options):
+        if progress is True:
+            unit_callback = _PrintUnitProgress()
+        elif progress is False or progress is None:
+            unit_callback = None
+        elif callable(progress):
+            unit_callback = progress
+        else:
+            raise TypeError("progress: give True, False or a callable(event, gyro, temp, cv_rms)")
+        raw_unit, note = _g.fit_unit(static_paths, table_paths, settings, options, unit_callback)
+        if note is not None:
+            _warn([note])
+        return UnitModel(raw_unit)
     if progress is True:
         callback = _PrintProgress(epochs)
     elif progress is False or progress is None:
@@ -270,6 +409,6 @@ def fit(
         callback = progress
     else:
         raise TypeError("progress: give True, False or a callable(target, epoch, loss)")
-    raw = _g.fit(static_paths, table_paths, settings, read_options(log_options), callback)
+    raw = _g.fit(static_paths, table_paths, settings, options, callback)
     _warn(raw.load_warnings)
     return Model(raw)

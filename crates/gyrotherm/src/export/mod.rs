@@ -12,6 +12,7 @@
 
 pub mod c;
 pub mod rust;
+pub mod unit;
 
 use std::path::{Path, PathBuf};
 
@@ -33,6 +34,8 @@ pub enum ExportError {
     Model(ModelFileError),
     /// The model cannot be turned into flight form.
     Flight(CompensateError),
+    /// An inertial-unit model fails its checks, or one of its axes cannot be exported.
+    Unit(crate::imu_model::ImuError),
     /// Writing an output file failed.
     Io {
         path: PathBuf,
@@ -46,6 +49,7 @@ impl std::fmt::Display for ExportError {
             ExportError::Model(_) | ExportError::Flight(_) => {
                 f.write_str("model cannot be exported")
             }
+            ExportError::Unit(_) => f.write_str("inertial-unit model cannot be exported"),
             ExportError::Io { path, .. } => write!(f, "cannot write {}", path.display()),
         }
     }
@@ -57,6 +61,7 @@ impl std::error::Error for ExportError {
             ExportError::Io { source, .. } => Some(source),
             ExportError::Model(e) => Some(e),
             ExportError::Flight(e) => Some(e),
+            ExportError::Unit(e) => Some(e),
         }
     }
 }
@@ -243,7 +248,14 @@ pub fn generate(model: &ModelFile, lang: Lang) -> Result<Vec<(&'static str, Stri
 /// Write the export of `model` for `lang` into `dir` (created if missing), each file
 /// atomically; returns the files written.
 pub fn export(model: &ModelFile, lang: Lang, dir: &Path) -> Result<Vec<PathBuf>, ExportError> {
-    let files = generate(model, lang)?;
+    write_files(generate(model, lang)?, dir)
+}
+
+/// Write generated `files` into `dir` (created if missing), each atomically.
+pub(crate) fn write_files(
+    files: Vec<(&'static str, String)>,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, ExportError> {
     std::fs::create_dir_all(dir).map_err(|source| ExportError::Io {
         path: dir.to_path_buf(),
         source,
@@ -284,7 +296,7 @@ pub fn is_generated_text(text: &str) -> bool {
 /// hash (hex), by which the model file can be found again. The file's free-text fields
 /// (`training.created_by`, `training.inputs`) are left out: they are whatever the file
 /// says, and in a comment of generated source they could close the comment and add code.
-fn describe(model: &ModelFile) -> Result<String, ExportError> {
+pub(crate) fn describe(model: &ModelFile) -> Result<String, ExportError> {
     // The enum's own fixed name, never the file's text.
     let method: &'static str = model.method.as_str();
     let kind = |s: &Option<SubModel>| match s {

@@ -97,7 +97,15 @@ pub fn generate(m: &StaticModel, about: &str) -> String {
     );
     out.push_str("/// The model (see the module doc).\n");
     out.push_str("#[rustfmt::skip]\n#[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n");
-    out.push_str("pub static MODEL: StaticModel = StaticModel {\n");
+    out.push_str("pub static MODEL: StaticModel = ");
+    out.push_str(&model_expr(m));
+    out.push_str(";\n");
+    out
+}
+
+/// The `StaticModel { ... }` expression of `m` (its fields indented by four spaces).
+pub(crate) fn model_expr(m: &StaticModel) -> String {
+    let mut out = String::from("StaticModel {\n");
     let s = &m.spec;
     let _ = writeln!(
         out,
@@ -143,6 +151,6 @@ pub fn generate(m: &StaticModel, about: &str) -> String {
             );
         }
     }
-    out.push_str("};\n");
+    out.push('}');
     out
 }

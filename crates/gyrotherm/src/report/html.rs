@@ -61,7 +61,8 @@ pub struct ReportContent {
     pub notes: Vec<String>,
 }
 
-const CSS: &str = "body{font-family:'DejaVu Sans',Helvetica,Arial,sans-serif;margin:2em auto;\
+pub(crate) const CSS: &str =
+    "body{font-family:'DejaVu Sans',Helvetica,Arial,sans-serif;margin:2em auto;\
 max-width:1050px;color:#222;line-height:1.4}h1{font-size:1.6em}h2{font-size:1.25em;\
 border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}table{border-collapse:collapse;\
 margin:.5em 0}th,td{border:1px solid #bbb;padding:.3em .7em;text-align:right}\
@@ -176,7 +177,7 @@ pub fn render_html(c: &ReportContent) -> String {
 }
 
 /// `t` as an HTML table of class `class`; rows shorter than the headers are padded.
-fn push_table(h: &mut String, t: &Table, class: &str) {
+pub(crate) fn push_table(h: &mut String, t: &Table, class: &str) {
     let _ = write!(h, "<table class=\"{class}\">\n<thead><tr>");
     for head in &t.headers {
         let _ = write!(h, "<th>{}</th>", escape(head));

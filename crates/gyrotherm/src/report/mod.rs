@@ -12,6 +12,8 @@
 //! - [`html`]: `DIR/index.html`, self-contained (inline CSS, no script, no network).
 //! - `job`: the full report of a held-out comparison ([`write_full_report`], used by
 //!   `gyrotherm report`), from the logs and a [`crate::compare::Comparison`].
+//! - [`unit`](mod@unit): the report of an inertial unit: the table across axes, a section per axis,
+//!   and each axis's full report in its own folder.
 //! - `decimate`: min/max per pixel column, so long runs draw fast without losing extremes.
 //! - `font`: the embedded DejaVu Sans font; no system font or graphics library is used.
 
@@ -22,6 +24,7 @@ pub(crate) mod font;
 pub mod html;
 pub(crate) mod job;
 pub(crate) mod plot;
+pub mod unit;
 
 use std::fmt;
 use std::path::PathBuf;

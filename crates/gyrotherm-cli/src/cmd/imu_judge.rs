@@ -1,0 +1,256 @@
+//! `evaluate`, `compare` and `report` for an inertial unit (`--gyro-col`/`--temp-col`
+//! lists, or `evaluate --model UNIT.json`): the figures per axis and the table across axes
+//! (`gyrotherm::imu_judge`, `gyrotherm::report::unit`).
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use gyrotherm::csvlog;
+use gyrotherm::imu_judge::{self, ImuComparison};
+use gyrotherm::imu_model::ImuModel;
+use gyrotherm::model::TempSensorDef;
+use gyrotherm::settings::EvaluateSettings;
+
+use super::compare::{print_table, CompareArgs};
+use super::evaluate::{print_evaluation, EvaluateArgs};
+use super::imu::{fit_event_printer, read_imu_logs};
+use super::progress::TrainingBars;
+use super::report::ReportArgs;
+
+/// `evaluate` on a unit log: each gyro column's figures; with `--model`, also each axis's
+/// compensated output.
+pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        args.spec.is_none(),
+        "--spec judges one column; for a unit log judge an axis at a time (compensate, then \
+         evaluate --column G_comp with --gyro-col G), or leave --spec out"
+    );
+    let model = args
+        .model
+        .as_ref()
+        .map(|p| {
+            // A readable file that is not a unit's model: say what to do instead.
+            if p.is_file() && !super::imu::is_imu_model(p)? {
+                anyhow::bail!(
+                    "{}: evaluate --model takes an inertial unit's model (train with column \
+                     lists); for a single-axis model run compensate, then evaluate --column \
+                     gyro_comp_dps",
+                    p.display()
+                );
+            }
+            ImuModel::load(p)
+                .map_err(anyhow::Error::new)
+                .with_context(|| format!("cannot use model {}", p.display()))
+        })
+        .transpose()?;
+    let base = args.log.read_options();
+    let opts = match &model {
+        Some(m) => m.read_options(&base),
+        None => base,
+    };
+    let (log, report) = csvlog::read_imu_log(&args.input, &opts, args.log.table_axis.as_deref())
+        .with_context(|| format!("cannot use log {}", args.input.display()))?;
+    if report.filled_gaps > 0 {
+        eprintln!(
+            "gyrotherm: {}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps-max-s)",
+            args.input.display(),
+            report.filled_gaps,
+            report.filled_samples
+        );
+    }
+    let settings = EvaluateSettings {
+        column: args.column.clone(),
+        tau_s: args.tau_s,
+        settle_s: args.settle_s,
+        reference_scale: args.reference_scale,
+    };
+    let (axes, tau) = imu_judge::evaluate_imu(&log, model.as_ref(), &settings)
+        .map_err(anyhow::Error::new)
+        .with_context(|| args.input.display().to_string())?;
+    if let Some(note) = tau.note(axes[0].raw.sample_period_s) {
+        eprintln!("gyrotherm: {note}");
+    }
+    let mut w = std::io::stdout().lock();
+    if args.json {
+        let j = serde_json::json!({ "tau_s": tau.tau_s, "axes": axes });
+        writeln!(w, "{}", serde_json::to_string_pretty(&j)?)?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    for (k, a) in axes.iter().enumerate() {
+        if k > 0 {
+            writeln!(w)?;
+        }
+        match &a.compensated {
+            Some(c) => {
+                writeln!(
+                    w,
+                    "axis {}: {} (model reads {})",
+                    k + 1,
+                    a.gyro,
+                    a.temps.join(", ")
+                )?;
+                writeln!(w, "raw:")?;
+                print_evaluation(&mut w, &a.raw)?;
+                writeln!(w, "compensated:")?;
+                print_evaluation(&mut w, c)?;
+            }
+            None => {
+                writeln!(w, "axis {}: {}", k + 1, a.gyro)?;
+                print_evaluation(&mut w, &a.raw)?;
+            }
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The comparison per axis (train and test logs read with the lists), with progress: the
+/// sensor choice's steps and a bar per axis and LSTM column.
+fn run_unit_comparison(
+    train: &[std::path::PathBuf],
+    test: &[std::path::PathBuf],
+    tau: Option<f64>,
+    columns: &super::compare::ColumnArgs,
+    fit: &super::train::FitArgs,
+    log: &super::common::LogArgs,
+) -> anyhow::Result<(ImuComparison, gyrotherm::compare::CompareConfig)> {
+    let train = read_imu_logs(train, log)?;
+    let test = read_imu_logs(test, log)?;
+    // The default τ is the single-axis rule on the first axis's view of the held-out logs
+    // (every axis shares the time column).
+    let axis0: Vec<(String, csvlog::TestLog)> = test
+        .iter()
+        .map(|(n, l)| (n.clone(), imu_judge::axis_test_log(l, 0, 0)))
+        .collect();
+    let tau_s = super::compare::resolve_tau(tau, &super::common::named(&axis0));
+    let cfg = columns.compare_config(fit, tau_s)?;
+    let started = std::time::Instant::now();
+    let sensors = train.first().map_or(0, |(_, l)| l.temp.len());
+    if sensors > 1 {
+        eprintln!(
+            "gyrotherm: choosing each axis's sensor as train does ({} fit, {sensors} sensors)",
+            cfg.fit.model_method().as_str()
+        );
+    }
+    let events = fit_event_printer(started, &train);
+    let gyro: Vec<String> = train
+        .first()
+        .map(|(_, l)| l.gyro.iter().map(|s| s.name.clone()).collect())
+        .unwrap_or_default();
+    let training: Vec<&'static str> = cfg
+        .candidates
+        .iter()
+        .filter(|c| c.trains_lstm(&cfg.fit))
+        .map(|c| c.key(&cfg.fit))
+        .collect();
+    let labels: Vec<String> = gyro
+        .iter()
+        .flat_map(|g| training.iter().map(move |k| format!("{g} {k}")))
+        .collect();
+    let label_refs: Vec<&str> = labels.iter().map(String::as_str).collect();
+    let epochs = cfg
+        .candidates
+        .iter()
+        .filter(|c| c.trains_lstm(&cfg.fit))
+        .map(|c| c.fit_config(&cfg.fit).recipe.epochs)
+        .max()
+        .unwrap_or(0);
+    let bars = TrainingBars::new(!labels.is_empty(), epochs, &label_refs);
+    let result = imu_judge::compare_imu(
+        &train,
+        &test,
+        &cfg,
+        &TempSensorDef::default(),
+        &|k, key, t, e, l| {
+            if let Some(g) = gyro.get(k) {
+                bars.update(&format!("{g} {key}"), t, e, l);
+            }
+        },
+        &events,
+    );
+    bars.finish();
+    let cmp = result
+        .map_err(anyhow::Error::new)
+        .context("comparison failed")?;
+    Ok((cmp, cfg))
+}
+
+/// Per axis the single-axis table, then the table across axes.
+fn print_unit_tables(
+    w: &mut dyn Write,
+    cmp: &ImuComparison,
+    cfg: &gyrotherm::compare::CompareConfig,
+) -> std::io::Result<()> {
+    for (k, a) in cmp.axes.iter().enumerate() {
+        writeln!(w, "axis {}: {} (temperature {})", k + 1, a.gyro, a.temp)?;
+        print_table(w, &a.comparison, cfg)?;
+        writeln!(w)?;
+    }
+    writeln!(w, "across axes:")?;
+    imu_judge::write_text_table(w, &cmp.across_axes(cfg))
+}
+
+/// Each axis's extrapolation findings, once per finding.
+fn unit_warnings(cmp: &ImuComparison) -> Vec<String> {
+    let mut out = Vec::new();
+    for a in &cmp.axes {
+        for w in gyrotherm::report::grouped_warnings(&a.test_named(), &a.comparison) {
+            out.push(format!("{}: {w}", a.gyro));
+        }
+    }
+    out
+}
+
+fn refuse_spec(spec: &Option<std::path::PathBuf>) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        spec.is_none(),
+        "--spec is judged on single-axis columns; with --gyro-col/--temp-col lists leave it out \
+         (compare or report one axis with --gyro-col G --temp-col T to judge it)"
+    );
+    Ok(())
+}
+
+/// `compare` with column lists.
+pub fn compare(args: CompareArgs) -> anyhow::Result<ExitCode> {
+    refuse_spec(&args.spec)?;
+    let (cmp, cfg) = run_unit_comparison(
+        &args.train,
+        &args.test,
+        args.tau_s,
+        &args.columns,
+        &args.fit,
+        &args.log,
+    )?;
+    let mut out = std::io::stdout().lock();
+    if args.json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&cmp.summary(&cfg))?)?;
+    } else {
+        print_unit_tables(&mut out, &cmp, &cfg)?;
+    }
+    for w in unit_warnings(&cmp) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `report` with column lists: the unit page and a full page per axis.
+pub fn report(args: ReportArgs) -> anyhow::Result<ExitCode> {
+    refuse_spec(&args.spec)?;
+    let (cmp, cfg) = run_unit_comparison(
+        &args.train,
+        &args.test,
+        args.tau_s,
+        &args.columns,
+        &args.fit,
+        &args.log,
+    )?;
+    let index = gyrotherm::report::unit::write_unit_report(&args.out, &cmp, &cfg, &[])
+        .with_context(|| format!("cannot write the report in {}", args.out.display()))?;
+    let mut out = std::io::stdout().lock();
+    print_unit_tables(&mut out, &cmp, &cfg)?;
+    writeln!(out, "report: {}", index.display())?;
+    for w in unit_warnings(&cmp) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
+    Ok(ExitCode::SUCCESS)
+}

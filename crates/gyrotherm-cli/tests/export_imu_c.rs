@@ -1,0 +1,404 @@
+//! `gyrotherm export --lang c` of inertial-unit models: the generated C (`gt_step_imu_bk`,
+//! and `gt_step_imu` beside it), built with gcc `-std=c99 -ffp-contract=off -Wall -Wextra
+//! -Werror -pedantic`, gives every axis the same status, rate, bias and scale factor as
+//! `compensate --stream` with the unit model (in process: `compensate_imu_lines`), to the last
+//! bit, and `gt_coverage_of_axis` the verdict and sigma_dph of the core's coverage map on that
+//! axis's compensator (the core `Unit` stepped alongside; two axis models in three carry a
+//! map), on generated units (one to three axes, each axis one of the generated single-axis
+//! models of every method, one to five temperature sensors, each axis on a drawn sensor)
+//! under faulted streams: one sensor NaN for a minute and out of range, time glitches and
+//! lasting clock resets and jumps, huge and non-finite gyro samples. The units' column names
+//! hold `*/` and `??`: none reaches the generated text.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+mod cli;
+use cli::run_ok;
+mod export_gen;
+use export_gen::{generated_model, Lcg, HUGE};
+
+/// Units in the test.
+const UNITS: usize = 120;
+/// Units linked into one driver binary.
+const BATCH: usize = 60;
+/// Lines per stream.
+const LINES: usize = 600;
+
+fn have_gcc() -> bool {
+    Command::new("gcc")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Unit `u`: its model JSON, axis count and temperature count. Axis `k` is generated model
+/// `3u + k` (kinds cycle through every method); the sensor each axis reads is drawn.
+fn unit_model(u: usize) -> (serde_json::Value, usize, usize) {
+    let mut rng = Lcg(0x1417 + u as u64);
+    let mut pick = |n: usize| ((rng.next() + 0.5) * n as f64) as usize % n;
+    let n_axes = 1 + (u + pick(3)) % 3;
+    let n_temps = 1 + pick(5);
+    let gyro_cols: Vec<String> = (0..n_axes).map(|k| format!("g{k} */ x??=")).collect();
+    let temp_cols: Vec<String> = (0..n_temps).map(|j| format!("t{j} */??/")).collect();
+    let axes: Vec<serde_json::Value> = (0..n_axes)
+        .map(|k| {
+            serde_json::json!({
+                "gyro": gyro_cols[k],
+                "temps": [temp_cols[pick(n_temps)]],
+                "scores": [],
+                "model": generated_model(3 * u + k),
+            })
+        })
+        .collect();
+    let m = serde_json::json!({
+        "imu_format_version": 1, "gyro_cols": gyro_cols, "temp_cols": temp_cols, "axes": axes,
+    });
+    (m, n_axes, n_temps)
+}
+
+/// Unit `u`'s stream: rows of (t, gyro per axis, temperature per sensor). About one line in
+/// eight has a fault of any kind; sensor `u % temps` is NaN for lines 100 to 159 and reads
+/// -127 °C (a DS18B20 bus error) at lines 300 to 304.
+fn unit_stream(u: usize, axes: usize, temps: usize) -> Vec<Vec<f64>> {
+    let mut rng = Lcg(0xfa17 + u as u64);
+    let bad_sensor = u % temps;
+    let (mut offset, mut out) = (0.0f64, Vec::new());
+    for i in 0..LINES {
+        let x = i as f64;
+        let fault = rng.next() + 0.5 < 0.13;
+        let kind = ((rng.next() + 0.5) * 24.0) as usize;
+        let axis = ((rng.next() + 0.5) * axes as f64) as usize % axes;
+        let sensor = ((rng.next() + 0.5) * temps as f64) as usize % temps;
+        let mut t = x + offset;
+        let mut g: Vec<f64> = (0..axes)
+            .map(|k| 0.01 * (k + 1) as f64 + 1e-3 * rng.next())
+            .collect();
+        let mut c: Vec<f64> = (0..temps)
+            .map(|j| 15.0 + 20.0 * (x / 100.0).sin() + 2.0 * j as f64)
+            .collect();
+        if (100..160).contains(&i) {
+            c[bad_sensor] = f64::NAN;
+        }
+        if (300..305).contains(&i) {
+            c[bad_sensor] = -127.0;
+        }
+        if fault {
+            match kind {
+                0 => t = f64::NAN,
+                1 => t = f64::INFINITY,
+                2 => t = 1e308,
+                3 => t = -1e308,
+                4 => t -= 1.0,
+                5 => t -= 30.0,
+                6 => t += 1e9,
+                7 => {
+                    offset = -x; // lasting reset to 0
+                    t = 0.0;
+                }
+                8 => {
+                    offset += 1e9; // lasting jump
+                    t += 1e9;
+                }
+                9 => offset += 90.0, // a dropout from here on
+                10 => g[axis] = f64::NAN,
+                11 => g[axis] = HUGE,
+                12 => g[axis] = -HUGE,
+                13 => g[axis] = f64::INFINITY,
+                14 => c[sensor] = f64::NAN,
+                15 => c[sensor] = 95.0,
+                16 => c[sensor] = 85.0,
+                _ => c[sensor] += 30.0 * rng.next(),
+            }
+        }
+        let mut row = vec![t];
+        row.extend(g);
+        row.extend(c);
+        out.push(row);
+    }
+    out
+}
+
+/// `compensate --stream` of the unit, in process: per line and axis (status index, rate or
+/// NaN when empty, bias, scale).
+fn stream_in_process(
+    model: &gyrotherm::imu_model::ImuModel,
+    rows: &[Vec<f64>],
+) -> Vec<Vec<(usize, f64, f64, f64)>> {
+    let mut text = String::from("time_s,");
+    let names: Vec<&str> = model
+        .gyro_cols
+        .iter()
+        .chain(&model.temp_cols)
+        .map(String::as_str)
+        .collect();
+    text.push_str(&names.join(","));
+    text.push('\n');
+    for r in rows {
+        let f: Vec<String> = r.iter().map(|v| format!("{v:?}")).collect();
+        text.push_str(&f.join(","));
+        text.push('\n');
+    }
+    let mut out = Vec::new();
+    gyrotherm::compensate_imu_lines::compensate_imu_lines(
+        model,
+        text.as_bytes(),
+        Path::new("generated"),
+        &gyrotherm::ReadOptions::default(),
+        &mut out,
+        gyrotherm::compensate_lines::Mode::Stream,
+        false,
+    )
+    .unwrap();
+    let text = String::from_utf8(out).unwrap();
+    let width = 1 + names.len();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            let num = |s: &str| s.parse::<f64>().unwrap_or(f64::NAN);
+            (0..model.gyro_cols.len())
+                .map(|k| {
+                    let a = width + 4 * k;
+                    let status = ["ok", "held", "degraded", "invalid"]
+                        .iter()
+                        .position(|s| *s == f[a + 3])
+                        .unwrap();
+                    (status, num(f[a + 2]), num(f[a]), num(f[a + 1]))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn gcc(opt: &str, args: &[&str], files: &[&Path], out: &Path) {
+    run_ok(
+        Command::new("gcc")
+            .arg(opt)
+            .args([
+                "-std=c99",
+                "-ffp-contract=off",
+                "-Wall",
+                "-Wextra",
+                "-Werror",
+                "-pedantic",
+            ])
+            .args(args)
+            .args(files)
+            .arg("-lm")
+            .arg("-o")
+            .arg(out),
+    );
+}
+
+#[test]
+fn generated_unit_c_equals_the_unit_stream() {
+    if !have_gcc() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "gcc is required in CI for the C export test"
+        );
+        eprintln!("skipped: gcc not found (the C export test needs it)");
+        return;
+    }
+    let start = std::time::Instant::now();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
+    let (mut lines, mut axis_lines, mut differ, mut statuses) = (0usize, 0, 0, [0usize; 4]);
+    let mut verdicts = [0usize; 5];
+    let mut failures = Vec::new();
+    let workers = std::thread::available_parallelism().map_or(2, |n| n.get().min(4));
+    for batch in 0..UNITS.div_ceil(BATCH) {
+        let ids: Vec<usize> = (batch * BATCH..((batch + 1) * BATCH).min(UNITS)).collect();
+        let bdir = d.join(format!("batch{batch}"));
+        std::fs::create_dir_all(&bdir).unwrap();
+        let mut units = Vec::new();
+        for &u in &ids {
+            let (json, axes, temps) = unit_model(u);
+            let m = gyrotherm::imu_model::ImuModel::from_json(&json.to_string())
+                .unwrap_or_else(|e| panic!("generated unit {u}: {e}"));
+            let mdir = bdir.join(format!("u{u}"));
+            let files =
+                gyrotherm::export::unit::export_imu(&m, gyrotherm::export::Lang::C, &mdir).unwrap();
+            for f in files {
+                let text = std::fs::read_to_string(f).unwrap();
+                assert!(gyrotherm::export::is_generated_text(&text), "unit {u}");
+                assert!(!text.contains("*/ x") && !text.contains("g0 "), "unit {u}");
+            }
+            units.push((u, m, mdir, axes, temps));
+        }
+        let objs: Vec<PathBuf> = std::thread::scope(|s| {
+            let chunks: Vec<_> = units.chunks(units.len().div_ceil(workers)).collect();
+            let handles: Vec<_> = chunks
+                .into_iter()
+                .map(|chunk| {
+                    let here = &here;
+                    s.spawn(move || {
+                        chunk
+                            .iter()
+                            .map(|(u, _, mdir, _, _)| {
+                                let obj = mdir.join("unit.o");
+                                // -O0 as the single-axis differential test (compile time).
+                                gcc(
+                                    "-O0",
+                                    &[
+                                        "-c",
+                                        &format!("-DGT_RUN=run_{u}"),
+                                        &format!("-Dgt_init=gt_init_{u}"),
+                                        &format!("-Dgt_step_imu=gt_step_imu_{u}"),
+                                        &format!("-Dgt_step_imu_bk=gt_step_imu_bk_{u}"),
+                                        &format!("-Dgt_coverage_of_axis=gt_coverage_of_axis_{u}"),
+                                        "-I",
+                                        mdir.to_str().unwrap(),
+                                    ],
+                                    &[&here.join("wrap_imu.c")],
+                                    &obj,
+                                );
+                                obj
+                            })
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap())
+                .collect()
+        });
+        let mut runners = String::new();
+        for &u in &ids {
+            runners.push_str(&format!(
+                "size_t run_{u}(size_t n, const double *in, unsigned char *status, double *out);\n"
+            ));
+        }
+        let list: Vec<String> = ids.iter().map(|u| format!("run_{u}")).collect();
+        runners.push_str(&format!(
+            "static const runner RUNS[] = {{{}}};\n",
+            list.join(", ")
+        ));
+        std::fs::write(bdir.join("batch_runners.h"), runners).unwrap();
+        let exe = bdir.join("batch");
+        let main = here.join("batch_imu_main.c");
+        let mut files: Vec<&Path> = vec![&main];
+        files.extend(objs.iter().map(PathBuf::as_path));
+        gcc("-O2", &["-I", bdir.to_str().unwrap()], &files, &exe);
+        let streams: Vec<Vec<Vec<f64>>> = units
+            .iter()
+            .map(|(u, _, _, axes, temps)| unit_stream(*u, *axes, *temps))
+            .collect();
+        let mut input = Vec::new();
+        for ((_, _, _, axes, temps), s) in units.iter().zip(&streams) {
+            for v in [s.len(), 1 + axes + temps, *axes] {
+                input.extend((v as u64).to_le_bytes());
+            }
+            for row in s {
+                for v in row {
+                    input.extend(v.to_le_bytes());
+                }
+            }
+        }
+        std::fs::write(bdir.join("in.bin"), input).unwrap();
+        run_ok(
+            Command::new(&exe)
+                .arg(bdir.join("in.bin"))
+                .arg(bdir.join("out.bin")),
+        );
+        let out = std::fs::read(bdir.join("out.bin")).unwrap();
+        let mut at = 0usize;
+        for ((u, m, _, axes, _), s) in units.iter().zip(&streams) {
+            let want = stream_in_process(m, s);
+            assert_eq!(want.len(), s.len(), "unit {u}: one line out per line in");
+            // The coverage verdicts: the core unit stepped here, each axis's map on its
+            // features (C: 0 inside, 1 edge, 2 outside, 3 no verdict yet, 4 no map).
+            let mut unit = gyrotherm::compensate_imu_lines::flight_unit(m).unwrap();
+            let maps: Vec<_> = m
+                .axes
+                .iter()
+                .map(|a| a.model.coverage.as_ref().map(|c| c.to_core().unwrap()))
+                .collect();
+            let cover: Vec<Vec<(usize, f64)>> = s
+                .iter()
+                .map(|r| {
+                    unit.step(r[0], &r[1..1 + axes], &r[1 + axes..]);
+                    maps.iter()
+                        .enumerate()
+                        .map(|(k, map)| match map {
+                            None => (4, f64::NAN),
+                            Some(map) => match map.verdict_of(unit.axis(k).unwrap().features()) {
+                                Some(v) => (v.coverage as usize, v.sigma_dph),
+                                None => (3, f64::NAN),
+                            },
+                        })
+                        .collect()
+                })
+                .collect();
+            let st: Vec<u8> = out[at..at + s.len() * axes].to_vec();
+            at += s.len() * axes;
+            let vals: Vec<f64> = out[at..at + s.len() * axes * 40]
+                .chunks_exact(8)
+                .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+                .collect();
+            at += s.len() * axes * 40;
+            for (line, w) in want.iter().enumerate() {
+                lines += 1;
+                let mut same_line = true;
+                for (k, &(ws, wr, wb, wk)) in w.iter().enumerate() {
+                    let j = line * axes + k;
+                    let (cs, r, b, sc) = (
+                        st[j] as usize,
+                        vals[5 * j],
+                        vals[5 * j + 1],
+                        vals[5 * j + 2],
+                    );
+                    let (cv, sigma) = (vals[5 * j + 3] as usize, vals[5 * j + 4]);
+                    let (wc, wsig) = cover[line][k];
+                    axis_lines += 1;
+                    statuses[ws] += 1;
+                    verdicts[wc] += 1;
+                    let same = cs == ws
+                        && b.to_bits() == wb.to_bits()
+                        && sc.to_bits() == wk.to_bits()
+                        && (cs == 3 || r.to_bits() == wr.to_bits())
+                        && cv == wc
+                        && (sigma.to_bits() == wsig.to_bits() || (sigma.is_nan() && wsig.is_nan()));
+                    if !same {
+                        same_line = false;
+                        if failures.len() < 5 {
+                            failures.push(format!(
+                                "unit {u} line {line} axis {k} {:?}: C ({cs}, {r:e}, {b:e}, \
+                                 {sc:e}, {cv}, {sigma:e}) vs stream ({ws}, {wr:e}, {wb:e}, \
+                                 {wk:e}, {wc}, {wsig:e})",
+                                s[line]
+                            ));
+                        }
+                    }
+                }
+                differ += usize::from(!same_line);
+            }
+        }
+        assert_eq!(at, out.len(), "driver output length");
+    }
+    println!(
+        "unit differential: {UNITS} units, {lines} lines ({axis_lines} axis-lines) compared, \
+         {differ} lines differ (axis-lines ok {}, held {}, degraded {}, invalid {}; coverage \
+         inside {}, edge {}, outside {}, no verdict {}, no map {}); {:.1} s",
+        statuses[0],
+        statuses[1],
+        statuses[2],
+        statuses[3],
+        verdicts[0],
+        verdicts[1],
+        verdicts[2],
+        verdicts[3],
+        verdicts[4],
+        start.elapsed().as_secs_f64()
+    );
+    assert!(
+        failures.is_empty() && differ == 0,
+        "{differ} lines differ: {failures:#?}"
+    );
+    // Every status occurred often, so each path was compared.
+    assert!(statuses.iter().all(|v| *v > 1000), "statuses {statuses:?}");
+    assert!(verdicts.iter().all(|v| *v > 500), "verdicts {verdicts:?}");
+}

@@ -1,0 +1,295 @@
+//! An inertial unit in flight: one [`Compensator`] per gyro axis, all fed by one call per
+//! sample with the unit's time stamp, its gyro outputs and all its temperature sensors.
+//!
+//! Each axis compensator reads its own temperature channel(s) (through
+//! [`crate::multi::AxisCompensator::step`], which with one channel is
+//! [`Compensator::step_unit`] exactly), so:
+//! - a fault on one temperature sensor (NaN, out of range, too fast) is a temperature fault
+//!   only for the axes that read it; the others stay `ok`;
+//! - a bad time stamp reaches every axis, and every axis's time axis (see
+//!   [`crate::compensator`]) judges it alike: the same sample is placed, held or re-bases on
+//!   all axes;
+//! - a non-finite gyro sample makes only its own axis `invalid`.
+//!
+//! The capacity is a const generic (default [`MAX_AXES`], three gyros); the unit holds up to
+//! that many axes, no heap. [`Unit::step`] is panic-free for every input: a gyro slice shorter
+//! than the axis count gives NaN (`invalid`) for the missing axes, a temperature slice shorter
+//! than a channel a fault (NaN) for the axes reading it.
+//!
+//! ```
+//! use gyrotherm_core::compensator::{Status, TargetModel};
+//! use gyrotherm_core::unit::Unit;
+//! use gyrotherm_core::{Compensator, FeatureSpec};
+//!
+//! let axis = |channel| {
+//!     Compensator::new(
+//!         FeatureSpec::PUBLISHED,
+//!         TargetModel::constant(1e-3),
+//!         TargetModel::constant(1.0),
+//!     )
+//!     .unwrap()
+//!     .with_channel(channel)
+//! };
+//! // Axis 0 reads sensor 1, axis 1 reads sensor 2; sensor 0 (the case) is read by neither.
+//! let mut unit: Unit = Unit::new(3);
+//! unit.push_axis(axis(1)).unwrap();
+//! unit.push_axis(axis(2)).unwrap();
+//! let out = unit.step(0.0, &[0.01, 0.02], &[20.0, 21.0, 22.0]);
+//! assert_eq!(out[0].status, Status::Ok);
+//! // Sensor 2 fails: only axis 1 is held.
+//! let out = unit.step(1.0, &[0.01, 0.02], &[20.0, 21.0, f64::NAN]);
+//! assert_eq!((out[0].status, out[1].status), (Status::Ok, Status::Held));
+//! ```
+
+use crate::compensator::{Compensator, Corrected, ModelError, Status};
+use crate::multi::AxisCompensator;
+use crate::static_model::StaticModel;
+use core::fmt;
+
+/// Default capacity of a [`Unit`]: three gyro axes.
+pub const MAX_AXES: usize = 3;
+
+/// What a unit's slots beyond its axis count give: no rate.
+const NO_AXIS: Corrected = Corrected {
+    status: Status::Invalid,
+    bias_dps: 0.0,
+    scale: 1.0,
+    rate_dps: 0.0,
+};
+
+/// Why a unit cannot be built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum UnitError {
+    /// More axes than the unit's capacity.
+    TooManyAxes { capacity: usize },
+    /// An axis reads a temperature channel the unit does not have.
+    Channel {
+        axis: usize,
+        channel: usize,
+        n_temps: usize,
+    },
+    /// The model lists differ in length (axes and their channels).
+    Layout { axes: usize, channels: usize },
+    /// An axis's model cannot be built.
+    Model { axis: usize, source: ModelError },
+}
+
+impl fmt::Display for UnitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            UnitError::TooManyAxes { capacity } => {
+                write!(f, "more than {capacity} axes for this unit")
+            }
+            UnitError::Channel {
+                axis,
+                channel,
+                n_temps,
+            } => write!(
+                f,
+                "axis {axis} reads temperature channel {channel}, but the unit has {n_temps}"
+            ),
+            UnitError::Layout { axes, channels } => {
+                write!(f, "{axes} axis models but {channels} channels")
+            }
+            UnitError::Model { axis, .. } => write!(f, "the model of axis {axis}"),
+        }
+    }
+}
+
+impl core::error::Error for UnitError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            UnitError::Model { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
+
+/// An inertial unit's compensators (see the module doc).
+#[derive(Debug, Clone)]
+pub struct Unit<const N: usize = MAX_AXES> {
+    axes: [Option<AxisCompensator>; N],
+    n_axes: usize,
+    n_temps: usize,
+}
+
+impl<const N: usize> Unit<N> {
+    /// An empty unit whose samples carry `n_temps` temperature channels.
+    pub fn new(n_temps: usize) -> Self {
+        Unit {
+            axes: [const { None }; N],
+            n_axes: 0,
+            n_temps,
+        }
+    }
+
+    /// Add the next axis (gyro index = the number of axes so far); it reads its
+    /// [`Compensator::channel`], which must be below the unit's channel count.
+    pub fn push_axis(&mut self, axis: Compensator) -> Result<(), UnitError> {
+        let channel = axis.channel();
+        self.push_axis_sensors(AxisCompensator::new(axis, channel))
+    }
+
+    /// Add the next axis reading one or more temperature channels
+    /// ([`crate::multi::AxisCompensator`]); every channel must be below the unit's count.
+    pub fn push_axis_sensors(&mut self, axis: AxisCompensator) -> Result<(), UnitError> {
+        if let Some(channel) = axis.sensors().find(|&c| c >= self.n_temps) {
+            return Err(UnitError::Channel {
+                axis: self.n_axes,
+                channel,
+                n_temps: self.n_temps,
+            });
+        }
+        let slot = self
+            .axes
+            .get_mut(self.n_axes)
+            .ok_or(UnitError::TooManyAxes { capacity: N })?;
+        *slot = Some(axis);
+        self.n_axes += 1;
+        Ok(())
+    }
+
+    /// The unit of exported static models (`gyrotherm export --lang rust` of a unit model):
+    /// axis `i` runs `models[i]` on temperature channel `channels[i]` of `n_temps`.
+    pub fn from_static(
+        models: &[StaticModel],
+        channels: &[u8],
+        n_temps: usize,
+    ) -> Result<Self, UnitError> {
+        if models.len() != channels.len() {
+            return Err(UnitError::Layout {
+                axes: models.len(),
+                channels: channels.len(),
+            });
+        }
+        let mut unit = Unit::new(n_temps);
+        for (axis, (m, ch)) in models.iter().zip(channels).enumerate() {
+            let c =
+                Compensator::from_static(m).map_err(|source| UnitError::Model { axis, source })?;
+            unit.push_axis(c.with_channel(usize::from(*ch)))?;
+        }
+        Ok(unit)
+    }
+
+    /// Number of axes.
+    pub fn n_axes(&self) -> usize {
+        self.n_axes
+    }
+
+    /// Number of temperature channels a sample carries.
+    pub fn n_temps(&self) -> usize {
+        self.n_temps
+    }
+
+    /// Axis `i`'s compensator (its features, its channel; of its first sensor when it reads
+    /// several).
+    pub fn axis(&self, i: usize) -> Option<&Compensator> {
+        self.axes
+            .get(i)
+            .and_then(Option::as_ref)
+            .map(AxisCompensator::first)
+    }
+
+    /// Axis `i`, with every sensor it reads.
+    pub fn axis_sensors(&self, i: usize) -> Option<&AxisCompensator> {
+        self.axes.get(i).and_then(Option::as_ref)
+    }
+
+    /// One sample of the unit: time (s), the gyro outputs (°/s, axis order) and every
+    /// temperature channel (°C). Entry `i` of the result is axis `i`'s; entries from
+    /// [`Unit::n_axes`] on are `invalid` with no rate. Never fails (see the module doc).
+    pub fn step(&mut self, time_s: f64, gyro_dps: &[f64], temps_c: &[f64]) -> [Corrected; N] {
+        let mut out = [NO_AXIS; N];
+        for (i, (slot, axis)) in out.iter_mut().zip(self.axes.iter_mut()).enumerate() {
+            if let Some(c) = axis {
+                let g = gyro_dps.get(i).copied().unwrap_or(f64::NAN);
+                *slot = c.step(time_s, g, temps_c);
+            }
+        }
+        out
+    }
+
+    /// Start over on every axis (see [`Compensator::reset`]).
+    pub fn reset(&mut self) {
+        for c in self.axes.iter_mut().flatten() {
+            c.reset();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensator::TargetModel;
+    use crate::features::FeatureSpec;
+
+    fn axis(channel: usize) -> Compensator {
+        Compensator::new(
+            FeatureSpec::PUBLISHED,
+            TargetModel::constant(1e-3),
+            TargetModel::constant(1.0),
+        )
+        .unwrap()
+        .with_channel(channel)
+    }
+
+    #[test]
+    fn each_axis_equals_its_own_compensator_on_its_channel() {
+        let mut unit: Unit = Unit::new(4);
+        let mut alone = [axis(1), axis(3), axis(1)];
+        for a in &alone {
+            unit.push_axis(a.clone()).unwrap();
+        }
+        for i in 0..300 {
+            let x = f64::from(i);
+            // Faults: sensor 3 NaN for a while, a NaN time, a backward time, a NaN gyro.
+            let t = match i {
+                100 => f64::NAN,
+                150 => x - 40.0,
+                _ => x,
+            };
+            let s3 = if (50..80).contains(&i) {
+                f64::NAN
+            } else {
+                25.0
+            };
+            let temps = [20.0, 21.0 + 0.01 * x, 22.0, s3];
+            let gyro = [0.01, if i == 7 { f64::NAN } else { 0.02 }, 0.03];
+            let out = unit.step(t, &gyro, &temps);
+            for k in 0..3 {
+                let want = alone[k].step(t, gyro[k], temps[alone[k].channel()]);
+                assert_eq!(out[k], want, "sample {i} axis {k}");
+            }
+            if (50..80).contains(&i) {
+                assert_eq!(out[0].status, Status::Ok);
+                assert_ne!(out[1].status, Status::Ok);
+            }
+        }
+    }
+
+    #[test]
+    fn refuses_what_it_cannot_hold_and_never_panics_on_short_inputs() {
+        let mut unit: Unit<2> = Unit::new(2);
+        assert_eq!(
+            unit.push_axis(axis(2)),
+            Err(UnitError::Channel {
+                axis: 0,
+                channel: 2,
+                n_temps: 2
+            })
+        );
+        unit.push_axis(axis(0)).unwrap();
+        unit.push_axis(axis(1)).unwrap();
+        assert_eq!(
+            unit.push_axis(axis(0)),
+            Err(UnitError::TooManyAxes { capacity: 2 })
+        );
+        let out = unit.step(0.0, &[0.01], &[20.0]);
+        assert_eq!(out[0].status, Status::Ok);
+        // No gyro for axis 1: invalid; its channel is missing: not ok either way.
+        assert_eq!(out[1].status, Status::Invalid);
+        let out = unit.step(1.0, &[0.01, 0.02], &[20.0]);
+        assert_eq!(out[1].status, Status::Degraded);
+    }
+}

@@ -1,0 +1,357 @@
+//! Inertial units: logs read with column lists (`read_imu_log`), the unit fit (`fit_unit`,
+//! the CLI's `train` with `--gyro-col`/`--temp-col` lists) and the unit model file
+//! (`RawUnitModel`: load, save, compensate per axis).
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use gyrotherm::csvlog::{self, ImuLog, NamedSeries};
+use gyrotherm::imu_model::{self, ImuFitEvent, ImuModel};
+use gyrotherm::model::TempSensorDef;
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::allan::slice;
+use crate::logs::LogOptions;
+use crate::model::FitArgs;
+use crate::{py_err, CompensationError, FitError, LogError, ModelError};
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<RawUnitModel>()?;
+    m.add_function(wrap_pyfunction!(read_imu_log, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_unit, m)?)?;
+    m.add_function(wrap_pyfunction!(is_unit_model_file, m)?)?;
+    Ok(())
+}
+
+fn read(path: &std::path::Path, options: &LogOptions) -> PyResult<(ImuLog, csvlog::ReadReport)> {
+    let opts = options.read_options()?;
+    csvlog::read_imu_log(path, &opts, options.table_axis.as_deref())
+        .map_err(|e| LogError::new_err(gyrotherm::error_chain(&e)))
+}
+
+/// Read a unit log: a dict of numpy arrays (time, each gyro in °/s and each temperature
+/// under its column name, the table rate as `table_dps`, the pass-through columns) and a
+/// report dict (with the gyro and temperature columns and the table's axis).
+#[pyfunction]
+fn read_imu_log<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    options: LogOptions,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+    let (log, report) = py.detach(|| read(&path, &options))?;
+    let sample_period = imu_judge_period(&log);
+    let cols = PyDict::new(py);
+    let rep = PyDict::new(py);
+    rep.set_item(
+        "gyro_cols",
+        log.gyro.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
+    )?;
+    rep.set_item(
+        "temp_cols",
+        log.temp.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
+    )?;
+    rep.set_item("table_axis", log.table_axis.clone())?;
+    let ImuLog {
+        time_s,
+        gyro,
+        temp,
+        table,
+        extra,
+        ..
+    } = log;
+    cols.set_item(csvlog::TIME_COL, time_s.into_pyarray(py))?;
+    for s in gyro.into_iter().chain(temp) {
+        cols.set_item(s.name, s.values.into_pyarray(py))?;
+    }
+    if let Some(t) = table {
+        cols.set_item(csvlog::DEFAULT_TABLE_COL, t.values.into_pyarray(py))?;
+    }
+    for c in extra {
+        let numeric: Option<Vec<f64>> = c.values.iter().map(|v| v.trim().parse().ok()).collect();
+        match numeric {
+            Some(v) => cols.set_item(c.name, v.into_pyarray(py))?,
+            None => cols.set_item(c.name, c.values)?,
+        }
+    }
+    rep.set_item("rows", report.rows)?;
+    rep.set_item("filled_samples", report.filled_samples)?;
+    rep.set_item("filled_gaps", report.filled_gaps)?;
+    rep.set_item(
+        "sample_period_s",
+        sample_period.is_finite().then_some(sample_period),
+    )?;
+    rep.set_item("sample_period_estimated", report.sample_period_estimated)?;
+    rep.set_item("path", path.display().to_string())?;
+    Ok((cols, rep))
+}
+
+/// The sample period as the single-axis reader states it (the first axis's view).
+fn imu_judge_period(log: &ImuLog) -> f64 {
+    if log.gyro.is_empty() || log.temp.is_empty() {
+        return f64::NAN;
+    }
+    gyrotherm::imu_judge::axis_test_log(log, 0, 0).sample_period_s()
+}
+
+/// Whether the file holds an inertial unit's model.
+#[pyfunction]
+fn is_unit_model_file(path: PathBuf) -> bool {
+    std::fs::read_to_string(path).is_ok_and(|t| imu_model::is_imu_model_text(&t))
+}
+
+/// A unit model file in memory.
+#[pyclass(module = "gyrotherm._gyrotherm", name = "RawUnitModel", frozen)]
+pub struct RawUnitModel {
+    file: ImuModel,
+}
+
+fn model_err(e: impl std::error::Error + 'static) -> PyErr {
+    ModelError::new_err(gyrotherm::error_chain(&e))
+}
+
+type AxisColumns<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<u8>>,
+);
+
+#[pymethods]
+impl RawUnitModel {
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<RawUnitModel> {
+        let file = py.detach(|| ImuModel::load(&path)).map_err(model_err)?;
+        Ok(RawUnitModel { file })
+    }
+
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<RawUnitModel> {
+        let file = ImuModel::from_json(text).map_err(py_err::<ModelError>)?;
+        Ok(RawUnitModel { file })
+    }
+
+    /// Write the file atomically (the bytes `gyrotherm train` writes).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| self.file.save(&path)).map_err(model_err)
+    }
+
+    fn to_json(&self) -> PyResult<String> {
+        self.file.to_json().map_err(py_err::<ModelError>)
+    }
+
+    #[getter]
+    fn gyro_cols(&self) -> Vec<String> {
+        self.file.gyro_cols.clone()
+    }
+
+    #[getter]
+    fn temp_cols(&self) -> Vec<String> {
+        self.file.temp_cols.clone()
+    }
+
+    /// Per axis: gyro, the sensors it reads, the score of each sensor tried, the method and
+    /// the kinds of its bias and scale-factor models.
+    #[getter]
+    fn axes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let out = PyList::empty(py);
+        for a in &self.file.axes {
+            let d = PyDict::new(py);
+            d.set_item("gyro", &a.gyro)?;
+            d.set_item("temps", &a.temps)?;
+            let scores = PyDict::new(py);
+            for s in &a.scores {
+                scores.set_item(&s.temp, s.cv_rms)?;
+            }
+            d.set_item("cv_rms", scores)?;
+            d.set_item("method", a.model.method.as_str())?;
+            d.set_item("bias_kind", a.model.bias.as_ref().map(|s| s.kind()))?;
+            d.set_item("scale_kind", a.model.scale.as_ref().map(|s| s.kind()))?;
+            out.append(d)?;
+        }
+        Ok(out)
+    }
+
+    /// Compensate a unit's samples: `gyro` one array per gyro column and `temp` one per
+    /// temperature column, in the model's orders; per axis (bias °/s, scale, compensated
+    /// rate °/s, status), the numbers `gyrotherm compensate` writes as G_bias … G_status.
+    fn compensate<'py>(
+        &self,
+        py: Python<'py>,
+        time_s: PyReadonlyArray1<'py, f64>,
+        gyro: Vec<PyReadonlyArray1<'py, f64>>,
+        temp: Vec<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<Vec<AxisColumns<'py>>> {
+        let m = &self.file;
+        let t = slice(&time_s, "time_s")?;
+        let count = |what: &str, got: usize, want: &[String]| {
+            if got == want.len() {
+                Ok(())
+            } else {
+                Err(CompensationError::new_err(format!(
+                    "{what}: {got} arrays given, the model needs {} ({})",
+                    want.len(),
+                    want.join(", ")
+                )))
+            }
+        };
+        count("gyro", gyro.len(), &m.gyro_cols)?;
+        count("temp", temp.len(), &m.temp_cols)?;
+        let series = |arrays: &[PyReadonlyArray1<'py, f64>], names: &[String]| {
+            arrays
+                .iter()
+                .zip(names)
+                .map(|(a, n)| {
+                    let v = slice(a, n)?;
+                    if v.len() != t.len() {
+                        return Err(CompensationError::new_err(format!(
+                            "{n}: {} values but {} times; give one value per sample",
+                            v.len(),
+                            t.len()
+                        )));
+                    }
+                    Ok(NamedSeries {
+                        name: n.clone(),
+                        values: v.to_vec(),
+                    })
+                })
+                .collect::<PyResult<Vec<_>>>()
+        };
+        let log = ImuLog {
+            time_s: t.to_vec(),
+            gyro: series(&gyro, &m.gyro_cols)?,
+            temp: series(&temp, &m.temp_cols)?,
+            ..Default::default()
+        };
+        let out = py
+            .detach(|| imu_model::compensate_imu(m, &log))
+            .map_err(py_err::<CompensationError>)?;
+        Ok(out
+            .into_iter()
+            .map(|c| {
+                (
+                    c.bias_dps.into_pyarray(py),
+                    c.scale.into_pyarray(py),
+                    c.gyro_comp_dps.into_pyarray(py),
+                    c.status
+                        .into_iter()
+                        .map(|s| s as u8)
+                        .collect::<Vec<_>>()
+                        .into_pyarray(py),
+                )
+            })
+            .collect())
+    }
+
+    /// A human-readable description.
+    fn summary(&self) -> String {
+        let m = &self.file;
+        let mut s = format!(
+            "gyrotherm unit model ({} axes; gyro columns {}; temperature columns {})\n",
+            m.axes.len(),
+            m.gyro_cols.join(", "),
+            m.temp_cols.join(", ")
+        );
+        for a in &m.axes {
+            s += &format!(
+                "  {}: reads {} (method {}, bias: {}, scale factor: {})\n",
+                a.gyro,
+                a.temps.join(", "),
+                a.model.method.as_str(),
+                a.model.bias.as_ref().map_or("none", |b| b.kind()),
+                a.model.scale.as_ref().map_or("none", |b| b.kind())
+            );
+        }
+        s
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "UnitModel(gyro_cols={:?}, temp_cols={:?})",
+            self.file.gyro_cols, self.file.temp_cols
+        )
+    }
+}
+
+/// Fit a unit model, as `gyrotherm train --gyro-col LIST --temp-col LIST --input S…
+/// --input T…` does (same defaults, same file). `progress(event)` gets a tuple per step:
+/// `("start"|"done"|"axis", gyro, temp, cv_rms)`.
+#[pyfunction]
+#[pyo3(signature = (static_logs, table_logs, settings, options, progress=None))]
+fn fit_unit(
+    py: Python<'_>,
+    static_logs: Vec<PathBuf>,
+    table_logs: Vec<PathBuf>,
+    settings: FitArgs,
+    options: LogOptions,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(RawUnitModel, Option<String>)> {
+    let (cfg, deprecation) = settings.config()?;
+    let table_col = options.table_col.clone();
+    let failed: Mutex<Option<PyErr>> = Mutex::new(None);
+    let file = py.detach(|| -> PyResult<ImuModel> {
+        let mut logs: Vec<(String, ImuLog)> = Vec::new();
+        for (paths, want_static) in [(&static_logs, true), (&table_logs, false)] {
+            for p in paths {
+                let (log, _) = read(p, &options)?;
+                let name = p.display().to_string();
+                let is_static = log
+                    .table
+                    .as_ref()
+                    .is_none_or(|t| t.values.iter().all(|v| *v == 0.0));
+                if want_static != is_static {
+                    return Err(FitError::new_err(if want_static {
+                        format!("{name}: given as a static log but its {table_col} column has non-zero rates; pass it in table=[...]")
+                    } else {
+                        format!("{name}: given as a rate-table log but it has no non-zero {table_col} rate; pass it in static=[...]")
+                    }));
+                }
+                logs.push((name, log));
+            }
+        }
+        let gyro: Vec<String> = logs
+            .first()
+            .map(|(_, l)| l.gyro.iter().map(|s| s.name.clone()).collect())
+            .unwrap_or_default();
+        let temp: Vec<String> = logs
+            .first()
+            .map(|(_, l)| l.temp.iter().map(|s| s.name.clone()).collect())
+            .unwrap_or_default();
+        let events = |e: ImuFitEvent| {
+            let Some(cb) = &progress else { return };
+            let (what, axis, sensor, cv) = match e {
+                ImuFitEvent::AxisStarted { axis } => ("axis_start", axis, usize::MAX, None),
+                ImuFitEvent::SensorStarted { axis, sensor } => ("start", axis, sensor, None),
+                ImuFitEvent::SensorFinished {
+                    axis,
+                    sensor,
+                    cv_rms,
+                } => ("done", axis, sensor, cv_rms),
+                ImuFitEvent::AxisFinished { axis, sensor } => ("axis", axis, sensor, None),
+                _ => return,
+            };
+            Python::attach(|py| {
+                // An axis's start names no sensor yet.
+                let sensor = temp.get(sensor).cloned();
+                let args = (what, gyro[axis].clone(), sensor, cv);
+                if let Err(e) = cb.call1(py, args) {
+                    let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
+                    slot.get_or_insert(e);
+                }
+            });
+        };
+        imu_model::fit_imu_with_events(
+            &logs,
+            &cfg,
+            &TempSensorDef::default(),
+            &|_, _, _, _, _| {},
+            &events,
+        )
+        .map_err(|e| FitError::new_err(format!("training failed: {}", gyrotherm::error_chain(&e))))
+    })?;
+    if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
+    Ok((RawUnitModel { file }, deprecation))
+}

@@ -1,0 +1,361 @@
+//! Compensate an inertial unit's CSV log line by line: what `gyrotherm compensate --stream`
+//! runs with a unit model ([`crate::imu_model`]).
+//!
+//! The line handling is the single-axis stream's ([`compensate_lines`](mod@crate::compensate_lines)): the header
+//! (comments and blank lines before it), the line cap [`MAX_LINE_BYTES`], the separator and
+//! decimal comma, comment and blank lines dropped, one output line per data line, and
+//! [`Mode::Strict`] (stop on a malformed line, naming file, line and column) or
+//! [`Mode::Stream`] (write it as `invalid` and go on; a time that is a number but NaN,
+//! infinite or out of order goes to the time axes). Every input field is written as it was,
+//! then for each gyro column G of the model, in the model's order, the columns of batch
+//! `compensate`: `G_bias` (°/s), `G_scale`, `G_comp` (°/s; empty when the axis is
+//! `invalid`) and `G_status`.
+//!
+//! The numbers are those of flight code: the flight [`Unit`] of
+//! [`gyrotherm_core::unit`] steps every axis with the line's time, gyro fields and all the
+//! model's temperature fields, and each axis reads its own sensor, so a temperature field that
+//! is empty, not a number or implausible holds only the axes that read it, and a gyro field
+//! that is not a number (or NaN, infinite) makes only its own axis `invalid` (in
+//! [`Mode::Strict`] a gyro field that is not a number stops the run, as a malformed line). A
+//! bad time stamp reaches every axis alike. The columns are looked up by the model's names;
+//! the log must hold every one (the error names the first missing). Coverage columns and
+//! extrapolation warnings are the single-axis stream's only.
+
+use std::io::{BufRead, Write};
+use std::path::Path;
+
+use gyrotherm_core::compensator::{Corrected, Status};
+use gyrotherm_core::unit::Unit;
+
+use crate::compensate_lines::{
+    parse_number, read_header, read_line_capped, too_long_error, Fields, FileError, LineRead,
+    LinesError, Mode, MAX_LINE_BYTES,
+};
+use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
+use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
+
+/// Most gyro axes a unit model can have in the ground stream (flight code fixes its own
+/// capacity, three by default: [`gyrotherm_core::unit::MAX_AXES`]).
+pub const MAX_STREAM_AXES: usize = 16;
+
+/// The ground stream's unit: the core's, with room for [`MAX_STREAM_AXES`] axes.
+pub type StreamUnit = Unit<MAX_STREAM_AXES>;
+
+/// Suffixes of the columns added per gyro column, in order.
+pub const AXIS_SUFFIXES: [&str; 4] = ["bias", "scale", "comp", "status"];
+
+/// The names of the columns added for `model`: `G_bias`, `G_scale`, `G_comp`, `G_status`
+/// per gyro column G.
+pub fn output_columns(model: &ImuModel) -> Vec<String> {
+    model
+        .gyro_cols
+        .iter()
+        .flat_map(|g| AXIS_SUFFIXES.iter().map(move |s| format!("{g}_{s}")))
+        .collect()
+}
+
+/// The flight unit of `model`: axis `i` runs axis `i`'s model on its sensors' indices among
+/// the model's temperature columns.
+pub fn flight_unit(model: &ImuModel) -> Result<StreamUnit, ImuError> {
+    let comps = imu_axis_compensators(model)?;
+    let mut unit = StreamUnit::new(model.temp_cols.len());
+    for (c, a) in comps.into_iter().zip(&model.axes) {
+        unit.push_axis_sensors(c).map_err(|e| {
+            ImuError::Layout(format!(
+                "axis {}: {e} (a unit runs at most {MAX_STREAM_AXES} axes)",
+                a.gyro
+            ))
+        })?;
+    }
+    Ok(unit)
+}
+
+/// Counts of a run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ImuLinesSummary {
+    /// Data lines written (= data lines read).
+    pub rows: u64,
+    /// Malformed lines written as invalid on every axis ([`Mode::Stream`] only).
+    pub malformed: u64,
+    /// Per axis, in the model's order: lines ok, held, degraded, invalid.
+    pub per_axis: Vec<[u64; 4]>,
+}
+
+impl ImuLinesSummary {
+    /// `N lines (m malformed); gyro_x: ok a, held b, degraded c, invalid d; ...`.
+    pub fn describe(&self, model: &ImuModel) -> String {
+        let mut s = format!("{} lines", self.rows);
+        if self.malformed > 0 {
+            s.push_str(&format!(" ({} malformed)", self.malformed));
+        }
+        for (g, [ok, held, degraded, invalid]) in model.gyro_cols.iter().zip(&self.per_axis) {
+            s.push_str(&format!(
+                "; {g}: ok {ok}, held {held}, degraded {degraded}, invalid {invalid}"
+            ));
+        }
+        s
+    }
+}
+
+/// Compensate `input` (CSV with a header) with the unit model into `output`; see the module
+/// doc. The columns are the model's: `opts` gives the time column, separator, gyro unit and
+/// the rest; its gyro and temperature columns are not used. `source` names the input in
+/// errors. With `flush_each_row` every line is flushed as soon as it is written.
+pub fn compensate_imu_lines<R: BufRead, W: Write>(
+    model: &ImuModel,
+    mut input: R,
+    source: &Path,
+    opts: &ReadOptions,
+    output: W,
+    mode: Mode,
+    flush_each_row: bool,
+) -> Result<ImuLinesSummary, LinesError> {
+    let mut unit = flight_unit(model).map_err(LinesError::Unit)?;
+    let n_axes = model.gyro_cols.len();
+    let (Some(gyro0), Some(temp0)) = (model.gyro_cols.first(), model.temp_cols.first()) else {
+        return Err(LinesError::Unit(ImuError::Layout(
+            "the model lists no gyro or no temperature column".into(),
+        )));
+    };
+    // The log reader checks the header with the first gyro and sensor (its messages); the
+    // other columns are looked up below.
+    let first = ReadOptions {
+        gyro_col: gyro0.clone(),
+        temp_col: temp0.clone(),
+        ..opts.clone()
+    };
+    let (headers, mut line_no) = read_header(&mut input, source, &first)?;
+    let err = |kind, line, column: Option<&str>, message: String| {
+        LinesError::Log(LogError::new(kind, source, Some(line), column, message))
+    };
+    let find = |name: &str, what: &str| {
+        headers.iter().position(|h| h == name).ok_or_else(|| {
+            err(
+                LogErrorKind::MissingColumn,
+                line_no,
+                Some(name),
+                format!(
+                    "{what} column not found, and the model needs it; the header has: {}",
+                    headers.join(", ")
+                ),
+            )
+        })
+    };
+    let ti = find(&opts.time_col, "time")?;
+    let gi = model
+        .gyro_cols
+        .iter()
+        .map(|g| find(g, "gyro"))
+        .collect::<Result<Vec<_>, _>>()?;
+    let ci = model
+        .temp_cols
+        .iter()
+        .map(|t| find(t, "temperature"))
+        .collect::<Result<Vec<_>, _>>()?;
+    let gyro_scale = opts.gyro_unit.dps_per_unit();
+    let delimiter = opts.delimiter;
+    let decimal_comma = delimiter != b',';
+    let added = output_columns(model);
+    let mut writer = LogWriter::with_delimiter(
+        output,
+        headers
+            .iter()
+            .map(String::as_str)
+            .chain(added.iter().map(String::as_str)),
+        delimiter,
+    )?;
+    writer.set_flush_each_row(flush_each_row);
+    let mut summary = ImuLinesSummary {
+        per_axis: vec![[0; 4]; n_axes],
+        ..ImuLinesSummary::default()
+    };
+    let mut fields = Fields::default();
+    let mut buf = Vec::new();
+    let mut last_time: Option<(f64, u64)> = None;
+    let mut gyro = vec![0.0; n_axes];
+    let mut temps = vec![0.0; ci.len()];
+    // A line with no usable output: its fields (or empty ones), every axis invalid.
+    let malformed = |writer: &mut LogWriter<W>,
+                     summary: &mut ImuLinesSummary,
+                     keep: Option<(&Fields, &[u8])>|
+     -> std::io::Result<()> {
+        for k in 0..headers.len() {
+            writer.push_raw(keep.map_or(&[][..], |(f, line)| f.get(line, k)));
+        }
+        for counts in &mut summary.per_axis {
+            for _ in 0..3 {
+                writer.push_raw(b"");
+            }
+            writer.push_raw(Status::Invalid.as_str().as_bytes());
+            counts[Status::Invalid as usize] += 1;
+        }
+        summary.malformed += 1;
+        writer.end_row()
+    };
+    loop {
+        let read = read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)?;
+        if read == LineRead::Eof {
+            break;
+        }
+        line_no += 1;
+        if read == LineRead::TooLong {
+            if mode == Mode::Strict {
+                return Err(too_long_error(source, line_no));
+            }
+            summary.rows += 1;
+            malformed(&mut writer, &mut summary, None)?;
+            continue;
+        }
+        let line = buf.strip_suffix(b"\n").unwrap_or(&buf);
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let trimmed = line.trim_ascii();
+        if trimmed.is_empty() || trimmed.starts_with(b"#") {
+            continue;
+        }
+        summary.rows += 1;
+        let parsed: Result<f64, LinesError> = (|| {
+            if !fields.split(line, delimiter) || fields.len() != headers.len() {
+                return Err(err(
+                    LogErrorKind::FieldCount,
+                    line_no,
+                    None,
+                    format!(
+                        "{} fields, but the header has {}; fix the line (a missing or extra \
+                         {}) or comment it out with '#'",
+                        fields.len(),
+                        headers.len(),
+                        match delimiter {
+                            b'\t' => "tab".to_string(),
+                            d => format!("'{}'", char::from(d)),
+                        }
+                    ),
+                ));
+            }
+            let time_s = match parse_number(fields.get(line, ti), decimal_comma) {
+                Some(t) if t.is_finite() => t,
+                // A live feed hands a NaN or infinite time to the unit, whose time axes give
+                // it a status.
+                Some(t) if mode == Mode::Stream => t,
+                _ => {
+                    return Err(err(
+                        LogErrorKind::NotANumber,
+                        line_no,
+                        Some(&headers[ti]),
+                        format!(
+                            "{:?} is not a finite time; fix the value or comment the line out \
+                             with '#'",
+                            String::from_utf8_lossy(fields.get(line, ti))
+                        ),
+                    ))
+                }
+            };
+            if let (Some((t0, line0)), Mode::Strict) = (last_time, mode) {
+                if time_s <= t0 {
+                    return Err(err(
+                        LogErrorKind::TimeNotIncreasing,
+                        line_no,
+                        Some(&headers[ti]),
+                        format!(
+                            "time is not strictly increasing: {time_s} s comes after {t0} s \
+                             (line {line0}); sort the log by time or remove the row"
+                        ),
+                    ));
+                }
+            }
+            for (g, &k) in gyro.iter_mut().zip(&gi) {
+                *g = match parse_number(fields.get(line, k), decimal_comma) {
+                    Some(v) => v * gyro_scale,
+                    // One axis's fault: the others go on.
+                    None if mode == Mode::Stream => f64::NAN,
+                    None => {
+                        return Err(err(
+                            LogErrorKind::NotANumber,
+                            line_no,
+                            Some(&headers[k]),
+                            format!(
+                                "{:?} is not a number; fix the value or comment the line out \
+                                 with '#'",
+                                String::from_utf8_lossy(fields.get(line, k))
+                            ),
+                        ))
+                    }
+                };
+            }
+            // A temperature that is not a number is a sensor fault: NaN, held.
+            for (c, &k) in temps.iter_mut().zip(&ci) {
+                *c = parse_number(fields.get(line, k), decimal_comma).unwrap_or(f64::NAN);
+            }
+            Ok(time_s)
+        })();
+        let time_s = match parsed {
+            Ok(t) => t,
+            Err(e) if mode == Mode::Strict => return Err(e),
+            Err(_) => {
+                let keep = fields.len() == headers.len();
+                malformed(&mut writer, &mut summary, keep.then_some((&fields, line)))?;
+                continue;
+            }
+        };
+        last_time = Some((time_s, line_no));
+        let out: [Corrected; MAX_STREAM_AXES] = unit.step(time_s, &gyro, &temps);
+        for k in 0..fields.len() {
+            writer.push_raw(fields.get(line, k));
+        }
+        for (c, counts) in out.iter().zip(&mut summary.per_axis) {
+            writer.push_f64(c.bias_dps);
+            writer.push_f64(c.scale);
+            match c.rate() {
+                Some(r) => writer.push_f64(r),
+                None => writer.push_raw(b""),
+            }
+            writer.push_raw(c.status.as_str().as_bytes());
+            counts[c.status as usize] += 1;
+        }
+        writer.end_row()?;
+    }
+    writer.flush()?;
+    if summary.rows == 0 {
+        return Err(err(
+            LogErrorKind::NoData,
+            line_no,
+            None,
+            "no data rows after the header; the log is empty or holds only comments".into(),
+        ));
+    }
+    Ok(summary)
+}
+
+/// Compensate the unit log `input` into the CSV file `out` ([`Mode::Strict`]), written to a
+/// temporary file and renamed into place: what `gyrotherm compensate --input --out` does with
+/// a unit model. The same lines as the stream for every log the strict mode accepts.
+pub fn compensate_imu_file(
+    model: &ImuModel,
+    input: &Path,
+    out: &Path,
+    opts: &ReadOptions,
+) -> Result<ImuLinesSummary, FileError> {
+    let file = std::fs::File::open(input).map_err(|source| FileError::Open {
+        path: input.to_path_buf(),
+        source,
+    })?;
+    crate::atomic_file::write_atomically(out, |w: &mut std::io::BufWriter<std::fs::File>| {
+        let s = compensate_imu_lines(
+            model,
+            std::io::BufReader::new(&file),
+            input,
+            opts,
+            &mut *w,
+            Mode::Strict,
+            false,
+        )?;
+        w.flush()?;
+        Ok::<_, LinesError>(s)
+    })
+    .map_err(|e| match e {
+        LinesError::Io(source) => FileError::Write {
+            path: out.to_path_buf(),
+            source,
+        },
+        other => FileError::Lines(other),
+    })
+}

@@ -1,0 +1,561 @@
+//! The standard figures of an inertial unit, axis by axis: `evaluate` (each gyro column, raw
+//! and with a unit model compensated), `compare` (every method fitted and judged per axis)
+//! and the table across axes that `report` and `compare` show.
+//!
+//! Each axis is judged as a single-axis log ([`axis_test_log`]): its gyro, the sensor its
+//! model reads, the table rate only in the runs where the table turns this axis (in the
+//! others the axis stands still, so they are static runs for it), and, in a simulated log,
+//! the axis's truth columns under the single-axis names (`noise_dps_x` → `noise_dps`) so the
+//! noise floor is the axis's own. The single-axis figures and comparison then apply as they
+//! are, so a one-axis figure and its per-axis counterpart are the same number.
+//!
+//! The comparison's sensor per axis is the one the unit's fit with the comparison's fit
+//! settings (`train` with the same lists) reads; every method of that axis is fitted on it,
+//! so the columns differ only by method.
+
+use serde::Serialize;
+
+use crate::compare::{
+    compare, CompareConfig, CompareError, Comparison, ComparisonSummary, TableFigure,
+};
+use crate::csvlog::{ExtraColumn, ImuLog, TestLog, GYRO_COL};
+use crate::fit::{NamedLog, Target};
+use crate::imu_model::{compensate_imu, fit_imu_with_events, ImuError, ImuEvents, ImuModel};
+use crate::metrics::Evaluation;
+use crate::model::TempSensorDef;
+use crate::report::html::Table;
+use crate::settings::evaluate::{EvaluateError, EvaluateSettings, ResolvedTau};
+
+/// Why a unit's figures could not be computed.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum ImuJudgeError {
+    /// The figures of axis `gyro` (`output`: raw or compensated).
+    Evaluate {
+        gyro: String,
+        output: &'static str,
+        source: EvaluateError,
+    },
+    /// The comparison of axis `gyro`.
+    Compare { gyro: String, source: CompareError },
+    /// The unit model (fitting it, or compensating with it).
+    Unit(ImuError),
+    /// The logs or settings do not fit together (the message says what to do).
+    Layout(String),
+}
+
+impl std::fmt::Display for ImuJudgeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ImuJudgeError::Evaluate { gyro, output, .. } => {
+                write!(f, "axis {gyro} ({output} output)")
+            }
+            ImuJudgeError::Compare { gyro, .. } => write!(f, "axis {gyro}"),
+            ImuJudgeError::Unit(_) => write!(f, "the unit model"),
+            ImuJudgeError::Layout(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl std::error::Error for ImuJudgeError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ImuJudgeError::Evaluate { source, .. } => Some(source),
+            ImuJudgeError::Compare { source, .. } => Some(source),
+            ImuJudgeError::Unit(e) => Some(e),
+            ImuJudgeError::Layout(_) => None,
+        }
+    }
+}
+
+/// Axis `axis` of a unit log as a single-axis log for judging (see the module doc):
+/// gyro `axis`, temperature `temp`, the table rate when the table turns this axis, and the
+/// pass-through columns, the axis's truth columns renamed to the single-axis names.
+pub fn axis_test_log(log: &ImuLog, axis: usize, temp: usize) -> TestLog {
+    let mut out = log.axis_data(axis, temp);
+    let suffix = crate::sim::imu::axis_of_gyro_col(&log.gyro[axis].name).map(|a| format!("_{a}"));
+    out.extra = log
+        .extra
+        .iter()
+        .map(|c| {
+            let base = suffix
+                .as_deref()
+                .and_then(|s| c.name.strip_suffix(s))
+                .filter(|b| !b.is_empty());
+            match base {
+                Some(b) => ExtraColumn {
+                    name: b.to_owned(),
+                    values: c.values.clone(),
+                },
+                None => c.clone(),
+            }
+        })
+        .collect();
+    out
+}
+
+/// The figures of one axis: of the raw gyro column, and of its compensated output when a
+/// unit model was given.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisEvaluation {
+    /// The gyro column.
+    pub gyro: String,
+    /// The temperature columns its model reads (empty without a model).
+    pub temps: Vec<String>,
+    pub raw: Evaluation,
+    pub compensated: Option<Evaluation>,
+}
+
+/// `evaluate` on a unit log: the figures of each gyro column (raw, in °/s as read), and with
+/// `model` of each axis's compensated output (`G_comp`, the flight compensator's output as
+/// `compensate` writes it). `settings.column` must be the default (the gyro columns are
+/// named by the log's column list). Returns the axes in column order and the τ used.
+pub fn evaluate_imu(
+    log: &ImuLog,
+    model: Option<&ImuModel>,
+    settings: &EvaluateSettings,
+) -> Result<(Vec<AxisEvaluation>, ResolvedTau), ImuJudgeError> {
+    if settings.column != GYRO_COL {
+        return Err(ImuJudgeError::Layout(format!(
+            "column {:?}: a unit log is judged per gyro column (--gyro-col lists them); leave \
+             the column at its default {GYRO_COL}",
+            settings.column
+        )));
+    }
+    if log.gyro.is_empty() || log.temp.is_empty() {
+        return Err(ImuJudgeError::Layout(
+            "the log has no gyro or no temperature column".into(),
+        ));
+    }
+    let comp = model
+        .map(|m| compensate_imu(m, log))
+        .transpose()
+        .map_err(ImuJudgeError::Unit)?;
+    let mut axes = Vec::with_capacity(log.gyro.len());
+    let mut tau = None;
+    for (k, g) in log.gyro.iter().enumerate() {
+        let axis_log = axis_test_log(log, k, 0);
+        let tau0_s = axis_log.sample_period_s();
+        if !(tau0_s.is_finite() && tau0_s > 0.0) {
+            return Err(ImuJudgeError::Layout(
+                "cannot tell the sample period (need at least two samples with increasing time)"
+                    .into(),
+            ));
+        }
+        let judge = |values: &[f64], output: &'static str, name: String| {
+            let (mut e, t) = settings
+                .evaluate(&axis_log, values, tau0_s)
+                .map_err(|source| ImuJudgeError::Evaluate {
+                    gyro: g.name.clone(),
+                    output,
+                    source,
+                })?;
+            e.column = name;
+            Ok::<_, ImuJudgeError>((e, t))
+        };
+        let (raw, t) = judge(&g.values, "raw", g.name.clone())?;
+        tau.get_or_insert(t);
+        let (compensated, temps) = match (&comp, model) {
+            (Some(c), Some(m)) => {
+                // compensate_imu returns the model's axes in order; find this column's.
+                let i = m
+                    .axes
+                    .iter()
+                    .position(|a| a.gyro == g.name)
+                    .ok_or_else(|| {
+                        ImuJudgeError::Layout(format!("the model has no axis {}", g.name))
+                    })?;
+                let (e, _) = judge(
+                    &c[i].gyro_comp_dps,
+                    "compensated",
+                    format!("{}_comp", g.name),
+                )?;
+                (Some(e), m.axes[i].temps.clone())
+            }
+            _ => (None, Vec::new()),
+        };
+        axes.push(AxisEvaluation {
+            gyro: g.name.clone(),
+            temps,
+            raw,
+            compensated,
+        });
+    }
+    let tau = tau.ok_or_else(|| ImuJudgeError::Layout("no gyro column".into()))?;
+    Ok((axes, tau))
+}
+
+/// One axis of a unit comparison: the single-axis logs it was judged on and the comparison.
+#[derive(Debug, Clone)]
+pub struct AxisComparison {
+    /// The gyro column.
+    pub gyro: String,
+    /// The temperature column every method of this axis reads.
+    pub temp: String,
+    /// The training logs as this axis saw them (name, log).
+    pub train: Vec<(String, TestLog)>,
+    /// The held-out logs as this axis saw them, in order.
+    pub test: Vec<(String, TestLog)>,
+    pub comparison: Comparison,
+}
+
+impl AxisComparison {
+    /// The training logs as named logs (what the single-axis report takes).
+    pub fn train_named(&self) -> Vec<NamedLog<'_>> {
+        self.train
+            .iter()
+            .map(|(n, l)| NamedLog { name: n, log: l })
+            .collect()
+    }
+
+    /// The held-out logs as named logs.
+    pub fn test_named(&self) -> Vec<NamedLog<'_>> {
+        self.test
+            .iter()
+            .map(|(n, l)| NamedLog { name: n, log: l })
+            .collect()
+    }
+}
+
+/// A unit comparison: one comparison per axis, in gyro column order.
+#[derive(Debug, Clone)]
+pub struct ImuComparison {
+    pub axes: Vec<AxisComparison>,
+}
+
+/// Progress of a unit comparison: axis index, then the comparison's own (column key,
+/// target, epoch, loss).
+pub type ImuCompareProgress<'a> = dyn Fn(usize, &'static str, Target, usize, f64) + Sync + 'a;
+
+/// `compare` on unit logs: the sensor per axis from the unit fit with `cfg.fit` (skipped
+/// with one temperature column; `events` tells its steps), then every column of `cfg`
+/// fitted and judged per axis on that sensor, the axes on their own threads.
+pub fn compare_imu(
+    train: &[(String, ImuLog)],
+    test: &[(String, ImuLog)],
+    cfg: &CompareConfig,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuCompareProgress,
+    events: &ImuEvents,
+) -> Result<ImuComparison, ImuJudgeError> {
+    let first = train
+        .first()
+        .map(|(_, l)| l)
+        .ok_or_else(|| ImuJudgeError::Layout("no training logs".into()))?;
+    let names = |l: &ImuLog| {
+        (
+            l.gyro.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
+            l.temp.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
+        )
+    };
+    let (gyro_cols, temp_cols) = names(first);
+    for (n, l) in train.iter().chain(test) {
+        if names(l) != (gyro_cols.clone(), temp_cols.clone()) {
+            return Err(ImuJudgeError::Layout(format!(
+                "{n}: every log must be read with the same gyro and temperature columns"
+            )));
+        }
+    }
+    let sensors: Vec<usize> = if temp_cols.len() == 1 {
+        vec![0; gyro_cols.len()]
+    } else {
+        fit_imu_with_events(train, &cfg.fit, temp_sensor, &|_, _, _, _, _| {}, events)
+            .map_err(ImuJudgeError::Unit)?
+            .sensor_index()
+    };
+    let axes: Vec<Result<AxisComparison, ImuJudgeError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..gyro_cols.len())
+            .map(|k| {
+                let (gyro_cols, temp_cols, sensors) = (&gyro_cols, &temp_cols, &sensors);
+                scope.spawn(move || {
+                    let j = sensors[k];
+                    let per_axis = |logs: &[(String, ImuLog)]| -> Vec<(String, TestLog)> {
+                        logs.iter()
+                            .map(|(n, l)| (n.clone(), axis_test_log(l, k, j)))
+                            .collect()
+                    };
+                    let (train, test) = (per_axis(train), per_axis(test));
+                    let comparison = {
+                        let tr: Vec<NamedLog> = train
+                            .iter()
+                            .map(|(n, l)| NamedLog { name: n, log: l })
+                            .collect();
+                        let te: Vec<NamedLog> = test
+                            .iter()
+                            .map(|(n, l)| NamedLog { name: n, log: l })
+                            .collect();
+                        compare(&tr, &te, cfg, &|key, t, e, l| progress(k, key, t, e, l)).map_err(
+                            |source| ImuJudgeError::Compare {
+                                gyro: gyro_cols[k].clone(),
+                                source,
+                            },
+                        )?
+                    };
+                    Ok(AxisComparison {
+                        gyro: gyro_cols[k].clone(),
+                        temp: temp_cols[j].clone(),
+                        train,
+                        test,
+                        comparison,
+                    })
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| match h.join() {
+                Ok(r) => r,
+                Err(p) => std::panic::resume_unwind(p),
+            })
+            .collect()
+    });
+    Ok(ImuComparison {
+        axes: axes.into_iter().collect::<Result<Vec<_>, _>>()?,
+    })
+}
+
+/// One axis in `gyrotherm compare --json` for a unit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisSummary {
+    pub gyro: String,
+    pub temp: String,
+    pub comparison: ComparisonSummary,
+}
+
+/// A unit comparison as `gyrotherm compare --json` prints it: per axis the single-axis
+/// summary, then the table across axes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImuComparisonSummary {
+    pub axes: Vec<AxisSummary>,
+    pub across_axes: AcrossAxes,
+}
+
+/// The table across axes as JSON: its headers and rows of formatted cells.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AcrossAxes {
+    pub headers: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl ImuComparison {
+    /// The JSON form.
+    pub fn summary(&self, cfg: &CompareConfig) -> ImuComparisonSummary {
+        let t = self.across_axes(cfg);
+        ImuComparisonSummary {
+            axes: self
+                .axes
+                .iter()
+                .map(|a| AxisSummary {
+                    gyro: a.gyro.clone(),
+                    temp: a.temp.clone(),
+                    comparison: a.comparison.summary(cfg),
+                })
+                .collect(),
+            across_axes: AcrossAxes {
+                headers: t.headers,
+                rows: t.rows,
+            },
+        }
+    }
+
+    /// The table across axes (axis × figure): per held-out log and figure (bias stability,
+    /// × noise floor, scale-factor error, SF thermal error) one row per axis, with the raw
+    /// output, each method (columns named by method, the same for every axis) and the noise
+    /// floor. The per-rate output ranges stay in the axes' own tables.
+    pub fn across_axes(&self, cfg: &CompareConfig) -> Table {
+        let mut headers = vec![
+            "held-out log".to_owned(),
+            "figure".to_owned(),
+            "axis".to_owned(),
+            "raw".to_owned(),
+        ];
+        let keys: Vec<&'static str> = cfg.candidates.iter().map(|c| c.key(&cfg.fit)).collect();
+        headers.extend(keys.iter().map(|k| (*k).to_owned()));
+        headers.push("noise floor".to_owned());
+        let tables: Vec<_> = self.axes.iter().map(|a| a.comparison.table(cfg)).collect();
+        let mut rows = Vec::new();
+        let n_tests = tables.iter().map(|t| t.blocks.len()).max().unwrap_or(0);
+        for b in 0..n_tests {
+            // A table run is static for the axes it does not turn, so the axes' blocks of
+            // one log may hold different figures: every figure any axis has, in order.
+            let mut figures = Vec::new();
+            for t in &tables {
+                for row in t.blocks.get(b).into_iter().flat_map(|blk| &blk.rows) {
+                    let per_rate = matches!(row.figure, TableFigure::OutputAt { .. });
+                    if !per_rate && !figures.contains(&row.figure) {
+                        figures.push(row.figure);
+                    }
+                }
+            }
+            let log = tables
+                .iter()
+                .find_map(|t| t.blocks.get(b))
+                .map_or(String::new(), |blk| blk.log.clone());
+            let mut first_row = true;
+            for figure in figures {
+                let mut first_axis = true;
+                for (a, t) in self.axes.iter().zip(&tables) {
+                    let Some(r) = t
+                        .blocks
+                        .get(b)
+                        .and_then(|blk| blk.rows.iter().find(|x| x.figure == figure))
+                    else {
+                        continue;
+                    };
+                    let mut cells = vec![
+                        if first_row {
+                            log.clone()
+                        } else {
+                            String::new()
+                        },
+                        if first_axis {
+                            figure.label()
+                        } else {
+                            String::new()
+                        },
+                        a.gyro.clone(),
+                    ];
+                    first_row = false;
+                    first_axis = false;
+                    cells.extend(r.cells.iter().cloned());
+                    cells.push(r.floor.clone().unwrap_or_default());
+                    rows.push(cells);
+                }
+            }
+        }
+        Table { headers, rows }
+    }
+}
+
+/// `t` as aligned text: the header, a rule, the rows (columns padded to their widest cell).
+pub fn write_text_table(w: &mut dyn std::io::Write, t: &Table) -> std::io::Result<()> {
+    let n = t
+        .headers
+        .len()
+        .max(t.rows.iter().map(Vec::len).max().unwrap_or(0));
+    let mut width = vec![0usize; n];
+    for row in std::iter::once(&t.headers).chain(&t.rows) {
+        for (i, c) in row.iter().enumerate() {
+            width[i] = width[i].max(c.chars().count());
+        }
+    }
+    let line = |w: &mut dyn std::io::Write, row: &[String]| -> std::io::Result<()> {
+        let cells: Vec<String> = (0..n)
+            .map(|i| {
+                let c = row.get(i).map_or("", String::as_str);
+                let pad = width[i].saturating_sub(c.chars().count());
+                if i < 3 {
+                    format!("{c}{}", " ".repeat(pad))
+                } else {
+                    format!("{}{c}", " ".repeat(pad))
+                }
+            })
+            .collect();
+        writeln!(w, "{}", cells.join("  ").trim_end())
+    };
+    line(w, &t.headers)?;
+    writeln!(
+        w,
+        "{}",
+        "-".repeat(width.iter().sum::<usize>() + 2 * n.saturating_sub(1))
+    )?;
+    for r in &t.rows {
+        line(w, r)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::csvlog::NamedSeries;
+
+    fn series(name: &str, v: &[f64]) -> NamedSeries {
+        NamedSeries {
+            name: name.into(),
+            values: v.to_vec(),
+        }
+    }
+
+    fn text(name: &str, v: &[&str]) -> ExtraColumn {
+        ExtraColumn {
+            name: name.into(),
+            values: v.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn an_axis_sees_its_own_truth_under_the_single_axis_names() {
+        let log = ImuLog {
+            time_s: vec![0.0, 1.0],
+            gyro: vec![
+                series("gyro_x_dps", &[1.0, 2.0]),
+                series("gyro_y_dps", &[3.0, 4.0]),
+            ],
+            temp: vec![series("temp_case_c", &[20.0, 21.0])],
+            table: Some(series("table_dps", &[0.0, 20.0])),
+            table_axis: Some("gyro_y_dps".into()),
+            extra: vec![
+                text("noise_dps_x", &["0.1", "0.2"]),
+                text("noise_dps_y", &["0.3", "0.4"]),
+                text("chamber_temp_c", &["22", "23"]),
+            ],
+        };
+        let y = axis_test_log(&log, 1, 0);
+        assert_eq!(y.gyro_dps, [3.0, 4.0]);
+        assert_eq!(y.extra_f64("noise_dps"), Some(vec![0.3, 0.4]));
+        assert_eq!(y.extra_f64("noise_dps_x"), Some(vec![0.1, 0.2]));
+        assert_eq!(y.extra_f64("chamber_temp_c"), Some(vec![22.0, 23.0]));
+        assert_eq!(y.table_dps.as_deref(), Some(&[0.0, 20.0][..]));
+        let x = axis_test_log(&log, 0, 0);
+        assert_eq!(x.extra_f64("noise_dps"), Some(vec![0.1, 0.2]));
+        // The table turns y: for x the run is static.
+        assert!(x.table_dps.is_none());
+        // Gyro names the simulator did not write get no renaming.
+        let mut other = log.clone();
+        other.gyro[1].name = "gy".into();
+        other.table_axis = Some("gy".into());
+        assert!(axis_test_log(&other, 1, 0).extra_f64("noise_dps").is_none());
+    }
+
+    #[test]
+    fn the_table_across_axes_aligns_its_columns() {
+        let t = Table {
+            headers: vec![
+                "held-out log".into(),
+                "figure".into(),
+                "axis".into(),
+                "raw".into(),
+            ],
+            rows: vec![vec![
+                "a.csv".into(),
+                "bias".into(),
+                "gx".into(),
+                "0.5".into(),
+            ]],
+        };
+        let mut out = Vec::new();
+        write_text_table(&mut out, &t).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "held-out log  figure  axis  raw");
+        assert_eq!(lines[1], "-".repeat(31));
+        assert_eq!(lines[2], "a.csv         bias    gx    0.5");
+    }
+
+    #[test]
+    fn evaluate_refuses_a_column_other_than_the_gyros() {
+        let log = ImuLog {
+            time_s: vec![0.0, 1.0],
+            gyro: vec![series("gx", &[1.0, 2.0])],
+            temp: vec![series("t", &[20.0, 21.0])],
+            ..Default::default()
+        };
+        let s = EvaluateSettings {
+            column: "other_dps".into(),
+            ..Default::default()
+        };
+        let e = evaluate_imu(&log, None, &s).unwrap_err().to_string();
+        assert!(e.contains("judged per gyro column"), "{e}");
+    }
+}

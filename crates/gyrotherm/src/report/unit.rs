@@ -1,0 +1,126 @@
+//! The report of an inertial unit (`gyrotherm report` with column lists): `DIR/index.html`
+//! with the table across axes (axis × figure) and a section per axis (its comparison table,
+//! its compensation and bias figures, a link to its full page), and each axis's full
+//! single-axis report in `DIR/axisN/` (N = 1, 2, … in gyro column order: folder names never
+//! come from the log's column names).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::html::{escape, push_table, CSS};
+use super::{comparison_table, grouped_warnings, write_full_report_with, ReportError};
+use crate::atomic_file::write_bytes_atomically;
+use crate::compare::CompareConfig;
+use crate::imu_judge::ImuComparison;
+
+/// The figures of each axis's page that the unit page shows in the axis's section, with
+/// their captions.
+pub const UNIT_PAGE_FIGURES: [(&str, &str); 2] = [
+    (
+        "fig7_compensation",
+        "raw and compensated output of the main held-out log",
+    ),
+    (
+        "fig6_rate_table",
+        "output at the table rates (an axis with a rate-table held-out log)",
+    ),
+];
+
+/// The across-axes table names the log, the figure and the axis in its first three columns.
+const UNIT_CSS: &str = "table.across-axes td:nth-child(-n+3){text-align:left}";
+
+/// The folder of axis `k` (0-based) inside the report folder.
+pub fn axis_folder(k: usize) -> String {
+    format!("axis{}", k + 1)
+}
+
+/// Write every axis's full report, then `dir/index.html`; returns the unit page's path.
+/// `extra_warnings` (e.g. gaps filled on reading) are listed after the axes' findings.
+pub fn write_unit_report(
+    dir: &Path,
+    cmp: &ImuComparison,
+    cfg: &CompareConfig,
+    extra_warnings: &[String],
+) -> Result<PathBuf, ReportError> {
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut warnings = Vec::new();
+    for (k, a) in cmp.axes.iter().enumerate() {
+        let train = a.train_named();
+        let test = a.test_named();
+        write_full_report_with(
+            &dir.join(axis_folder(k)),
+            &train,
+            &test,
+            &a.comparison,
+            cfg,
+            &[],
+        )?;
+        for w in grouped_warnings(&test, &a.comparison) {
+            warnings.push(format!("{}: {w}", a.gyro));
+        }
+    }
+    warnings.extend(extra_warnings.iter().cloned());
+
+    let mut h = String::with_capacity(8192);
+    let title = "gyrotherm report: thermal compensation of an inertial unit, per axis";
+    // `write!` into a String cannot fail.
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <title>{title}</title>\n<style>{CSS}{UNIT_CSS}</style>\n</head>\n<body>\n<h1>{title}</h1>\n"
+    );
+    h.push_str("<h2>Across axes</h2>\n");
+    push_table(&mut h, &cmp.across_axes(cfg), "across-axes");
+    h.push_str("<h2>Warnings</h2>\n");
+    if warnings.is_empty() {
+        h.push_str("<p>None.</p>\n");
+    } else {
+        h.push_str("<ul class=\"warnings\">\n");
+        for w in &warnings {
+            let _ = writeln!(h, "<li>{}</li>", escape(w));
+        }
+        h.push_str("</ul>\n");
+    }
+    let mut n = 0;
+    for (k, a) in cmp.axes.iter().enumerate() {
+        let folder = axis_folder(k);
+        let _ = writeln!(
+            h,
+            "<section class=\"axis\">\n<h2>Axis {}: {} (temperature {})</h2>",
+            k + 1,
+            escape(&a.gyro),
+            escape(&a.temp)
+        );
+        push_table(&mut h, &comparison_table(&a.comparison, cfg), "comparison");
+        for (stem, caption) in UNIT_PAGE_FIGURES {
+            // An axis without the run a figure needs has no such file (its page says why).
+            if !dir.join(&folder).join(format!("{stem}.png")).is_file() {
+                continue;
+            }
+            n += 1;
+            let caption = escape(&format!("{}: {caption}", a.gyro));
+            let _ = write!(
+                h,
+                "<figure>\n<img src=\"{folder}/{stem}.png\" alt=\"{caption}\">\n\
+                 <figcaption>Figure {n}. {caption} (<a href=\"{folder}/{stem}.svg\">SVG</a>)\
+                 </figcaption>\n</figure>\n"
+            );
+        }
+        let _ = writeln!(
+            h,
+            "<p><a href=\"{folder}/index.html\">The full report of axis {}</a>: every figure, \
+             the models and the training logs.</p>\n</section>",
+            k + 1
+        );
+    }
+    h.push_str("</body>\n</html>\n");
+    let path = dir.join("index.html");
+    write_bytes_atomically(&path, h.as_bytes()).map_err(|source| ReportError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    Ok(path)
+}
