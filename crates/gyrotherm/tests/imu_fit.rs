@@ -160,3 +160,59 @@ fn every_sensor_when_cross_validation_keeps_it() {
         assert!(comp[0].status.contains(&Status::Degraded), "sensor {k}");
     }
 }
+
+#[test]
+fn the_stream_runs_an_axis_on_several_sensors_as_compensate_imu_does() {
+    let all = ImuFitSettings {
+        sensors: ImuSensors::All,
+        min_gain: -1.0,
+    };
+    let model = fit_imu_with(
+        &training(),
+        &thermal(),
+        &all,
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap();
+    assert_eq!(model.axes[0].temps.len(), 2);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.csv");
+    let mut test = run(3, None);
+    // A fault on the further sensor: the stream and the in-memory path must both hold.
+    let further = model
+        .temp_cols
+        .iter()
+        .position(|t| *t == model.axes[0].temps[1])
+        .unwrap();
+    test.temp[further].values[5000] = f64::NAN;
+    gyrotherm::csvlog::write_imu_log(&path, &test).unwrap();
+    let want = compensate_imu(&model, &test).unwrap();
+    assert_eq!(want[0].status[5000], Status::Held);
+    let mut out = Vec::new();
+    gyrotherm::compensate_imu_lines::compensate_imu_lines(
+        &model,
+        std::io::BufReader::new(std::fs::File::open(&path).unwrap()),
+        &path,
+        &gyrotherm::csvlog::ReadOptions::default(),
+        &mut out,
+        gyrotherm::compensate_lines::Mode::Stream,
+        false,
+    )
+    .unwrap();
+    let text = String::from_utf8(out).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let comp = header.iter().position(|h| *h == "gyro_x_dps_comp").unwrap();
+    let status = header
+        .iter()
+        .position(|h| *h == "gyro_x_dps_status")
+        .unwrap();
+    for (i, l) in lines.enumerate() {
+        let f: Vec<&str> = l.split(',').collect();
+        assert_eq!(f[status], want[0].status[i].as_str(), "line {}", i + 2);
+        if want[0].status[i] != Status::Invalid {
+            assert_eq!(f[comp].parse::<f64>().unwrap(), want[0].gyro_comp_dps[i]);
+        }
+    }
+}
