@@ -13,8 +13,8 @@
 //! reads the further sensors only when its own cross-validated RMS passes the same test.
 //!
 //! The default `min_gain` is −1: a sensor joins unless it doubles the cross-validated RMS.
-//! On the design family the blocked cross-validation within the chamber runs scores further
-//! sensors 2–20 % worse, while on held-out profiles they lower the error (median 1.41 →
+//! On the design family the blocked cross-validation within the chamber runs scored further
+//! sensors up to 20 % worse (unit 1000), while on held-out profiles they lower the error (median 1.41 →
 //! 1.26 × the noise floor, worst 7.85 → 5.91; docs/experiments/imu.md): the chamber runs do
 //! not move the gradients independently enough for the folds to see what they carry, so the
 //! test is kept as a guard against a sensor that ruins the fit, not as a filter.
