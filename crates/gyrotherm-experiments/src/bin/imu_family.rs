@@ -22,7 +22,9 @@
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin imu_family -- [--family
 //! design|confirm] [--units 30] [--first 0] [--settings case,chosen,all] [--threads 2]
-//! [--min-gain 0.02] [--cases FILE]`; `bench/imu_family.sh` runs it as recorded in `docs/experiments/imu.md`.
+//! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned]`; `--train planned` adds a
+//! static run on the chamber profile `gyrotherm plan` proposes from the unit's own airborne
+//! run (case sensor, a seed other than the held-out one's) to the training runs; `bench/imu_family.sh` runs it as recorded in `docs/experiments/imu.md`.
 //! Settings are chosen on the design family only; the confirmation family is run once.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -54,7 +56,21 @@ fn sim(
     seed: u64,
     table_axis: Option<usize>,
 ) -> Result<ImuLog, String> {
-    let mut run = SimConfig::new(Profile::builtin(profile).map_err(|e| e.to_string())?);
+    sim_profile(
+        unit,
+        Profile::builtin(profile).map_err(|e| e.to_string())?,
+        seed,
+        table_axis,
+    )
+}
+
+fn sim_profile(
+    unit: &ImuUnit,
+    profile: Profile,
+    seed: u64,
+    table_axis: Option<usize>,
+) -> Result<ImuLog, String> {
+    let mut run = SimConfig::new(profile);
     run.seed = seed;
     run.truth = true;
     run.table_rate_dps = table_axis.map(|_| TABLE_RATE_DPS);
@@ -109,6 +125,24 @@ struct Case {
 struct Job<'a> {
     settings: &'a [String],
     min_gain: f64,
+    /// Add a static run on the chamber profile `gyrotherm plan` proposes for the unit.
+    planned: bool,
+}
+
+/// The flight's envelope as `gyrotherm plan` reads it: time and the case sensor.
+fn case_log(log: &ImuLog) -> Result<gyrotherm::csvlog::TestLog, String> {
+    let temp = log
+        .temp
+        .iter()
+        .find(|s| s.name == CASE_SENSOR_COL)
+        .ok_or("no case sensor")?;
+    Ok(gyrotherm::csvlog::TestLog {
+        time_s: log.time_s.clone(),
+        gyro_dps: log.gyro[0].values.clone(),
+        temp_c: temp.values.clone(),
+        table_dps: None,
+        extra: Vec::new(),
+    })
 }
 
 fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
@@ -123,6 +157,21 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         train.push((
             format!("seed-shock-table-{axis}"),
             sim(&unit, "seed-shock", s0 + 2 + k as u64, Some(k))?,
+        ));
+    }
+    if job.planned {
+        // As in the single-axis benchmark: the flight input is an airborne run of this unit
+        // with its own seed, never the held-out one; the profile depends on its envelope
+        // and the chamber limits only.
+        let flight = case_log(&sim(&unit, "airborne", s0 + 31, None)?)?;
+        let env = gyrotherm::plan::envelope_of(&flight)
+            .map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
+        let plan =
+            gyrotherm::plan::propose(&env, &gyrotherm::settings::plan::PlanSettings::default())
+                .map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
+        train.push((
+            "planned-static".to_owned(),
+            sim_profile(&unit, plan.profile(), s0 + 41, None)?,
         ));
     }
     for (_, l) in &mut train {
@@ -263,9 +312,15 @@ fn run() -> Result<(), String> {
     let min_gain: f64 = get("--min-gain").map_or(Ok(ImuFitSettings::default().min_gain), |v| {
         v.parse().map_err(|e| format!("--min-gain: {e}"))
     })?;
+    let planned = match get("--train").as_deref() {
+        None | Some("seed-shock") => false,
+        Some("planned") => true,
+        Some(v) => return Err(format!("--train {v:?}: use seed-shock or planned")),
+    };
     let job = Job {
         settings: &settings,
         min_gain,
+        planned,
     };
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     eprintln!(
@@ -331,8 +386,9 @@ fn run() -> Result<(), String> {
     }
     println!();
     println!(
-        "{family} family ({} units × 3 axes), trained on seed-shock static + one table run per axis",
-        seeds.len()
+        "{family} family ({} units × 3 axes), trained on seed-shock static + one table run per axis{}",
+        seeds.len(),
+        if planned { " + a static run on the planned profile" } else { "" }
     );
     println!("| setting | profile | ×floor median | ×floor worst | SF ppm median | SF ppm worst | fit s per unit |");
     println!("|---|---|---|---|---|---|---|");
