@@ -131,6 +131,10 @@ pub enum ModelError {
     Baseline(crate::baseline::BaselineError),
     /// LSTM weights refused (wrong shape or not finite).
     Weights(crate::lstm::WeightError),
+    /// A further sensor of an axis ([`crate::multi::AxisCompensator::with_sensor`]): more
+    /// than [`crate::multi::MAX_SENSORS`], one already read, or a step period or rate lag
+    /// other than the first sensor's.
+    Sensors,
 }
 
 impl core::fmt::Display for ModelError {
@@ -146,6 +150,12 @@ impl core::fmt::Display for ModelError {
             ModelError::Limits(_) => f.write_str("temperature-sensor limits"),
             ModelError::Baseline(_) => f.write_str("baseline"),
             ModelError::Weights(_) => f.write_str("lstm weights"),
+            ModelError::Sensors => write!(
+                f,
+                "further sensors: at most {} per axis, each read once, with the first \
+                 sensor's step period and rate lag",
+                crate::multi::MAX_SENSORS
+            ),
         }
     }
 }
@@ -158,7 +168,9 @@ impl core::error::Error for ModelError {
             ModelError::Limits(e) => Some(e),
             ModelError::Baseline(e) => Some(e),
             ModelError::Weights(e) => Some(e),
-            ModelError::BadNormalisation | ModelError::FeatureCount { .. } => None,
+            ModelError::BadNormalisation
+            | ModelError::FeatureCount { .. }
+            | ModelError::Sensors => None,
         }
     }
 }
@@ -472,6 +484,60 @@ impl Corrected {
     }
 }
 
+/// What an axis reads besides its first sensor: the hook through which
+/// [`crate::multi::AxisCompensator`] shares the time axis and the fault handling of
+/// [`Compensator`]. Every method of [`NoMoreSensors`] does nothing, so the one-sensor path is
+/// unchanged.
+pub(crate) trait MoreSensors {
+    /// Whether every further sensor's reading in `temps` at `time_s` (placed) is believed.
+    fn plausible(&self, limits: &TempLimits, time_s: f64, temps: &[f64]) -> bool;
+    /// Feed the further pipelines the sample (believed); false if one refused it.
+    fn push(&mut self, time_s: f64, temps: &[f64]) -> bool;
+    /// The sample was used: remember each reading as the sensor's latest good one.
+    fn accepted(&mut self, time_s: f64, temps: &[f64]);
+    /// Add each further sensor's part to B and K at a new step; false if one gave none.
+    fn add(&mut self, bias_dps: &mut f64, scale: &mut f64) -> bool;
+    /// A new time base: restart the pipelines, forget the readings.
+    fn rebase(&mut self);
+}
+
+/// No further sensors: the one-sensor compensator.
+pub(crate) struct NoMoreSensors;
+
+impl MoreSensors for NoMoreSensors {
+    fn plausible(&self, _: &TempLimits, _: f64, _: &[f64]) -> bool {
+        true
+    }
+    fn push(&mut self, _: f64, _: &[f64]) -> bool {
+        true
+    }
+    fn accepted(&mut self, _: f64, _: &[f64]) {}
+    fn add(&mut self, _: &mut f64, _: &mut f64) -> bool {
+        true
+    }
+    fn rebase(&mut self) {}
+}
+
+/// Whether a temperature reading at `time_s` is believed against the limits and the
+/// sensor's latest accepted reading.
+pub(crate) fn plausible_reading(
+    l: &TempLimits,
+    last_good: Option<(f64, f64)>,
+    time_s: f64,
+    temp_c: f64,
+) -> bool {
+    if !(temp_c >= l.min_c && temp_c <= l.max_c) {
+        return false;
+    }
+    match last_good {
+        None => true,
+        Some((t, v)) => {
+            let allowed = l.max_rate_c_per_s * (time_s - t) + l.step_allowance_c;
+            libm::fabs(temp_c - v) <= allowed
+        }
+    }
+}
+
 /// Bias and scale-factor models on one streaming feature pipeline (see the module doc).
 #[derive(Debug, Clone)]
 pub struct Compensator {
@@ -577,25 +643,32 @@ impl Compensator {
     /// Whether a temperature reading at `time_s` (already placed on the time base) is
     /// believed.
     fn plausible(&self, time_s: f64, temp_c: f64) -> bool {
-        let l = &self.limits;
-        if !(temp_c >= l.min_c && temp_c <= l.max_c) {
-            return false;
-        }
-        match self.last_good {
-            None => true,
-            Some((t, v)) => {
-                let allowed = l.max_rate_c_per_s * (time_s - t) + l.step_allowance_c;
-                libm::fabs(temp_c - v) <= allowed
-            }
-        }
+        plausible_reading(&self.limits, self.last_good, time_s, temp_c)
     }
 
     /// One sample: time (s, increasing), gyro output Ĝ (°/s), temperature (°C). Never fails:
     /// the [`Status`] says what the output is worth (see the module doc).
     pub fn step(&mut self, time_s: f64, gyro_dps: f64, temp_c: f64) -> Corrected {
+        self.step_with(time_s, gyro_dps, temp_c, &mut NoMoreSensors, &[])
+    }
+
+    /// [`step`](Self::step) for an axis that reads further sensors (`more`, their readings
+    /// among `temps`): the sample is used only when every sensor the axis reads is believed,
+    /// and all pipelines step together. With [`NoMoreSensors`] this is `step` exactly.
+    pub(crate) fn step_with<M: MoreSensors>(
+        &mut self,
+        time_s: f64,
+        gyro_dps: f64,
+        temp_c: f64,
+        more: &mut M,
+        temps: &[f64],
+    ) -> Corrected {
         let mut fresh = false;
-        if self.place(time_s) && self.plausible(time_s, temp_c) {
-            fresh = self.push(time_s, temp_c);
+        if self.place(time_s, more)
+            && self.plausible(time_s, temp_c)
+            && more.plausible(&self.limits, time_s, temps)
+        {
+            fresh = self.push(time_s, temp_c, more, temps);
         }
         if fresh {
             self.last_ok_s = self.base_s;
@@ -637,7 +710,7 @@ impl Compensator {
 
     /// The time axis (module doc): whether `time_s` is placed on the time base, re-basing
     /// when the candidate has gathered [`REBASE_AFTER`] samples.
-    fn place(&mut self, time_s: f64) -> bool {
+    fn place<M: MoreSensors>(&mut self, time_s: f64, more: &mut M) -> bool {
         let d = self.limits.degraded_after_s;
         let fits = |base: f64| time_s > base && time_s - base <= d;
         if !time_s.is_finite() {
@@ -656,7 +729,7 @@ impl Compensator {
             _ => 1,
         };
         if n >= REBASE_AFTER {
-            self.rebase();
+            self.rebase(more);
             self.base_s = Some(time_s);
             self.unplaced = 0;
             self.candidate = None;
@@ -669,7 +742,8 @@ impl Compensator {
 
     /// Start a new time base: restart the pipeline and the LSTM states, forget the
     /// temperature history; B and K stay held until the new pipeline's first step.
-    fn rebase(&mut self) {
+    fn rebase<M: MoreSensors>(&mut self, more: &mut M) {
+        more.rebase();
         self.pipeline.reset();
         self.bias.reset();
         self.scale.reset();
@@ -681,26 +755,41 @@ impl Compensator {
     }
 
     /// Feed a placed, believed sample to the pipeline; true when B and K are fresh.
-    fn push(&mut self, time_s: f64, temp_c: f64) -> bool {
+    fn push<M: MoreSensors>(
+        &mut self,
+        time_s: f64,
+        temp_c: f64,
+        more: &mut M,
+        temps: &[f64],
+    ) -> bool {
         let pushed = match self.pipeline.push(time_s, temp_c) {
             // Steps can no longer be counted exactly on this base: start a new one here.
             Err(InputError::TimeOutOfRange) => {
-                self.rebase();
+                self.rebase(more);
                 self.pipeline.push(time_s, temp_c)
             }
             r => r,
         };
+        // The further pipelines see the same times, so they step when the first one does.
+        // Unreachable failure (time and temperatures were checked): start a new base, so
+        // that the pipelines stay in step.
+        if pushed.is_ok() && !more.push(time_s, temps) {
+            self.rebase(more);
+            return false;
+        }
         match pushed {
             Ok(Some(step)) => {
                 self.last_good = Some((time_s, temp_c));
+                more.accepted(time_s, temps);
                 if self.rebased {
                     self.rebased = false;
                     self.settle_end_s = Some(time_s + self.spec().settle_s());
                 }
-                self.eval(&step.features)
+                self.eval(&step.features, more)
             }
             Ok(None) => {
                 self.last_good = Some((time_s, temp_c));
+                more.accepted(time_s, temps);
                 self.current
             }
             // Unreachable: time and temperature were checked before.
@@ -708,12 +797,16 @@ impl Compensator {
         }
     }
 
-    /// Evaluate both models on a new step; keep B and K only if both are usable.
-    fn eval(&mut self, f: &Features) -> bool {
+    /// Evaluate both models on a new step (the first sensor's part, then each further
+    /// sensor's, added in order); keep B and K only if both are usable.
+    fn eval<M: MoreSensors>(&mut self, f: &Features, more: &mut M) -> bool {
         self.current = false;
-        let (Ok(b), Ok(k)) = (self.bias.eval(f), self.scale.eval(f)) else {
+        let (Ok(mut b), Ok(mut k)) = (self.bias.eval(f), self.scale.eval(f)) else {
             return false;
         };
+        if !more.add(&mut b, &mut k) {
+            return false;
+        }
         // K > 0 also refuses NaN; a finite rate needs a finite quotient.
         if !(k > 0.0 && b.is_finite() && k.is_finite()) {
             return false;

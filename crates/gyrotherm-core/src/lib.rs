@@ -12,6 +12,8 @@
 //! - [`baseline`]: evaluation of fitted linear/polynomial baseline models (f64).
 //! - [`compensator`]: bias and scale factor to corrected rate, G = (Ĝ − B)/K (eq. 4 of the
 //!   paper), riding through temperature-sensor faults with a [`Status`] per sample.
+//! - [`multi`]: an axis reading several temperature sensors ([`multi::AxisCompensator`]),
+//!   each with its own lags, on the compensator's time axis and fault handling.
 //! - [`coverage`]: the training region in (T, dT) and a per-sample verdict (inside, edge,
 //!   outside) with a 1σ estimate of the residual bias error.
 //! - [`static_model`]: a model as plain static data (`gyrotherm export --lang rust`).
@@ -37,6 +39,7 @@ pub mod coverage;
 pub mod error;
 pub mod features;
 pub mod lstm;
+pub mod multi;
 pub mod static_model;
 pub mod unit;
 

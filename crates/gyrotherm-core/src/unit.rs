@@ -1,10 +1,10 @@
-//! An inertial unit in flight: one [`Compensator`] per gyro axis, all fed by one call per
+//! An inertial unit in flight: one [`AxisCompensator`] per gyro axis, all fed by one call per
 //! sample with the unit's time stamp, its gyro outputs and all its temperature sensors.
 //!
-//! Each axis compensator reads its own temperature channel(s) through
-//! [`Compensator::step_unit`], so:
+//! Each axis reads its own temperature channel(s) ([`AxisCompensator::step`]: one sensor, as
+//! [`Compensator::step_unit`], or several), so:
 //! - a fault on one temperature sensor (NaN, out of range, too fast) is a temperature fault
-//!   only for the axes that read it; the others stay `ok`;
+//!   only for the axes that read it (as first or as further sensor); the others stay `ok`;
 //! - a bad time stamp reaches every axis, and every axis's time axis (see
 //!   [`crate::compensator`]) judges it alike: the same sample is placed, held or re-bases on
 //!   all axes;
@@ -41,7 +41,8 @@
 //! ```
 
 use crate::compensator::{Compensator, Corrected, ModelError, Status};
-use crate::static_model::StaticModel;
+use crate::multi::AxisCompensator;
+use crate::static_model::{StaticModel, StaticSensor};
 use core::fmt;
 
 /// Default capacity of a [`Unit`]: three gyro axes.
@@ -67,7 +68,7 @@ pub enum UnitError {
         channel: usize,
         n_temps: usize,
     },
-    /// The model lists differ in length (axes and their channels).
+    /// The model lists differ in length (axes and their channels or further sensors).
     Layout { axes: usize, channels: usize },
     /// An axis's model cannot be built.
     Model { axis: usize, source: ModelError },
@@ -107,7 +108,7 @@ impl core::error::Error for UnitError {
 /// An inertial unit's compensators (see the module doc).
 #[derive(Debug, Clone)]
 pub struct Unit<const N: usize = MAX_AXES> {
-    axes: [Option<Compensator>; N],
+    axes: [Option<AxisCompensator>; N],
     n_axes: usize,
     n_temps: usize,
 }
@@ -122,13 +123,15 @@ impl<const N: usize> Unit<N> {
         }
     }
 
-    /// Add the next axis (gyro index = the number of axes so far); it reads its
-    /// [`Compensator::channel`], which must be below the unit's channel count.
-    pub fn push_axis(&mut self, axis: Compensator) -> Result<(), UnitError> {
-        if axis.channel() >= self.n_temps {
+    /// Add the next axis (gyro index = the number of axes so far): a [`Compensator`] (one
+    /// sensor, its [`Compensator::channel`]) or an [`AxisCompensator`]; every sensor it reads
+    /// must be below the unit's channel count.
+    pub fn push_axis(&mut self, axis: impl Into<AxisCompensator>) -> Result<(), UnitError> {
+        let axis = axis.into();
+        if let Some(channel) = axis.sensors().find(|&c| c >= self.n_temps) {
             return Err(UnitError::Channel {
                 axis: self.n_axes,
-                channel: axis.channel(),
+                channel,
                 n_temps: self.n_temps,
             });
         }
@@ -141,24 +144,47 @@ impl<const N: usize> Unit<N> {
         Ok(())
     }
 
-    /// The unit of exported static models (`gyrotherm export --lang rust` of a unit model):
-    /// axis `i` runs `models[i]` on temperature channel `channels[i]` of `n_temps`.
+    /// The unit of exported static models (`gyrotherm export --lang rust` of a unit model
+    /// whose axes read one sensor each): axis `i` runs `models[i]` on temperature channel
+    /// `channels[i]` of `n_temps`.
     pub fn from_static(
         models: &[StaticModel],
         channels: &[u8],
         n_temps: usize,
     ) -> Result<Self, UnitError> {
-        if models.len() != channels.len() {
+        Self::from_static_sensors(models, channels, &[], n_temps)
+    }
+
+    /// [`Unit::from_static`] with further sensors: axis `i` also reads `sensors[i]` (each
+    /// further sensor's channel, features and parts; an axis beyond `sensors` reads none).
+    pub fn from_static_sensors(
+        models: &[StaticModel],
+        channels: &[u8],
+        sensors: &[&[StaticSensor]],
+        n_temps: usize,
+    ) -> Result<Self, UnitError> {
+        if models.len() != channels.len() || sensors.len() > models.len() {
             return Err(UnitError::Layout {
                 axes: models.len(),
-                channels: channels.len(),
+                channels: channels.len().max(sensors.len()),
             });
         }
         let mut unit = Unit::new(n_temps);
         for (axis, (m, ch)) in models.iter().zip(channels).enumerate() {
             let c =
                 Compensator::from_static(m).map_err(|source| UnitError::Model { axis, source })?;
-            unit.push_axis(c.with_channel(usize::from(*ch)))?;
+            let mut a = AxisCompensator::new(c, usize::from(*ch));
+            for s in sensors.get(axis).copied().unwrap_or(&[]) {
+                let part = |b: &Option<crate::static_model::StaticBaseline>| {
+                    b.as_ref().map(|b| b.to_model()).transpose()
+                };
+                a = part(&s.bias)
+                    .and_then(|bias| {
+                        a.with_sensor(usize::from(s.channel), s.spec, bias, part(&s.scale)?)
+                    })
+                    .map_err(|source| UnitError::Model { axis, source })?;
+            }
+            unit.push_axis(a)?;
         }
         Ok(unit)
     }
@@ -173,8 +199,8 @@ impl<const N: usize> Unit<N> {
         self.n_temps
     }
 
-    /// Axis `i`'s compensator (its features, its channel).
-    pub fn axis(&self, i: usize) -> Option<&Compensator> {
+    /// Axis `i`'s compensator (its first sensor's features, its sensors).
+    pub fn axis(&self, i: usize) -> Option<&AxisCompensator> {
         self.axes.get(i).and_then(Option::as_ref)
     }
 
@@ -186,13 +212,13 @@ impl<const N: usize> Unit<N> {
         for (i, (slot, axis)) in out.iter_mut().zip(self.axes.iter_mut()).enumerate() {
             if let Some(c) = axis {
                 let g = gyro_dps.get(i).copied().unwrap_or(f64::NAN);
-                *slot = c.step_unit(time_s, g, temps_c);
+                *slot = c.step(time_s, g, temps_c);
             }
         }
         out
     }
 
-    /// Start over on every axis (see [`Compensator::reset`]).
+    /// Start over on every axis (see [`AxisCompensator::reset`]).
     pub fn reset(&mut self) {
         for c in self.axes.iter_mut().flatten() {
             c.reset();

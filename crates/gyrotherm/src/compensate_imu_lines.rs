@@ -13,8 +13,9 @@
 //!
 //! The numbers are those of flight code: the flight [`Unit`] of
 //! [`gyrotherm_core::unit`] steps every axis with the line's time, gyro fields and all the
-//! model's temperature fields, and each axis reads its own sensor, so a temperature field that
-//! is empty, not a number or implausible holds only the axes that read it, and a gyro field
+//! model's temperature fields, and each axis reads its own sensors (one, or several with a
+//! model whose axes read further sensors), so a temperature field that is empty, not a number
+//! or implausible holds only the axes that read it, and a gyro field
 //! that is not a number (or NaN, infinite) makes only its own axis `invalid` (in
 //! [`Mode::Strict`] a gyro field that is not a number stops the run, as a malformed line). A
 //! bad time stamp reaches every axis alike. The columns are looked up by the model's names;
@@ -32,7 +33,7 @@ use crate::compensate_lines::{
     LinesError, Mode, MAX_LINE_BYTES,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
-use crate::imu_model::{imu_compensators, ImuError, ImuModel};
+use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
 
 /// Most gyro axes a unit model can have in the ground stream (flight code fixes its own
 /// capacity, three by default: [`gyrotherm_core::unit::MAX_AXES`]).
@@ -54,13 +55,14 @@ pub fn output_columns(model: &ImuModel) -> Vec<String> {
         .collect()
 }
 
-/// The flight unit of `model`: axis `i` runs axis `i`'s model on its sensor's index among
-/// the model's temperature columns.
+/// The flight unit of `model`: axis `i` runs axis `i`'s model on its sensors' indices among
+/// the model's temperature columns (the first sensor's compensator and any further sensors'
+/// parts, [`imu_axis_compensators`]), the same axes as batch [`crate::imu_model::compensate_imu`].
 pub fn flight_unit(model: &ImuModel) -> Result<StreamUnit, ImuError> {
-    let comps = imu_compensators(model)?;
+    let comps = imu_axis_compensators(model)?;
     let mut unit = StreamUnit::new(model.temp_cols.len());
-    for ((c, ch), a) in comps.into_iter().zip(model.sensor_index()).zip(&model.axes) {
-        unit.push_axis(c.with_channel(ch)).map_err(|e| {
+    for (c, a) in comps.into_iter().zip(&model.axes) {
+        unit.push_axis(c).map_err(|e| {
             ImuError::Layout(format!(
                 "axis {}: {e} (a unit runs at most {MAX_STREAM_AXES} axes)",
                 a.gyro

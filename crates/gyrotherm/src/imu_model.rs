@@ -1,32 +1,45 @@
 //! One model file for an inertial unit: per gyro axis a bias and a scale-factor model, the
-//! gyro columns and the temperature sensors the unit's log must hold, and which sensor each
+//! gyro columns and the temperature sensors the unit's log must hold, and which sensors each
 //! axis reads.
 //!
-//! What this stage does: each axis is fitted once per listed sensor (the axes on their own
-//! threads), and keeps the sensor whose fit has the lowest cross-validated RMS on the bias
-//! target (`thermal`'s 5-fold time-segment cross-validation; on the scale factor when the
-//! axis has no static log). Methods without cross-validation keep each axis on the first
-//! sensor. Each axis's model is an ordinary single-sensor [`ModelFile`], so the flight
-//! [`Compensator`] runs it unchanged; a fault in one sensor reaches only the axes that read it.
-//! What it does not do yet: one axis model reading several sensors at once (lags per sensor,
-//! differences between sensors).
+//! By default ([`ImuSensors::All`]) every axis may read every listed sensor: with the
+//! `thermal` method each sensor's lags are identified on its own, the sensor whose one-sensor
+//! fit has the lowest cross-validated RMS comes first, and the others join while they lower
+//! the cross-validated RMS ([`crate::fit::thermal::multi`]); the axis's model is then the first
+//! sensor's model plus each further sensor's linear part ([`SensorModel`]), run by the flight
+//! [`AxisCompensator`]. With [`ImuSensors::ChooseOne`] (and for methods without
+//! cross-validation, which keep the first sensor) each axis reads one sensor, an ordinary
+//! single-sensor [`ModelFile`]. The axes fit on their own threads. A fault in one sensor
+//! reaches only the axes that read it.
 //!
 //! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
-//! format is unchanged), sealed with `content_sha256` like a single-axis file.
+//! format is unchanged): 1 when every axis reads one sensor (as older builds wrote), 2 when
+//! an axis reads several; sealed with `content_sha256` like a single-axis file.
 
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 use gyrotherm_core::compensator::{Compensator, Status};
+use gyrotherm_core::features::LagOutputs;
+use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 
 use crate::compensate::compensator;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
-use crate::fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog};
-use crate::model::{sha256_hex, ModelFile, ModelFileError, TempSensorDef, CHECKSUM_KEY};
+use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
+use crate::fit::{
+    fit_model, fit_model_identified, uses_identification, FitConfig, FitError, FitOutcome,
+    NamedLog,
+};
+use crate::model::{sha256_hex, ModelFile, ModelFileError, SubModel, TempSensorDef, CHECKSUM_KEY};
+pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
+use crate::targets;
 use crate::CompensateError;
 
-/// Version of the inertial-unit file layout.
-pub const IMU_FORMAT_VERSION: u32 = 1;
+/// Version of the inertial-unit file layout when an axis reads several sensors.
+pub const IMU_FORMAT_VERSION: u32 = 2;
+/// Version of the layout when every axis reads one sensor (the first layout; such files are
+/// written as before).
+pub const IMU_FORMAT_VERSION_ONE_SENSOR: u32 = 1;
 /// The key that marks an inertial-unit model file.
 pub const IMU_VERSION_KEY: &str = "imu_format_version";
 
@@ -41,18 +54,40 @@ pub struct SensorScore {
     pub cv_rms: Option<f64>,
 }
 
+/// A further sensor an axis reads (`temps[i + 1]` for `more[i]`): its lags and its parts of
+/// the bias and the scale factor, each a baseline over that sensor's features (`T, dT,
+/// T − lag_j(T)`, the first sensor's step period and rate lag) without a constant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorModel {
+    /// Time constants of this sensor's lags, s, fastest first.
+    pub lags_s: Vec<f64>,
+    /// Its part of the bias, °/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias: Option<SubModel>,
+    /// Its part of the scale factor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<SubModel>,
+}
+
 /// One gyro axis of the unit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ImuAxis {
     /// The gyro column.
     pub gyro: String,
-    /// The temperature columns this axis's model reads (one at this stage).
+    /// The temperature columns this axis's model reads, the first sensor first.
     pub temps: Vec<String>,
-    /// Every sensor tried, in column order, with its score.
+    /// Every sensor tried, in column order, with its one-sensor score.
     pub scores: Vec<SensorScore>,
-    /// The axis's bias and scale-factor model.
+    /// The first sensor's bias and scale-factor model (the whole model with one sensor).
     pub model: ModelFile,
+    /// The further sensors' parts, in the order of `temps[1..]` (empty: one sensor).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub more: Vec<SensorModel>,
+    /// Cross-validated RMS of the bias on all the sensors read (with several).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub multi_cv_rms: Option<f64>,
 }
 
 /// An inertial unit's model.
@@ -169,28 +204,58 @@ pub enum ImuFitEvent {
         sensor: usize,
         cv_rms: Option<f64>,
     },
-    /// Axis `axis` is done and reads sensor `sensor`.
+    /// Axis `axis` is done and reads sensor `sensor` first (and any further sensors chosen).
     AxisFinished { axis: usize, sensor: usize },
 }
 
 /// Receiver of [`ImuFitEvent`]s.
 pub type ImuEvents<'a> = dyn Fn(ImuFitEvent) + Sync + 'a;
 
-/// Fit every axis of the unit (see the module doc): logs read with the column lists; each
-/// axis on its own thread; `temp_sensor` the limits every axis's compensator believes.
+/// Fit every axis of the unit with the default [`ImuFitSettings`] (see [`fit_imu_with`]).
 pub fn fit_imu(
     logs: &[(String, ImuLog)],
     cfg: &FitConfig,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
 ) -> Result<ImuModel, ImuError> {
-    fit_imu_with_events(logs, cfg, temp_sensor, progress, &|_| {})
+    fit_imu_with(logs, cfg, &ImuFitSettings::default(), temp_sensor, progress)
 }
 
 /// [`fit_imu`], telling `events` as each axis and each sensor tried starts and finishes.
 pub fn fit_imu_with_events(
     logs: &[(String, ImuLog)],
     cfg: &FitConfig,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
+) -> Result<ImuModel, ImuError> {
+    fit_imu_full(
+        logs,
+        cfg,
+        &ImuFitSettings::default(),
+        temp_sensor,
+        progress,
+        events,
+    )
+}
+
+/// Fit every axis of the unit (see the module doc): logs read with the column lists; each
+/// axis on its own thread; `temp_sensor` the limits every axis's compensator believes.
+pub fn fit_imu_with(
+    logs: &[(String, ImuLog)],
+    cfg: &FitConfig,
+    settings: &ImuFitSettings,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+) -> Result<ImuModel, ImuError> {
+    fit_imu_full(logs, cfg, settings, temp_sensor, progress, &|_| {})
+}
+
+/// [`fit_imu_with`], telling `events` as each axis and each sensor tried starts and finishes.
+pub fn fit_imu_full(
+    logs: &[(String, ImuLog)],
+    cfg: &FitConfig,
+    settings: &ImuFitSettings,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
     events: &ImuEvents,
@@ -215,16 +280,30 @@ pub fn fit_imu_with_events(
             .map(|k| {
                 let (gyro_cols, temp_cols) = (&gyro_cols, &temp_cols);
                 scope.spawn(move || {
-                    fit_axis(
-                        logs,
-                        k,
-                        gyro_cols,
-                        temp_cols,
-                        cfg,
-                        temp_sensor,
-                        progress,
-                        events,
-                    )
+                    if settings.sensors == ImuSensors::All && uses_identification(cfg) {
+                        fit_axis_multi(
+                            logs,
+                            k,
+                            gyro_cols,
+                            temp_cols,
+                            cfg,
+                            settings,
+                            temp_sensor,
+                            progress,
+                            events,
+                        )
+                    } else {
+                        fit_axis(
+                            logs,
+                            k,
+                            gyro_cols,
+                            temp_cols,
+                            cfg,
+                            temp_sensor,
+                            progress,
+                            events,
+                        )
+                    }
                 })
             })
             .collect();
@@ -237,8 +316,13 @@ pub fn fit_imu_with_events(
             .collect()
     });
     let axes = axes.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let several = axes.iter().any(|a| !a.more.is_empty());
     let model = ImuModel {
-        imu_format_version: IMU_FORMAT_VERSION,
+        imu_format_version: if several {
+            IMU_FORMAT_VERSION
+        } else {
+            IMU_FORMAT_VERSION_ONE_SENSOR
+        },
         gyro_cols,
         temp_cols,
         axes,
@@ -310,13 +394,163 @@ fn fit_axis(
         }
     }
     let (j, mut outcome) = best.ok_or_else(|| ImuError::Layout("no temperature columns".into()))?;
-    events(ImuFitEvent::AxisFinished { axis: k, sensor: j });
     outcome.model.features.temp_sensor = *temp_sensor;
+    events(ImuFitEvent::AxisFinished { axis: k, sensor: j });
     Ok(ImuAxis {
         gyro: gyro_cols[k].clone(),
         temps: vec![temp_cols[j].clone()],
         scores,
         model: outcome.model,
+        more: Vec::new(),
+        multi_cv_rms: None,
+    })
+}
+
+/// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
+/// the sensors chosen by cross-validation, one fit over the chosen sensors.
+#[allow(clippy::too_many_arguments)]
+fn fit_axis_multi(
+    logs: &[(String, ImuLog)],
+    k: usize,
+    gyro_cols: &[String],
+    temp_cols: &[String],
+    cfg: &FitConfig,
+    settings: &ImuFitSettings,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
+) -> Result<ImuAxis, ImuError> {
+    events(ImuFitEvent::AxisStarted { axis: k });
+    let fit_err = |j: usize, source: FitError| ImuError::Fit {
+        gyro: gyro_cols[k].clone(),
+        temp: temp_cols[j].clone(),
+        source: Box::new(source),
+    };
+    let target_err = |j: usize, run: &str, source: targets::TargetError| {
+        fit_err(
+            j,
+            FitError::Targets {
+                run: run.to_owned(),
+                source,
+            },
+        )
+    };
+    let mut per_sensor = Vec::with_capacity(temp_cols.len());
+    for j in 0..temp_cols.len() {
+        events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
+        let axis_logs: Vec<(String, TestLog)> = logs
+            .iter()
+            .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
+            .collect();
+        let named: Vec<NamedLog> = axis_logs
+            .iter()
+            .map(|(n, l)| NamedLog { name: n, log: l })
+            .collect();
+        let id = crate::fit::identify(&named, cfg).map_err(|e| fit_err(j, e))?;
+        let (mut bias, mut scale) = (Vec::new(), Vec::new());
+        for (name, l) in &axis_logs {
+            if targets::is_static(l) {
+                bias.push(
+                    targets::bias_targets(l, &id.spec, cfg.bias_window_s)
+                        .map_err(|e| target_err(j, name, e))?,
+                );
+            } else {
+                scale.push(
+                    targets::scale_targets(l, &id.spec, cfg.settle_s, cfg.scale_window_s)
+                        .map_err(|e| target_err(j, name, e))?,
+                );
+            }
+        }
+        per_sensor.push((axis_logs, id, bias, scale));
+    }
+    let data: Vec<SensorData> = per_sensor
+        .iter()
+        .map(|(_, id, bias, scale)| SensorData {
+            id,
+            bias,
+            scale,
+        })
+        .collect();
+    let (order, single) = multi::select(
+        &data,
+        &cfg.thermal,
+        &MultiConfig {
+            min_gain: settings.min_gain,
+        },
+    );
+    let scores: Vec<SensorScore> = temp_cols
+        .iter()
+        .zip(&single)
+        .map(|(t, s)| SensorScore {
+            temp: t.clone(),
+            cv_rms: *s,
+        })
+        .collect();
+    // The one-sensor scores come from the selection, after every sensor's identification.
+    for (j, s) in single.iter().enumerate() {
+        events(ImuFitEvent::SensorFinished {
+            axis: k,
+            sensor: j,
+            cv_rms: *s,
+        });
+    }
+    let j0 = order[0];
+    let (axis_logs, id0, _, _) = &per_sensor[j0];
+    let named: Vec<NamedLog> = axis_logs
+        .iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect();
+    let mut outcome = fit_model_identified(&named, cfg, Some(id0.clone()), &|t, e, loss| {
+        progress(k, j0, t, e, loss)
+    })
+    .map_err(|e| fit_err(j0, e))?;
+    outcome.model.features.temp_sensor = *temp_sensor;
+    let mut more = Vec::new();
+    let mut multi_cv_rms = None;
+    if order.len() > 1 {
+        let thermal_err = |e: crate::fit::thermal::ThermalError| fit_err(j0, FitError::from(e));
+        let has_bias = data.iter().all(|d| !d.bias.is_empty());
+        let has_scale = data.iter().all(|d| !d.scale.is_empty());
+        let bias = has_bias
+            .then(|| multi::fit_multi(&data, &order, &cfg.thermal, false))
+            .transpose()
+            .map_err(thermal_err)?;
+        // The scale factor reads the further sensors only when they help it too.
+        let scale = if has_scale {
+            let one = multi::cv_rms(&data, &order[..1], &cfg.thermal, true);
+            let all = multi::fit_multi(&data, &order, &cfg.thermal, true).map_err(thermal_err)?;
+            match (one, all.cv_rms) {
+                (Some(o), Some(a)) if a < o * (1.0 - settings.min_gain) => Some(all),
+                _ => None,
+            }
+        } else {
+            None
+        };
+        if let Some(b) = &bias {
+            outcome.model.bias = Some(b.first.clone());
+            multi_cv_rms = b.cv_rms;
+            // The coverage map's error estimate is the one-sensor model's.
+            outcome.model.coverage = None;
+        }
+        if let Some(s) = &scale {
+            outcome.model.scale = Some(s.first.clone());
+        }
+        for (i, &j) in order[1..].iter().enumerate() {
+            more.push(SensorModel {
+                lags_s: data[j].id.report.lags_s.clone(),
+                bias: bias.as_ref().map(|b| b.extra[i].clone()),
+                scale: scale.as_ref().map(|s| s.extra[i].clone()),
+            });
+        }
+    }
+    events(ImuFitEvent::AxisFinished { axis: k, sensor: j0 });
+    Ok(ImuAxis {
+        gyro: gyro_cols[k].clone(),
+        temps: order.iter().map(|&j| temp_cols[j].clone()).collect(),
+        scores,
+        model: outcome.model,
+        more,
+        multi_cv_rms,
     })
 }
 
@@ -324,9 +558,17 @@ impl ImuModel {
     /// Checks the layout (one axis per gyro column, in order; each axis's sensors among the
     /// temperature columns) and every axis's model.
     pub fn validate(&self) -> Result<(), ImuError> {
-        if self.imu_format_version != IMU_FORMAT_VERSION {
+        let several = self.axes.iter().any(|a| a.temps.len() > 1);
+        let expected = if several {
+            IMU_FORMAT_VERSION
+        } else {
+            IMU_FORMAT_VERSION_ONE_SENSOR
+        };
+        if self.imu_format_version != expected {
             return Err(ImuError::Layout(format!(
-                "{IMU_VERSION_KEY} {} is not supported (this build reads {IMU_FORMAT_VERSION})",
+                "{IMU_VERSION_KEY} {} is not supported here (this build reads \
+                 {IMU_FORMAT_VERSION_ONE_SENSOR} when every axis reads one sensor, \
+                 {IMU_FORMAT_VERSION} when an axis reads several)",
                 self.imu_format_version
             )));
         }
@@ -337,19 +579,80 @@ impl ImuModel {
             ));
         }
         for a in &self.axes {
-            if a.temps.len() != 1 || !a.temps.iter().all(|t| self.temp_cols.contains(t)) {
+            let distinct = a
+                .temps
+                .iter()
+                .enumerate()
+                .all(|(i, t)| !a.temps[..i].contains(t));
+            if a.temps.is_empty()
+                || a.temps.len() > MAX_SENSORS
+                || !distinct
+                || !a.temps.iter().all(|t| self.temp_cols.contains(t))
+            {
                 return Err(ImuError::Layout(format!(
-                    "axis {} must read one of the temperature columns ({})",
+                    "axis {} must read 1 to {MAX_SENSORS} distinct temperature columns among \
+                     {}",
                     a.gyro,
                     self.temp_cols.join(", ")
+                )));
+            }
+            if a.more.len() + 1 != a.temps.len() {
+                return Err(ImuError::Layout(format!(
+                    "axis {}: `more` must hold one entry per further sensor ({} of them)",
+                    a.gyro,
+                    a.temps.len() - 1
                 )));
             }
             a.model.validate().map_err(|source| ImuError::Axis {
                 gyro: a.gyro.clone(),
                 source: Box::new(source),
             })?;
+            if !a.more.is_empty() {
+                // The further sensors' parts must build a flight compensator.
+                self.axis_compensator(a)?;
+            }
         }
         Ok(())
+    }
+
+    /// The flight compensator of one axis: its first sensor's [`Compensator`] and each
+    /// further sensor's pipeline and parts, reading the indices of its sensors among
+    /// [`ImuModel::temp_cols`].
+    pub fn axis_compensator(&self, a: &ImuAxis) -> Result<AxisCompensator, ImuError> {
+        let index = |t: &String| {
+            self.temp_cols
+                .iter()
+                .position(|c| c == t)
+                .ok_or_else(|| ImuError::Layout(format!("axis {} reads unknown sensor {t}", a.gyro)))
+        };
+        let layout = |what: String| ImuError::Layout(format!("axis {}: {what}", a.gyro));
+        let first = compensator(&a.model).map_err(|source| ImuError::Compensate {
+            gyro: a.gyro.clone(),
+            source: Box::new(source),
+        })?;
+        let spec0 = *first.spec();
+        let mut axis = AxisCompensator::new(first, index(&a.temps[0])?);
+        for (t, m) in a.temps.iter().skip(1).zip(&a.more) {
+            let spec = spec0
+                .with_lags(&m.lags_s, LagOutputs::DiffFromT)
+                .map_err(|e| layout(format!("sensor {t}: {e}")))?;
+            let part = |sub: &Option<SubModel>, what: &str| match sub {
+                None => Ok(None),
+                Some(SubModel::Baseline {
+                    terms,
+                    coefficients,
+                }) => crate::baseline::to_core(terms, coefficients)
+                    .map(Some)
+                    .map_err(|e| layout(format!("sensor {t}, {what}: {e}"))),
+                Some(_) => Err(layout(format!(
+                    "sensor {t}, {what}: a further sensor's part must be a baseline"
+                ))),
+            };
+            axis = axis
+                .with_sensor(index(t)?, spec, part(&m.bias, "bias")?, part(&m.scale, "scale")?)
+                .map_err(|e| layout(format!("sensor {t}: {e}")))?;
+        }
+        Ok(axis)
     }
 
     /// The sealed JSON text (pretty; `content_sha256` of the compact content last).
@@ -411,7 +714,7 @@ impl ImuModel {
         }
     }
 
-    /// Index of each axis's sensor in the temperature columns.
+    /// Index of each axis's first (or only) sensor in the temperature columns.
     pub fn sensor_index(&self) -> Vec<usize> {
         self.axes
             .iter()
@@ -434,12 +737,20 @@ pub struct AxisCompensated {
     pub status: Vec<Status>,
 }
 
-/// The flight compensators of every axis, in axis order.
+/// The one-sensor flight compensators of every axis, in axis order; refused for a model whose
+/// axes read several sensors (use [`imu_axis_compensators`]).
 pub fn imu_compensators(model: &ImuModel) -> Result<Vec<Compensator>, ImuError> {
     model
         .axes
         .iter()
         .map(|a| {
+            if !a.more.is_empty() {
+                return Err(ImuError::Layout(format!(
+                    "axis {} reads {} sensors: it needs the multi-sensor compensator",
+                    a.gyro,
+                    a.temps.len()
+                )));
+            }
             compensator(&a.model).map_err(|source| ImuError::Compensate {
                 gyro: a.gyro.clone(),
                 source: Box::new(source),
@@ -448,9 +759,19 @@ pub fn imu_compensators(model: &ImuModel) -> Result<Vec<Compensator>, ImuError> 
         .collect()
 }
 
-/// Compensate an inertial unit's log: each axis's flight compensator fed with its gyro
-/// column and its sensor's column. The log must hold the model's columns (the error names
-/// the first one missing).
+/// The flight compensators of every axis, in axis order, each reading its own sensors
+/// among `temps[]` in the order of [`ImuModel::temp_cols`].
+pub fn imu_axis_compensators(model: &ImuModel) -> Result<Vec<AxisCompensator>, ImuError> {
+    model
+        .axes
+        .iter()
+        .map(|a| model.axis_compensator(a))
+        .collect()
+}
+
+/// Compensate an inertial unit's log: each axis's flight compensator fed, sample by sample,
+/// with its gyro column and the model's temperature columns. The log must hold the model's
+/// columns (the error names the first one missing).
 pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensated>, ImuError> {
     let find = |list: &[crate::csvlog::NamedSeries], name: &str, role| {
         list.iter()
@@ -460,12 +781,17 @@ pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensa
                 role,
             })
     };
-    let mut comps = imu_compensators(model)?;
+    let mut comps = imu_axis_compensators(model)?;
+    let temps: Vec<&[f64]> = model
+        .temp_cols
+        .iter()
+        .map(|t| find(&log.temp, t, "temperature").map(|i| log.temp[i].values.as_slice()))
+        .collect::<Result<_, _>>()?;
+    let n = log.len();
     let mut out = Vec::with_capacity(model.axes.len());
+    let mut row = vec![0.0; temps.len()];
     for (a, comp) in model.axes.iter().zip(&mut comps) {
         let g = &log.gyro[find(&log.gyro, &a.gyro, "gyro")?].values;
-        let t = &log.temp[find(&log.temp, &a.temps[0], "temperature")?].values;
-        let n = log.len();
         let mut r = AxisCompensated {
             bias_dps: Vec::with_capacity(n),
             scale: Vec::with_capacity(n),
@@ -473,7 +799,10 @@ pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensa
             status: Vec::with_capacity(n),
         };
         for i in 0..n {
-            let c = comp.step(log.time_s[i], g[i], t[i]);
+            for (v, t) in row.iter_mut().zip(&temps) {
+                *v = t[i];
+            }
+            let c = comp.step(log.time_s[i], g[i], &row);
             r.bias_dps.push(c.bias_dps);
             r.scale.push(c.scale);
             r.gyro_comp_dps.push(c.rate_dps);

@@ -1,9 +1,14 @@
-//! The inertial-unit fit (`imu_model::fit_imu`): each axis keeps the sensor with the lowest
-//! cross-validated RMS, the file round-trips sealed, a sensor fault reaches only the axes that
-//! read it.
+//! The inertial-unit fit (`imu_model::fit_imu_with`): with one sensor per axis each axis keeps
+//! the sensor with the lowest cross-validated RMS; with every sensor an axis reads the ones
+//! cross-validation keeps; the file round-trips sealed, a sensor fault reaches only the axes
+//! that read it.
 
 use gyrotherm::csvlog::ImuLog;
-use gyrotherm::imu_model::{compensate_imu, fit_imu, ImuModel};
+use gyrotherm::compensate::compensate_log;
+use gyrotherm::imu_model::{
+    compensate_imu, fit_imu_with, ImuFitSettings, ImuModel, ImuSensors,
+    IMU_FORMAT_VERSION, IMU_FORMAT_VERSION_ONE_SENSOR,
+};
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::{FitSettings, Method};
 use gyrotherm::sim::imu::{imu_from_family, simulate_imu, ImuConfig};
@@ -28,21 +33,38 @@ fn run(seed: u64, table: Option<usize>) -> ImuLog {
     log
 }
 
-#[test]
-fn gyro_x_of_unit_1000_reads_its_coil_sensor() {
-    // As `gyrotherm train` with a static run (seed 1) and a table run per axis (seed 2).
-    let logs: Vec<(String, ImuLog)> = [(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]
+/// As `gyrotherm train` with a static run (seed 1) and a table run per axis (seed 2).
+fn training() -> Vec<(String, ImuLog)> {
+    [(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]
         .into_iter()
         .map(|(seed, table)| (format!("{seed} {table:?}"), run(seed, table)))
-        .collect();
-    let cfg = FitSettings {
+        .collect()
+}
+
+fn thermal() -> gyrotherm::fit::FitConfig {
+    FitSettings {
         method: Method::Thermal,
         ..FitSettings::default()
     }
     .fit_config()
     .unwrap()
-    .0;
-    let model = fit_imu(&logs, &cfg, &TempSensorDef::default(), &|_, _, _, _, _| {}).unwrap();
+    .0
+}
+
+#[test]
+fn gyro_x_of_unit_1000_reads_its_coil_sensor() {
+    let one = ImuFitSettings {
+        sensors: ImuSensors::ChooseOne,
+        ..ImuFitSettings::default()
+    };
+    let model = fit_imu_with(
+        &training(),
+        &thermal(),
+        &one,
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap();
     let a = &model.axes[0];
     // Measured (`gyrotherm simulate --imu --unit random --unit-seed 1000`, seeds as above,
     // then `gyrotherm train --gyro-col gyro_x_dps,gyro_y_dps,gyro_z_dps --temp-col
@@ -54,6 +76,9 @@ fn gyro_x_of_unit_1000_reads_its_coil_sensor() {
     let (case, coil) = (a.scores[0].cv_rms.unwrap(), a.scores[1].cv_rms.unwrap());
     assert!(coil < case, "{case} {coil}");
     let text = model.to_json().unwrap();
+    // One sensor per axis: the first layout, as older builds wrote and read it.
+    assert_eq!(model.imu_format_version, IMU_FORMAT_VERSION_ONE_SENSOR);
+    assert!(!text.contains("\"more\"") && !text.contains("multi_cv_rms"));
     assert_eq!(ImuModel::from_json(&text).unwrap(), model);
     let tampered = text.replacen("\"temp_x_c\"", "\"temp_case_c\"", 1);
     assert!(ImuModel::from_json(&tampered).is_err());
@@ -72,4 +97,62 @@ fn gyro_x_of_unit_1000_reads_its_coil_sensor() {
     }
     let comp = compensate_imu(&model, &test).unwrap();
     assert!(comp[0].status.contains(&Status::Degraded));
+}
+
+#[test]
+fn every_sensor_when_cross_validation_keeps_it() {
+    // A gain threshold of -1 keeps every sensor unless it doubles the cross-validated RMS:
+    // the test is about the layout and the flight path, not about which sensors help.
+    let all = ImuFitSettings {
+        sensors: ImuSensors::All,
+        min_gain: -1.0,
+    };
+    let model = fit_imu_with(
+        &training(),
+        &thermal(),
+        &all,
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap();
+    let a = &model.axes[0];
+    assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
+    assert_eq!(a.more.len(), 1);
+    assert_eq!(model.imu_format_version, IMU_FORMAT_VERSION);
+    let text = model.to_json().unwrap();
+    assert_eq!(ImuModel::from_json(&text).unwrap(), model);
+    // A further sensor that is not a column of the unit is refused.
+    let mut bad = model.clone();
+    bad.axes[0].temps[1] = "temp_q_c".into();
+    assert!(bad.validate().is_err());
+    // Nor a further sensor without its part.
+    let mut bad = model.clone();
+    bad.axes[0].more.clear();
+    assert!(bad.validate().is_err());
+
+    // Without the further sensor's part the axis is its first sensor's model: the same
+    // output as the single-axis compensator on that sensor's column.
+    let test = run(3, None);
+    let mut first_only = model.clone();
+    first_only.axes[0].temps.truncate(1);
+    first_only.axes[0].more.clear();
+    first_only.imu_format_version = IMU_FORMAT_VERSION_ONE_SENSOR;
+    let j = model.temp_cols.iter().position(|t| *t == a.temps[0]).unwrap();
+    let single = compensate_log(&a.model, &test.axis_data(0, j)).unwrap();
+    let unit = compensate_imu(&first_only, &test).unwrap();
+    assert_eq!(single.gyro_comp_dps, unit[0].gyro_comp_dps);
+    // With it, the output differs.
+    let both = compensate_imu(&model, &test).unwrap();
+    assert_ne!(single.gyro_comp_dps, both[0].gyro_comp_dps);
+
+    // A fault on either sensor the axis reads holds it, then degrades it.
+    for k in 0..2 {
+        let mut test = run(3, None);
+        for v in &mut test.temp[k].values[5000..5200] {
+            *v = f64::NAN;
+        }
+        let comp = compensate_imu(&model, &test).unwrap();
+        assert_eq!(comp[0].status[5000], Status::Held, "sensor {k}");
+        assert!(comp[0].status.contains(&Status::Degraded), "sensor {k}");
+    }
 }

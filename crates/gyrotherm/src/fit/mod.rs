@@ -250,18 +250,43 @@ pub fn fit_model(
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
-    let identified = if cfg.method.is_recipe() && cfg.recipe.kind == RecipeKind::Thermal {
-        let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
-        Some(thermal::identify(
-            &named,
-            &cfg.thermal,
-            cfg.bias_window_s,
-            cfg.settle_s,
-            cfg.scale_window_s,
-        )?)
+    let identified = if uses_identification(cfg) {
+        Some(identify(logs, cfg)?)
     } else {
         None
     };
+    fit_model_identified(logs, cfg, identified, progress)
+}
+
+/// Whether the method identifies lags from the data (the `thermal` recipe).
+pub fn uses_identification(cfg: &FitConfig) -> bool {
+    cfg.method.is_recipe() && cfg.recipe.kind == RecipeKind::Thermal
+}
+
+/// The `thermal` recipe's identification on the training logs (the first part of
+/// [`fit_model`]).
+pub fn identify(logs: &[NamedLog], cfg: &FitConfig) -> Result<thermal::Identified, FitError> {
+    let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
+    Ok(thermal::identify(
+        &named,
+        &cfg.thermal,
+        cfg.bias_window_s,
+        cfg.settle_s,
+        cfg.scale_window_s,
+    )?)
+}
+
+/// [`fit_model`] with the identification already made ([`identify`] on the same logs and
+/// settings; None for methods without one).
+pub fn fit_model_identified(
+    logs: &[NamedLog],
+    cfg: &FitConfig,
+    identified: Option<thermal::Identified>,
+    progress: &(dyn Fn(Target, usize, f64) + Sync),
+) -> Result<FitOutcome, FitError> {
+    if logs.is_empty() {
+        return Err(FitError::NoLogs);
+    }
     let spec = identified
         .as_ref()
         .map_or_else(|| feature_spec(cfg), |id| id.spec);

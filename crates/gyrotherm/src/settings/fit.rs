@@ -20,6 +20,41 @@ pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 /// Names of the deprecated `recipe` setting (the recipe methods' names).
 pub const RECIPE_NAMES: [&str; 5] = ["thermal", "residual", "generic", "direct", "published"];
 
+/// Default least relative drop of an inertial-unit axis's cross-validated RMS for a further
+/// temperature sensor to join its model: −1, a sensor joins unless it doubles the
+/// cross-validated RMS (chosen on the design family against +0.02, which kept one sensor
+/// per axis: docs/experiments/imu.md).
+pub const DEFAULT_IMU_MIN_GAIN: f64 = -1.0;
+
+/// Which temperature sensors each axis of an inertial unit may read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ImuSensors {
+    /// Every listed sensor; cross-validation decides which stay (several per axis).
+    #[default]
+    All,
+    /// One sensor per axis, the one whose fit has the lowest cross-validated RMS.
+    ChooseOne,
+}
+
+/// How the axes of an inertial unit use its temperature sensors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuFitSettings {
+    /// Which sensors an axis may read.
+    pub sensors: ImuSensors,
+    /// Least relative drop of the cross-validated RMS for a further sensor to join
+    /// (negative: the rise it may cause, −1 allowing up to double).
+    pub min_gain: f64,
+}
+
+impl Default for ImuFitSettings {
+    fn default() -> Self {
+        ImuFitSettings {
+            sensors: ImuSensors::default(),
+            min_gain: DEFAULT_IMU_MIN_GAIN,
+        }
+    }
+}
+
 /// How to fit a model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitSettings {

@@ -37,6 +37,7 @@ use crate::model::SubModel;
 use crate::targets::{self, TargetSet};
 
 mod allowance;
+pub mod multi;
 mod ridge;
 
 use allowance::*;

@@ -1,0 +1,226 @@
+//! An axis that reads several temperature sensors: one gyro of an inertial unit whose bias and
+//! scale factor follow its coil and the housing, seen by a sensor beside the coil and one on
+//! the case (their difference is the radial gradient a single sensor cannot see).
+//!
+//! [`AxisCompensator`] is stepped with all of the unit's sensor readings, `temps`, and reads
+//! its own indices among them: its first sensor through an ordinary [`Compensator`] (the time
+//! axis, the fault handling, the bias and scale-factor models over that sensor's features,
+//! unchanged), and up to [`MAX_SENSORS`]` − 1` further sensors, each with its own feature
+//! pipeline (its own lags) and its own part of B and K, a [`BaselineModel`] over that
+//! sensor's features without a constant:
+//!
+//! `B = bias(f_0) + Σ_s bias_s(f_s)`, `K = scale(f_0) + Σ_s scale_s(f_s)`,
+//!
+//! the first sensor's model first, then each further sensor's in the order they were added.
+//! Differences between sensors (gradients) are linear combinations of these terms.
+//!
+//! Faults: a sample is used only when every sensor the axis reads is believed (each judged as
+//! [`Compensator`] judges its one sensor, against its own latest accepted reading); otherwise
+//! the axis holds, as with a rejected temperature. A reading the axis does not read changes
+//! nothing. A missing index (`temps` shorter than the axis expects) is a fault of that sensor.
+//!
+//! No allocation, fixed sizes, no panics on any input.
+
+use crate::baseline::BaselineModel;
+use crate::compensator::{
+    plausible_reading, Compensator, Corrected, ModelError, MoreSensors, TempLimits,
+};
+use crate::features::{FeaturePipeline, FeatureSpec};
+
+/// Most sensors one axis reads (the first included).
+pub const MAX_SENSORS: usize = 4;
+
+/// A further sensor of an axis: its pipeline and its parts of B and K.
+#[derive(Debug, Clone)]
+struct SensorPart {
+    index: usize,
+    pipeline: FeaturePipeline,
+    bias: Option<BaselineModel>,
+    scale: Option<BaselineModel>,
+    last_good: Option<(f64, f64)>,
+}
+
+/// The further sensors of an axis, in the order they were added.
+#[derive(Debug, Clone)]
+struct MoreParts {
+    parts: [Option<SensorPart>; MAX_SENSORS - 1],
+}
+
+fn reading(temps: &[f64], index: usize) -> f64 {
+    temps.get(index).copied().unwrap_or(f64::NAN)
+}
+
+impl MoreSensors for MoreParts {
+    fn plausible(&self, limits: &TempLimits, time_s: f64, temps: &[f64]) -> bool {
+        let mut ok = true;
+        for p in self.parts.iter().flatten() {
+            ok = ok && plausible_reading(limits, p.last_good, time_s, reading(temps, p.index));
+        }
+        ok
+    }
+
+    fn push(&mut self, time_s: f64, temps: &[f64]) -> bool {
+        let mut ok = true;
+        for p in self.parts.iter_mut().flatten() {
+            let t = reading(temps, p.index);
+            ok = p.pipeline.push(time_s, t).is_ok() && ok;
+        }
+        ok
+    }
+
+    fn accepted(&mut self, time_s: f64, temps: &[f64]) {
+        for p in self.parts.iter_mut().flatten() {
+            p.last_good = Some((time_s, reading(temps, p.index)));
+        }
+    }
+
+    fn add(&mut self, bias_dps: &mut f64, scale: &mut f64) -> bool {
+        for p in self.parts.iter().flatten() {
+            let Some(f) = p.pipeline.current() else {
+                return false;
+            };
+            if let Some(m) = &p.bias {
+                match m.eval_features(f) {
+                    Ok(v) => *bias_dps += v,
+                    Err(_) => return false,
+                }
+            }
+            if let Some(m) = &p.scale {
+                match m.eval_features(f) {
+                    Ok(v) => *scale += v,
+                    Err(_) => return false,
+                }
+            }
+        }
+        true
+    }
+
+    fn rebase(&mut self) {
+        for p in self.parts.iter_mut().flatten() {
+            p.pipeline.reset();
+            p.last_good = None;
+        }
+    }
+}
+
+/// One gyro axis reading one or more of the unit's temperature sensors (see the module doc).
+#[derive(Debug, Clone)]
+pub struct AxisCompensator {
+    /// The first sensor's compensator; its [`Compensator::channel`] is the first sensor's
+    /// index among `temps`.
+    first: Compensator,
+    more: MoreParts,
+}
+
+impl From<Compensator> for AxisCompensator {
+    /// A one-sensor axis reading `temps[c.channel()]`: it steps exactly as
+    /// [`Compensator::step_unit`].
+    fn from(c: Compensator) -> Self {
+        let channel = c.channel();
+        AxisCompensator::new(c, channel)
+    }
+}
+
+impl AxisCompensator {
+    /// An axis whose first (or only) sensor is `temps[first_index]`, with that sensor's
+    /// compensator.
+    pub fn new(first: Compensator, first_index: usize) -> Self {
+        AxisCompensator {
+            first: first.with_channel(first_index),
+            more: MoreParts {
+                parts: core::array::from_fn(|_| None),
+            },
+        }
+    }
+
+    /// Add a further sensor, `temps[index]`, read through `spec` (the same step period and
+    /// rate lag as the first sensor's; its own lags), with its parts of B and K (each over
+    /// `spec`'s features, no constant needed). Refused: more than [`MAX_SENSORS`] sensors,
+    /// a sensor already read, a spec or model that does not fit.
+    pub fn with_sensor(
+        mut self,
+        index: usize,
+        spec: FeatureSpec,
+        bias: Option<BaselineModel>,
+        scale: Option<BaselineModel>,
+    ) -> Result<Self, ModelError> {
+        let pipeline = FeaturePipeline::new(spec).map_err(ModelError::Spec)?;
+        let first = self.first.spec();
+        if spec.step_period_s != first.step_period_s || spec.rate_lag_s != first.rate_lag_s {
+            return Err(ModelError::Sensors);
+        }
+        let n = spec.n_features();
+        for m in bias.iter().chain(scale.iter()) {
+            if m.n_features() != n {
+                return Err(ModelError::FeatureCount {
+                    expected: n,
+                    got: m.n_features(),
+                });
+            }
+        }
+        if index == self.first.channel() || self.sensors().any(|i| i == index) {
+            return Err(ModelError::Sensors);
+        }
+        let Some(slot) = self.more.parts.iter_mut().find(|p| p.is_none()) else {
+            return Err(ModelError::Sensors);
+        };
+        *slot = Some(SensorPart {
+            index,
+            pipeline,
+            bias,
+            scale,
+            last_good: None,
+        });
+        Ok(self)
+    }
+
+    /// The indices into `temps` this axis reads, first sensor first.
+    pub fn sensors(&self) -> impl Iterator<Item = usize> + '_ {
+        core::iter::once(self.first.channel()).chain(self.more.parts.iter().flatten().map(|p| p.index))
+    }
+
+    /// The further sensors, in the order they were added: each one's index among `temps`,
+    /// its features and its parts of B and K (what an export writes).
+    pub fn further(
+        &self,
+    ) -> impl Iterator<
+        Item = (
+            usize,
+            &FeatureSpec,
+            Option<&BaselineModel>,
+            Option<&BaselineModel>,
+        ),
+    > + '_ {
+        self.more
+            .parts
+            .iter()
+            .flatten()
+            .map(|p| (p.index, p.pipeline.spec(), p.bias.as_ref(), p.scale.as_ref()))
+    }
+
+    /// The first sensor's features of the latest step (as [`Compensator::features`]).
+    pub fn features(&self) -> Option<&crate::features::Features> {
+        self.first.features()
+    }
+
+    /// The first sensor's compensator (its spec and limits).
+    pub fn first(&self) -> &Compensator {
+        &self.first
+    }
+
+    /// One sample: time (s), gyro output (°/s), and every sensor of the unit (°C), of which
+    /// this axis reads its own. Never fails; see [`Compensator::step`]. With no further
+    /// sensor this is `Compensator::step` on `temps[first_index]` exactly
+    /// ([`Compensator::step_unit`]).
+    pub fn step(&mut self, time_s: f64, gyro_dps: f64, temps: &[f64]) -> Corrected {
+        let t0 = reading(temps, self.first.channel());
+        self.first
+            .step_with(time_s, gyro_dps, t0, &mut self.more, temps)
+    }
+
+    /// Start over (as [`Compensator::reset`], for every sensor).
+    pub fn reset(&mut self) {
+        self.first.reset();
+        self.more.rebase();
+    }
+}
