@@ -176,7 +176,8 @@ impl AxisCompensator {
 
     /// The indices into `temps` this axis reads, first sensor first.
     pub fn sensors(&self) -> impl Iterator<Item = usize> + '_ {
-        core::iter::once(self.first.channel()).chain(self.more.parts.iter().flatten().map(|p| p.index))
+        core::iter::once(self.first.channel())
+            .chain(self.more.parts.iter().flatten().map(|p| p.index))
     }
 
     /// The further sensors, in the order they were added: each one's index among `temps`,
@@ -191,11 +192,14 @@ impl AxisCompensator {
             Option<&BaselineModel>,
         ),
     > + '_ {
-        self.more
-            .parts
-            .iter()
-            .flatten()
-            .map(|p| (p.index, p.pipeline.spec(), p.bias.as_ref(), p.scale.as_ref()))
+        self.more.parts.iter().flatten().map(|p| {
+            (
+                p.index,
+                p.pipeline.spec(),
+                p.bias.as_ref(),
+                p.scale.as_ref(),
+            )
+        })
     }
 
     /// The first sensor's features of the latest step (as [`Compensator::features`]).

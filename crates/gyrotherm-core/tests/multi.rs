@@ -67,8 +67,18 @@ fn one_sensor_is_the_compensator_bit_for_bit() {
         let a = one.step(time, g, x[2]);
         let b = axis.step(time, g, &x);
         assert_eq!(
-            (a.status, a.bias_dps.to_bits(), a.scale.to_bits(), a.rate_dps.to_bits()),
-            (b.status, b.bias_dps.to_bits(), b.scale.to_bits(), b.rate_dps.to_bits()),
+            (
+                a.status,
+                a.bias_dps.to_bits(),
+                a.scale.to_bits(),
+                a.rate_dps.to_bits()
+            ),
+            (
+                b.status,
+                b.bias_dps.to_bits(),
+                b.scale.to_bits(),
+                b.rate_dps.to_bits()
+            ),
             "sample {i}"
         );
     }
@@ -79,7 +89,12 @@ fn further_sensors_add_their_parts() {
     let mut axis = AxisCompensator::new(first(), 0)
         .with_sensor(1, FeatureSpec::PUBLISHED, Some(part(3e-5)), None)
         .unwrap()
-        .with_sensor(3, FeatureSpec::PUBLISHED, Some(part(-1e-5)), Some(part(2e-6)))
+        .with_sensor(
+            3,
+            FeatureSpec::PUBLISHED,
+            Some(part(-1e-5)),
+            Some(part(2e-6)),
+        )
         .unwrap();
     assert_eq!(axis.sensors().collect::<Vec<_>>(), [0, 1, 3]);
     for i in 0..200 {
@@ -140,7 +155,10 @@ fn further_sensors_are_checked() {
     );
     assert!(matches!(
         AxisCompensator::new(first(), 0).with_sensor(1, lags, Some(part(1.0)), None),
-        Err(ModelError::FeatureCount { expected: 3, got: 2 })
+        Err(ModelError::FeatureCount {
+            expected: 3,
+            got: 2
+        })
     ));
     let slow = FeatureSpec {
         step_period_s: 2.0,

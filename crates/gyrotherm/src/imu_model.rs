@@ -27,8 +27,7 @@ use crate::compensate::compensator;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{
-    fit_model, fit_model_identified, uses_identification, FitConfig, FitError, FitOutcome,
-    NamedLog,
+    fit_model, fit_model_identified, uses_identification, FitConfig, FitError, FitOutcome, NamedLog,
 };
 use crate::model::{sha256_hex, ModelFile, ModelFileError, SubModel, TempSensorDef, CHECKSUM_KEY};
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
@@ -465,11 +464,7 @@ fn fit_axis_multi(
     }
     let data: Vec<SensorData> = per_sensor
         .iter()
-        .map(|(_, id, bias, scale)| SensorData {
-            id,
-            bias,
-            scale,
-        })
+        .map(|(_, id, bias, scale)| SensorData { id, bias, scale })
         .collect();
     let (order, single) = multi::select(
         &data,
@@ -543,7 +538,10 @@ fn fit_axis_multi(
             });
         }
     }
-    events(ImuFitEvent::AxisFinished { axis: k, sensor: j0 });
+    events(ImuFitEvent::AxisFinished {
+        axis: k,
+        sensor: j0,
+    });
     Ok(ImuAxis {
         gyro: gyro_cols[k].clone(),
         temps: order.iter().map(|&j| temp_cols[j].clone()).collect(),
@@ -620,10 +618,9 @@ impl ImuModel {
     /// [`ImuModel::temp_cols`].
     pub fn axis_compensator(&self, a: &ImuAxis) -> Result<AxisCompensator, ImuError> {
         let index = |t: &String| {
-            self.temp_cols
-                .iter()
-                .position(|c| c == t)
-                .ok_or_else(|| ImuError::Layout(format!("axis {} reads unknown sensor {t}", a.gyro)))
+            self.temp_cols.iter().position(|c| c == t).ok_or_else(|| {
+                ImuError::Layout(format!("axis {} reads unknown sensor {t}", a.gyro))
+            })
         };
         let layout = |what: String| ImuError::Layout(format!("axis {}: {what}", a.gyro));
         let first = compensator(&a.model).map_err(|source| ImuError::Compensate {
@@ -649,7 +646,12 @@ impl ImuModel {
                 ))),
             };
             axis = axis
-                .with_sensor(index(t)?, spec, part(&m.bias, "bias")?, part(&m.scale, "scale")?)
+                .with_sensor(
+                    index(t)?,
+                    spec,
+                    part(&m.bias, "bias")?,
+                    part(&m.scale, "scale")?,
+                )
                 .map_err(|e| layout(format!("sensor {t}: {e}")))?;
         }
         Ok(axis)

@@ -3,11 +3,11 @@
 //! cross-validation keeps; the file round-trips sealed, a sensor fault reaches only the axes
 //! that read it.
 
-use gyrotherm::csvlog::ImuLog;
 use gyrotherm::compensate::compensate_log;
+use gyrotherm::csvlog::ImuLog;
 use gyrotherm::imu_model::{
-    compensate_imu, fit_imu_with, ImuFitSettings, ImuModel, ImuSensors,
-    IMU_FORMAT_VERSION, IMU_FORMAT_VERSION_ONE_SENSOR,
+    compensate_imu, fit_imu_with, ImuFitSettings, ImuModel, ImuSensors, IMU_FORMAT_VERSION,
+    IMU_FORMAT_VERSION_ONE_SENSOR,
 };
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::{FitSettings, Method};
@@ -137,7 +137,11 @@ fn every_sensor_when_cross_validation_keeps_it() {
     first_only.axes[0].temps.truncate(1);
     first_only.axes[0].more.clear();
     first_only.imu_format_version = IMU_FORMAT_VERSION_ONE_SENSOR;
-    let j = model.temp_cols.iter().position(|t| *t == a.temps[0]).unwrap();
+    let j = model
+        .temp_cols
+        .iter()
+        .position(|t| *t == a.temps[0])
+        .unwrap();
     let single = compensate_log(&a.model, &test.axis_data(0, j)).unwrap();
     let unit = compensate_imu(&first_only, &test).unwrap();
     assert_eq!(single.gyro_comp_dps, unit[0].gyro_comp_dps);

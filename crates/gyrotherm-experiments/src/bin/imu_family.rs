@@ -48,7 +48,12 @@ const DEFAULT_SETTINGS: &str = "case,chosen,all";
 const DESIGN_BASE_SEED: u64 = 1000;
 const CONFIRM_BASE_SEED: u64 = 5000;
 
-fn sim(unit: &ImuUnit, profile: &str, seed: u64, table_axis: Option<usize>) -> Result<ImuLog, String> {
+fn sim(
+    unit: &ImuUnit,
+    profile: &str,
+    seed: u64,
+    table_axis: Option<usize>,
+) -> Result<ImuLog, String> {
     let mut run = SimConfig::new(Profile::builtin(profile).map_err(|e| e.to_string())?);
     run.seed = seed;
     run.truth = true;
@@ -110,7 +115,10 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     let settings = job.settings;
     let unit = imu_from_family(unit_seed);
     let s0 = unit_seed * 100;
-    let mut train = vec![("seed-shock-static".to_owned(), sim(&unit, "seed-shock", s0 + 1, None)?)];
+    let mut train = vec![(
+        "seed-shock-static".to_owned(),
+        sim(&unit, "seed-shock", s0 + 1, None)?,
+    )];
     for k in 0..AXIS_NAMES.len() {
         train.push((
             format!("seed-shock-table-{}", AXIS_NAMES[k]),
@@ -155,14 +163,21 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         let t0 = Instant::now();
         let model: ImuModel = match setting.as_str() {
             "case" => {
-                let logs: Vec<(String, ImuLog)> =
-                    train.iter().map(|(n, l)| (n.clone(), case_only(l))).collect();
+                let logs: Vec<(String, ImuLog)> = train
+                    .iter()
+                    .map(|(n, l)| (n.clone(), case_only(l)))
+                    .collect();
                 fit_imu_with(&logs, &cfg, &one, &sensor, &|_, _, _, _, _| {})
             }
             "chosen" => fit_imu_with(&train, &cfg, &one, &sensor, &|_, _, _, _, _| {}),
             _ => fit_imu_with(&train, &cfg, &all, &sensor, &|_, _, _, _, _| {}),
         }
-        .map_err(|e| format!("unit {unit_seed} {setting}: {e}: {:?}", std::error::Error::source(&e).map(|s| s.to_string())))?;
+        .map_err(|e| {
+            format!(
+                "unit {unit_seed} {setting}: {e}: {:?}",
+                std::error::Error::source(&e).map(|s| s.to_string())
+            )
+        })?;
         let fit_s = t0.elapsed().as_secs_f64();
         for (profile, st, tabs, floors) in &tests {
             let cs = compensate_imu(&model, st).map_err(|e| e.to_string())?;
@@ -240,12 +255,14 @@ fn run() -> Result<(), String> {
         .map(str::to_owned)
         .collect();
     if let Some(s) = settings.iter().find(|s| !SETTINGS.contains(&s.as_str())) {
-        return Err(format!("--settings: unknown {s:?}; use {}", SETTINGS.join(", ")));
+        return Err(format!(
+            "--settings: unknown {s:?}; use {}",
+            SETTINGS.join(", ")
+        ));
     }
-    let min_gain: f64 = get("--min-gain").map_or(
-        Ok(ImuFitSettings::default().min_gain),
-        |v| v.parse().map_err(|e| format!("--min-gain: {e}")),
-    )?;
+    let min_gain: f64 = get("--min-gain").map_or(Ok(ImuFitSettings::default().min_gain), |v| {
+        v.parse().map_err(|e| format!("--min-gain: {e}"))
+    })?;
     let job = Job {
         settings: &settings,
         min_gain,
@@ -291,15 +308,26 @@ fn run() -> Result<(), String> {
         ))
     });
     if let Some(path) = get("--cases") {
-        let mut text = String::from("unit_seed\tsetting\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\n");
+        let mut text =
+            String::from("unit_seed\tsetting\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\n");
         for c in &cases {
             text.push_str(&format!(
                 "{}\t{}\t{}\t{}\t{:.4}\t{:.3}\t{:.2}\t{}\n",
-                c.unit_seed, c.setting, AXIS_NAMES[c.axis], c.profile, c.x_floor, c.sf_ppm, c.fit_s, c.temps
+                c.unit_seed,
+                c.setting,
+                AXIS_NAMES[c.axis],
+                c.profile,
+                c.x_floor,
+                c.sf_ppm,
+                c.fit_s,
+                c.temps
             ));
         }
-        gyrotherm::atomic_file::write_bytes_atomically(std::path::Path::new(&path), text.as_bytes())
-            .map_err(|e| format!("{path}: {e}"))?;
+        gyrotherm::atomic_file::write_bytes_atomically(
+            std::path::Path::new(&path),
+            text.as_bytes(),
+        )
+        .map_err(|e| format!("{path}: {e}"))?;
     }
     println!();
     println!(

@@ -110,9 +110,11 @@ pub(crate) fn sensor_expr(
     bias: &Option<StaticBaseline>,
     scale: &Option<StaticBaseline>,
 ) -> String {
-    let mut out = format!("StaticSensor {{
+    let mut out = format!(
+        "StaticSensor {{
     channel: {channel},
-");
+"
+    );
     out.push_str(&spec_expr(spec));
     out.push('\n');
     for (name, b) in [("bias", bias), ("scale", scale)] {

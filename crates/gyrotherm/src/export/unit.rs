@@ -97,7 +97,10 @@ pub fn column_map(model: &ImuModel) -> Vec<String> {
                 format!("temp[{j}]")
             })
             .collect();
-        out.push(format!("gyro[{i}] = {g} (axis {i}, reads {})", reads.join(", ")));
+        out.push(format!(
+            "gyro[{i}] = {g} (axis {i}, reads {})",
+            reads.join(", ")
+        ));
     }
     for (j, t) in model.temp_cols.iter().enumerate() {
         out.push(format!("temp[{j}] = {t}"));
@@ -249,12 +252,20 @@ impl Layout<'_> {
                 .into(),
         );
         for (i, a) in axes.iter().enumerate() {
-            let reads: Vec<String> = a.channels().iter().map(|c| format!("{temp}[{c}]")).collect();
+            let reads: Vec<String> = a
+                .channels()
+                .iter()
+                .map(|c| format!("{temp}[{c}]"))
+                .collect();
             out.push(format!(
                 "  {gyro}[{i}] is the model's {} gyro column; axis {i} reads {}{};",
                 ordinal(i + 1),
                 reads.join(", "),
-                if reads.len() > 1 { " (first sensor first)" } else { "" }
+                if reads.len() > 1 {
+                    " (first sensor first)"
+                } else {
+                    ""
+                }
             ));
         }
         for j in 0..self.n_temps {
@@ -374,7 +385,10 @@ fn sensor_pieces(src: &str, parts: bool) -> String {
     }
     out.push('\n');
     if parts {
-        let typedef = between("typedef struct {\n    int n_terms;", "typedef struct {\n    int n_inputs;");
+        let typedef = between(
+            "typedef struct {\n    int n_terms;",
+            "typedef struct {\n    int n_inputs;",
+        );
         out.push_str(typedef);
         let data = between("} target_def;\n", SHARED_FROM);
         for line in data.lines().skip(1) {
@@ -384,9 +398,15 @@ fn sensor_pieces(src: &str, parts: bool) -> String {
             }
         }
     }
-    out.push_str(between("/* The i-th newest stored step", "/* Compensator::rebase"));
+    out.push_str(between(
+        "/* The i-th newest stored step",
+        "/* Compensator::rebase",
+    ));
     if parts {
-        out.push_str(between("/* BaselineModel::eval. */", "/* TargetModel::eval. */"));
+        out.push_str(between(
+            "/* BaselineModel::eval. */",
+            "/* TargetModel::eval. */",
+        ));
     }
     out
 }
@@ -490,7 +510,10 @@ fn further_sensors(i: usize, sensors: &[SensorExport]) -> (c::Hooks, String, Str
         "/* Each further sensor's parts of B and K, added in order; 0 if one gave none. */\n\
          static int more_add{a}(const gt_state{a} *s, double *b, double *k)\n{{"
     );
-    if sensors.iter().any(|s| s.bias.is_some() || s.scale.is_some()) {
+    if sensors
+        .iter()
+        .any(|s| s.bias.is_some() || s.scale.is_some())
+    {
         f.push_str("    double v;\n");
     }
     f.push_str("    (void)b;\n    (void)k;\n");
@@ -552,8 +575,16 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
             let ss = format!("{suffix}s{}", k + 1);
             let (sh, ssrc) = c::generate(&se.model, "a further sensor");
             let names = file_scope_names(&ssrc);
-            let _ = writeln!(h, "#define GT_N_FEATURES{ss} {}", se.model.spec.n_features());
-            let _ = writeln!(h, "#define GT_LAG_SLOTS{ss} {}", se.model.spec.lags().len().max(1));
+            let _ = writeln!(
+                h,
+                "#define GT_N_FEATURES{ss} {}",
+                se.model.spec.n_features()
+            );
+            let _ = writeln!(
+                h,
+                "#define GT_LAG_SLOTS{ss} {}",
+                se.model.spec.lags().len().max(1)
+            );
             let from = sh.find("struct gt_state {").unwrap_or(0);
             let to = sh[from..].find("\n};\n").map_or(sh.len(), |k| from + k + 4);
             let _ = writeln!(h, "typedef struct gt_state{ss} gt_state{ss};");
@@ -758,7 +789,12 @@ fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
             a.sensors.len()
         );
         for s in &a.sensors {
-            out.push_str(&rust::sensor_expr(s.channel, &s.model.spec, &s.bias, &s.scale));
+            out.push_str(&rust::sensor_expr(
+                s.channel,
+                &s.model.spec,
+                &s.bias,
+                &s.scale,
+            ));
             out.push_str(",\n");
         }
         out.push_str("];\n");
