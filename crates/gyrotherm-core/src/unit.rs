@@ -276,6 +276,80 @@ mod tests {
         }
     }
 
+    /// An axis on sensor `first` reading `more` further sensors, each a part of B linear in
+    /// its `T` (coefficient 1e-5 per sensor index, an independent choice) and one lag.
+    fn multi_axis(first: usize, more: &[usize]) -> AxisCompensator {
+        let mut a = AxisCompensator::new(axis(first), first);
+        for &j in more {
+            let spec = FeatureSpec::PUBLISHED
+                .with_lags(&[50.0], crate::features::LagOutputs::DiffFromT)
+                .unwrap();
+            let mut b = crate::baseline::BaselineModel::new(spec.n_features()).unwrap();
+            let mut p = [0u8; crate::features::MAX_FEATURES];
+            p[0] = 1;
+            b.push_term(&p[..spec.n_features()], 1e-5 * (j as f64 + 1.0))
+                .unwrap();
+            a = a.with_sensor(j, spec, Some(b), None).unwrap();
+        }
+        a
+    }
+
+    #[test]
+    fn multi_sensor_axes_equal_their_own_axis_compensators() {
+        let mut unit: Unit = Unit::new(4);
+        let mut alone = [
+            multi_axis(1, &[0, 3]),
+            multi_axis(2, &[]),
+            multi_axis(3, &[2, 1, 0]),
+        ];
+        for a in &alone {
+            unit.push_axis(a.clone()).unwrap();
+        }
+        let (mut held0, mut held1) = (0, 0);
+        for i in 0..300 {
+            let x = f64::from(i);
+            let t = if i == 100 { f64::NAN } else { x };
+            // Sensor 0 (read by axes 0 and 2 as a further sensor) fails for a while.
+            let s0 = if (50..80).contains(&i) {
+                f64::NAN
+            } else {
+                20.0
+            };
+            let temps = [s0, 21.0 + 0.01 * x, 22.0, 25.0];
+            let gyro = [0.01, 0.02, 0.03];
+            let out = unit.step(t, &gyro, &temps);
+            for k in 0..3 {
+                assert_eq!(
+                    out[k],
+                    alone[k].step(t, gyro[k], &temps),
+                    "sample {i} axis {k}"
+                );
+            }
+            if (50..80).contains(&i) {
+                held0 += usize::from(out[0].status != Status::Ok);
+                held1 += usize::from(out[1].status != Status::Ok);
+            }
+        }
+        // The fault reaches the axes that read sensor 0 only.
+        assert_eq!((held0, held1), (30, 0));
+    }
+
+    #[test]
+    fn one_sensor_axis_is_step_unit() {
+        let mut a = AxisCompensator::from(axis(2));
+        let mut c = axis(2);
+        for i in 0..200 {
+            let x = f64::from(i);
+            let temps = [f64::NAN, 20.0, 21.0 + 0.02 * x];
+            let t = if i == 40 { x - 10.0 } else { x };
+            assert_eq!(
+                a.step(t, 0.01, &temps),
+                c.step_unit(t, 0.01, &temps),
+                "sample {i}"
+            );
+        }
+    }
+
     #[test]
     fn refuses_what_it_cannot_hold_and_never_panics_on_short_inputs() {
         let mut unit: Unit<2> = Unit::new(2);
@@ -292,6 +366,16 @@ mod tests {
         assert_eq!(
             unit.push_axis(axis(0)),
             Err(UnitError::TooManyAxes { capacity: 2 })
+        );
+        // A further sensor beyond the unit's channels is refused too.
+        let mut small: Unit<2> = Unit::new(2);
+        assert_eq!(
+            small.push_axis(multi_axis(0, &[3])),
+            Err(UnitError::Channel {
+                axis: 0,
+                channel: 3,
+                n_temps: 2
+            })
         );
         let out = unit.step(0.0, &[0.01], &[20.0]);
         assert_eq!(out[0].status, Status::Ok);

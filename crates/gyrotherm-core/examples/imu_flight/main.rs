@@ -19,7 +19,8 @@ use gyrotherm_model::{AXES, CHANNELS, MODELS, SENSORS, TEMPS};
 
 fn main() {
     // Start-up: the only fallible step, done once.
-    let Ok(mut unit) = Unit::<AXES>::from_static_sensors(&MODELS, &CHANNELS, &SENSORS, TEMPS) else {
+    let Ok(mut unit) = Unit::<AXES>::from_static_sensors(&MODELS, &CHANNELS, &SENSORS, TEMPS)
+    else {
         std::process::exit(2);
     };
     // Mock sensors: the unit at rest in a bay cooling from +40 °C to −20 °C; one temperature
