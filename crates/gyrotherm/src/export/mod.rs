@@ -183,14 +183,11 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, Co
     let Some(sub) = sub else {
         return Ok(StaticTarget::constant(absent));
     };
-    let baseline = match sub
+    let baseline = sub
         .baseline_core()
         .transpose()
         .map_err(CompensateError::Baseline)?
-    {
-        None => None,
-        Some(b) => Some(static_baseline(&b)),
-    };
+        .map(|b| static_baseline(&b));
     let lstm = match sub.lstm() {
         Some((params, input_norm, target_norm)) => {
             let w = crate::compensate::padded_core_lstm(params)?;
