@@ -119,9 +119,9 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         "seed-shock-static".to_owned(),
         sim(&unit, "seed-shock", s0 + 1, None)?,
     )];
-    for k in 0..AXIS_NAMES.len() {
+    for (k, axis) in AXIS_NAMES.iter().enumerate() {
         train.push((
-            format!("seed-shock-table-{}", AXIS_NAMES[k]),
+            format!("seed-shock-table-{axis}"),
             sim(&unit, "seed-shock", s0 + 2 + k as u64, Some(k))?,
         ));
     }
