@@ -7,7 +7,8 @@
 # crates/gyrotherm-core/examples/flight_loop/model.json (bias and scale-factor LSTMs).
 # Then an inertial unit: 3 gyros and 4 temperature sensors (case + one per coil), `thermal`
 # trained on simulated runs of unit 1000 of the design family (`simulate --imu`: a static
-# run and a rate-table run per axis), exported with gt_step_imu.
+# run and a rate-table run per axis) with the default multi-sensor fit (each axis may read
+# several sensors; the line after the table says which), exported with gt_step_imu.
 # Per model: the object file's text, data and bss; flash = text + data; RAM = data + bss +
 # sizeof(gt_state) (one gyro axis; the whole unit for the unit); stack: an upper bound for one gt_step (gt_step_imu) call; and the flash a linked image grows by against an empty
 # main (--specs=nano.specs, -Wl,--gc-sections): the model plus the soft-float double
@@ -77,7 +78,7 @@ state=$(arm-none-eabi-size "$dir/probe.o" | awk 'NR==2 {print $3}')
 arm-none-eabi-gcc "${CFLAGS[@]}" -DWITH_IMU -I "$dir" bench/m4/size_main.c \
     "$dir/gyrotherm_model.c" "${LDFLAGS[@]}" -o "$dir/image.elf" -lm
 image=$(arm-none-eabi-size "$dir/image.elf" | awk 'NR==2 {print $1 + $2}')
-parts=$(python3 -c "import json,sys; m=json.load(open(sys.argv[1])); print('3x4 reads ' + ','.join(a['temps'][0] for a in m['axes']))" "$work/imu.json")
+parts=$(python3 -c "import json,sys; m=json.load(open(sys.argv[1])); print('axes read ' + '; '.join('+'.join(a['temps']) for a in m['axes']))" "$work/imu.json")
 printf '%-10s %-20s %6d %6d %6d %8d %8d %7d %14d\n' "imu" "3 axes, 4 sensors" "$text" "$data" "$bss" \
     $((text + data)) $((data + bss + state)) "$stack" $((image - empty))
 echo "imu: $parts; sizeof(gt_state) = $state bytes for the unit (RAM includes it); stack: sum"

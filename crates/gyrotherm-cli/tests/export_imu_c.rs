@@ -5,8 +5,9 @@
 //! bit, and `gt_coverage_of_axis` the verdict and sigma_dph of the core's coverage map on that
 //! axis's compensator (the core `Unit` stepped alongside; two axis models in three carry a
 //! map), on generated units (one to three axes, each axis one of the generated single-axis
-//! models of every method, one to five temperature sensors, each axis on a drawn sensor)
-//! under faulted streams: one sensor NaN for a minute and out of range, time glitches and
+//! models of every method, one to five temperature sensors, each axis on one to four drawn
+//! sensors: the first through its model, each further one with drawn lags (0 to 4) and drawn
+//! linear parts of B and K, either, both or neither) under faulted streams: one sensor NaN for a minute and out of range, time glitches and
 //! lasting clock resets and jumps, huge and non-finite gyro samples. The units' column names
 //! hold `*/` and `??`: none reaches the generated text.
 
@@ -32,27 +33,70 @@ fn have_gcc() -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
+/// A further sensor's part of B or K: linear in its features (`T`, `dT`, the smoothed `T`
+/// when the axis smooths, `T - lag_j(T)`), no constant, small coefficients (a part of K
+/// keeps K near its constant).
+fn further_part(rng: &mut Lcg, nf: usize, scale: f64) -> serde_json::Value {
+    let powers: Vec<Vec<u8>> = (0..nf)
+        .map(|i| (0..nf).map(|j| u8::from(i == j)).collect())
+        .collect();
+    let c: Vec<f64> = (0..nf).map(|_| scale * rng.next()).collect();
+    serde_json::json!({"baseline": {"terms": {"n_features": nf, "powers": powers},
+                                    "coefficients": c}})
+}
+
 /// Unit `u`: its model JSON, axis count and temperature count. Axis `k` is generated model
-/// `3u + k` (kinds cycle through every method); the sensor each axis reads is drawn.
+/// `3u + k` (kinds cycle through every method) on a drawn first sensor, and reads up to three
+/// further drawn sensors (as many as the unit has), each with its own drawn lags and parts.
 fn unit_model(u: usize) -> (serde_json::Value, usize, usize) {
     let mut rng = Lcg(0x1417 + u as u64);
-    let mut pick = |n: usize| ((rng.next() + 0.5) * n as f64) as usize % n;
-    let n_axes = 1 + (u + pick(3)) % 3;
-    let n_temps = 1 + pick(5);
+    let pick = |rng: &mut Lcg, n: usize| ((rng.next() + 0.5) * n as f64) as usize % n;
+    let n_axes = 1 + (u + pick(&mut rng, 3)) % 3;
+    let n_temps = 1 + pick(&mut rng, 5);
     let gyro_cols: Vec<String> = (0..n_axes).map(|k| format!("g{k} */ x??=")).collect();
     let temp_cols: Vec<String> = (0..n_temps).map(|j| format!("t{j} */??/")).collect();
+    let mut several = false;
     let axes: Vec<serde_json::Value> = (0..n_axes)
         .map(|k| {
+            let model = generated_model(3 * u + k);
+            // Draw the sensors: a shuffled list of the unit's, then how many to read.
+            let mut order: Vec<usize> = (0..n_temps).collect();
+            for i in (1..n_temps).rev() {
+                order.swap(i, pick(&mut rng, i + 1));
+            }
+            let n_read = 1 + pick(&mut rng, n_temps.min(4));
+            several |= n_read > 1;
+            let smooth = model["features"]["smoothing_window_s"].as_f64().unwrap() > 0.0;
+            let more: Vec<serde_json::Value> = order[1..n_read]
+                .iter()
+                .map(|_| {
+                    let n_lags = pick(&mut rng, 5);
+                    let lags: Vec<f64> = [40.0, 200.0, 800.0, 2500.0][..n_lags].to_vec();
+                    let nf = 2 + usize::from(smooth) + n_lags;
+                    let mut m = serde_json::json!({"lags_s": lags});
+                    // Both parts, K's only, B's only, neither.
+                    let which = pick(&mut rng, 4);
+                    if which == 0 || which == 2 {
+                        m["bias"] = further_part(&mut rng, nf, 1e-4);
+                    }
+                    if which == 0 || which == 1 {
+                        m["scale"] = further_part(&mut rng, nf, 1e-3);
+                    }
+                    m
+                })
+                .collect();
             serde_json::json!({
                 "gyro": gyro_cols[k],
-                "temps": [temp_cols[pick(n_temps)]],
+                "temps": order[..n_read].iter().map(|&j| &temp_cols[j]).collect::<Vec<_>>(),
                 "scores": [],
-                "model": generated_model(3 * u + k),
+                "model": model,
+                "more": more,
             })
         })
         .collect();
     let m = serde_json::json!({
-        "imu_format_version": 1, "gyro_cols": gyro_cols, "temp_cols": temp_cols, "axes": axes,
+        "imu_format_version": if several { 2 } else { 1 }, "gyro_cols": gyro_cols,
+        "temp_cols": temp_cols, "axes": axes,
     });
     (m, n_axes, n_temps)
 }
@@ -207,6 +251,8 @@ fn generated_unit_c_equals_the_unit_stream() {
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
     let (mut lines, mut axis_lines, mut differ, mut statuses) = (0usize, 0, 0, [0usize; 4]);
     let mut verdicts = [0usize; 5];
+    // Axis-lines by the number of sensors the axis reads (1 to 4).
+    let mut by_sensors = [0usize; 5];
     let mut failures = Vec::new();
     let workers = std::thread::available_parallelism().map_or(2, |n| n.get().min(4));
     for batch in 0..UNITS.div_ceil(BATCH) {
@@ -354,6 +400,7 @@ fn generated_unit_c_equals_the_unit_stream() {
                     let (cv, sigma) = (vals[5 * j + 3] as usize, vals[5 * j + 4]);
                     let (wc, wsig) = cover[line][k];
                     axis_lines += 1;
+                    by_sensors[m.axes[k].temps.len()] += 1;
                     statuses[ws] += 1;
                     verdicts[wc] += 1;
                     let same = cs == ws
@@ -382,7 +429,8 @@ fn generated_unit_c_equals_the_unit_stream() {
     println!(
         "unit differential: {UNITS} units, {lines} lines ({axis_lines} axis-lines) compared, \
          {differ} lines differ (axis-lines ok {}, held {}, degraded {}, invalid {}; coverage \
-         inside {}, edge {}, outside {}, no verdict {}, no map {}); {:.1} s",
+         inside {}, edge {}, outside {}, no verdict {}, no map {}; axis-lines on an axis reading \
+         1, 2, 3, 4 sensors: {:?}); {:.1} s",
         statuses[0],
         statuses[1],
         statuses[2],
@@ -392,6 +440,7 @@ fn generated_unit_c_equals_the_unit_stream() {
         verdicts[2],
         verdicts[3],
         verdicts[4],
+        &by_sensors[1..],
         start.elapsed().as_secs_f64()
     );
     assert!(
@@ -401,4 +450,9 @@ fn generated_unit_c_equals_the_unit_stream() {
     // Every status occurred often, so each path was compared.
     assert!(statuses.iter().all(|v| *v > 1000), "statuses {statuses:?}");
     assert!(verdicts.iter().all(|v| *v > 500), "verdicts {verdicts:?}");
+    // Axes reading each number of sensors were compared.
+    assert!(
+        by_sensors[1..].iter().all(|v| *v > 2000),
+        "by sensors {by_sensors:?}"
+    );
 }

@@ -106,9 +106,19 @@ impl MoreSensors for MoreParts {
 /// One gyro axis reading one or more of the unit's temperature sensors (see the module doc).
 #[derive(Debug, Clone)]
 pub struct AxisCompensator {
+    /// The first sensor's compensator; its [`Compensator::channel`] is the first sensor's
+    /// index among `temps`.
     first: Compensator,
-    first_index: usize,
     more: MoreParts,
+}
+
+impl From<Compensator> for AxisCompensator {
+    /// A one-sensor axis reading `temps[c.channel()]`: it steps exactly as
+    /// [`Compensator::step_unit`].
+    fn from(c: Compensator) -> Self {
+        let channel = c.channel();
+        AxisCompensator::new(c, channel)
+    }
 }
 
 impl AxisCompensator {
@@ -117,7 +127,6 @@ impl AxisCompensator {
     pub fn new(first: Compensator, first_index: usize) -> Self {
         AxisCompensator {
             first: first.with_channel(first_index),
-            first_index,
             more: MoreParts {
                 parts: core::array::from_fn(|_| None),
             },
@@ -149,7 +158,7 @@ impl AxisCompensator {
                 });
             }
         }
-        if index == self.first_index || self.sensors().any(|i| i == index) {
+        if index == self.first.channel() || self.sensors().any(|i| i == index) {
             return Err(ModelError::Sensors);
         }
         let Some(slot) = self.more.parts.iter_mut().find(|p| p.is_none()) else {
@@ -167,7 +176,35 @@ impl AxisCompensator {
 
     /// The indices into `temps` this axis reads, first sensor first.
     pub fn sensors(&self) -> impl Iterator<Item = usize> + '_ {
-        core::iter::once(self.first_index).chain(self.more.parts.iter().flatten().map(|p| p.index))
+        core::iter::once(self.first.channel())
+            .chain(self.more.parts.iter().flatten().map(|p| p.index))
+    }
+
+    /// The further sensors, in the order they were added: each one's index among `temps`,
+    /// its features and its parts of B and K (what an export writes).
+    pub fn further(
+        &self,
+    ) -> impl Iterator<
+        Item = (
+            usize,
+            &FeatureSpec,
+            Option<&BaselineModel>,
+            Option<&BaselineModel>,
+        ),
+    > + '_ {
+        self.more.parts.iter().flatten().map(|p| {
+            (
+                p.index,
+                p.pipeline.spec(),
+                p.bias.as_ref(),
+                p.scale.as_ref(),
+            )
+        })
+    }
+
+    /// The first sensor's features of the latest step (as [`Compensator::features`]).
+    pub fn features(&self) -> Option<&crate::features::Features> {
+        self.first.features()
     }
 
     /// The first sensor's compensator (its spec and limits).
@@ -177,9 +214,10 @@ impl AxisCompensator {
 
     /// One sample: time (s), gyro output (°/s), and every sensor of the unit (°C), of which
     /// this axis reads its own. Never fails; see [`Compensator::step`]. With no further
-    /// sensor this is `Compensator::step` on `temps[first_index]` exactly.
+    /// sensor this is `Compensator::step` on `temps[first_index]` exactly
+    /// ([`Compensator::step_unit`]).
     pub fn step(&mut self, time_s: f64, gyro_dps: f64, temps: &[f64]) -> Corrected {
-        let t0 = reading(temps, self.first_index);
+        let t0 = reading(temps, self.first.channel());
         self.first
             .step_with(time_s, gyro_dps, t0, &mut self.more, temps)
     }

@@ -145,20 +145,39 @@ pub struct StaticLstm {
     pub target_std: f64,
 }
 
+impl StaticBaseline {
+    /// The checked model.
+    pub fn to_model(&self) -> Result<BaselineModel, ModelError> {
+        let mut m = BaselineModel::new(self.n_features as usize).map_err(ModelError::Baseline)?;
+        let terms = self.powers.iter().zip(&self.coefficients);
+        for (powers, &c) in terms.take(self.n_terms as usize) {
+            let p = powers.get(..self.n_features as usize).unwrap_or(&[]);
+            m.push_term(p, c).map_err(ModelError::Baseline)?;
+        }
+        Ok(m)
+    }
+}
+
+/// A further sensor of an axis as plain data (see [`crate::multi`]): the index of its reading
+/// among the unit's temperatures, its feature definition (the axis's step period and rate
+/// lag, its own lags) and its parts of the bias and the scale factor (no constant).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticSensor {
+    /// Index of the sensor's reading among the unit's temperatures.
+    pub channel: u8,
+    /// Its features.
+    pub spec: FeatureSpec,
+    /// Its part of the bias, °/s.
+    pub bias: Option<StaticBaseline>,
+    /// Its part of the scale factor.
+    pub scale: Option<StaticBaseline>,
+}
+
 impl StaticTarget {
     fn to_target(&self) -> Result<TargetModel, ModelError> {
         let baseline = match &self.baseline {
             None => None,
-            Some(b) => {
-                let mut m =
-                    BaselineModel::new(b.n_features as usize).map_err(ModelError::Baseline)?;
-                let terms = b.powers.iter().zip(&b.coefficients);
-                for (powers, &c) in terms.take(b.n_terms as usize) {
-                    let p = powers.get(..b.n_features as usize).unwrap_or(&[]);
-                    m.push_term(p, c).map_err(ModelError::Baseline)?;
-                }
-                Some(m)
-            }
+            Some(b) => Some(b.to_model()?),
         };
         let lstm = match &self.lstm {
             None => None,

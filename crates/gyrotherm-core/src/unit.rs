@@ -1,11 +1,10 @@
-//! An inertial unit in flight: one [`Compensator`] per gyro axis, all fed by one call per
+//! An inertial unit in flight: one [`AxisCompensator`] per gyro axis, all fed by one call per
 //! sample with the unit's time stamp, its gyro outputs and all its temperature sensors.
 //!
-//! Each axis compensator reads its own temperature channel(s) (through
-//! [`crate::multi::AxisCompensator::step`], which with one channel is
-//! [`Compensator::step_unit`] exactly), so:
+//! Each axis reads its own temperature channel(s) ([`AxisCompensator::step`]: one sensor, as
+//! [`Compensator::step_unit`], or several), so:
 //! - a fault on one temperature sensor (NaN, out of range, too fast) is a temperature fault
-//!   only for the axes that read it; the others stay `ok`;
+//!   only for the axes that read it (as first or as further sensor); the others stay `ok`;
 //! - a bad time stamp reaches every axis, and every axis's time axis (see
 //!   [`crate::compensator`]) judges it alike: the same sample is placed, held or re-bases on
 //!   all axes;
@@ -43,7 +42,7 @@
 
 use crate::compensator::{Compensator, Corrected, ModelError, Status};
 use crate::multi::AxisCompensator;
-use crate::static_model::StaticModel;
+use crate::static_model::{StaticModel, StaticSensor};
 use core::fmt;
 
 /// Default capacity of a [`Unit`]: three gyro axes.
@@ -69,7 +68,7 @@ pub enum UnitError {
         channel: usize,
         n_temps: usize,
     },
-    /// The model lists differ in length (axes and their channels).
+    /// The model lists differ in length (axes and their channels or further sensors).
     Layout { axes: usize, channels: usize },
     /// An axis's model cannot be built.
     Model { axis: usize, source: ModelError },
@@ -124,16 +123,11 @@ impl<const N: usize> Unit<N> {
         }
     }
 
-    /// Add the next axis (gyro index = the number of axes so far); it reads its
-    /// [`Compensator::channel`], which must be below the unit's channel count.
-    pub fn push_axis(&mut self, axis: Compensator) -> Result<(), UnitError> {
-        let channel = axis.channel();
-        self.push_axis_sensors(AxisCompensator::new(axis, channel))
-    }
-
-    /// Add the next axis reading one or more temperature channels
-    /// ([`crate::multi::AxisCompensator`]); every channel must be below the unit's count.
-    pub fn push_axis_sensors(&mut self, axis: AxisCompensator) -> Result<(), UnitError> {
+    /// Add the next axis (gyro index = the number of axes so far): a [`Compensator`] (one
+    /// sensor, its [`Compensator::channel`]) or an [`AxisCompensator`]; every sensor it reads
+    /// must be below the unit's channel count.
+    pub fn push_axis(&mut self, axis: impl Into<AxisCompensator>) -> Result<(), UnitError> {
+        let axis = axis.into();
         if let Some(channel) = axis.sensors().find(|&c| c >= self.n_temps) {
             return Err(UnitError::Channel {
                 axis: self.n_axes,
@@ -150,24 +144,47 @@ impl<const N: usize> Unit<N> {
         Ok(())
     }
 
-    /// The unit of exported static models (`gyrotherm export --lang rust` of a unit model):
-    /// axis `i` runs `models[i]` on temperature channel `channels[i]` of `n_temps`.
+    /// The unit of exported static models (`gyrotherm export --lang rust` of a unit model
+    /// whose axes read one sensor each): axis `i` runs `models[i]` on temperature channel
+    /// `channels[i]` of `n_temps`.
     pub fn from_static(
         models: &[StaticModel],
         channels: &[u8],
         n_temps: usize,
     ) -> Result<Self, UnitError> {
-        if models.len() != channels.len() {
+        Self::from_static_sensors(models, channels, &[], n_temps)
+    }
+
+    /// [`Unit::from_static`] with further sensors: axis `i` also reads `sensors[i]` (each
+    /// further sensor's channel, features and parts; an axis beyond `sensors` reads none).
+    pub fn from_static_sensors(
+        models: &[StaticModel],
+        channels: &[u8],
+        sensors: &[&[StaticSensor]],
+        n_temps: usize,
+    ) -> Result<Self, UnitError> {
+        if models.len() != channels.len() || sensors.len() > models.len() {
             return Err(UnitError::Layout {
                 axes: models.len(),
-                channels: channels.len(),
+                channels: channels.len().max(sensors.len()),
             });
         }
         let mut unit = Unit::new(n_temps);
         for (axis, (m, ch)) in models.iter().zip(channels).enumerate() {
             let c =
                 Compensator::from_static(m).map_err(|source| UnitError::Model { axis, source })?;
-            unit.push_axis(c.with_channel(usize::from(*ch)))?;
+            let mut a = AxisCompensator::new(c, usize::from(*ch));
+            for s in sensors.get(axis).copied().unwrap_or(&[]) {
+                let part = |b: &Option<crate::static_model::StaticBaseline>| {
+                    b.as_ref().map(|b| b.to_model()).transpose()
+                };
+                a = part(&s.bias)
+                    .and_then(|bias| {
+                        a.with_sensor(usize::from(s.channel), s.spec, bias, part(&s.scale)?)
+                    })
+                    .map_err(|source| UnitError::Model { axis, source })?;
+            }
+            unit.push_axis(a)?;
         }
         Ok(unit)
     }
@@ -182,17 +199,8 @@ impl<const N: usize> Unit<N> {
         self.n_temps
     }
 
-    /// Axis `i`'s compensator (its features, its channel; of its first sensor when it reads
-    /// several).
-    pub fn axis(&self, i: usize) -> Option<&Compensator> {
-        self.axes
-            .get(i)
-            .and_then(Option::as_ref)
-            .map(AxisCompensator::first)
-    }
-
-    /// Axis `i`, with every sensor it reads.
-    pub fn axis_sensors(&self, i: usize) -> Option<&AxisCompensator> {
+    /// Axis `i`'s compensator (its first sensor's features, its sensors).
+    pub fn axis(&self, i: usize) -> Option<&AxisCompensator> {
         self.axes.get(i).and_then(Option::as_ref)
     }
 
@@ -210,7 +218,7 @@ impl<const N: usize> Unit<N> {
         out
     }
 
-    /// Start over on every axis (see [`Compensator::reset`]).
+    /// Start over on every axis (see [`AxisCompensator::reset`]).
     pub fn reset(&mut self) {
         for c in self.axes.iter_mut().flatten() {
             c.reset();
@@ -268,6 +276,80 @@ mod tests {
         }
     }
 
+    /// An axis on sensor `first` reading `more` further sensors, each a part of B linear in
+    /// its `T` (coefficient 1e-5 per sensor index, an independent choice) and one lag.
+    fn multi_axis(first: usize, more: &[usize]) -> AxisCompensator {
+        let mut a = AxisCompensator::new(axis(first), first);
+        for &j in more {
+            let spec = FeatureSpec::PUBLISHED
+                .with_lags(&[50.0], crate::features::LagOutputs::DiffFromT)
+                .unwrap();
+            let mut b = crate::baseline::BaselineModel::new(spec.n_features()).unwrap();
+            let mut p = [0u8; crate::features::MAX_FEATURES];
+            p[0] = 1;
+            b.push_term(&p[..spec.n_features()], 1e-5 * (j as f64 + 1.0))
+                .unwrap();
+            a = a.with_sensor(j, spec, Some(b), None).unwrap();
+        }
+        a
+    }
+
+    #[test]
+    fn multi_sensor_axes_equal_their_own_axis_compensators() {
+        let mut unit: Unit = Unit::new(4);
+        let mut alone = [
+            multi_axis(1, &[0, 3]),
+            multi_axis(2, &[]),
+            multi_axis(3, &[2, 1, 0]),
+        ];
+        for a in &alone {
+            unit.push_axis(a.clone()).unwrap();
+        }
+        let (mut held0, mut held1) = (0, 0);
+        for i in 0..300 {
+            let x = f64::from(i);
+            let t = if i == 100 { f64::NAN } else { x };
+            // Sensor 0 (read by axes 0 and 2 as a further sensor) fails for a while.
+            let s0 = if (50..80).contains(&i) {
+                f64::NAN
+            } else {
+                20.0
+            };
+            let temps = [s0, 21.0 + 0.01 * x, 22.0, 25.0];
+            let gyro = [0.01, 0.02, 0.03];
+            let out = unit.step(t, &gyro, &temps);
+            for k in 0..3 {
+                assert_eq!(
+                    out[k],
+                    alone[k].step(t, gyro[k], &temps),
+                    "sample {i} axis {k}"
+                );
+            }
+            if (50..80).contains(&i) {
+                held0 += usize::from(out[0].status != Status::Ok);
+                held1 += usize::from(out[1].status != Status::Ok);
+            }
+        }
+        // The fault reaches the axes that read sensor 0 only.
+        assert_eq!((held0, held1), (30, 0));
+    }
+
+    #[test]
+    fn one_sensor_axis_is_step_unit() {
+        let mut a = AxisCompensator::from(axis(2));
+        let mut c = axis(2);
+        for i in 0..200 {
+            let x = f64::from(i);
+            let temps = [f64::NAN, 20.0, 21.0 + 0.02 * x];
+            let t = if i == 40 { x - 10.0 } else { x };
+            assert_eq!(
+                a.step(t, 0.01, &temps),
+                c.step_unit(t, 0.01, &temps),
+                "sample {i}"
+            );
+        }
+    }
+
     #[test]
     fn refuses_what_it_cannot_hold_and_never_panics_on_short_inputs() {
         let mut unit: Unit<2> = Unit::new(2);
@@ -284,6 +366,16 @@ mod tests {
         assert_eq!(
             unit.push_axis(axis(0)),
             Err(UnitError::TooManyAxes { capacity: 2 })
+        );
+        // A further sensor beyond the unit's channels is refused too.
+        let mut small: Unit<2> = Unit::new(2);
+        assert_eq!(
+            small.push_axis(multi_axis(0, &[3])),
+            Err(UnitError::Channel {
+                axis: 0,
+                channel: 3,
+                n_temps: 2
+            })
         );
         let out = unit.step(0.0, &[0.01], &[20.0]);
         assert_eq!(out[0].status, Status::Ok);

@@ -13,8 +13,9 @@
 //!
 //! The numbers are those of flight code: the flight [`Unit`] of
 //! [`gyrotherm_core::unit`] steps every axis with the line's time, gyro fields and all the
-//! model's temperature fields, and each axis reads its own sensor, so a temperature field that
-//! is empty, not a number or implausible holds only the axes that read it, and a gyro field
+//! model's temperature fields, and each axis reads its own sensors (one, or several with a
+//! model whose axes read further sensors), so a temperature field that is empty, not a number
+//! or implausible holds only the axes that read it, and a gyro field
 //! that is not a number (or NaN, infinite) makes only its own axis `invalid` (in
 //! [`Mode::Strict`] a gyro field that is not a number stops the run, as a malformed line). A
 //! bad time stamp reaches every axis alike. The columns are looked up by the model's names;
@@ -55,12 +56,13 @@ pub fn output_columns(model: &ImuModel) -> Vec<String> {
 }
 
 /// The flight unit of `model`: axis `i` runs axis `i`'s model on its sensors' indices among
-/// the model's temperature columns.
+/// the model's temperature columns (the first sensor's compensator and any further sensors'
+/// parts, [`imu_axis_compensators`]), the same axes as batch [`crate::imu_model::compensate_imu`].
 pub fn flight_unit(model: &ImuModel) -> Result<StreamUnit, ImuError> {
     let comps = imu_axis_compensators(model)?;
     let mut unit = StreamUnit::new(model.temp_cols.len());
     for (c, a) in comps.into_iter().zip(&model.axes) {
-        unit.push_axis_sensors(c).map_err(|e| {
+        unit.push_axis(c).map_err(|e| {
             ImuError::Layout(format!(
                 "axis {}: {e} (a unit runs at most {MAX_STREAM_AXES} axes)",
                 a.gyro

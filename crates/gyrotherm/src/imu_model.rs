@@ -193,8 +193,7 @@ pub type ImuProgress<'a> = dyn Fn(usize, usize, crate::fit::Target, usize, f64) 
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum ImuFitEvent {
-    /// Axis `axis` starts (its sensors are then tried in column order; with every sensor
-    /// allowed, each sensor's `SensorFinished` comes once all are identified).
+    /// Axis `axis` starts (its sensors are then tried in column order).
     AxisStarted { axis: usize },
     /// Axis `axis` starts its fit on sensor `sensor` (indices into the column lists).
     SensorStarted { axis: usize, sensor: usize },
@@ -204,7 +203,7 @@ pub enum ImuFitEvent {
         sensor: usize,
         cv_rms: Option<f64>,
     },
-    /// Axis `axis` is done and reads sensor `sensor` (its first, when it reads several).
+    /// Axis `axis` is done and reads sensor `sensor` first (and any further sensors chosen).
     AxisFinished { axis: usize, sensor: usize },
 }
 
@@ -229,7 +228,7 @@ pub fn fit_imu_with_events(
     progress: &ImuProgress,
     events: &ImuEvents,
 ) -> Result<ImuModel, ImuError> {
-    fit_imu_with_settings(
+    fit_imu_full(
         logs,
         cfg,
         &ImuFitSettings::default(),
@@ -239,7 +238,8 @@ pub fn fit_imu_with_events(
     )
 }
 
-/// [`fit_imu`] with `settings`.
+/// Fit every axis of the unit (see the module doc): logs read with the column lists; each
+/// axis on its own thread; `temp_sensor` the limits every axis's compensator believes.
 pub fn fit_imu_with(
     logs: &[(String, ImuLog)],
     cfg: &FitConfig,
@@ -247,13 +247,11 @@ pub fn fit_imu_with(
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
 ) -> Result<ImuModel, ImuError> {
-    fit_imu_with_settings(logs, cfg, settings, temp_sensor, progress, &|_| {})
+    fit_imu_full(logs, cfg, settings, temp_sensor, progress, &|_| {})
 }
 
-/// Fit every axis of the unit (see the module doc): logs read with the column lists; each
-/// axis on its own thread; `temp_sensor` the limits every axis's compensator believes;
-/// `events` told as each axis and each sensor starts and finishes.
-pub fn fit_imu_with_settings(
+/// [`fit_imu_with`], telling `events` as each axis and each sensor tried starts and finishes.
+pub fn fit_imu_full(
     logs: &[(String, ImuLog)],
     cfg: &FitConfig,
     settings: &ImuFitSettings,
@@ -395,8 +393,8 @@ fn fit_axis(
         }
     }
     let (j, mut outcome) = best.ok_or_else(|| ImuError::Layout("no temperature columns".into()))?;
-    events(ImuFitEvent::AxisFinished { axis: k, sensor: j });
     outcome.model.features.temp_sensor = *temp_sensor;
+    events(ImuFitEvent::AxisFinished { axis: k, sensor: j });
     Ok(ImuAxis {
         gyro: gyro_cols[k].clone(),
         temps: vec![temp_cols[j].clone()],
@@ -475,13 +473,6 @@ fn fit_axis_multi(
             min_gain: settings.min_gain,
         },
     );
-    for (j, cv_rms) in single.iter().enumerate() {
-        events(ImuFitEvent::SensorFinished {
-            axis: k,
-            sensor: j,
-            cv_rms: *cv_rms,
-        });
-    }
     let scores: Vec<SensorScore> = temp_cols
         .iter()
         .zip(&single)
@@ -490,6 +481,14 @@ fn fit_axis_multi(
             cv_rms: *s,
         })
         .collect();
+    // The one-sensor scores come from the selection, after every sensor's identification.
+    for (j, s) in single.iter().enumerate() {
+        events(ImuFitEvent::SensorFinished {
+            axis: k,
+            sensor: j,
+            cv_rms: *s,
+        });
+    }
     let j0 = order[0];
     let (axis_logs, id0, _, _) = &per_sensor[j0];
     let named: Vec<NamedLog> = axis_logs

@@ -189,8 +189,33 @@ fn coverage(m: &StaticModel) -> String {
     )
 }
 
+/// What an axis that reads further sensors adds to the single-axis port (see
+/// [`super::unit`]): text for the `@MORE_*@` places of the templates, each a whole line or
+/// lines (or, for `plausible`, a condition to append); all empty for a one-sensor model, which
+/// leaves the port as it is.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Hooks {
+    /// Fields appended to `struct gt_state`.
+    pub state: String,
+    /// `&& ...`: the further sensors' readings are believed.
+    pub plausible: String,
+    /// Statements at the end of `rebase`.
+    pub rebase: String,
+    /// Statements after the first pipeline's push (`r` its result).
+    pub push: String,
+    /// Statements where a pushed sample is accepted.
+    pub accepted: String,
+    /// Statements after both models were evaluated (`vb`, `vk`).
+    pub add: String,
+}
+
 /// `(header, source)`.
 pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
+    generate_with(m, about, &Hooks::default())
+}
+
+/// [`generate`] with an axis's further sensors' hooks.
+pub(crate) fn generate_with(m: &StaticModel, about: &str, hooks: &Hooks) -> (String, String) {
     let spec = &m.spec;
     let nf = spec.n_features();
     let n_lags = spec.lags().len();
@@ -222,6 +247,7 @@ pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
         .replace("@NF@", &nf.to_string())
         .replace("@LAGS@", &lag_slots.to_string())
         .replace("@HIST@", &HISTORY_STEPS.to_string())
+        .replace("@MORE_STATE@", &hooks.state)
         .replace(
             "@COVERAGE_NOTE@",
             &match &m.coverage {
@@ -275,6 +301,11 @@ pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
             "@HAS_COVERAGE@",
             &u8::from(m.coverage.is_some()).to_string(),
         )
+        .replace("@MORE_REBASE@", &hooks.rebase)
+        .replace("@MORE_PLAUSIBLE@", &hooks.plausible)
+        .replace("@MORE_PUSH@", &hooks.push)
+        .replace("@MORE_ACCEPTED@", &hooks.accepted)
+        .replace("@MORE_ADD@", &hooks.add)
         .replace("@DATA@", &data)
         .replace("@COVERAGE@", &coverage(m));
     (header, source)

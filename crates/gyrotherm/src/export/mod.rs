@@ -162,32 +162,32 @@ fn static_coverage(model: &ModelFile) -> Result<Option<StaticCoverage>, ExportEr
     }))
 }
 
+/// A core baseline as plain data.
+pub(crate) fn static_baseline(b: &gyrotherm_core::baseline::BaselineModel) -> StaticBaseline {
+    let mut s = StaticBaseline {
+        n_features: b.n_features() as u8,
+        n_terms: b.n_terms() as u8,
+        powers: [[0; MAX_FEATURES]; gyrotherm_core::baseline::MAX_TERMS],
+        coefficients: [0.0; gyrotherm_core::baseline::MAX_TERMS],
+    };
+    for j in 0..b.n_terms() {
+        if let Some((p, c)) = b.term(j) {
+            s.powers[j][..p.len()].copy_from_slice(p);
+            s.coefficients[j] = c;
+        }
+    }
+    s
+}
+
 fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, CompensateError> {
     let Some(sub) = sub else {
         return Ok(StaticTarget::constant(absent));
     };
-    let baseline = match sub
+    let baseline = sub
         .baseline_core()
         .transpose()
         .map_err(CompensateError::Baseline)?
-    {
-        None => None,
-        Some(b) => {
-            let mut s = StaticBaseline {
-                n_features: b.n_features() as u8,
-                n_terms: b.n_terms() as u8,
-                powers: [[0; MAX_FEATURES]; gyrotherm_core::baseline::MAX_TERMS],
-                coefficients: [0.0; gyrotherm_core::baseline::MAX_TERMS],
-            };
-            for j in 0..b.n_terms() {
-                if let Some((p, c)) = b.term(j) {
-                    s.powers[j][..p.len()].copy_from_slice(p);
-                    s.coefficients[j] = c;
-                }
-            }
-            Some(s)
-        }
-    };
+        .map(|b| static_baseline(&b));
     let lstm = match sub.lstm() {
         Some((params, input_norm, target_norm)) => {
             let w = crate::compensate::padded_core_lstm(params)?;

@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 
 use gyrotherm_core::features::LagOutputs;
-use gyrotherm_core::static_model::{StaticModel, StaticTarget};
+use gyrotherm_core::static_model::{StaticBaseline, StaticModel, StaticTarget};
 
 use super::{f32_lit, f64_lit};
 
@@ -103,12 +103,44 @@ pub fn generate(m: &StaticModel, about: &str) -> String {
     out
 }
 
-/// The `StaticModel { ... }` expression of `m` (its fields indented by four spaces).
-pub(crate) fn model_expr(m: &StaticModel) -> String {
-    let mut out = String::from("StaticModel {\n");
-    let s = &m.spec;
-    let _ = writeln!(
-        out,
+/// The `StaticSensor { ... }` expression of a further sensor.
+pub(crate) fn sensor_expr(
+    channel: usize,
+    spec: &gyrotherm_core::features::FeatureSpec,
+    bias: &Option<StaticBaseline>,
+    scale: &Option<StaticBaseline>,
+) -> String {
+    let mut out = format!(
+        "StaticSensor {{
+    channel: {channel},
+"
+    );
+    out.push_str(&spec_expr(spec));
+    out.push('\n');
+    for (name, b) in [("bias", bias), ("scale", scale)] {
+        match b {
+            None => {
+                let _ = writeln!(out, "    {name}: None,");
+            }
+            Some(b) => {
+                let _ = writeln!(
+                    out,
+                    "    {name}: Some(StaticBaseline {{\n        n_features: {},\n        n_terms: {},\n        powers: {},\n        coefficients: {},\n    }}),",
+                    b.n_features,
+                    b.n_terms,
+                    list(&b.powers, |row| list(row, |p| p.to_string())),
+                    f64s(&b.coefficients)
+                );
+            }
+        }
+    }
+    out.push('}');
+    out
+}
+
+/// The `    spec: FeatureSpec { ... },` field of `s` (no newline at the end).
+fn spec_expr(s: &gyrotherm_core::features::FeatureSpec) -> String {
+    format!(
         "    spec: FeatureSpec {{\n        step_period_s: {},\n        rate_lag_s: {},\n        smoothing_window_s: {},\n        lag_tau_s: {},\n        n_lags: {},\n        lag_outputs: LagOutputs::{},\n    }},",
         f64_lit(s.step_period_s),
         f64_lit(s.rate_lag_s),
@@ -120,7 +152,14 @@ pub(crate) fn model_expr(m: &StaticModel) -> String {
             LagOutputs::DiffFromT => "DiffFromT",
             LagOutputs::Both => "Both",
         }
-    );
+    )
+}
+
+/// The `StaticModel { ... }` expression of `m` (its fields indented by four spaces).
+pub(crate) fn model_expr(m: &StaticModel) -> String {
+    let mut out = String::from("StaticModel {\n");
+    out.push_str(&spec_expr(&m.spec));
+    out.push('\n');
     let l = &m.limits;
     let _ = writeln!(
         out,

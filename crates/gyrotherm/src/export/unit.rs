@@ -16,13 +16,20 @@
 //! `gyrotherm_model.c` holds, per axis, the single-axis port of [`super::c`] for that axis's
 //! model, its file-scope names suffixed `_a<i>` (comments untouched), the model-independent
 //! helpers (`expm1`, `exp`, bit casts) once; then the unit functions, which call axis `i`'s
-//! `gt_step` with `gyro[i]` and the temperature of the sensor it reads. So each axis computes
-//! exactly what a one-axis export of its model computes, and what the core's
-//! [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last bit.
+//! `gt_step` with `gyro[i]` and the temperature of the first sensor it reads. An axis that
+//! reads further sensors ([`gyrotherm_core::multi`]) gets, per further sensor, the feature
+//! pipeline and baseline code of the same port (the port of a model on that sensor's features
+//! whose B and K are its parts), suffixed `_a<i>s<j>`, and the port's hooks (`@MORE_*@`) call
+//! the `more_*` functions, a port of the core's further-sensor handling: plausibility against
+//! each sensor's own last good reading, the pipelines pushed together, the parts added in
+//! order, every pipeline restarted on a new time base. So each axis computes exactly what the
+//! core's [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last
+//! bit.
 //!
-//! **Rust.** `gyrotherm_model.rs` holds `AXES`, `TEMPS`, `CHANNELS` (the sensor each axis
-//! reads) and `MODELS` (one [`StaticModel`] per
-//! axis), for [`Unit::from_static`](gyrotherm_core::unit::Unit::from_static).
+//! **Rust.** `gyrotherm_model.rs` holds `AXES`, `TEMPS`, `CHANNELS` (the first sensor each
+//! axis reads), `MODELS` (one [`StaticModel`] per axis) and `SENSORS` (each axis's further
+//! sensors), for
+//! [`Unit::from_static_sensors`](gyrotherm_core::unit::Unit::from_static_sensors).
 //!
 //! **Column names.** Generated source holds only generator text and numbers: the column
 //! names, which come from the model file, are never written into it (a name could close a
@@ -35,9 +42,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use gyrotherm_core::features::HISTORY_STEPS;
-use gyrotherm_core::static_model::StaticModel;
+use gyrotherm_core::static_model::{StaticBaseline, StaticModel, StaticTarget};
 
-use super::{c, describe, rust, static_model, write_files, ExportError, Lang};
+use super::{c, describe, rust, static_baseline, static_model, write_files, ExportError, Lang};
 use crate::imu_model::{ImuError, ImuModel};
 use crate::model::CHECKSUM_KEY;
 
@@ -80,12 +87,19 @@ fn ordinal(n: usize) -> String {
 /// The unit's name-to-index map, one line each, for the user (stderr): the names come from
 /// the model file and go nowhere into generated source.
 pub fn column_map(model: &ImuModel) -> Vec<String> {
-    let idx = model.sensor_index();
     let mut out = Vec::new();
-    for (i, g) in model.gyro_cols.iter().enumerate() {
+    for (i, (g, a)) in model.gyro_cols.iter().zip(&model.axes).enumerate() {
+        let reads: Vec<String> = a
+            .temps
+            .iter()
+            .map(|t| {
+                let j = model.temp_cols.iter().position(|c| c == t).unwrap_or(0);
+                format!("temp[{j}]")
+            })
+            .collect();
         out.push(format!(
-            "gyro[{i}] = {g} (axis {i}, reads temp[{}])",
-            idx.get(i).copied().unwrap_or(0)
+            "gyro[{i}] = {g} (axis {i}, reads {})",
+            reads.join(", ")
         ));
     }
     for (j, t) in model.temp_cols.iter().enumerate() {
@@ -122,15 +136,43 @@ pub fn generate_imu(
             }),
             other => other,
         };
-        axes.push((
-            static_model(&a.model).map_err(err)?,
-            describe(&a.model).map_err(err)?,
-        ));
+        let first = static_model(&a.model).map_err(err)?;
+        // The further sensors as the core axis holds them (what the stream runs).
+        let core = model.axis_compensator(a).map_err(ExportError::Unit)?;
+        let sensors = core
+            .further()
+            .map(|(channel, spec, bias, scale)| {
+                let bias = bias.map(static_baseline);
+                let scale = scale.map(static_baseline);
+                let part = |b: &Option<StaticBaseline>| StaticTarget {
+                    offset: 0.0,
+                    baseline: *b,
+                    lstm: None,
+                    lstm_reads_base: false,
+                };
+                SensorExport {
+                    channel,
+                    model: StaticModel {
+                        spec: *spec,
+                        limits: first.limits,
+                        bias: part(&bias),
+                        scale: part(&scale),
+                        coverage: None,
+                    },
+                    bias,
+                    scale,
+                }
+            })
+            .collect();
+        axes.push(AxisExport {
+            channel: core.first().channel(),
+            about: describe(&a.model).map_err(err)?,
+            model: first,
+            sensors,
+        });
     }
-    let channels = model.sensor_index();
     let layout = Layout {
         n_temps: model.temp_cols.len(),
-        channels: &channels,
         digest: &digest,
     };
     Ok(match lang {
@@ -142,6 +184,33 @@ pub fn generate_imu(
     })
 }
 
+/// One axis to export: its first sensor's model and channel, its further sensors.
+struct AxisExport {
+    model: StaticModel,
+    about: String,
+    channel: usize,
+    sensors: Vec<SensorExport>,
+}
+
+impl AxisExport {
+    /// The `temp[]` entries the axis reads, first sensor first.
+    fn channels(&self) -> Vec<usize> {
+        std::iter::once(self.channel)
+            .chain(self.sensors.iter().map(|s| s.channel))
+            .collect()
+    }
+}
+
+/// A further sensor of an axis: its `temp[]` entry, its features, its parts of B and K, and
+/// the single-axis model whose port gives its pipeline and baseline code (the axis's limits,
+/// the parts as baselines without offset).
+struct SensorExport {
+    channel: usize,
+    model: StaticModel,
+    bias: Option<StaticBaseline>,
+    scale: Option<StaticBaseline>,
+}
+
 /// Write the export of a unit model for `lang` into `dir` (created if missing), each file
 /// atomically; returns the files written.
 pub fn export_imu(model: &ImuModel, lang: Lang, dir: &Path) -> Result<Vec<PathBuf>, ExportError> {
@@ -151,13 +220,12 @@ pub fn export_imu(model: &ImuModel, lang: Lang, dir: &Path) -> Result<Vec<PathBu
 /// What the files say about the unit besides the axes' models.
 struct Layout<'a> {
     n_temps: usize,
-    channels: &'a [usize],
     digest: &'a str,
 }
 
 impl Layout<'_> {
     /// The comment lines (without comment markers) on the model and the column order.
-    fn about(&self, axes: &[(StaticModel, String)], gyro: &str, temp: &str) -> Vec<String> {
+    fn about(&self, axes: &[AxisExport], gyro: &str, temp: &str) -> Vec<String> {
         let n = axes.len();
         let mut out = vec![
             format!(
@@ -166,8 +234,24 @@ impl Layout<'_> {
             ),
             format!("{CHECKSUM_KEY} {}.", self.digest),
         ];
-        for (i, (_, about)) in axes.iter().enumerate() {
-            out.push(format!("Axis {i}: {about}."));
+        for (i, a) in axes.iter().enumerate() {
+            out.push(format!("Axis {i}: {}.", a.about));
+            for (j, s) in a.sensors.iter().enumerate() {
+                let spec = &s.model.spec;
+                let lags: Vec<String> = spec.lags().iter().map(|t| format!("{t} s")).collect();
+                out.push(format!(
+                    "  further sensor {}: {temp}[{}], lags [{}] (T - lag outputs), parts of {};",
+                    j + 1,
+                    s.channel,
+                    lags.join(", "),
+                    match (s.bias.is_some(), s.scale.is_some()) {
+                        (true, true) => "B and K",
+                        (true, false) => "B",
+                        (false, true) => "K",
+                        (false, false) => "neither B nor K",
+                    }
+                ));
+            }
         }
         out.push(
             "Column order. The model's column names are not copied into generated source;".into(),
@@ -177,11 +261,21 @@ impl Layout<'_> {
              (gyro_cols, temp_cols):"
                 .into(),
         );
-        for i in 0..n {
+        for (i, a) in axes.iter().enumerate() {
+            let reads: Vec<String> = a
+                .channels()
+                .iter()
+                .map(|c| format!("{temp}[{c}]"))
+                .collect();
             out.push(format!(
-                "  {gyro}[{i}] is the model's {} gyro column; axis {i} reads {temp}[{}];",
+                "  {gyro}[{i}] is the model's {} gyro column; axis {i} reads {}{};",
                 ordinal(i + 1),
-                self.channels[i]
+                reads.join(", "),
+                if reads.len() > 1 {
+                    " (first sensor first)"
+                } else {
+                    ""
+                }
             ));
         }
         for j in 0..self.n_temps {
@@ -262,8 +356,196 @@ fn file_scope_names(source: &str) -> Vec<String> {
     names
 }
 
+/// The pieces of a further sensor's single-axis port that the axis uses: the constants of
+/// its feature pipeline, its baseline type and data (the parts of B and K), the pipeline
+/// (`hist_back`, `emit`, `pipe_push`) and `base_eval`. The rest of that port (its compensator,
+/// its LSTM code) the axis does not run, so it is left out (C99 warns of unused statics).
+fn sensor_pieces(src: &str, parts: bool) -> String {
+    const NEEDED: [&str; 10] = [
+        "N_LAGS",
+        "LAG_LEVELS",
+        "LAG_DIFFS",
+        "STEP_P",
+        "BOUNDARY_TOL",
+        "RATE_LAG_STEPS",
+        "WINDOW_STEPS",
+        "LAG_TAU",
+        "LAG_GAIN",
+        "MAX_STEP_INDEX",
+    ];
+    let between = |from: &str, to: &str| -> &str {
+        let a = src.find(from).unwrap_or(src.len());
+        let b = src[a..].find(to).map_or(src.len(), |k| a + k);
+        &src[a..b]
+    };
+    let mut out = String::new();
+    for line in between("#define N_LAGS", "typedef struct {").lines() {
+        let name = match line.strip_prefix("#define ") {
+            Some(r) => r.split(' ').next(),
+            None => line
+                .split_once(" = ")
+                .and_then(|(h, _)| h.rsplit(' ').next())
+                .and_then(|n| n.split('[').next()),
+        }
+        .unwrap_or("");
+        if NEEDED.contains(&name) {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out.push('\n');
+    if parts {
+        let typedef = between(
+            "typedef struct {\n    int n_terms;",
+            "typedef struct {\n    int n_inputs;",
+        );
+        out.push_str(typedef);
+        let data = between("} target_def;\n", SHARED_FROM);
+        for line in data.lines().skip(1) {
+            if !line.contains("_target = {") {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    out.push_str(between(
+        "/* The i-th newest stored step",
+        "/* Compensator::rebase",
+    ));
+    if parts {
+        out.push_str(between(
+            "/* BaselineModel::eval. */",
+            "/* TargetModel::eval. */",
+        ));
+    }
+    out
+}
+
+/// The C of an axis's further sensors (suffix `_a<i>`): the hooks into its single-axis port,
+/// and the functions they call (`more_*`), placed after the port. Each further sensor `j`
+/// keeps its pipeline state `m<j>`, its reading of this sample `m<j>_t` and its latest features
+/// `m<j>_feat` in the axis's state; the functions are a port of the core's `MoreParts`
+/// (gyrotherm-core's multi.rs), in its order.
+fn further_sensors(i: usize, sensors: &[SensorExport]) -> (c::Hooks, String, String) {
+    if sensors.is_empty() {
+        return (c::Hooks::default(), String::new(), String::new());
+    }
+    let a = format!("_a{i}");
+    let mut hooks = c::Hooks::default();
+    for (k, s) in sensors.iter().enumerate() {
+        let j = k + 1;
+        let _ = write!(
+            hooks.state,
+            "    gt_state{a}s{j} m{j};              /* further sensor {j}: pipeline, latest good reading */\n    \
+             double m{j}_t;                   /* its reading of this sample */\n    \
+             double m{j}_feat[GT_N_FEATURES{a}s{j}]; /* its latest features */\n"
+        );
+        let _ = s;
+    }
+    hooks.plausible = format!(" && more_plausible{a}(s, time_s)");
+    hooks.rebase = format!("    more_rebase{a}(s);\n");
+    hooks.push = format!(
+        "    /* The further pipelines see the same times, so they step when this one does. */\n    \
+         if ((r == 1 || r == 0) && !more_push{a}(s, time_s)) {{\n        rebase(s);\n        return 0;\n    }}\n"
+    );
+    hooks.accepted = format!("        more_accepted{a}(s, time_s);\n");
+    hooks.add = format!("    if (!more_add{a}(s, &vb, &vk)) {{\n        return 0;\n    }}\n");
+    let protos = format!(
+        "static int more_plausible{a}(const gt_state{a} *s, double time_s);\n\
+         static void more_rebase{a}(gt_state{a} *s);\n\
+         static int more_push{a}(gt_state{a} *s, double time_s);\n\
+         static void more_accepted{a}(gt_state{a} *s, double time_s);\n\
+         static int more_add{a}(const gt_state{a} *s, double *b, double *k);\n"
+    );
+    let mut f = String::new();
+    let _ = write!(
+        f,
+        "\n/* Axis {i}'s further sensors (gyrotherm_core::multi): each reading believed as the\n \
+         * first sensor's is (Compensator::plausible), against its own latest good reading. */\n\
+         static int more_reading{a}(int has_good, double good_time_s, double good_temp_c,\n    \
+         double time_s, double temp_c)\n{{\n    \
+         if (!(temp_c >= T_MIN{a} && temp_c <= T_MAX{a})) {{\n        return 0;\n    }}\n    \
+         if (has_good) {{\n        \
+         double allowed = RATE_MAX{a} * (time_s - good_time_s) + STEP_ALLOWANCE{a};\n        \
+         return fabs(temp_c - good_temp_c) <= allowed;\n    }}\n    return 1;\n}}\n\n\
+         static int more_plausible{a}(const gt_state{a} *s, double time_s)\n{{\n    int ok = 1;\n"
+    );
+    for j in 1..=sensors.len() {
+        let _ = writeln!(
+            f,
+            "    ok = ok && more_reading{a}(s->m{j}.has_good, s->m{j}.good_time_s, s->m{j}.good_temp_c, time_s, s->m{j}_t);"
+        );
+    }
+    f.push_str("    return ok;\n}\n\n");
+    let _ = writeln!(
+        f,
+        "/* A new time base: restart the pipelines (FeaturePipeline::reset), forget the readings. */\n\
+         static void more_rebase{a}(gt_state{a} *s)\n{{"
+    );
+    for j in 1..=sensors.len() {
+        let _ = writeln!(
+            f,
+            "    s->m{j}.hist_head = 0u;\n    s->m{j}.hist_len = 0u;\n    \
+             memset(s->m{j}.lag_c, 0, sizeof s->m{j}.lag_c);\n    s->m{j}.started = 0u;\n    \
+             s->m{j}.last_step = 0u;\n    s->m{j}.has_good = 0u;"
+        );
+    }
+    f.push_str("}\n\n");
+    let _ = writeln!(
+        f,
+        "/* Every further pipeline takes the sample; 0 if one refused it. */\n\
+         static int more_push{a}(gt_state{a} *s, double time_s)\n{{\n    int ok = 1;"
+    );
+    for j in 1..=sensors.len() {
+        let _ = writeln!(
+            f,
+            "    ok = pipe_push{a}s{j}(&s->m{j}, time_s, s->m{j}_t, s->m{j}_feat) >= 0 && ok;"
+        );
+    }
+    f.push_str("    return ok;\n}\n\n");
+    let _ = writeln!(
+        f,
+        "/* The sample was used: each reading is its sensor's latest good one. */\n\
+         static void more_accepted{a}(gt_state{a} *s, double time_s)\n{{"
+    );
+    for j in 1..=sensors.len() {
+        let _ = writeln!(
+            f,
+            "    s->m{j}.has_good = 1u;\n    s->m{j}.good_time_s = time_s;\n    s->m{j}.good_temp_c = s->m{j}_t;"
+        );
+    }
+    f.push_str("}\n\n");
+    let _ = writeln!(
+        f,
+        "/* Each further sensor's parts of B and K, added in order; 0 if one gave none. */\n\
+         static int more_add{a}(const gt_state{a} *s, double *b, double *k)\n{{"
+    );
+    if sensors
+        .iter()
+        .any(|s| s.bias.is_some() || s.scale.is_some())
+    {
+        f.push_str("    double v;\n");
+    }
+    f.push_str("    (void)b;\n    (void)k;\n");
+    for (k, s) in sensors.iter().enumerate() {
+        let j = k + 1;
+        let _ = writeln!(f, "    if (!s->m{j}.started) {{\n        return 0;\n    }}");
+        for (part, name, acc) in [(&s.bias, "bias", "b"), (&s.scale, "scale", "k")] {
+            if part.is_some() {
+                let _ = writeln!(
+                    f,
+                    "    if (!base_eval{a}s{j}(&{name}_base{a}s{j}, s->m{j}_feat, &v)) {{\n        \
+                     return 0;\n    }}\n    *{acc} += v;"
+                );
+            }
+        }
+    }
+    f.push_str("    return 1;\n}\n");
+    (hooks, protos, f)
+}
+
 /// `(header, source)` of the unit.
-fn generate_c(axes: &[(StaticModel, String)], layout: &Layout) -> (String, String) {
+fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
     let n = axes.len();
     let mut h = String::new();
     h.push_str(
@@ -287,13 +569,47 @@ fn generate_c(axes: &[(StaticModel, String)], layout: &Layout) -> (String, Strin
         "/* gyrotherm_model.c: generated by `gyrotherm export --lang c` for an inertial unit.\n \
          * Per axis, the single-axis port of gyrotherm-core (the text of a one-axis export of\n \
          * that axis's model, its file-scope names suffixed _a<axis>), the model-independent\n \
-         * helpers once; then the unit's functions. Do not edit: re-export instead. */\n\
+         * helpers once; for an axis with further sensors, each sensor's feature pipeline and\n \
+         * baseline code from the same port (suffixed _a<axis>s<sensor>) and the functions that\n \
+         * join them to the axis (more_*); then the unit's functions. Do not edit: re-export\n \
+         * instead. */\n\
          #include \"gyrotherm_model.h\"\n\n#include <math.h>\n#include <string.h>\n",
     );
     let mut states = String::new();
-    for (i, (m, about)) in axes.iter().enumerate() {
-        let (ah, asrc) = c::generate(m, about);
+    for (i, ax) in axes.iter().enumerate() {
+        let (m, about) = (&ax.model, &ax.about);
         let suffix = format!("_a{i}");
+        // The further sensors' state types first (the axis's state holds them).
+        let mut sensor_src = String::new();
+        for (k, se) in ax.sensors.iter().enumerate() {
+            let ss = format!("{suffix}s{}", k + 1);
+            let (sh, ssrc) = c::generate(&se.model, "a further sensor");
+            let names = file_scope_names(&ssrc);
+            let _ = writeln!(
+                h,
+                "#define GT_N_FEATURES{ss} {}",
+                se.model.spec.n_features()
+            );
+            let _ = writeln!(
+                h,
+                "#define GT_LAG_SLOTS{ss} {}",
+                se.model.spec.lags().len().max(1)
+            );
+            let from = sh.find("struct gt_state {").unwrap_or(0);
+            let to = sh[from..].find("\n};\n").map_or(sh.len(), |k| from + k + 4);
+            let _ = writeln!(h, "typedef struct gt_state{ss} gt_state{ss};");
+            h.push_str(&rename(&sh[from..to], &names, &ss));
+            h.push('\n');
+            let _ = write!(
+                sensor_src,
+                "\n/* ---- axis {i}, further sensor {}: its pipeline and parts ---- */\n",
+                k + 1
+            );
+            let parts = se.bias.is_some() || se.scale.is_some();
+            sensor_src.push_str(&rename(&sensor_pieces(&ssrc, parts), &names, &ss));
+        }
+        let (hooks, protos, more_fns) = further_sensors(i, &ax.sensors);
+        let (ah, asrc) = c::generate_with(m, about, &hooks);
         // The axis's own sizes and state, from its single-axis header.
         let nf = m.spec.n_features();
         let lag_slots = m.spec.lags().len().max(1);
@@ -322,7 +638,10 @@ fn generate_c(axes: &[(StaticModel, String)], layout: &Layout) -> (String, Strin
              double temp_c, double *rate_dps, double *bias_dps, double *scale);\n\
              static gt_coverage gt_coverage_of{suffix}(const gt_state{suffix} *s, double *sigma_dph);\n"
         );
+        src.push_str(&protos);
         src.push_str(&rename(&body, &names, &suffix));
+        src.push_str(&sensor_src);
+        src.push_str(&more_fns);
     }
     h.push_str(
         "typedef struct gt_state gt_state;\n\n\
@@ -342,11 +661,14 @@ fn generate_c(axes: &[(StaticModel, String)], layout: &Layout) -> (String, Strin
          const double temp[GT_TEMPS], double rate[GT_AXES], gt_status status[GT_AXES],\n    \
          double bias[GT_AXES], double scale[GT_AXES])\n{\n",
     );
-    for i in 0..n {
+    for (i, ax) in axes.iter().enumerate() {
+        for (k, se) in ax.sensors.iter().enumerate() {
+            let _ = writeln!(src, "    s->a{i}.m{}_t = temp[{}];", k + 1, se.channel);
+        }
         let _ = writeln!(
             src,
             "    status[{i}] = gt_step_a{i}(&s->a{i}, t, gyro[{i}], temp[{}], &rate[{i}], &bias[{i}], &scale[{i}]);",
-            layout.channels[i]
+            ax.channel
         );
     }
     src.push_str(
@@ -380,9 +702,12 @@ const UNIT_HEADER_DOC: &str =
  * axis's B (deg/s) and K too. Each axis runs the single-axis compensator (gt_step of a
  * one-axis export of its model: the same statuses GT_OK, GT_HELD, GT_DEGRADED, GT_INVALID,
  * the same time axis and degraded clock, see gyrotherm-core's compensator module) on its
- * gyro and the one temperature it reads, so a fault in one temperature sensor holds only the
- * axes that read it, a bad time stamp reaches every axis alike, and a non-finite gyro sample
- * makes only its own axis GT_INVALID. gt_coverage_of_axis(s, i, &sigma_dph) is gt_coverage_of
+ * gyro and the first temperature it reads. An axis that reads further sensors (listed above)
+ * also runs each one's feature pipeline on the same time axis and adds each one's part of B
+ * and K after the first sensor's, in order; it uses a sample only when every sensor it reads
+ * is believed, each against its own latest good reading (gyrotherm-core's multi module). So a
+ * fault in one temperature sensor holds only the axes that read it, a bad time stamp reaches
+ * every axis alike, and a non-finite gyro sample makes only its own axis GT_INVALID. gt_coverage_of_axis(s, i, &sigma_dph) is gt_coverage_of
  * for axis i (GT_NO_VERDICT and NaN for an axis out of range).
  * The numbers equal gyrotherm-core's (and `gyrotherm compensate --stream`'s) to the last bit
  * when compiled with -ffp-contract=off on IEEE 754 hardware with FLT_EVAL_METHOD == 0. */
@@ -414,7 +739,7 @@ gt_coverage gt_coverage_of_axis(const gt_state *s, int axis, double *sigma_dph);
 ";
 
 /// The Rust module of the unit.
-fn generate_rust(axes: &[(StaticModel, String)], layout: &Layout) -> String {
+fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
     let n = axes.len();
     let mut out = String::from(
         "//! Inertial-unit compensation model for gyrotherm-core, generated by\n\
@@ -424,10 +749,12 @@ fn generate_rust(axes: &[(StaticModel, String)], layout: &Layout) -> String {
         let _ = writeln!(out, "//! {line}");
     }
     out.push_str(
-        "//! Use: `let mut unit = gyrotherm_core::unit::Unit::<AXES>::from_static(&MODELS, \
-         &CHANNELS, TEMPS)?;`\n\
+        "//! Use: `let mut unit = gyrotherm_core::unit::Unit::<AXES>::from_static_sensors(&MODELS, \
+         &CHANNELS, &SENSORS, TEMPS)?;`\n\
          //! then `unit.step(time_s, &gyro, &temps)` per sample: entry i is axis i's corrected\n\
-         //! sample (axis i runs MODELS[i] on temps[CHANNELS[i]]).\n\
+         //! sample (axis i runs MODELS[i] on temps[CHANNELS[i]], and SENSORS[i] on the further\n\
+         //! sensors it reads; with no further sensor `Unit::from_static(&MODELS, &CHANNELS, TEMPS)`\n\
+         //! is the same).\n\
          //! Do not edit: re-export instead.\n\n\
          use gyrotherm_core::compensator::TempLimits;\n\
          #[allow(unused_imports)]\n\
@@ -435,7 +762,7 @@ fn generate_rust(axes: &[(StaticModel, String)], layout: &Layout) -> String {
          use gyrotherm_core::features::{FeatureSpec, LagOutputs};\n\
          #[allow(unused_imports)]\n\
          use gyrotherm_core::static_model::{\n    \
-         StaticBaseline, StaticCoverage, StaticLstm, StaticModel, StaticTarget,\n\
+         StaticBaseline, StaticCoverage, StaticLstm, StaticModel, StaticSensor, StaticTarget,\n\
          };\n\n",
     );
     let _ = writeln!(
@@ -449,22 +776,48 @@ fn generate_rust(axes: &[(StaticModel, String)], layout: &Layout) -> String {
     );
     let _ = writeln!(
         out,
-        "/// The temps[] entry each axis reads.\npub static CHANNELS: [u8; AXES] = [{}];\n",
-        layout
-            .channels
-            .iter()
-            .map(|c| c.to_string())
+        "/// The temps[] entry each axis reads first.\npub static CHANNELS: [u8; AXES] = [{}];\n",
+        axes.iter()
+            .map(|a| a.channel.to_string())
             .collect::<Vec<_>>()
             .join(", ")
     );
     out.push_str("/// Each axis's model, in axis order.\n");
     out.push_str("#[rustfmt::skip]\n#[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n");
     out.push_str("pub static MODELS: [StaticModel; AXES] = [\n");
-    for (m, _) in axes {
-        out.push_str(&rust::model_expr(m));
+    for a in axes {
+        out.push_str(&rust::model_expr(&a.model));
         out.push_str(",\n");
     }
     out.push_str("];\n");
+    for (i, a) in axes.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "\n/// Axis {i}'s further sensors, in order.\n#[rustfmt::skip]\n\
+             #[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n\
+             pub static SENSORS_A{i}: [StaticSensor; {}] = [",
+            a.sensors.len()
+        );
+        for s in &a.sensors {
+            out.push_str(&rust::sensor_expr(
+                s.channel,
+                &s.model.spec,
+                &s.bias,
+                &s.scale,
+            ));
+            out.push_str(",\n");
+        }
+        out.push_str("];\n");
+    }
+    let _ = writeln!(
+        out,
+        "\n/// Each axis's further sensors (none: the axis reads CHANNELS[i] alone).\n\
+         pub static SENSORS: [&[StaticSensor]; AXES] = [{}];",
+        (0..n)
+            .map(|i| format!("&SENSORS_A{i}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     out
 }
 
