@@ -115,16 +115,6 @@ pub fn generate_imu(
     lang: Lang,
 ) -> Result<Vec<(&'static str, String)>, ExportError> {
     model.validate().map_err(ExportError::Unit)?;
-    // The generated code runs one sensor per axis; exporting only an axis's first sensor
-    // would silently drop the further sensors' parts.
-    if let Some(a) = model.axes.iter().find(|a| !a.more.is_empty()) {
-        return Err(ExportError::Unit(ImuError::Layout(format!(
-            "axis {} reads {} temperature sensors; the C and Rust export runs one sensor per \
-             axis so far (the multi-sensor port is not written yet)",
-            a.gyro,
-            a.temps.len()
-        ))));
-    }
     let compact = serde_json::to_string(model).map_err(|e| ExportError::Unit(ImuError::Json(e)))?;
     let digest = crate::model::sha256_hex(compact.as_bytes());
     let mut axes = Vec::with_capacity(model.axes.len());
