@@ -29,8 +29,8 @@ use gyrotherm_core::compensator::{Corrected, Status};
 use gyrotherm_core::unit::Unit;
 
 use crate::compensate_lines::{
-    parse_number, read_header, read_line_capped, too_long_error, Fields, FileError, LineRead,
-    LinesError, Mode, MAX_LINE_BYTES,
+    parse_number, read_header, read_line_capped, split_and_time, too_long_error, Fields, FileError,
+    LineCheck, LineRead, LinesError, Mode, MAX_LINE_BYTES,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
@@ -216,54 +216,19 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
         }
         summary.rows += 1;
         let parsed: Result<f64, LinesError> = (|| {
-            if !fields.split(line, delimiter) || fields.len() != headers.len() {
-                return Err(err(
-                    LogErrorKind::FieldCount,
-                    line_no,
-                    None,
-                    format!(
-                        "{} fields, but the header has {}; fix the line (a missing or extra \
-                         {}) or comment it out with '#'",
-                        fields.len(),
-                        headers.len(),
-                        match delimiter {
-                            b'\t' => "tab".to_string(),
-                            d => format!("'{}'", char::from(d)),
-                        }
-                    ),
-                ));
-            }
-            let time_s = match parse_number(fields.get(line, ti), decimal_comma) {
-                Some(t) if t.is_finite() => t,
-                // A live feed hands a NaN or infinite time to the unit, whose time axes give
-                // it a status.
-                Some(t) if mode == Mode::Stream => t,
-                _ => {
-                    return Err(err(
-                        LogErrorKind::NotANumber,
-                        line_no,
-                        Some(&headers[ti]),
-                        format!(
-                            "{:?} is not a finite time; fix the value or comment the line out \
-                             with '#'",
-                            String::from_utf8_lossy(fields.get(line, ti))
-                        ),
-                    ))
-                }
-            };
-            if let (Some((t0, line0)), Mode::Strict) = (last_time, mode) {
-                if time_s <= t0 {
-                    return Err(err(
-                        LogErrorKind::TimeNotIncreasing,
-                        line_no,
-                        Some(&headers[ti]),
-                        format!(
-                            "time is not strictly increasing: {time_s} s comes after {t0} s \
-                             (line {line0}); sort the log by time or remove the row"
-                        ),
-                    ));
-                }
-            }
+            let time_s = split_and_time(
+                &mut fields,
+                line,
+                &LineCheck {
+                    source,
+                    headers: &headers,
+                    delimiter,
+                    time_index: ti,
+                    mode,
+                },
+                line_no,
+                last_time,
+            )?;
             for (g, &k) in gyro.iter_mut().zip(&gi) {
                 *g = match parse_number(fields.get(line, k), decimal_comma) {
                     Some(v) => v * gyro_scale,

@@ -32,7 +32,7 @@ use std::path::Path;
 
 use gyrotherm_core::compensator::{Corrected, Status};
 
-use crate::csvlog::{GyroUnit, LogError, LogErrorKind, LogReader, LogWriter, ReadOptions};
+use crate::csvlog::{LogError, LogErrorKind, LogReader, LogWriter, ReadOptions};
 use crate::model::ModelFile;
 
 /// Longest line read, bytes (line break included). A longer line is malformed: in
@@ -370,6 +370,81 @@ impl std::error::Error for FileError {
     }
 }
 
+/// What [`split_and_time`] checks a line against.
+pub(crate) struct LineCheck<'a> {
+    pub source: &'a Path,
+    pub headers: &'a [String],
+    pub delimiter: u8,
+    /// The time column's index.
+    pub time_index: usize,
+    pub mode: Mode,
+}
+
+/// The checks every stream makes before its own columns: split `line` into `fields` (as many
+/// as the header has) and read its time, finite and (in strict mode) after `last_time`'s; a
+/// live feed (stream mode) hands a NaN or infinite time on, and the compensator's time axis
+/// gives it a status.
+pub(crate) fn split_and_time(
+    fields: &mut Fields,
+    line: &[u8],
+    c: &LineCheck<'_>,
+    line_no: u64,
+    last_time: Option<(f64, u64)>,
+) -> Result<f64, LinesError> {
+    let (headers, delimiter, ti, mode) = (c.headers, c.delimiter, c.time_index, c.mode);
+    let decimal_comma = delimiter != b',';
+    let err = |kind, line, column: Option<&str>, message: String| {
+        LinesError::Log(LogError::new(kind, c.source, Some(line), column, message))
+    };
+    if !fields.split(line, delimiter) || fields.len() != headers.len() {
+        return Err(err(
+            LogErrorKind::FieldCount,
+            line_no,
+            None,
+            format!(
+                "{} fields, but the header has {}; fix the line (a missing or extra \
+                 {}) or comment it out with '#'",
+                fields.len(),
+                headers.len(),
+                match delimiter {
+                    b'\t' => "tab".to_string(),
+                    d => format!("'{}'", char::from(d)),
+                }
+            ),
+        ));
+    }
+    let time_s = match parse_number(fields.get(line, ti), decimal_comma) {
+        Some(t) if t.is_finite() => t,
+        Some(t) if mode == Mode::Stream => t,
+        _ => {
+            return Err(err(
+                LogErrorKind::NotANumber,
+                line_no,
+                Some(&headers[ti]),
+                format!(
+                    "{:?} is not a finite time; fix the value or comment the line out \
+                     with '#'",
+                    String::from_utf8_lossy(fields.get(line, ti))
+                ),
+            ))
+        }
+    };
+    if let (Some((t0, line0)), Mode::Strict) = (last_time, mode) {
+        if time_s <= t0 {
+            return Err(err(
+                LogErrorKind::TimeNotIncreasing,
+                line_no,
+                Some(&headers[ti]),
+                format!(
+                    "time is not strictly increasing: {time_s} s comes after {t0} s \
+                     (line {line0}); sort the log by time or remove the row"
+                ),
+            ));
+        }
+    }
+    Ok(time_s)
+}
+
 /// A line over [`MAX_LINE_BYTES`] at `line` of `source`.
 pub(crate) fn too_long_error(source: &Path, line: u64) -> LinesError {
     LinesError::Log(LogError::new(
@@ -448,11 +523,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             "a mapped column is missing from the header",
         )));
     };
-    let gyro_scale = match opts.gyro_unit {
-        GyroUnit::Dps => 1.0,
-        GyroUnit::Dph => 1.0 / 3600.0,
-        GyroUnit::RadPerS => 180.0 / std::f64::consts::PI,
-    };
+    let gyro_scale = opts.gyro_unit.dps_per_unit();
     let delimiter = opts.delimiter;
     let decimal_comma = delimiter != b',';
     let mut writer = LogWriter::with_delimiter(
@@ -499,54 +570,19 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         summary.rows += 1;
         // Parse; `None` is a malformed line (with the reason for strict mode).
         let parsed: Result<(f64, f64, f64), LinesError> = (|| {
-            if !fields.split(line, delimiter) || fields.len() != headers.len() {
-                return Err(err(
-                    LogErrorKind::FieldCount,
-                    line_no,
-                    None,
-                    format!(
-                        "{} fields, but the header has {}; fix the line (a missing or extra \
-                         {}) or comment it out with '#'",
-                        fields.len(),
-                        headers.len(),
-                        match delimiter {
-                            b'\t' => "tab".to_string(),
-                            d => format!("'{}'", char::from(d)),
-                        }
-                    ),
-                ));
-            }
-            let time_s = match parse_number(fields.get(line, ti), decimal_comma) {
-                Some(t) if t.is_finite() => t,
-                // A live feed hands a NaN or infinite time to the compensator, whose time
-                // axis gives it a status (and the gyro sample a rate).
-                Some(t) if mode == Mode::Stream => t,
-                _ => {
-                    return Err(err(
-                        LogErrorKind::NotANumber,
-                        line_no,
-                        Some(&headers[ti]),
-                        format!(
-                            "{:?} is not a finite time; fix the value or comment the line out \
-                             with '#'",
-                            String::from_utf8_lossy(fields.get(line, ti))
-                        ),
-                    ))
-                }
-            };
-            if let (Some((t0, line0)), Mode::Strict) = (last_time, mode) {
-                if time_s <= t0 {
-                    return Err(err(
-                        LogErrorKind::TimeNotIncreasing,
-                        line_no,
-                        Some(&headers[ti]),
-                        format!(
-                            "time is not strictly increasing: {time_s} s comes after {t0} s \
-                             (line {line0}); sort the log by time or remove the row"
-                        ),
-                    ));
-                }
-            }
+            let time_s = split_and_time(
+                &mut fields,
+                line,
+                &LineCheck {
+                    source,
+                    headers: &headers,
+                    delimiter,
+                    time_index: ti,
+                    mode,
+                },
+                line_no,
+                last_time,
+            )?;
             let gyro = match parse_number(fields.get(line, gi), decimal_comma) {
                 Some(g) => g * gyro_scale,
                 None => {
