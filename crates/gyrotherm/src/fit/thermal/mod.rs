@@ -635,41 +635,20 @@ pub fn fit_target(
         id.folds
     };
     let mut notes = id.report.notes.clone();
-    let (cv, lambda) = if folds == 0 {
-        if id.folds > 0 {
-            notes.push(format!(
-                "no cross-validation for this target ({per_run_min} labelled steps); ridge \
-                 strength fixed at {:.0e}",
-                cfg.fallback_ridge
-            ));
-        }
-        (None, cfg.fallback_ridge)
-    } else {
-        let (s, l) = best_ridge(
-            &d,
-            nc,
-            folds,
-            id.gap_steps,
-            &cfg.ridge_grid,
-            cfg.ridge_tolerance,
-        );
-        (
-            s.is_finite().then_some(s),
-            if s.is_finite() { l } else { cfg.fallback_ridge },
-        )
-    };
-    let stats = run_stats(&d, nc);
-    let (g, b, _) = centred_normal(&stats, nc);
-    let beta = ridge_solve(&g, &b, nc, lambda).ok_or(ThermalError::Singular)?;
-    // The constant: the labelled-step-weighted mean of the per-run offsets.
-    let (mut c0, mut n) = (0.0, 0.0);
-    for s in &stats {
-        if s.n >= 1.0 {
-            c0 += s.sy - s.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>();
-            n += s.n;
-        }
+    if folds == 0 && id.folds > 0 {
+        notes.push(format!(
+            "no cross-validation for this target ({per_run_min} labelled steps); ridge \
+             strength fixed at {:.0e}",
+            cfg.fallback_ridge
+        ));
     }
-    let mut coefficients = vec![c0 / n];
+    let RidgeFit {
+        cv,
+        lambda,
+        beta,
+        constant,
+    } = ridge_fit(&d, nc, folds, id.gap_steps, cfg)?;
+    let mut coefficients = vec![constant];
     coefficients.extend_from_slice(&beta);
     let report = ThermalReport {
         cv_rms: cv,

@@ -247,34 +247,14 @@ pub fn fit_multi<'a>(
         });
     }
     let folds = folds_for(&d, first.id);
-    let (cv, lambda) = if folds == 0 {
-        (None, cfg.fallback_ridge)
-    } else {
-        let (s, l) = best_ridge(
-            &d,
-            nc,
-            folds,
-            first.id.gap_steps,
-            &cfg.ridge_grid,
-            cfg.ridge_tolerance,
-        );
-        (
-            s.is_finite().then_some(s),
-            if s.is_finite() { l } else { cfg.fallback_ridge },
-        )
-    };
-    let stats = run_stats(&d, nc);
-    let (g, b, _) = centred_normal(&stats, nc);
-    let beta = ridge_solve(&g, &b, nc, lambda).ok_or(ThermalError::Singular)?;
-    let (mut c0, mut n) = (0.0, 0.0);
-    for s in &stats {
-        if s.n >= 1.0 {
-            c0 += s.sy - s.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>();
-            n += s.n;
-        }
-    }
+    let RidgeFit {
+        cv,
+        lambda,
+        beta,
+        constant,
+    } = ridge_fit(&d, nc, folds, first.id.gap_steps, cfg)?;
     let n0 = t0.len() - 1;
-    let mut coefficients = vec![c0 / n];
+    let mut coefficients = vec![constant];
     coefficients.extend_from_slice(&beta[..n0]);
     let mut at = n0;
     let mut extra_models = Vec::new();

@@ -224,3 +224,56 @@ pub(super) fn in_sample_rms(d: &Design, nc: usize, lambda: f64) -> f64 {
     }
     (ss / n.max(1.0)).sqrt()
 }
+
+/// A ridge fit of a design: its cross-validated RMS (None without folds), the strength used,
+/// the coefficients of the columns and the constant.
+pub(super) struct RidgeFit {
+    pub cv: Option<f64>,
+    pub lambda: f64,
+    pub beta: Vec<f64>,
+    /// The labelled-step-weighted mean of the per-run offsets.
+    pub constant: f64,
+}
+
+/// Fit `d` with the strength [`best_ridge`] chooses over `folds` blocked folds (`fallback`
+/// when there are none or the cross-validation gives no finite score).
+pub(super) fn ridge_fit(
+    d: &Design,
+    nc: usize,
+    folds: usize,
+    gap_steps: usize,
+    cfg: &ThermalConfig,
+) -> Result<RidgeFit, ThermalError> {
+    let (cv, lambda) = if folds == 0 {
+        (None, cfg.fallback_ridge)
+    } else {
+        let (s, l) = best_ridge(
+            d,
+            nc,
+            folds,
+            gap_steps,
+            &cfg.ridge_grid,
+            cfg.ridge_tolerance,
+        );
+        (
+            s.is_finite().then_some(s),
+            if s.is_finite() { l } else { cfg.fallback_ridge },
+        )
+    };
+    let stats = run_stats(d, nc);
+    let (g, b, _) = centred_normal(&stats, nc);
+    let beta = ridge_solve(&g, &b, nc, lambda).ok_or(ThermalError::Singular)?;
+    let (mut c0, mut n) = (0.0, 0.0);
+    for s in &stats {
+        if s.n >= 1.0 {
+            c0 += s.sy - s.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>();
+            n += s.n;
+        }
+    }
+    Ok(RidgeFit {
+        cv,
+        lambda,
+        beta,
+        constant: c0 / n,
+    })
+}
