@@ -29,8 +29,8 @@ use gyrotherm_core::compensator::{Corrected, Status};
 use gyrotherm_core::unit::Unit;
 
 use crate::compensate_lines::{
-    parse_number, read_header, read_line_capped, split_and_time, too_long_error, Fields, FileError,
-    LineCheck, LineRead, LinesError, Mode, MAX_LINE_BYTES,
+    lines_to_file, parse_number, read_header, read_line_capped, split_and_time, too_long_error,
+    Fields, FileError, LineCheck, LineRead, LinesError, Mode, MAX_LINE_BYTES,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
@@ -301,28 +301,7 @@ pub fn compensate_imu_file(
     out: &Path,
     opts: &ReadOptions,
 ) -> Result<ImuLinesSummary, FileError> {
-    let file = std::fs::File::open(input).map_err(|source| FileError::Open {
-        path: input.to_path_buf(),
-        source,
-    })?;
-    crate::atomic_file::write_atomically(out, |w: &mut std::io::BufWriter<std::fs::File>| {
-        let s = compensate_imu_lines(
-            model,
-            std::io::BufReader::new(&file),
-            input,
-            opts,
-            &mut *w,
-            Mode::Strict,
-            false,
-        )?;
-        w.flush()?;
-        Ok::<_, LinesError>(s)
-    })
-    .map_err(|e| match e {
-        LinesError::Io(source) => FileError::Write {
-            path: out.to_path_buf(),
-            source,
-        },
-        other => FileError::Lines(other),
+    lines_to_file(input, out, |r, w| {
+        compensate_imu_lines(model, r, input, opts, w, Mode::Strict, false)
     })
 }

@@ -304,20 +304,27 @@ pub fn compensate_file(
     out: &Path,
     opts: &ReadOptions,
 ) -> Result<LinesSummary, FileError> {
+    lines_to_file(input, out, |r, w| {
+        compensate_lines(model, r, input, opts, w, Mode::Strict, false)
+    })
+}
+
+/// Run `lines` from the file `input` into the CSV file `out`, written to a temporary file
+/// and renamed into place (the batch form of a stream).
+pub(crate) fn lines_to_file<S>(
+    input: &Path,
+    out: &Path,
+    lines: impl FnOnce(
+        std::io::BufReader<&std::fs::File>,
+        &mut std::io::BufWriter<std::fs::File>,
+    ) -> Result<S, LinesError>,
+) -> Result<S, FileError> {
     let file = std::fs::File::open(input).map_err(|source| FileError::Open {
         path: input.to_path_buf(),
         source,
     })?;
     crate::atomic_file::write_atomically(out, |w: &mut std::io::BufWriter<std::fs::File>| {
-        let s = compensate_lines(
-            model,
-            std::io::BufReader::new(&file),
-            input,
-            opts,
-            &mut *w,
-            Mode::Strict,
-            false,
-        )?;
+        let s = lines(std::io::BufReader::new(&file), w)?;
         w.flush()?;
         Ok::<_, LinesError>(s)
     })
