@@ -29,8 +29,8 @@ use gyrotherm_core::compensator::{Corrected, Status};
 use gyrotherm_core::unit::Unit;
 
 use crate::compensate_lines::{
-    lines_to_file, parse_number, read_header, read_line_capped, split_and_time, too_long_error,
-    Fields, FileError, LineCheck, LineRead, LinesError, Mode, MAX_LINE_BYTES,
+    lines_to_file, parse_number, read_header, read_line_capped, record, split_and_time,
+    too_long_error, Fields, FileError, LineCheck, LineRead, LinesError, Mode, MAX_LINE_BYTES,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
@@ -194,6 +194,13 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
         summary.malformed += 1;
         writer.end_row()
     };
+    let check = LineCheck {
+        source,
+        headers: &headers,
+        delimiter,
+        time_index: ti,
+        mode,
+    };
     loop {
         let read = read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)?;
         if read == LineRead::Eof {
@@ -208,27 +215,12 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
             malformed(&mut writer, &mut summary, None)?;
             continue;
         }
-        let line = buf.strip_suffix(b"\n").unwrap_or(&buf);
-        let line = line.strip_suffix(b"\r").unwrap_or(line);
-        let trimmed = line.trim_ascii();
-        if trimmed.is_empty() || trimmed.starts_with(b"#") {
+        let Some(line) = record(&buf) else {
             continue;
-        }
+        };
         summary.rows += 1;
         let parsed: Result<f64, LinesError> = (|| {
-            let time_s = split_and_time(
-                &mut fields,
-                line,
-                &LineCheck {
-                    source,
-                    headers: &headers,
-                    delimiter,
-                    time_index: ti,
-                    mode,
-                },
-                line_no,
-                last_time,
-            )?;
+            let time_s = split_and_time(&mut fields, line, &check, line_no, last_time)?;
             for (g, &k) in gyro.iter_mut().zip(&gi) {
                 *g = match parse_number(fields.get(line, k), decimal_comma) {
                     Some(v) => v * gyro_scale,

@@ -377,6 +377,15 @@ impl std::error::Error for FileError {
     }
 }
 
+/// The record a line read into `buf` holds: without its line ending; None for a blank line
+/// or a comment (`#` first), which every stream skips.
+pub(crate) fn record(buf: &[u8]) -> Option<&[u8]> {
+    let line = buf.strip_suffix(b"\n").unwrap_or(buf);
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    let trimmed = line.trim_ascii();
+    (!trimmed.is_empty() && !trimmed.starts_with(b"#")).then_some(line)
+}
+
 /// What [`split_and_time`] checks a line against.
 pub(crate) struct LineCheck<'a> {
     pub source: &'a Path,
@@ -547,6 +556,13 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     let mut last_time: Option<(f64, u64)> = None;
     let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
     let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
+    let check = LineCheck {
+        source,
+        headers: &headers,
+        delimiter,
+        time_index: ti,
+        mode,
+    };
     loop {
         let read = read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)?;
         if read == LineRead::Eof {
@@ -568,28 +584,13 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             writer.end_row()?;
             continue;
         }
-        let line = buf.strip_suffix(b"\n").unwrap_or(&buf);
-        let line = line.strip_suffix(b"\r").unwrap_or(line);
-        let trimmed = line.trim_ascii();
-        if trimmed.is_empty() || trimmed.starts_with(b"#") {
+        let Some(line) = record(&buf) else {
             continue;
-        }
+        };
         summary.rows += 1;
         // Parse; `None` is a malformed line (with the reason for strict mode).
         let parsed: Result<(f64, f64, f64), LinesError> = (|| {
-            let time_s = split_and_time(
-                &mut fields,
-                line,
-                &LineCheck {
-                    source,
-                    headers: &headers,
-                    delimiter,
-                    time_index: ti,
-                    mode,
-                },
-                line_no,
-                last_time,
-            )?;
+            let time_s = split_and_time(&mut fields, line, &check, line_no, last_time)?;
             let gyro = match parse_number(fields.get(line, gi), decimal_comma) {
                 Some(g) => g * gyro_scale,
                 None => {
