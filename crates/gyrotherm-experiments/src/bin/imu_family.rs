@@ -154,6 +154,8 @@ struct Case {
     sf_ppm: f64,
     fit_s: f64,
     temps: String,
+    /// How far the static run leaves the training ranges.
+    outside: Outside,
 }
 
 struct Job<'a> {
@@ -229,25 +231,7 @@ fn transform(parts: &[Part], feats: &mut [Vec<f64>], spec: &[FeatureSpec], hold:
         return;
     }
     if hold.starts_with("shrink") {
-        // `shrink-xN`: the ranges widened N times about 0 before the factor is found.
-        let w = match hold {
-            "shrink-x2" => 2.0,
-            "shrink-x4" => 4.0,
-            _ => 1.0,
-        };
-        let mut s = 1.0f64;
-        for ((p, f), sp) in parts.iter().zip(feats.iter()).zip(spec) {
-            for (i, &x) in f.iter().enumerate() {
-                if held_kind(hold, sp.kind(i)) {
-                    let (lo, hi) = (w * p.env.lo[i].min(0.0), w * p.env.hi[i].max(0.0));
-                    if x > hi {
-                        s = s.min(hi / x);
-                    } else if x < lo {
-                        s = s.min(lo / x);
-                    }
-                }
-            }
-        }
+        let s = shrink_factor(parts, feats, spec, hold);
         if s < 1.0 {
             for (f, sp) in feats.iter_mut().zip(spec) {
                 for (i, x) in f.iter_mut().enumerate() {
@@ -268,6 +252,38 @@ fn transform(parts: &[Part], feats: &mut [Vec<f64>], spec: &[FeatureSpec], hold:
     }
 }
 
+/// The common factor of `shrink` holds (see [`transform`]); 1 inside every range.
+fn shrink_factor(parts: &[Part], feats: &[Vec<f64>], spec: &[FeatureSpec], hold: &str) -> f64 {
+    // `shrink-xN`: the ranges widened N times about 0 before the factor is found.
+    let w = match hold {
+        "shrink-x2" => 2.0,
+        "shrink-x4" => 4.0,
+        _ => 1.0,
+    };
+    let mut s = 1.0f64;
+    for ((p, f), sp) in parts.iter().zip(feats).zip(spec) {
+        for (i, &x) in f.iter().enumerate() {
+            if held_kind(hold, sp.kind(i)) {
+                let (lo, hi) = (w * p.env.lo[i].min(0.0), w * p.env.hi[i].max(0.0));
+                if x > hi {
+                    s = s.min(hi / x);
+                } else if x < lo {
+                    s = s.min(lo / x);
+                }
+            }
+        }
+    }
+    s
+}
+
+/// How far a run leaves the training ranges of an axis's lag differences: the fraction of
+/// steps outside them and the smallest `shrink` factor (1: never outside).
+#[derive(Debug, Clone, Copy)]
+struct Outside {
+    frac: f64,
+    min_s: f64,
+}
+
 /// A replica of `compensate_imu` for a log without sensor faults or time gaps (every sample
 /// steps every pipeline), with each axis's features transformed as `hold` says
 /// ([`transform`]) before its baselines read them: the compensated rate per axis. With
@@ -277,7 +293,7 @@ fn compensate_held(
     log: &ImuLog,
     envs: &[Vec<(FeatureSpec, FeatureBounds)>],
     hold: &str,
-) -> Result<Vec<Vec<f64>>, String> {
+) -> Result<Vec<(Vec<f64>, Outside)>, String> {
     let comps = imu_axis_compensators(model).map_err(|e| e.to_string())?;
     let temps: Vec<&[f64]> = model
         .temp_cols
@@ -331,6 +347,7 @@ fn compensate_held(
         let mut held = (0.0, 1.0);
         let mut feats: Vec<Vec<f64>> = vec![Vec::new(); parts.len()];
         let mut r = Vec::with_capacity(log.len());
+        let (mut steps, mut outside, mut min_s) = (0usize, 0usize, 1.0f64);
         for i in 0..log.len() {
             let mut stepped = false;
             for (j, p) in parts.iter_mut().enumerate() {
@@ -347,6 +364,10 @@ fn compensate_held(
                     f.clear();
                     f.extend_from_slice(p.pipeline.current().ok_or("no step")?.as_slice());
                 }
+                let s = shrink_factor(&parts, &feats, &specs, "shrink");
+                steps += 1;
+                outside += usize::from(s < 1.0);
+                min_s = min_s.min(s);
                 transform(&parts, &mut feats, &specs, hold);
                 let ev = |m: &BaselineModel, f: &[f64]| m.eval(f).map_err(|e| e.to_string());
                 let mut b = 0.0;
@@ -371,7 +392,8 @@ fn compensate_held(
             }
             r.push((g[i] - held.0) / held.1);
         }
-        out.push(r);
+        let frac = outside as f64 / steps.max(1) as f64;
+        out.push((r, Outside { frac, min_s }));
     }
     Ok(out)
 }
@@ -496,7 +518,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                 if hold == "none" {
                     // The replica must be compensate_imu exactly.
                     let reference = compensate_imu(&model, st).map_err(|e| e.to_string())?;
-                    for (c, r) in cs.iter().zip(&reference) {
+                    for ((c, _), r) in cs.iter().zip(&reference) {
                         if c.iter()
                             .map(|x| x.to_bits())
                             .ne(r.gyro_comp_dps.iter().map(|x| x.to_bits()))
@@ -506,14 +528,14 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                     }
                 }
                 for (k, axis) in model.axes.iter().enumerate() {
-                    let b = bias_stability_dph(&cs[k], 1.0, TAU_S)
+                    let b = bias_stability_dph(&cs[k].0, 1.0, TAU_S)
                         .map_err(|e| e.to_string())?
                         .bias_stability_dph;
                     let tab = &tabs[k];
                     let ct = compensate_held(&model, tab, &envs, hold)?;
                     let rep = scale_factor(
                         &tab.time_s,
-                        &ct[k],
+                        &ct[k].0,
                         &tab.table.as_ref().ok_or("no table")?.values,
                         &ScaleFactorOptions::default(),
                     )
@@ -528,6 +550,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                         sf_ppm: rep.sf_thermal_error_ppm,
                         fit_s,
                         temps: axis.temps.join("+"),
+                        outside: cs[k].1,
                     });
                 }
             }
@@ -653,7 +676,7 @@ fn run() -> Result<(), String> {
         // The hold column only when a hold was asked for (the recorded files keep their form).
         let with_hold = holds.iter().any(|h| h != "none");
         let mut text = String::from(if with_hold {
-            "unit_seed\tsetting\thold\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\n"
+            "unit_seed\tsetting\thold\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\tout_frac\tmin_s\n"
         } else {
             "unit_seed\tsetting\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\n"
         });
@@ -674,6 +697,13 @@ fn run() -> Result<(), String> {
                 c.fit_s,
                 c.temps
             ));
+            if with_hold {
+                text.pop();
+                text.push_str(&format!(
+                    "\t{:.4}\t{:.4}\n",
+                    c.outside.frac, c.outside.min_s
+                ));
+            }
         }
         gyrotherm::atomic_file::write_bytes_atomically(
             std::path::Path::new(&path),
