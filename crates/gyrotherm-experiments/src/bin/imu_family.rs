@@ -33,7 +33,8 @@
 //! `all` (every feature), `lags` (the lag differences `T − lag_j(T)`), `fast` (the fastest
 //! lag difference only), `temp` (T only), `rate` (dT only), each feature on its own;
 //! `shrink` / `shrink-fast`: every lag difference (the fastest) of all the axis's sensors
-//! scaled toward 0 by one common factor (see `transform`). Applied by a replica of
+//! scaled toward 0 by one common factor (see `transform`); `k-<hold>`: that hold on the
+//! scale factor's inputs only (the bias reads them as they are). Applied by a replica of
 //! `compensate_imu` (checked bit-equal with `none`). One fit serves every hold.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -68,7 +69,7 @@ const TAU_S: f64 = 100.0;
 const TEST_PROFILES: [&str; 2] = ["airborne", "shock-5"];
 const SETTINGS: [&str; 3] = ["case", "chosen", "all"];
 const DEFAULT_SETTINGS: &str = "case,chosen,all";
-const HOLDS: [&str; 10] = [
+const HOLDS: [&str; 14] = [
     "none",
     "all",
     "lags",
@@ -79,6 +80,10 @@ const HOLDS: [&str; 10] = [
     "shrink-fast",
     "shrink-x2",
     "shrink-x4",
+    "k-lags",
+    "k-fast",
+    "k-shrink",
+    "k-shrink-fast",
 ];
 const DESIGN_BASE_SEED: u64 = 1000;
 const CONFIRM_BASE_SEED: u64 = 5000;
@@ -165,6 +170,8 @@ struct Job<'a> {
     planned: bool,
     /// Input holds to apply each model with (see the module doc).
     holds: &'a [String],
+    /// A hold other than `none` was asked for: apply every hold through the replica.
+    replica: bool,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -346,6 +353,7 @@ fn compensate_held(
         let specs: Vec<FeatureSpec> = parts.iter().map(|p| *p.pipeline.spec()).collect();
         let mut held = (0.0, 1.0);
         let mut feats: Vec<Vec<f64>> = vec![Vec::new(); parts.len()];
+        let mut kfeats: Vec<Vec<f64>> = Vec::new();
         let mut r = Vec::with_capacity(log.len());
         let (mut steps, mut outside, mut min_s) = (0usize, 0usize, 1.0f64);
         for i in 0..log.len() {
@@ -368,7 +376,15 @@ fn compensate_held(
                 steps += 1;
                 outside += usize::from(s < 1.0);
                 min_s = min_s.min(s);
-                transform(&parts, &mut feats, &specs, hold);
+                // `k-<hold>`: the hold on the scale factor's inputs only.
+                kfeats.clone_from(&feats);
+                match hold.strip_prefix("k-") {
+                    Some(h) => transform(&parts, &mut kfeats, &specs, h),
+                    None => {
+                        transform(&parts, &mut feats, &specs, hold);
+                        kfeats.clone_from(&feats);
+                    }
+                }
                 let ev = |m: &BaselineModel, f: &[f64]| m.eval(f).map_err(|e| e.to_string());
                 let mut b = 0.0;
                 if let Some(m) = &parts[0].bias {
@@ -376,14 +392,14 @@ fn compensate_held(
                 }
                 let mut k = if first_scale_absent { 1.0 } else { 0.0 };
                 if let Some(m) = &parts[0].scale {
-                    k += ev(m, &feats[0])?;
+                    k += ev(m, &kfeats[0])?;
                 }
-                for (p, f) in parts.iter().zip(&feats).skip(1) {
+                for ((p, f), kf) in parts.iter().zip(&feats).zip(&kfeats).skip(1) {
                     if let Some(m) = &p.bias {
                         b += ev(m, f)?;
                     }
                     if let Some(m) = &p.scale {
-                        k += ev(m, f)?;
+                        k += ev(m, kf)?;
                     }
                 }
                 if k > 0.0 && b.is_finite() && k.is_finite() {
@@ -501,7 +517,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         let train_logs: Vec<&ImuLog> = train.iter().map(|(_, l)| l).collect();
         let comps = imu_axis_compensators(&model).map_err(|e| e.to_string())?;
         let mut envs = Vec::new();
-        for (a, comp) in model.axes.iter().zip(&comps) {
+        for (a, comp) in model.axes.iter().zip(&comps).filter(|_| job.replica) {
             let mut specs = vec![*comp.first().spec()];
             specs.extend(comp.further().map(|(_, s, _, _)| *s));
             envs.push(
@@ -513,9 +529,25 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             );
         }
         for hold in job.holds {
+            // Without a hold asked for, compensate_imu itself (the recorded runs unchanged);
+            // with one, the replica for every hold, checked against compensate_imu.
+            let apply = |log: &ImuLog| -> Result<Vec<(Vec<f64>, Outside)>, String> {
+                if job.replica {
+                    return compensate_held(&model, log, &envs, hold);
+                }
+                let unknown = Outside {
+                    frac: f64::NAN,
+                    min_s: f64::NAN,
+                };
+                Ok(compensate_imu(&model, log)
+                    .map_err(|e| e.to_string())?
+                    .into_iter()
+                    .map(|c| (c.gyro_comp_dps, unknown))
+                    .collect())
+            };
             for (profile, st, tabs, floors) in &tests {
-                let cs = compensate_held(&model, st, &envs, hold)?;
-                if hold == "none" {
+                let cs = apply(st)?;
+                if job.replica && hold == "none" {
                     // The replica must be compensate_imu exactly.
                     let reference = compensate_imu(&model, st).map_err(|e| e.to_string())?;
                     for ((c, _), r) in cs.iter().zip(&reference) {
@@ -532,7 +564,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                         .map_err(|e| e.to_string())?
                         .bias_stability_dph;
                     let tab = &tabs[k];
-                    let ct = compensate_held(&model, tab, &envs, hold)?;
+                    let ct = apply(tab)?;
                     let rep = scale_factor(
                         &tab.time_s,
                         &ct[k].0,
@@ -630,6 +662,7 @@ fn run() -> Result<(), String> {
         min_gain,
         planned,
         holds: &holds,
+        replica: holds.iter().any(|h| h != "none"),
     };
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     eprintln!(
@@ -674,7 +707,7 @@ fn run() -> Result<(), String> {
     });
     if let Some(path) = get("--cases") {
         // The hold column only when a hold was asked for (the recorded files keep their form).
-        let with_hold = holds.iter().any(|h| h != "none");
+        let with_hold = job.replica;
         let mut text = String::from(if with_hold {
             "unit_seed\tsetting\thold\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\tout_frac\tmin_s\n"
         } else {
@@ -717,8 +750,13 @@ fn run() -> Result<(), String> {
         seeds.len(),
         if planned { " + a static run on the planned profile" } else { "" }
     );
-    println!("| setting | hold | profile | ×floor median | ×floor worst | SF ppm median | SF ppm worst | fit s per unit |");
-    println!("|---|---|---|---|---|---|---|---|");
+    // The hold column only when a hold was asked for (the recorded tables keep their form).
+    let hold_head = if job.replica { " hold |" } else { "" };
+    println!("| setting |{hold_head} profile | ×floor median | ×floor worst | SF ppm median | SF ppm worst | fit s per unit |");
+    println!(
+        "|---|---|---|---|---|---|---|{}",
+        if job.replica { "---|" } else { "" }
+    );
     for setting in &settings {
         for hold in &holds {
             for profile in TEST_PROFILES.iter().map(Some).chain([None]) {
@@ -736,8 +774,13 @@ fn run() -> Result<(), String> {
                 let mut x: Vec<f64> = mine.iter().map(|c| c.x_floor).collect();
                 let mut sf: Vec<f64> = mine.iter().map(|c| c.sf_ppm).collect();
                 let fit_s = mine.iter().map(|c| c.fit_s).sum::<f64>() / mine.len() as f64;
+                let hold_cell = if job.replica {
+                    format!(" {hold} |")
+                } else {
+                    String::new()
+                };
                 println!(
-                    "| {setting} | {hold} | {} | {:.2} | {:.2} | {:.1} | {:.1} | {:.1} |",
+                    "| {setting} |{hold_cell} {} | {:.2} | {:.2} | {:.1} | {:.1} | {:.1} |",
                     profile.copied().unwrap_or("both"),
                     median(&mut x),
                     worst(&x),
