@@ -22,10 +22,20 @@
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin imu_family -- [--family
 //! design|confirm] [--units 30] [--first 0] [--settings case,chosen,all] [--threads 2]
-//! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned]`; `--train planned` adds a
+//! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned] [--hold none,lags,...]`; `--train planned` adds a
 //! static run on the chamber profile `gyrotherm plan` proposes from the unit's own airborne
 //! run (case sensor, a seed other than the held-out one's) to the training runs; `bench/imu_family.sh` runs it as recorded in `docs/experiments/imu.md`.
 //! Settings are chosen on the design family only; the confirmation family is run once.
+//!
+//! `--hold` (experiment, docs/experiments/imu-extrapolation.md): each model is also applied
+//! with its baseline inputs held within the range the training runs reached (per axis, per
+//! sensor, the min and max of each feature over the training logs): `none` (as fitted),
+//! `all` (every feature), `lags` (the lag differences `T − lag_j(T)`), `fast` (the fastest
+//! lag difference only), `temp` (T only), `rate` (dT only), each feature on its own;
+//! `shrink` / `shrink-fast`: every lag difference (the fastest) of all the axis's sensors
+//! scaled toward 0 by one common factor (see `transform`); `k-<hold>`: that hold on the
+//! scale factor's inputs only (the bias reads them as they are). Applied by a replica of
+//! `compensate_imu` (checked bit-equal with `none`). One fit serves every hold.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -33,20 +43,48 @@ use std::time::Instant;
 
 use gyrotherm::csvlog::{ImuLog, NamedSeries};
 use gyrotherm::fit::{FitConfig, RecipeKind, RecipeSettings};
-use gyrotherm::imu_model::{compensate_imu, fit_imu_with, ImuFitSettings, ImuModel, ImuSensors};
+use gyrotherm::imu_model::{
+    compensate_imu, fit_imu_with, imu_axis_compensators, ImuFitSettings, ImuModel, ImuSensors,
+};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
+use gyrotherm::model::SubModel;
 use gyrotherm::model::{Method, TempSensorDef};
 use gyrotherm::sim::imu::{
     imu_from_family, simulate_imu, truth_col, ImuConfig, ImuUnit, AXIS_NAMES, CASE_SENSOR_COL,
 };
 use gyrotherm::sim::{Profile, SimConfig};
+use gyrotherm_core::baseline::BaselineModel;
+use gyrotherm_core::features::{FeatureKind, FeaturePipeline, FeatureSpec, MAX_FEATURES};
+
+/// Per feature, lower and upper limits.
+#[derive(Debug, Clone, Copy)]
+struct FeatureBounds {
+    lo: [f64; MAX_FEATURES],
+    hi: [f64; MAX_FEATURES],
+}
 
 const TABLE_RATE_DPS: f64 = 20.0;
 const TAU_S: f64 = 100.0;
 const TEST_PROFILES: [&str; 2] = ["airborne", "shock-5"];
 const SETTINGS: [&str; 3] = ["case", "chosen", "all"];
 const DEFAULT_SETTINGS: &str = "case,chosen,all";
+const HOLDS: [&str; 14] = [
+    "none",
+    "all",
+    "lags",
+    "fast",
+    "temp",
+    "rate",
+    "shrink",
+    "shrink-fast",
+    "shrink-x2",
+    "shrink-x4",
+    "k-lags",
+    "k-fast",
+    "k-shrink",
+    "k-shrink-fast",
+];
 const DESIGN_BASE_SEED: u64 = 1000;
 const CONFIRM_BASE_SEED: u64 = 5000;
 
@@ -114,12 +152,15 @@ fn case_only(log: &ImuLog) -> ImuLog {
 struct Case {
     unit_seed: u64,
     setting: String,
+    hold: String,
     axis: usize,
     profile: &'static str,
     x_floor: f64,
     sf_ppm: f64,
     fit_s: f64,
     temps: String,
+    /// How far the static run leaves the training ranges.
+    outside: Outside,
 }
 
 struct Job<'a> {
@@ -127,6 +168,250 @@ struct Job<'a> {
     min_gain: f64,
     /// Add a static run on the chamber profile `gyrotherm plan` proposes for the unit.
     planned: bool,
+    /// Input holds to apply each model with (see the module doc).
+    holds: &'a [String],
+    /// A hold other than `none` was asked for: apply every hold through the replica.
+    replica: bool,
+}
+
+/// Per feature, the min and max a sensor's features reach over the training logs.
+fn envelope(spec: &FeatureSpec, logs: &[&ImuLog], temp_col: &str) -> Result<FeatureBounds, String> {
+    let mut b = FeatureBounds {
+        lo: [f64::INFINITY; MAX_FEATURES],
+        hi: [f64::NEG_INFINITY; MAX_FEATURES],
+    };
+    for log in logs {
+        let t = &log
+            .temp
+            .iter()
+            .find(|s| s.name == temp_col)
+            .ok_or_else(|| format!("no temperature {temp_col}"))?
+            .values;
+        let mut p = FeaturePipeline::new(*spec).map_err(|e| e.to_string())?;
+        for (&time, &temp) in log.time_s.iter().zip(t) {
+            if let Ok(Some(step)) = p.push(time, temp) {
+                for (i, &x) in step.features.as_slice().iter().enumerate() {
+                    b.lo[i] = b.lo[i].min(x);
+                    b.hi[i] = b.hi[i].max(x);
+                }
+            }
+        }
+    }
+    Ok(b)
+}
+
+/// One sensor of an axis as the replica evaluates it: its pipeline, training envelope and
+/// parts of B and K.
+struct Part {
+    col: usize,
+    pipeline: FeaturePipeline,
+    env: FeatureBounds,
+    bias: Option<BaselineModel>,
+    scale: Option<BaselineModel>,
+}
+
+/// Whether `hold` acts on feature kind `k`.
+fn held_kind(hold: &str, k: Option<FeatureKind>) -> bool {
+    matches!(
+        (hold, k),
+        ("all", _)
+            | (
+                "lags" | "shrink" | "shrink-x2" | "shrink-x4",
+                Some(FeatureKind::LagDiff(_))
+            )
+            | ("fast" | "shrink-fast", Some(FeatureKind::LagDiff(0)))
+            | ("temp", Some(FeatureKind::Temperature))
+            | ("rate", Some(FeatureKind::Rate))
+    )
+}
+
+/// The features of every sensor of an axis, transformed as `hold` says: `none` as they are;
+/// `all`, `lags`, `fast`, `temp`, `rate` each chosen feature held at the edge of its training
+/// range on its own; `shrink` (`shrink-fast`) every lag difference (the fastest one) of every
+/// sensor scaled by one common factor s ≤ 1 toward 0 (the steady state, inside every
+/// training range), the largest s that brings each of them within its range: the axis's
+/// thermal state kept in its direction, so that differences between sensors keep their
+/// sign and proportion, and held at the edge of what training saw; `shrink-x2`, `shrink-x4`:
+/// `shrink` with each range widened 2 or 4 times about 0.
+fn transform(parts: &[Part], feats: &mut [Vec<f64>], spec: &[FeatureSpec], hold: &str) {
+    if hold == "none" {
+        return;
+    }
+    if hold.starts_with("shrink") {
+        let s = shrink_factor(parts, feats, spec, hold);
+        if s < 1.0 {
+            for (f, sp) in feats.iter_mut().zip(spec) {
+                for (i, x) in f.iter_mut().enumerate() {
+                    if held_kind(hold, sp.kind(i)) {
+                        *x *= s;
+                    }
+                }
+            }
+        }
+        return;
+    }
+    for ((p, f), sp) in parts.iter().zip(feats.iter_mut()).zip(spec) {
+        for (i, x) in f.iter_mut().enumerate() {
+            if held_kind(hold, sp.kind(i)) {
+                *x = x.clamp(p.env.lo[i], p.env.hi[i]);
+            }
+        }
+    }
+}
+
+/// The common factor of `shrink` holds (see [`transform`]); 1 inside every range.
+fn shrink_factor(parts: &[Part], feats: &[Vec<f64>], spec: &[FeatureSpec], hold: &str) -> f64 {
+    // `shrink-xN`: the ranges widened N times about 0 before the factor is found.
+    let w = match hold {
+        "shrink-x2" => 2.0,
+        "shrink-x4" => 4.0,
+        _ => 1.0,
+    };
+    let mut s = 1.0f64;
+    for ((p, f), sp) in parts.iter().zip(feats).zip(spec) {
+        for (i, &x) in f.iter().enumerate() {
+            if held_kind(hold, sp.kind(i)) {
+                let (lo, hi) = (w * p.env.lo[i].min(0.0), w * p.env.hi[i].max(0.0));
+                if x > hi {
+                    s = s.min(hi / x);
+                } else if x < lo {
+                    s = s.min(lo / x);
+                }
+            }
+        }
+    }
+    s
+}
+
+/// How far a run leaves the training ranges of an axis's lag differences: the fraction of
+/// steps outside them and the smallest `shrink` factor (1: never outside).
+#[derive(Debug, Clone, Copy)]
+struct Outside {
+    frac: f64,
+    min_s: f64,
+}
+
+/// A replica of `compensate_imu` for a log without sensor faults or time gaps (every sample
+/// steps every pipeline), with each axis's features transformed as `hold` says
+/// ([`transform`]) before its baselines read them: the compensated rate per axis. With
+/// `none` it must equal `compensate_imu` bit for bit (checked by the caller).
+fn compensate_held(
+    model: &ImuModel,
+    log: &ImuLog,
+    envs: &[Vec<(FeatureSpec, FeatureBounds)>],
+    hold: &str,
+) -> Result<Vec<(Vec<f64>, Outside)>, String> {
+    let comps = imu_axis_compensators(model).map_err(|e| e.to_string())?;
+    let temps: Vec<&[f64]> = model
+        .temp_cols
+        .iter()
+        .map(|t| {
+            log.temp
+                .iter()
+                .find(|s| &s.name == t)
+                .map(|s| s.values.as_slice())
+                .ok_or_else(|| format!("no temperature {t}"))
+        })
+        .collect::<Result<_, _>>()?;
+    let core = |sub: Option<&SubModel>| -> Result<Option<BaselineModel>, String> {
+        match sub {
+            None => Ok(None),
+            Some(s) => match s.baseline_core() {
+                Some(r) => r.map(Some).map_err(|e| e.to_string()),
+                None => Err("the replica evaluates baselines only".into()),
+            },
+        }
+    };
+    let mut out = Vec::new();
+    for ((a, comp), env) in model.axes.iter().zip(&comps).zip(envs) {
+        let g = &log
+            .gyro
+            .iter()
+            .find(|s| s.name == a.gyro)
+            .ok_or("no gyro")?
+            .values;
+        let col = |t: &String| model.temp_cols.iter().position(|c| c == t).ok_or("column");
+        let mut parts = vec![Part {
+            col: col(&a.temps[0])?,
+            pipeline: FeaturePipeline::new(*comp.first().spec()).map_err(|e| e.to_string())?,
+            env: env[0].1,
+            bias: core(a.model.bias.as_ref())?,
+            scale: core(a.model.scale.as_ref())?,
+        }];
+        let first_scale_absent = a.model.scale.is_none();
+        for ((t, (_, spec, bias, scale)), (_, e)) in
+            a.temps.iter().skip(1).zip(comp.further()).zip(&env[1..])
+        {
+            parts.push(Part {
+                col: col(t)?,
+                pipeline: FeaturePipeline::new(*spec).map_err(|e| e.to_string())?,
+                env: *e,
+                bias: bias.copied(),
+                scale: scale.copied(),
+            });
+        }
+        let specs: Vec<FeatureSpec> = parts.iter().map(|p| *p.pipeline.spec()).collect();
+        let mut held = (0.0, 1.0);
+        let mut feats: Vec<Vec<f64>> = vec![Vec::new(); parts.len()];
+        let mut kfeats: Vec<Vec<f64>> = Vec::new();
+        let mut r = Vec::with_capacity(log.len());
+        let (mut steps, mut outside, mut min_s) = (0usize, 0usize, 1.0f64);
+        for i in 0..log.len() {
+            let mut stepped = false;
+            for (j, p) in parts.iter_mut().enumerate() {
+                let step = p
+                    .pipeline
+                    .push(log.time_s[i], temps[p.col][i])
+                    .map_err(|e| format!("sample {i}: {e}"))?;
+                if j == 0 {
+                    stepped = step.is_some();
+                }
+            }
+            if stepped {
+                for (f, p) in feats.iter_mut().zip(&parts) {
+                    f.clear();
+                    f.extend_from_slice(p.pipeline.current().ok_or("no step")?.as_slice());
+                }
+                let s = shrink_factor(&parts, &feats, &specs, "shrink");
+                steps += 1;
+                outside += usize::from(s < 1.0);
+                min_s = min_s.min(s);
+                // `k-<hold>`: the hold on the scale factor's inputs only.
+                kfeats.clone_from(&feats);
+                match hold.strip_prefix("k-") {
+                    Some(h) => transform(&parts, &mut kfeats, &specs, h),
+                    None => {
+                        transform(&parts, &mut feats, &specs, hold);
+                        kfeats.clone_from(&feats);
+                    }
+                }
+                let ev = |m: &BaselineModel, f: &[f64]| m.eval(f).map_err(|e| e.to_string());
+                let mut b = 0.0;
+                if let Some(m) = &parts[0].bias {
+                    b += ev(m, &feats[0])?;
+                }
+                let mut k = if first_scale_absent { 1.0 } else { 0.0 };
+                if let Some(m) = &parts[0].scale {
+                    k += ev(m, &kfeats[0])?;
+                }
+                for ((p, f), kf) in parts.iter().zip(&feats).zip(&kfeats).skip(1) {
+                    if let Some(m) = &p.bias {
+                        b += ev(m, f)?;
+                    }
+                    if let Some(m) = &p.scale {
+                        k += ev(m, kf)?;
+                    }
+                }
+                if k > 0.0 && b.is_finite() && k.is_finite() {
+                    held = (b, k);
+                }
+            }
+            r.push((g[i] - held.0) / held.1);
+        }
+        let frac = outside as f64 / steps.max(1) as f64;
+        out.push((r, Outside { frac, min_s }));
+    }
+    Ok(out)
 }
 
 /// The flight's envelope as `gyrotherm plan` reads it: time and the case sensor.
@@ -228,31 +513,78 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             )
         })?;
         let fit_s = t0.elapsed().as_secs_f64();
-        for (profile, st, tabs, floors) in &tests {
-            let cs = compensate_imu(&model, st).map_err(|e| e.to_string())?;
-            for (k, axis) in model.axes.iter().enumerate() {
-                let b = bias_stability_dph(&cs[k].gyro_comp_dps, 1.0, TAU_S)
+        // Each axis's training envelope, per sensor it reads (first sensor first).
+        let train_logs: Vec<&ImuLog> = train.iter().map(|(_, l)| l).collect();
+        let comps = imu_axis_compensators(&model).map_err(|e| e.to_string())?;
+        let mut envs = Vec::new();
+        for (a, comp) in model.axes.iter().zip(&comps).filter(|_| job.replica) {
+            let mut specs = vec![*comp.first().spec()];
+            specs.extend(comp.further().map(|(_, s, _, _)| *s));
+            envs.push(
+                specs
+                    .iter()
+                    .zip(&a.temps)
+                    .map(|(s, t)| envelope(s, &train_logs, t).map(|e| (*s, e)))
+                    .collect::<Result<Vec<_>, _>>()?,
+            );
+        }
+        for hold in job.holds {
+            // Without a hold asked for, compensate_imu itself (the recorded runs unchanged);
+            // with one, the replica for every hold, checked against compensate_imu.
+            let apply = |log: &ImuLog| -> Result<Vec<(Vec<f64>, Outside)>, String> {
+                if job.replica {
+                    return compensate_held(&model, log, &envs, hold);
+                }
+                let unknown = Outside {
+                    frac: f64::NAN,
+                    min_s: f64::NAN,
+                };
+                Ok(compensate_imu(&model, log)
                     .map_err(|e| e.to_string())?
-                    .bias_stability_dph;
-                let tab = &tabs[k];
-                let ct = compensate_imu(&model, tab).map_err(|e| e.to_string())?;
-                let rep = scale_factor(
-                    &tab.time_s,
-                    &ct[k].gyro_comp_dps,
-                    &tab.table.as_ref().ok_or("no table")?.values,
-                    &ScaleFactorOptions::default(),
-                )
-                .map_err(|e| e.to_string())?;
-                out.push(Case {
-                    unit_seed,
-                    setting: setting.clone(),
-                    axis: k,
-                    profile,
-                    x_floor: b / floors[k],
-                    sf_ppm: rep.sf_thermal_error_ppm,
-                    fit_s,
-                    temps: axis.temps.join("+"),
-                });
+                    .into_iter()
+                    .map(|c| (c.gyro_comp_dps, unknown))
+                    .collect())
+            };
+            for (profile, st, tabs, floors) in &tests {
+                let cs = apply(st)?;
+                if job.replica && hold == "none" {
+                    // The replica must be compensate_imu exactly.
+                    let reference = compensate_imu(&model, st).map_err(|e| e.to_string())?;
+                    for ((c, _), r) in cs.iter().zip(&reference) {
+                        if c.iter()
+                            .map(|x| x.to_bits())
+                            .ne(r.gyro_comp_dps.iter().map(|x| x.to_bits()))
+                        {
+                            return Err(format!("unit {unit_seed}: held replica differs"));
+                        }
+                    }
+                }
+                for (k, axis) in model.axes.iter().enumerate() {
+                    let b = bias_stability_dph(&cs[k].0, 1.0, TAU_S)
+                        .map_err(|e| e.to_string())?
+                        .bias_stability_dph;
+                    let tab = &tabs[k];
+                    let ct = apply(tab)?;
+                    let rep = scale_factor(
+                        &tab.time_s,
+                        &ct[k].0,
+                        &tab.table.as_ref().ok_or("no table")?.values,
+                        &ScaleFactorOptions::default(),
+                    )
+                    .map_err(|e| e.to_string())?;
+                    out.push(Case {
+                        unit_seed,
+                        setting: setting.clone(),
+                        hold: hold.clone(),
+                        axis: k,
+                        profile,
+                        x_floor: b / floors[k],
+                        sf_ppm: rep.sf_thermal_error_ppm,
+                        fit_s,
+                        temps: axis.temps.join("+"),
+                        outside: cs[k].1,
+                    });
+                }
             }
         }
     }
@@ -317,10 +649,20 @@ fn run() -> Result<(), String> {
         Some("planned") => true,
         Some(v) => return Err(format!("--train {v:?}: use seed-shock or planned")),
     };
+    let holds: Vec<String> = get("--hold")
+        .unwrap_or_else(|| "none".into())
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    if let Some(h) = holds.iter().find(|h| !HOLDS.contains(&h.as_str())) {
+        return Err(format!("--hold: unknown {h:?}; use {}", HOLDS.join(", ")));
+    }
     let job = Job {
         settings: &settings,
         min_gain,
         planned,
+        holds: &holds,
+        replica: holds.iter().any(|h| h != "none"),
     };
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     eprintln!(
@@ -355,21 +697,32 @@ fn run() -> Result<(), String> {
     let errors = errors.into_inner().unwrap_or_else(|p| p.into_inner());
     let mut cases = results.into_inner().unwrap_or_else(|p| p.into_inner());
     cases.sort_by(|a, b| {
-        (a.unit_seed, &a.setting, a.profile, a.axis).cmp(&(
+        (a.unit_seed, &a.setting, &a.hold, a.profile, a.axis).cmp(&(
             b.unit_seed,
             &b.setting,
+            &b.hold,
             b.profile,
             b.axis,
         ))
     });
     if let Some(path) = get("--cases") {
-        let mut text =
-            String::from("unit_seed\tsetting\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\n");
+        // The hold column only when a hold was asked for (the recorded files keep their form).
+        let with_hold = job.replica;
+        let mut text = String::from(if with_hold {
+            "unit_seed\tsetting\thold\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\tout_frac\tmin_s\n"
+        } else {
+            "unit_seed\tsetting\taxis\tprofile\tx_floor\tsf_ppm\tfit_s\ttemps\n"
+        });
         for c in &cases {
+            let setting = if with_hold {
+                format!("{}\t{}", c.setting, c.hold)
+            } else {
+                c.setting.clone()
+            };
             text.push_str(&format!(
                 "{}\t{}\t{}\t{}\t{:.4}\t{:.3}\t{:.2}\t{}\n",
                 c.unit_seed,
-                c.setting,
+                setting,
                 AXIS_NAMES[c.axis],
                 c.profile,
                 c.x_floor,
@@ -377,6 +730,13 @@ fn run() -> Result<(), String> {
                 c.fit_s,
                 c.temps
             ));
+            if with_hold {
+                text.pop();
+                text.push_str(&format!(
+                    "\t{:.4}\t{:.4}\n",
+                    c.outside.frac, c.outside.min_s
+                ));
+            }
         }
         gyrotherm::atomic_file::write_bytes_atomically(
             std::path::Path::new(&path),
@@ -390,29 +750,45 @@ fn run() -> Result<(), String> {
         seeds.len(),
         if planned { " + a static run on the planned profile" } else { "" }
     );
-    println!("| setting | profile | ×floor median | ×floor worst | SF ppm median | SF ppm worst | fit s per unit |");
-    println!("|---|---|---|---|---|---|---|");
+    // The hold column only when a hold was asked for (the recorded tables keep their form).
+    let hold_head = if job.replica { " hold |" } else { "" };
+    println!("| setting |{hold_head} profile | ×floor median | ×floor worst | SF ppm median | SF ppm worst | fit s per unit |");
+    println!(
+        "|---|---|---|---|---|---|---|{}",
+        if job.replica { "---|" } else { "" }
+    );
     for setting in &settings {
-        for profile in TEST_PROFILES.iter().map(Some).chain([None]) {
-            let mine: Vec<&Case> = cases
-                .iter()
-                .filter(|c| &c.setting == setting && profile.is_none_or(|p| c.profile == *p))
-                .collect();
-            if mine.is_empty() {
-                continue;
+        for hold in &holds {
+            for profile in TEST_PROFILES.iter().map(Some).chain([None]) {
+                let mine: Vec<&Case> = cases
+                    .iter()
+                    .filter(|c| {
+                        &c.setting == setting
+                            && &c.hold == hold
+                            && profile.is_none_or(|p| c.profile == *p)
+                    })
+                    .collect();
+                if mine.is_empty() {
+                    continue;
+                }
+                let mut x: Vec<f64> = mine.iter().map(|c| c.x_floor).collect();
+                let mut sf: Vec<f64> = mine.iter().map(|c| c.sf_ppm).collect();
+                let fit_s = mine.iter().map(|c| c.fit_s).sum::<f64>() / mine.len() as f64;
+                let hold_cell = if job.replica {
+                    format!(" {hold} |")
+                } else {
+                    String::new()
+                };
+                println!(
+                    "| {setting} |{hold_cell} {} | {:.2} | {:.2} | {:.1} | {:.1} | {:.1} |",
+                    profile.copied().unwrap_or("both"),
+                    median(&mut x),
+                    worst(&x),
+                    median(&mut sf),
+                    worst(&sf),
+                    fit_s
+                );
             }
-            let mut x: Vec<f64> = mine.iter().map(|c| c.x_floor).collect();
-            let mut sf: Vec<f64> = mine.iter().map(|c| c.sf_ppm).collect();
-            let fit_s = mine.iter().map(|c| c.fit_s).sum::<f64>() / mine.len() as f64;
-            println!(
-                "| {setting} | {} | {:.2} | {:.2} | {:.1} | {:.1} | {:.1} |",
-                profile.copied().unwrap_or("both"),
-                median(&mut x),
-                worst(&x),
-                median(&mut sf),
-                worst(&sf),
-                fit_s
-            );
         }
     }
     println!(
