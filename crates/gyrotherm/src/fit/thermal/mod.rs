@@ -39,6 +39,7 @@ use crate::targets::{self, TargetSet};
 mod allowance;
 pub mod multi;
 mod ridge;
+mod search;
 
 use allowance::*;
 use ridge::*;
@@ -464,35 +465,50 @@ pub fn identify(
         (ss / n.max(1) as f64).sqrt().max(f64::MIN_POSITIVE)
     };
     let (ref_main, ref_scale) = (spread(runs), spread(&scale_runs));
-    let score = |lags: &[f64]| -> Result<(f64, f64), ThermalError> {
-        let d = design(runs, lags, &terms)?;
+    // The candidates' scores from statistics kept between them (`search`); a term set the
+    // scorer does not take is scored from its design.
+    let mut main_scorer = match al.folds {
+        0 => None,
+        _ => search::Scorer::new(runs, &terms, al.folds, al.gap_steps)?,
+    };
+    let mut scale_scorer = match &joint {
+        Some(ak) => search::Scorer::new(&scale_runs, &scale_terms, ak.folds, ak.gap_steps)?,
+        None => None,
+    };
+    let mut score = |lags: &[f64]| -> Result<(f64, f64), ThermalError> {
         if al.folds == 0 {
             // No cross-validation: the in-sample RMS at the fixed ridge strength.
+            let d = design(runs, lags, &terms)?;
             return Ok((
                 in_sample_rms(&d, nc, cfg.fallback_ridge),
                 cfg.fallback_ridge,
             ));
         }
-        let (s, l) = best_ridge(
-            &d,
-            nc,
-            al.folds,
-            al.gap_steps,
-            &lambdas,
-            cfg.ridge_tolerance,
-        );
+        let (s, l) = match &mut main_scorer {
+            Some(sc) => choose_ridge(sc.scores(lags, &lambdas)?, &lambdas, cfg.ridge_tolerance),
+            None => best_ridge(
+                &design(runs, lags, &terms)?,
+                nc,
+                al.folds,
+                al.gap_steps,
+                &lambdas,
+                cfg.ridge_tolerance,
+            ),
+        };
         let Some(ak) = &joint else {
             return Ok((s, l));
         };
-        let dk = design(&scale_runs, lags, &scale_terms)?;
-        let (sk, _) = best_ridge(
-            &dk,
-            scale_terms.len() - 1,
-            ak.folds,
-            ak.gap_steps,
-            &lambdas,
-            cfg.ridge_tolerance,
-        );
+        let (sk, _) = match &mut scale_scorer {
+            Some(sc) => choose_ridge(sc.scores(lags, &lambdas)?, &lambdas, cfg.ridge_tolerance),
+            None => best_ridge(
+                &design(&scale_runs, lags, &scale_terms)?,
+                scale_terms.len() - 1,
+                ak.folds,
+                ak.gap_steps,
+                &lambdas,
+                cfg.ridge_tolerance,
+            ),
+        };
         Ok((s / ref_main + sk / ref_scale, l))
     };
     // 1. Grid over increasing lag tuples, neighbours at least one grid step apart.
