@@ -353,7 +353,7 @@ fn design(runs: &[RunData], lags: &[f64], terms: &Terms) -> Result<Design, Therm
         let mut step = Vec::new();
         for k in 0..table.n_rows().min(r.mask.len()) {
             if r.mask[k] {
-                x.extend_from_slice(&terms.design_row(table.row(k))[1..]);
+                terms.extend_design_row(table.row(k), 1, &mut x);
                 debug_assert_eq!(x.len() % nc.max(1), 0);
                 y.push(r.target[k]);
                 step.push(k);
@@ -627,7 +627,7 @@ pub fn fit_target(
         let mut step = Vec::new();
         for k in 0..s.table.n_rows() {
             if s.mask[k] && s.target[k].is_finite() {
-                x.extend_from_slice(&terms.design_row(s.table.row(k))[1..]);
+                terms.extend_design_row(s.table.row(k), 1, &mut x);
                 y.push(s.target[k]);
                 step.push(k);
             }
