@@ -465,6 +465,11 @@ pub fn identify(
         (ss / n.max(1) as f64).sqrt().max(f64::MIN_POSITIVE)
     };
     let (ref_main, ref_scale) = (spread(runs), spread(&scale_runs));
+    let g = cfg.tau_grid.max(al.n_lags + 1);
+    let (lo, hi) = (tau_min.ln(), al.tau_max_s.max(tau_min * 1.01).ln());
+    let grid: Vec<f64> = (0..g)
+        .map(|i| (lo + (hi - lo) * i as f64 / (g - 1) as f64).exp())
+        .collect();
     // The candidates' scores from statistics kept between them (`search`); a term set the
     // scorer does not take is scored from its design.
     let mut main_scorer = match al.folds {
@@ -475,6 +480,9 @@ pub fn identify(
         Some(ak) => search::Scorer::new(&scale_runs, &scale_terms, ak.folds, ak.gap_steps)?,
         None => None,
     };
+    for sc in [&mut main_scorer, &mut scale_scorer].into_iter().flatten() {
+        sc.make_lags(&grid)?;
+    }
     let mut score = |lags: &[f64]| -> Result<(f64, f64), ThermalError> {
         if al.folds == 0 {
             // No cross-validation: the in-sample RMS at the fixed ridge strength.
@@ -512,11 +520,6 @@ pub fn identify(
         Ok((s / ref_main + sk / ref_scale, l))
     };
     // 1. Grid over increasing lag tuples, neighbours at least one grid step apart.
-    let g = cfg.tau_grid.max(al.n_lags + 1);
-    let (lo, hi) = (tau_min.ln(), al.tau_max_s.max(tau_min * 1.01).ln());
-    let grid: Vec<f64> = (0..g)
-        .map(|i| (lo + (hi - lo) * i as f64 / (g - 1) as f64).exp())
-        .collect();
     let mut tuples: Vec<Vec<usize>> = vec![vec![]];
     for _ in 0..al.n_lags {
         let mut next = Vec::new();

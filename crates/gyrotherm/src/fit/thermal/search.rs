@@ -78,6 +78,8 @@ struct Run {
     /// `D(τ)` at the labelled steps, by τ's bits.
     lag: HashMap<u64, Vec<f64>>,
     cols: HashMap<Col, ColSums>,
+    /// Buffers of the centred columns, kept from one candidate to the next.
+    pool: Vec<Vec<f64>>,
     /// Per-segment Σx_i·x_j of centred columns, by the pair (in order).
     cross: HashMap<(Col, Col), Vec<f64>>,
 }
@@ -150,6 +152,7 @@ impl<'a> Scorer<'a> {
                 seg,
                 lag: HashMap::new(),
                 cols: HashMap::new(),
+                pool: Vec::new(),
                 cross: HashMap::new(),
             });
         }
@@ -158,6 +161,12 @@ impl<'a> Scorer<'a> {
             terms,
             folds,
         }))
+    }
+
+    /// Make the lag differences of `taus` ahead of the candidates that use them (one pass
+    /// over each run for all of them).
+    pub(super) fn make_lags(&mut self, taus: &[f64]) -> Result<(), ThermalError> {
+        self.runs.iter_mut().try_for_each(|r| r.make_lags(taus))
     }
 
     /// The cross-validated score of each ridge strength at `lags` (as [`cv_scores`] of the
@@ -187,39 +196,64 @@ impl<'a> Scorer<'a> {
     }
 }
 
-/// `T − lag_τ(T)` at every step of a run (`t` per step, `gaps` steps since the previous one,
-/// `p` the step period): the feature pipeline's lag difference, the same arithmetic
-/// (`gyrotherm_core::features`), without its other features.
-fn lag_difference(t: &[f64], gaps: &[u64], p: f64, tau: f64) -> Vec<f64> {
-    let g1 = -libm::expm1(-p / tau);
-    let mut c = t.first().copied().unwrap_or(0.0);
-    t.iter()
-        .zip(gaps)
-        .map(|(&v, &n)| {
-            let gain = match n {
-                0 => 0.0,
-                1 => g1,
-                _ => -libm::expm1(-(n as f64) * p / tau),
-            };
-            c += gain * (v - c);
-            v - c
-        })
-        .collect()
+/// `T − lag_τ(T)` at every step of a run for each τ of `taus` (`t` per step, `gaps` steps
+/// since the previous one, `p` the step period): the feature pipeline's lag difference, the
+/// same arithmetic (`gyrotherm_core::features`), without its other features. Eight lags go
+/// through the run together: each is a chain of dependent steps, and eight chains keep the
+/// processor busy where one waits on each step.
+fn lag_differences(t: &[f64], gaps: &[u64], p: f64, taus: &[f64]) -> Vec<Vec<f64>> {
+    const W: usize = 8;
+    let mut out: Vec<Vec<f64>> = taus.iter().map(|_| vec![0.0; t.len()]).collect();
+    for (tau, dst) in taus.chunks(W).zip(out.chunks_mut(W)) {
+        // Unused lanes run a τ of 1 s and are dropped.
+        let mut lane = [1.0; W];
+        lane[..tau.len()].copy_from_slice(tau);
+        let g1 = lane.map(|tau| -libm::expm1(-p / tau));
+        let mut c = [t.first().copied().unwrap_or(0.0); W];
+        let mut d = vec![[0.0; W]; t.len()];
+        for ((&v, &n), dk) in t.iter().zip(gaps).zip(&mut d) {
+            for i in 0..W {
+                let gain = match n {
+                    0 => 0.0,
+                    1 => g1[i],
+                    _ => -libm::expm1(-(n as f64) * p / lane[i]),
+                };
+                c[i] += gain * (v - c[i]);
+                dk[i] = v - c[i];
+            }
+        }
+        for (i, o) in dst.iter_mut().enumerate() {
+            o.iter_mut().zip(&d).for_each(|(x, dk)| *x = dk[i]);
+        }
+    }
+    out
 }
 
 impl Run {
-    /// Make every sum the columns `cols` at `lags` need and this run does not hold yet.
-    fn prepare(&mut self, lags: &[f64], cols: &[Col]) -> Result<(), ThermalError> {
-        for &tau in lags {
-            if !self.lag.contains_key(&tau.to_bits()) {
+    /// Make the lag differences of `taus` this run does not hold yet (all in one pass).
+    fn make_lags(&mut self, taus: &[f64]) -> Result<(), ThermalError> {
+        let mut new: Vec<f64> = Vec::new();
+        for &tau in taus {
+            if !self.lag.contains_key(&tau.to_bits()) && !new.contains(&tau) {
                 // The spec's checks on the lag (finite, > 0), as the pipeline makes them.
                 spec_with(&[tau])?;
-                let p = FeatureSpec::THERMAL_STATE.step_period_s;
-                let all = lag_difference(&self.t_all, &self.gaps, p, tau);
-                let d = self.steps.iter().map(|&k| all[k]).collect();
-                self.lag.insert(tau.to_bits(), d);
+                new.push(tau);
             }
         }
+        let p = FeatureSpec::THERMAL_STATE.step_period_s;
+        for (tau, all) in new
+            .iter()
+            .zip(lag_differences(&self.t_all, &self.gaps, p, &new))
+        {
+            let d = self.steps.iter().map(|&k| all[k]).collect();
+            self.lag.insert(tau.to_bits(), d);
+        }
+        Ok(())
+    }
+
+    /// Make every sum the columns `cols` at `lags` need and this run does not hold yet.
+    fn prepare(&mut self, lags: &[f64], cols: &[Col]) -> Result<(), ThermalError> {
+        self.make_lags(lags)?;
         // Centred values of the columns some missing sum needs, for this candidate only.
         let mut values: HashMap<Col, Vec<f64>> = HashMap::new();
         let mut missing = Vec::new();
@@ -233,7 +267,8 @@ impl Run {
         }
         for &c in cols {
             if !self.cols.contains_key(&c) || missing.iter().any(|&(a, b)| a == c || b == c) {
-                let v = self.centred(c);
+                let buf = self.pool.pop().unwrap_or_default();
+                let v = self.centred(c, buf);
                 if !self.cols.contains_key(&c) {
                     let sums = ColSums {
                         mean: v.1,
@@ -250,22 +285,22 @@ impl Run {
             let sums = self.per_segment(va, Some(vb));
             self.cross.insert((a, b), sums);
         }
+        self.pool.extend(values.into_values());
         Ok(())
     }
 
     /// Column `c` at the labelled steps, centred on its mean, and the mean.
-    fn centred(&self, c: Col) -> (Vec<f64>, f64) {
-        let lags =
-            c.d.iter()
-                .filter(|e| e.1 > 0)
-                .map(|&(bits, p)| (&self.lag[&bits], p));
+    fn centred(&self, c: Col, mut v: Vec<f64>) -> (Vec<f64>, f64) {
+        let lags = c.d.iter().filter(|e| e.1 > 0);
+        let lags = lags.map(|&(bits, p)| (&self.lag[&bits], p));
         let mut factors = std::iter::once((&self.t, c.t))
             .chain(lags)
             .flat_map(|(f, p)| std::iter::repeat_n(f, usize::from(p)));
-        let mut v = match factors.next() {
-            Some(f) => f.clone(),
-            None => vec![1.0; self.t.len()],
-        };
+        v.clear();
+        match factors.next() {
+            Some(f) => v.extend_from_slice(f),
+            None => v.resize(self.t.len(), 1.0),
+        }
         for f in factors {
             v.iter_mut().zip(f).for_each(|(x, fv)| *x *= fv);
         }
@@ -417,11 +452,17 @@ mod tests {
             let want: Vec<u64> = (0..table.n_rows())
                 .map(|k| table.row(k)[2].to_bits())
                 .collect();
-            let got: Vec<u64> = lag_difference(&t, &gaps, 1.0, tau)
-                .iter()
-                .map(|v| v.to_bits())
-                .collect();
-            assert_eq!(got, want, "τ = {tau}");
+            for taus in [
+                vec![tau],
+                vec![5.0, tau, 77.0, 1e4, 3.0, 9.0, 11.0, 13.0, 600.0],
+            ] {
+                let i = taus.iter().position(|&x| x == tau).unwrap();
+                let got: Vec<u64> = lag_differences(&t, &gaps, 1.0, &taus)[i]
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect();
+                assert_eq!(got, want, "τ = {tau} among {taus:?}");
+            }
         }
     }
 
