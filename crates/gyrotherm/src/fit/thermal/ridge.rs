@@ -30,14 +30,16 @@ impl Stats {
         self.n += sign;
         self.sy += sign * y;
         self.syy += sign * y * y;
+        let x = &x[..nc];
         for i in 0..nc {
             let xi = sign * x[i];
             self.sx[i] += xi;
             self.sxy[i] += xi * y;
-            let row = &mut self.sxx[i * nc..];
-            for j in i..nc {
-                row[j] += xi * x[j];
-            }
+            // The same sums in the same order as an indexed loop, without bounds checks.
+            let row = &mut self.sxx[i * nc + i..(i + 1) * nc];
+            row.iter_mut()
+                .zip(&x[i..])
+                .for_each(|(r, xj)| *r += xi * xj);
         }
     }
     #[cfg(test)]

@@ -202,31 +202,46 @@ impl<'a> Scorer<'a> {
 /// through the run together: each is a chain of dependent steps, and eight chains keep the
 /// processor busy where one waits on each step.
 fn lag_differences(t: &[f64], gaps: &[u64], p: f64, taus: &[f64]) -> Vec<Vec<f64>> {
-    const W: usize = 8;
     let mut out: Vec<Vec<f64>> = taus.iter().map(|_| vec![0.0; t.len()]).collect();
-    for (tau, dst) in taus.chunks(W).zip(out.chunks_mut(W)) {
-        // Unused lanes run a τ of 1 s and are dropped.
-        let mut lane = [1.0; W];
-        lane[..tau.len()].copy_from_slice(tau);
-        let g1 = lane.map(|tau| -libm::expm1(-p / tau));
-        let mut c = [t.first().copied().unwrap_or(0.0); W];
-        let mut d = vec![[0.0; W]; t.len()];
-        for ((&v, &n), dk) in t.iter().zip(gaps).zip(&mut d) {
+    for (tau, dst) in taus.chunks(8).zip(out.chunks_mut(8)) {
+        match tau.len() {
+            1 => lag_lanes::<1>(t, gaps, p, tau, dst),
+            2 => lag_lanes::<2>(t, gaps, p, tau, dst),
+            3 | 4 => lag_lanes::<4>(t, gaps, p, tau, dst),
+            _ => lag_lanes::<8>(t, gaps, p, tau, dst),
+        }
+    }
+    out
+}
+
+/// [`lag_differences`] of up to `W` lags (`dst` one output per lag), in `W` lanes; unused
+/// lanes run a τ of 1 s and are dropped.
+fn lag_lanes<const W: usize>(t: &[f64], gaps: &[u64], p: f64, tau: &[f64], dst: &mut [Vec<f64>]) {
+    let mut lane = [1.0; W];
+    lane[..tau.len()].copy_from_slice(tau);
+    let g1 = lane.map(|tau| -libm::expm1(-p / tau));
+    let mut c = [t.first().copied().unwrap_or(0.0); W];
+    let mut d = vec![[0.0; W]; t.len()];
+    for ((&v, &n), dk) in t.iter().zip(gaps).zip(&mut d) {
+        if n == 1 {
+            for i in 0..W {
+                c[i] += g1[i] * (v - c[i]);
+                dk[i] = v - c[i];
+            }
+        } else {
             for i in 0..W {
                 let gain = match n {
                     0 => 0.0,
-                    1 => g1[i],
                     _ => -libm::expm1(-(n as f64) * p / lane[i]),
                 };
                 c[i] += gain * (v - c[i]);
                 dk[i] = v - c[i];
             }
         }
-        for (i, o) in dst.iter_mut().enumerate() {
-            o.iter_mut().zip(&d).for_each(|(x, dk)| *x = dk[i]);
-        }
     }
-    out
+    for (i, o) in dst.iter_mut().enumerate() {
+        o.iter_mut().zip(&d).for_each(|(x, dk)| *x = dk[i]);
+    }
 }
 
 impl Run {
