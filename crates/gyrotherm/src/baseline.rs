@@ -189,6 +189,23 @@ impl Terms {
         }
     }
 
+    /// [`Terms::design_row`] from term `from` on, appended to `out` (the same values to the
+    /// bit: a power 0 contributes the exact factor 1 and a power 1 the value itself, so
+    /// both are taken without `powi`).
+    pub fn extend_design_row(&self, x: &[f64], from: usize, out: &mut Vec<f64>) {
+        out.extend(self.powers[from..].iter().map(|p| {
+            let mut acc = 1.0;
+            for (&q, &v) in p.iter().zip(x) {
+                match q {
+                    0 => {}
+                    1 => acc *= v,
+                    _ => acc *= v.powi(i32::from(q)),
+                }
+            }
+            acc
+        }));
+    }
+
     /// The monomial values of term `j..` at feature vector `x` (ground evaluation, `powi`).
     pub fn design_row(&self, x: &[f64]) -> Vec<f64> {
         self.powers

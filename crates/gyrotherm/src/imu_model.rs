@@ -26,9 +26,7 @@ use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 use crate::compensate::compensator;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
-use crate::fit::{
-    fit_model, fit_model_identified, uses_identification, FitConfig, FitError, FitOutcome, NamedLog,
-};
+use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
 use crate::model::{sha256_hex, ModelFile, ModelFileError, SubModel, TempSensorDef, CHECKSUM_KEY};
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
@@ -495,16 +493,19 @@ fn fit_axis_multi(
         .iter()
         .map(|(n, l)| NamedLog { name: n, log: l })
         .collect();
-    let mut outcome = fit_model_identified(&named, cfg, Some(id0.clone()), &|t, e, loss| {
-        progress(k, j0, t, e, loss)
-    })
-    .map_err(|e| fit_err(j0, e))?;
+    let has_bias = data.iter().all(|d| !d.bias.is_empty());
+    // Several sensors replace the bias model, and with it the one-sensor coverage map.
+    let coverage = !(order.len() > 1 && has_bias);
+    let mut outcome =
+        crate::fit::fit_model_with(&named, cfg, Some(id0.clone()), coverage, &|t, e, loss| {
+            progress(k, j0, t, e, loss)
+        })
+        .map_err(|e| fit_err(j0, e))?;
     outcome.model.features.temp_sensor = *temp_sensor;
     let mut more = Vec::new();
     let mut multi_cv_rms = None;
     if order.len() > 1 {
         let thermal_err = |e: crate::fit::thermal::ThermalError| fit_err(j0, FitError::from(e));
-        let has_bias = data.iter().all(|d| !d.bias.is_empty());
         let has_scale = data.iter().all(|d| !d.scale.is_empty());
         let bias = has_bias
             .then(|| multi::fit_multi(&data, &order, &cfg.thermal, false))

@@ -241,3 +241,25 @@ fn core_evaluation_equals_ground_evaluation() {
     // And the fit is useful: the residual is far below the target's spread.
     assert!(f.rms_residual < 1e-4, "rms {}", f.rms_residual);
 }
+
+/// `extend_design_row` appends `design_row`'s values to the bit (the reference: `design_row`
+/// itself, `powi` on every factor), at powers 0 to 4 and at zero, negative and tiny values.
+#[test]
+fn extend_design_row_is_design_row_to_the_bit() {
+    let terms = gyrotherm::fit::thermal::basis(gyrotherm::fit::thermal::Basis::Full, 3);
+    let mut t = terms.clone();
+    t.powers.push(vec![4, 0, 1, 0, 2]);
+    for x in [
+        [21.3125, 1e-3, -0.4, 2.75, -7.0],
+        [-38.0625, -0.06, 0.0, -1e-300, 3.5],
+        [0.0, 0.0, 1e-5, -0.0, 1.0 / 3.0],
+    ] {
+        let want: Vec<u64> = t.design_row(&x).iter().map(|v| v.to_bits()).collect();
+        for from in [0, 1] {
+            let mut out = vec![9.0];
+            t.extend_design_row(&x, from, &mut out);
+            let got: Vec<u64> = out[1..].iter().map(|v| v.to_bits()).collect();
+            assert_eq!(got, want[from..], "{x:?}");
+        }
+    }
+}

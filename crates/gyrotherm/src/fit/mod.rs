@@ -284,6 +284,18 @@ pub fn fit_model_identified(
     identified: Option<thermal::Identified>,
     progress: &(dyn Fn(Target, usize, f64) + Sync),
 ) -> Result<FitOutcome, FitError> {
+    fit_model_with(logs, cfg, identified, true, progress)
+}
+
+/// [`fit_model_identified`], the coverage map made only with `coverage` (a caller that
+/// replaces the bias model has no use for the one-sensor model's map).
+pub(crate) fn fit_model_with(
+    logs: &[NamedLog],
+    cfg: &FitConfig,
+    identified: Option<thermal::Identified>,
+    coverage: bool,
+    progress: &(dyn Fn(Target, usize, f64) + Sync),
+) -> Result<FitOutcome, FitError> {
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
@@ -397,7 +409,7 @@ pub fn fit_model_identified(
         coverage: None,
     };
     // What training covered, and the bias model's cross-validated error there.
-    let coverage = model.bias.as_ref().map(|b| {
+    let coverage = model.bias.as_ref().filter(|_| coverage).map(|b| {
         crate::coverage::cross_validated(
             b,
             &bias_sets,

@@ -39,6 +39,7 @@ use crate::targets::{self, TargetSet};
 mod allowance;
 pub mod multi;
 mod ridge;
+mod search;
 
 use allowance::*;
 use ridge::*;
@@ -352,7 +353,7 @@ fn design(runs: &[RunData], lags: &[f64], terms: &Terms) -> Result<Design, Therm
         let mut step = Vec::new();
         for k in 0..table.n_rows().min(r.mask.len()) {
             if r.mask[k] {
-                x.extend_from_slice(&terms.design_row(table.row(k))[1..]);
+                terms.extend_design_row(table.row(k), 1, &mut x);
                 debug_assert_eq!(x.len() % nc.max(1), 0);
                 y.push(r.target[k]);
                 step.push(k);
@@ -464,43 +465,61 @@ pub fn identify(
         (ss / n.max(1) as f64).sqrt().max(f64::MIN_POSITIVE)
     };
     let (ref_main, ref_scale) = (spread(runs), spread(&scale_runs));
-    let score = |lags: &[f64]| -> Result<(f64, f64), ThermalError> {
-        let d = design(runs, lags, &terms)?;
-        if al.folds == 0 {
-            // No cross-validation: the in-sample RMS at the fixed ridge strength.
-            return Ok((
-                in_sample_rms(&d, nc, cfg.fallback_ridge),
-                cfg.fallback_ridge,
-            ));
-        }
-        let (s, l) = best_ridge(
-            &d,
-            nc,
-            al.folds,
-            al.gap_steps,
-            &lambdas,
-            cfg.ridge_tolerance,
-        );
-        let Some(ak) = &joint else {
-            return Ok((s, l));
-        };
-        let dk = design(&scale_runs, lags, &scale_terms)?;
-        let (sk, _) = best_ridge(
-            &dk,
-            scale_terms.len() - 1,
-            ak.folds,
-            ak.gap_steps,
-            &lambdas,
-            cfg.ridge_tolerance,
-        );
-        Ok((s / ref_main + sk / ref_scale, l))
-    };
-    // 1. Grid over increasing lag tuples, neighbours at least one grid step apart.
     let g = cfg.tau_grid.max(al.n_lags + 1);
     let (lo, hi) = (tau_min.ln(), al.tau_max_s.max(tau_min * 1.01).ln());
     let grid: Vec<f64> = (0..g)
         .map(|i| (lo + (hi - lo) * i as f64 / (g - 1) as f64).exp())
         .collect();
+    // The candidates' scores from statistics kept between them (`search`); a term set the
+    // scorer does not take is scored from its design.
+    let mut main_scorer = match al.folds {
+        0 => None,
+        _ => search::Scorer::new(runs, &terms, al.folds, al.gap_steps)?,
+    };
+    let mut scale_scorer = match &joint {
+        Some(ak) => search::Scorer::new(&scale_runs, &scale_terms, ak.folds, ak.gap_steps)?,
+        None => None,
+    };
+    for sc in [&mut main_scorer, &mut scale_scorer].into_iter().flatten() {
+        sc.make_lags(&grid)?;
+    }
+    let mut score = |lags: &[f64]| -> Result<(f64, f64), ThermalError> {
+        if al.folds == 0 {
+            // No cross-validation: the in-sample RMS at the fixed ridge strength.
+            let d = design(runs, lags, &terms)?;
+            return Ok((
+                in_sample_rms(&d, nc, cfg.fallback_ridge),
+                cfg.fallback_ridge,
+            ));
+        }
+        let (s, l) = match &mut main_scorer {
+            Some(sc) => choose_ridge(sc.scores(lags, &lambdas)?, &lambdas, cfg.ridge_tolerance),
+            None => best_ridge(
+                &design(runs, lags, &terms)?,
+                nc,
+                al.folds,
+                al.gap_steps,
+                &lambdas,
+                cfg.ridge_tolerance,
+            ),
+        };
+        let Some(ak) = &joint else {
+            return Ok((s, l));
+        };
+        let (sk, _) = match &mut scale_scorer {
+            Some(sc) => choose_ridge(sc.scores(lags, &lambdas)?, &lambdas, cfg.ridge_tolerance),
+            None => best_ridge(
+                &design(&scale_runs, lags, &scale_terms)?,
+                scale_terms.len() - 1,
+                ak.folds,
+                ak.gap_steps,
+                &lambdas,
+                cfg.ridge_tolerance,
+            ),
+        };
+        Ok((s / ref_main + sk / ref_scale, l))
+    };
+    // 1. Grid over increasing lag tuples, neighbours at least one grid step apart.
     let mut tuples: Vec<Vec<usize>> = vec![vec![]];
     for _ in 0..al.n_lags {
         let mut next = Vec::new();
@@ -611,7 +630,7 @@ pub fn fit_target(
         let mut step = Vec::new();
         for k in 0..s.table.n_rows() {
             if s.mask[k] && s.target[k].is_finite() {
-                x.extend_from_slice(&terms.design_row(s.table.row(k))[1..]);
+                terms.extend_design_row(s.table.row(k), 1, &mut x);
                 y.push(s.target[k]);
                 step.push(k);
             }

@@ -103,8 +103,7 @@ fn combined(parts: &[(&[TargetSet], &Terms)]) -> (Design, usize) {
         for k in 0..n_rows {
             if s.mask[k] && s.target[k].is_finite() {
                 for (i, (sets, terms)) in parts.iter().enumerate() {
-                    let row = terms.design_row(sets[r].table.row(k));
-                    x.extend_from_slice(&row[usize::from(i == 0)..]);
+                    terms.extend_design_row(sets[r].table.row(k), usize::from(i == 0), &mut x);
                 }
                 y.push(s.target[k]);
                 step.push(k);

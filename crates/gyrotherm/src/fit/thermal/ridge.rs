@@ -11,6 +11,7 @@ pub(super) struct Stats {
     pub(super) sy: f64,
     pub(super) sxx: Vec<f64>,
     pub(super) sxy: Vec<f64>,
+    pub(super) syy: f64,
 }
 
 impl Stats {
@@ -21,22 +22,27 @@ impl Stats {
             sy: 0.0,
             sxx: vec![0.0; nc * nc],
             sxy: vec![0.0; nc],
+            syy: 0.0,
         }
     }
     pub(super) fn add(&mut self, x: &[f64], y: f64, sign: f64) {
         let nc = self.sx.len();
         self.n += sign;
         self.sy += sign * y;
+        self.syy += sign * y * y;
+        let x = &x[..nc];
         for i in 0..nc {
             let xi = sign * x[i];
             self.sx[i] += xi;
             self.sxy[i] += xi * y;
-            let row = &mut self.sxx[i * nc..];
-            for j in i..nc {
-                row[j] += xi * x[j];
-            }
+            // The same sums in the same order as an indexed loop, without bounds checks.
+            let row = &mut self.sxx[i * nc + i..(i + 1) * nc];
+            row.iter_mut()
+                .zip(&x[i..])
+                .for_each(|(r, xj)| *r += xi * xj);
         }
     }
+    #[cfg(test)]
     pub(super) fn minus(&self, o: &Stats) -> Stats {
         let sub = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p - q).collect();
         Stats {
@@ -45,7 +51,18 @@ impl Stats {
             sy: self.sy - o.sy,
             sxx: sub(&self.sxx, &o.sxx),
             sxy: sub(&self.sxy, &o.sxy),
+            syy: self.syy - o.syy,
         }
+    }
+    /// Add the statistics of a disjoint set of rows.
+    pub(super) fn merge(&mut self, o: &Stats) {
+        let add = |a: &mut [f64], b: &[f64]| a.iter_mut().zip(b).for_each(|(p, q)| *p += q);
+        self.n += o.n;
+        add(&mut self.sx, &o.sx);
+        self.sy += o.sy;
+        add(&mut self.sxx, &o.sxx);
+        add(&mut self.sxy, &o.sxy);
+        self.syy += o.syy;
     }
 }
 
@@ -104,8 +121,192 @@ pub(super) fn fold_range(n: usize, f: usize, folds: usize) -> (usize, usize) {
     (n * f / folds, n * (f + 1) / folds)
 }
 
+/// A run's steps cut so that every fold's held-out range and its training set are unions of
+/// whole segments: the cuts are each fold's ends and its ends moved out by the gap.
+pub(super) struct Layout {
+    /// Labelled-row range `[a, b)` of each segment, in step order.
+    pub(super) rows: Vec<(usize, usize)>,
+    /// Per fold, the segments held out `[a, b)`.
+    held: Vec<(usize, usize)>,
+    /// Per fold, the segments left out of training (held out and the gap either side).
+    left_out: Vec<(usize, usize)>,
+}
+
+/// The [`Layout`] of a run of `n_steps` steps whose labelled rows are at `steps` (increasing).
+pub(super) fn layout(steps: &[usize], n_steps: usize, folds: usize, gap: usize) -> Layout {
+    let mut cuts = vec![0, n_steps];
+    for f in 0..folds {
+        let (a, b) = fold_range(n_steps, f, folds);
+        cuts.extend([a, b, a.saturating_sub(gap), (b + gap).min(n_steps)]);
+    }
+    cuts.sort_unstable();
+    cuts.dedup();
+    let row = |step: usize| steps.partition_point(|&s| s < step);
+    let rows = cuts.windows(2).map(|w| (row(w[0]), row(w[1]))).collect();
+    let seg = |step: usize| cuts.partition_point(|&c| c < step);
+    let (mut held, mut left_out) = (Vec::new(), Vec::new());
+    for f in 0..folds {
+        let (a, b) = fold_range(n_steps, f, folds);
+        held.push((seg(a), seg(b)));
+        left_out.push((seg(a.saturating_sub(gap)), seg((b + gap).min(n_steps))));
+    }
+    Layout {
+        rows,
+        held,
+        left_out,
+    }
+}
+
+/// Per-segment statistics of each run of a design, its columns and target centred on the
+/// run's means (so that the residual sums taken from them lose no digits to the offsets).
+pub(super) fn segment_stats(d: &Design, nc: usize, layouts: &[Layout]) -> Vec<Vec<Stats>> {
+    let mut xc = vec![0.0; nc];
+    (0..d.x.len())
+        .map(|r| {
+            let (x, y) = (&d.x[r], &d.y[r]);
+            let n = y.len().max(1) as f64;
+            let mut mx = vec![0.0; nc];
+            for row in x.chunks_exact(nc.max(1)) {
+                mx.iter_mut().zip(row).for_each(|(m, v)| *m += v);
+            }
+            mx.iter_mut().for_each(|m| *m /= n);
+            let my = y.iter().sum::<f64>() / n;
+            layouts[r]
+                .rows
+                .iter()
+                .map(|&(a, b)| {
+                    let mut s = Stats::new(nc);
+                    for k in a..b {
+                        let row = &x[k * nc..(k + 1) * nc];
+                        xc.iter_mut()
+                            .zip(row.iter().zip(&mx))
+                            .for_each(|(c, (v, m))| *c = v - m);
+                        s.add(&xc, y[k] - my, 1.0);
+                    }
+                    s
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Blocked cross-validated RMS residual (per-run means removed) for each ridge strength, from
+/// each run's per-segment statistics ([`segment_stats`]): for each fold a ridge fit on the
+/// segments not left out, each run keeping its own offset, scored on the held-out segments by
+/// the residual's sum and sum of squares per run, which is all the pooled within-run RMS
+/// ([`crate::fit::select::pooled_within_run_rms`]) needs.
+pub(super) fn segment_scores(
+    runs: &[(&[Stats], &Layout)],
+    nc: usize,
+    folds: usize,
+    lambdas: &[f64],
+) -> Vec<f64> {
+    let nr = runs.len();
+    let nl = lambdas.len();
+    // Per λ and run: Σr, Σr², count of the held-out residuals.
+    let (mut s1, mut s2, mut cnt) = (vec![0.0; nl * nr], vec![0.0; nl * nr], vec![0.0; nr]);
+    let mut failed = vec![false; nl];
+    for f in 0..folds {
+        let mut train = Vec::with_capacity(nr);
+        let mut held = Vec::with_capacity(nr);
+        for (segs, lay) in runs {
+            let (la, lb) = lay.left_out[f];
+            let mut t = Stats::new(nc);
+            for s in segs[..la].iter().chain(&segs[lb..]) {
+                t.merge(s);
+            }
+            let (ha, hb) = lay.held[f];
+            let mut h = Stats::new(nc);
+            for s in &segs[ha..hb] {
+                h.merge(s);
+            }
+            train.push(t);
+            held.push(h);
+        }
+        let any_held = held.iter().any(|h| h.n >= 1.0);
+        held.iter()
+            .zip(&mut cnt)
+            .for_each(|(h, c)| *c += h.n.max(0.0));
+        let (g, b, _) = centred_normal(&train, nc);
+        for (li, &lam) in lambdas.iter().enumerate() {
+            let Some(beta) = ridge_solve(&g, &b, nc, lam) else {
+                // Every held-out step of the fold is left without a residual.
+                failed[li] |= any_held;
+                continue;
+            };
+            let dot = |a: &[f64]| a.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>();
+            for r in 0..nr {
+                let (t, h) = (&train[r], &held[r]);
+                if h.n < 1.0 {
+                    continue;
+                }
+                if t.n < 1.0 {
+                    failed[li] = true;
+                    continue;
+                }
+                let offset = (t.sy - dot(&t.sx)) / t.n;
+                let xb = dot(&h.sx);
+                let mut quad = 0.0;
+                for i in 0..nc {
+                    let row = &h.sxx[i * nc..];
+                    let mut acc = 0.5 * row[i] * beta[i];
+                    for j in i + 1..nc {
+                        acc += row[j] * beta[j];
+                    }
+                    quad += 2.0 * beta[i] * acc;
+                }
+                // r = y − x·β − offset over the held-out rows.
+                let sum = h.sy - xb - h.n * offset;
+                let sum2 = h.syy - 2.0 * dot(&h.sxy) + quad - 2.0 * offset * (h.sy - xb)
+                    + h.n * offset * offset;
+                s1[li * nr + r] += sum;
+                s2[li * nr + r] += sum2;
+            }
+        }
+    }
+    (0..nl)
+        .map(|li| {
+            if failed[li] {
+                return f64::INFINITY;
+            }
+            let (mut ss, mut n) = (0.0, 0.0);
+            for r in 0..nr {
+                if cnt[r] >= 1.0 {
+                    let (a, b) = (s1[li * nr + r], s2[li * nr + r]);
+                    ss += b - a * a / cnt[r];
+                    n += cnt[r];
+                }
+            }
+            let rms = (ss.max(0.0) / n).sqrt();
+            if n >= 1.0 && rms.is_finite() {
+                rms
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect()
+}
+
 /// Blocked cross-validated RMS residual (per-run means removed) for each ridge strength.
 pub(super) fn cv_scores(
+    d: &Design,
+    nc: usize,
+    folds: usize,
+    gap: usize,
+    lambdas: &[f64],
+) -> Vec<f64> {
+    let layouts: Vec<Layout> = (0..d.x.len())
+        .map(|r| layout(&d.step[r], d.n_steps[r], folds, gap))
+        .collect();
+    let segs = segment_stats(d, nc, &layouts);
+    let runs: Vec<(&[Stats], &Layout)> = segs.iter().map(Vec::as_slice).zip(&layouts).collect();
+    segment_scores(&runs, nc, folds, lambdas)
+}
+
+/// [`cv_scores`] the direct way: every held-out residual computed row by row (the reference
+/// the statistics-based one is checked against).
+#[cfg(test)]
+pub(super) fn cv_scores_rows(
     d: &Design,
     nc: usize,
     folds: usize,
@@ -176,7 +377,11 @@ pub(super) fn best_ridge(
     lambdas: &[f64],
     tol: f64,
 ) -> (f64, f64) {
-    let scores = cv_scores(d, nc, folds, gap, lambdas);
+    choose_ridge(cv_scores(d, nc, folds, gap, lambdas), lambdas, tol)
+}
+
+/// The strongest λ whose score is within `tol` of the least, with its score.
+pub(super) fn choose_ridge(scores: Vec<f64>, lambdas: &[f64], tol: f64) -> (f64, f64) {
     let least = scores.iter().copied().fold(f64::INFINITY, f64::min);
     scores
         .into_iter()
