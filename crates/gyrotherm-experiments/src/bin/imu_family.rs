@@ -36,6 +36,13 @@
 //! scaled toward 0 by one common factor (see `transform`); `k-<hold>`: that hold on the
 //! scale factor's inputs only (the bias reads them as they are). Applied by a replica of
 //! `compensate_imu` (checked bit-equal with `none`). One fit serves every hold.
+//!
+//! `--dump DIR` (experiment, docs/experiments/imu-worst-case.md): for setting `all`, per
+//! axis, the 100 s means of the bias error and of each simulator bias term on the training
+//! static run and each held-out static run ([`dump_run`]; `bench/imu_worst_case.py` reads
+//! them). `--tau-max S`, `--max-tau-fraction F`, `--basis lean|linear|small|full`: the
+//! thermal recipe's longest lag searched, its bound as a fraction of the longest run, and
+//! the bias basis (defaults: the recipe's).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -172,6 +179,13 @@ struct Job<'a> {
     holds: &'a [String],
     /// A hold other than `none` was asked for: apply every hold through the replica.
     replica: bool,
+    /// `--dump DIR`: per-block bias error and simulator terms ([`dump_run`]).
+    dump: Option<String>,
+    /// Thermal-recipe overrides (experiment): longest lag searched, s; its bound as a
+    /// fraction of the longest run; the bias basis.
+    tau_max_s: Option<f64>,
+    max_tau_fraction: Option<f64>,
+    basis: Option<gyrotherm::fit::thermal::Basis>,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -430,6 +444,113 @@ fn case_log(log: &ImuLog) -> Result<gyrotherm::csvlog::TestLog, String> {
     })
 }
 
+/// `--dump DIR` (experiment, docs/experiments/imu-worst-case.md): for one static run with
+/// truth, per axis, the 100 s means (the blocks `bias_stability_dph` takes) of the model's
+/// bias error (estimate − true, °/h) and of each term of the simulator's bias computed from
+/// the unit's parameters and the true node temperatures (°/h): the coil polynomial, the
+/// Shupe term's linear part and its ΔT part, the stress term (stress state integrated from
+/// the true coil temperature), the radial-gradient term (case rate by central difference),
+/// the saturating term; `recon` is the true bias less their sum (a constant if the terms are
+/// recomputed right). Also the coil rate, ΔT, and the axis's first sensor reading.
+fn dump_run(
+    dir: &str,
+    tag: &str,
+    unit_seed: u64,
+    unit: &ImuUnit,
+    model: &ImuModel,
+    log: &ImuLog,
+) -> Result<(), String> {
+    let comp = compensate_imu(model, log).map_err(|e| e.to_string())?;
+    let case = truth(log, gyrotherm::sim::CASE_TEMP_COL)?;
+    let n = log.len();
+    for (k, a) in AXIS_NAMES.iter().enumerate() {
+        let g = &unit.gyros[k];
+        let tb = truth(log, &truth_col(gyrotherm::csvlog::TRUE_BIAS_COL, a))?;
+        let coil = truth(log, &truth_col(gyrotherm::sim::COIL_TEMP_COL, a))?;
+        let first = &model.axes[k].temps[0];
+        let sens = &log
+            .temp
+            .iter()
+            .find(|s| &s.name == first)
+            .ok_or("no sensor")?
+            .values;
+        let alpha = 1.0 - (-1.0 / g.stress_tau_s).exp();
+        let mut stress_state = coil[0];
+        const COLS: usize = 12;
+        let mut rows: Vec<[f64; COLS]> = Vec::with_capacity(n);
+        for i in 0..n {
+            let dt = coil[i] - g.ref_temp_c;
+            let r = (case[i] - coil[i]) / g.coil_tau_s;
+            let case_rate = if i == 0 || i + 1 == n {
+                0.0
+            } else {
+                (case[i + 1] - case[i - 1]) / (log.time_s[i + 1] - log.time_s[i - 1])
+            };
+            let poly = (g.bias_c1_dph_per_c
+                + (g.bias_c2_dph_per_c2 + g.bias_c3_dph_per_c3 * dt) * dt)
+                * dt;
+            let shupe = g.shupe_dph_per_c_per_s * r;
+            let shupe_tc = g.shupe_dph_per_c_per_s * g.shupe_tc_per_c * dt * r;
+            let stress = g.stress_dph_per_c * (coil[i] - stress_state);
+            let grad = g.shupe_grad_dph_per_c_per_s * (case_rate - r);
+            let sat = g.rate_sat_dph * (r / g.rate_sat_c_per_s).tanh();
+            let tb_dph = tb[i] * 3600.0;
+            let e = (comp[k].bias_dps[i] - tb[i]) * 3600.0;
+            let recon = tb_dph - (poly + shupe + shupe_tc + stress + grad + sat);
+            rows.push([
+                log.time_s[i],
+                e,
+                poly,
+                shupe,
+                shupe_tc,
+                stress,
+                grad,
+                sat,
+                recon,
+                r,
+                dt,
+                sens[i],
+            ]);
+            // The stress state lags the coil, as `ThermalStep::advance` steps it.
+            stress_state += (coil[i] - stress_state) * alpha;
+        }
+        let mut text = String::from(
+            "t\te_dph\tpoly\tshupe\tshupe_tc\tstress\tgrad\tsat\trecon\tcoil_rate\tdT\tsensor\n",
+        );
+        let m = (TAU_S as usize).max(1);
+        for block in rows.chunks_exact(m) {
+            let mut mean = [0.0; COLS];
+            for row in block {
+                for (s, v) in mean.iter_mut().zip(row) {
+                    *s += v / m as f64;
+                }
+            }
+            let cells: Vec<String> = mean.iter().map(|v| format!("{v:.6e}")).collect();
+            text.push_str(&cells.join("\t"));
+            text.push('\n');
+        }
+        let path = format!("{dir}/{unit_seed}-{a}-{tag}.tsv");
+        gyrotherm::atomic_file::write_bytes_atomically(
+            std::path::Path::new(&path),
+            text.as_bytes(),
+        )
+        .map_err(|e| format!("{path}: {e}"))?;
+        // The sensors and lags the axis reads, for the record.
+        let more: Vec<&Vec<f64>> = model.axes[k].more.iter().map(|m| &m.lags_s).collect();
+        let info = format!(
+            "temps {:?}\nfirst {:?}\nmore lags {:?}\ngyro {:?}\n",
+            model.axes[k].temps, model.axes[k].model.features, more, unit.gyros[k]
+        );
+        let path = format!("{dir}/{unit_seed}-{a}-{tag}.model.txt");
+        gyrotherm::atomic_file::write_bytes_atomically(
+            std::path::Path::new(&path),
+            info.as_bytes(),
+        )
+        .map_err(|e| format!("{path}: {e}"))?;
+    }
+    Ok(())
+}
+
 fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     let settings = job.settings;
     let unit = imu_from_family(unit_seed);
@@ -459,6 +580,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             sim_profile(&unit, plan.profile(), s0 + 41, None)?,
         ));
     }
+    let train_static_truth = job.dump.as_ref().map(|_| train[0].1.clone());
     for (_, l) in &mut train {
         l.extra.clear();
     }
@@ -483,6 +605,15 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     let mut cfg = FitConfig::new(Method::Lstm);
     cfg.recipe = RecipeSettings::of_kind(RecipeKind::Thermal);
     cfg.seed = 1;
+    if let Some(t) = job.tau_max_s {
+        cfg.thermal.tau_range_s.1 = t;
+    }
+    if let Some(f) = job.max_tau_fraction {
+        cfg.thermal.max_tau_fraction = f;
+    }
+    if let Some(b) = job.basis {
+        cfg.thermal.basis = b;
+    }
     let sensor = TempSensorDef::default();
     let one = ImuFitSettings {
         sensors: ImuSensors::ChooseOne,
@@ -513,6 +644,14 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             )
         })?;
         let fit_s = t0.elapsed().as_secs_f64();
+        if let (Some(dir), "all") = (&job.dump, setting.as_str()) {
+            if let Some(l) = &train_static_truth {
+                dump_run(dir, "seed-shock", unit_seed, &unit, &model, l)?;
+            }
+            for (profile, st, _, _) in &tests {
+                dump_run(dir, profile, unit_seed, &unit, &model, st)?;
+            }
+        }
         // Each axis's training envelope, per sensor it reads (first sensor first).
         let train_logs: Vec<&ImuLog> = train.iter().map(|(_, l)| l).collect();
         let comps = imu_axis_compensators(&model).map_err(|e| e.to_string())?;
@@ -663,6 +802,21 @@ fn run() -> Result<(), String> {
         planned,
         holds: &holds,
         replica: holds.iter().any(|h| h != "none"),
+        dump: get("--dump"),
+        tau_max_s: get("--tau-max")
+            .map(|v| v.parse().map_err(|e| format!("--tau-max: {e}")))
+            .transpose()?,
+        max_tau_fraction: get("--max-tau-fraction")
+            .map(|v| v.parse().map_err(|e| format!("--max-tau-fraction: {e}")))
+            .transpose()?,
+        basis: match get("--basis").as_deref() {
+            None => None,
+            Some("lean") => Some(gyrotherm::fit::thermal::Basis::Lean),
+            Some("linear") => Some(gyrotherm::fit::thermal::Basis::Linear),
+            Some("small") => Some(gyrotherm::fit::thermal::Basis::Small),
+            Some("full") => Some(gyrotherm::fit::thermal::Basis::Full),
+            Some(v) => return Err(format!("--basis {v:?}: use lean, linear, small or full")),
+        },
     };
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     eprintln!(
