@@ -56,7 +56,7 @@ pub enum ImuJudgeError {
     Spec {
         gyro: String,
         output: &'static str,
-        source: SpecError,
+        source: Box<SpecError>,
     },
     /// The unit model (fitting it, or compensating with it).
     Unit(ImuError),
@@ -89,7 +89,7 @@ impl std::error::Error for ImuJudgeError {
             ImuJudgeError::Evaluate { source, .. } => Some(source),
             ImuJudgeError::Compare { source, .. } => Some(source),
             ImuJudgeError::UnitFit { source, .. } => Some(source),
-            ImuJudgeError::Spec { source, .. } => Some(source),
+            ImuJudgeError::Spec { source, .. } => Some(source.as_ref()),
             ImuJudgeError::Unit(e) => Some(e),
             ImuJudgeError::Layout(_) => None,
         }
@@ -376,7 +376,7 @@ fn judge_axis(
     let spec_err = |source| ImuJudgeError::Spec {
         gyro: gyro.to_owned(),
         output,
-        source,
+        source: Box::new(source),
     };
     let f = spec::measure(axis_log, &rate_dps, &opts).map_err(|source| {
         spec_err(SpecError::Measure {
