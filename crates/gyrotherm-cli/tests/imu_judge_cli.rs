@@ -368,12 +368,19 @@ fn report_has_a_page_across_axes_and_one_per_axis() {
     assert!(stdout.contains("across axes:"), "{stdout}");
     let page = std::fs::read_to_string(out_dir.join("index.html")).unwrap();
     assert!(page.contains("<table class=\"across-axes\">"), "{page}");
+    assert!(page.contains("unit fit (axis"), "{page}");
     for (k, g) in ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"]
         .iter()
         .enumerate()
     {
         assert!(
             page.contains(&format!("<h2>Axis {}: {g} (temperature temp_", k + 1)),
+            "{g}"
+        );
+        // Two sensors: the axis's table has the unit's own fit beside the methods.
+        assert!(
+            page.contains("; the unit&#39;s fit on temp_")
+                || page.contains("; the unit's fit on temp_"),
             "{g}"
         );
         let folder = out_dir.join(format!("axis{}", k + 1));

@@ -670,8 +670,9 @@ impl ImuComparison {
 
     /// The table across axes (axis × figure): per held-out log and figure (bias stability,
     /// × noise floor, scale-factor error, SF thermal error) one row per axis, with the raw
-    /// output, each method (columns named by method, the same for every axis) and the noise
-    /// floor. The per-rate output ranges stay in the axes' own tables.
+    /// output, each method (columns named by method, the same for every axis), the unit's own
+    /// fit when there is one ([`UNIT_FIT_HEADER`]: each axis's row reads that axis's sensors)
+    /// and the noise floor. The per-rate output ranges stay in the axes' own tables.
     pub fn across_axes(&self, cfg: &CompareConfig) -> Table {
         let mut headers = vec![
             "held-out log".to_owned(),
