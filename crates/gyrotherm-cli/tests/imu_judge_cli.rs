@@ -195,6 +195,8 @@ fn compare_per_axis_matches_each_axis_compared_alone() {
         let (u, s) = (&a["comparison"]["tests"][0], &alone["tests"][0]);
         assert_eq!(u["raw"], s["raw"], "{g}");
         assert_eq!(u["methods"], s["methods"], "{g}");
+        // One sensor: no unit fit beside the methods (it would be the thermal column).
+        assert!(a.get("unit_fit").is_none(), "{g}");
         // Alone, the log has no `noise_dps` column (only `noise_dps_x` …): no floor.
         assert!(s["floor_dph"].is_null());
         floors.push(u["floor_dph"].as_f64().expect("the axis's floor"));
@@ -217,6 +219,126 @@ fn compare_per_axis_matches_each_axis_compared_alone() {
             "gyro_z_dps"
         ]
     );
+}
+
+/// `compare` with several sensors: beside the one-sensor methods each axis's table holds
+/// the unit's own fit, the model `train` with the same lists builds. Its sensors are the
+/// trained model's, the one-sensor methods read that model's first sensor (the one-sensor
+/// choice), its label says what it holds and how many sensors it reads, and its bias
+/// stability on the held-out run is that of the column `compensate` writes with the trained
+/// model, evaluated alone with the same τ (an independent path: the file, the reader and
+/// the single-axis `evaluate`).
+#[test]
+fn compare_per_axis_holds_the_unit_fit_on_all_its_sensors() {
+    let dir = tempfile::tempdir().unwrap();
+    let temps = "temp_case_c,temp_x_c,temp_y_c,temp_z_c";
+    let s = sim(dir.path(), "s.csv", &["--seed", "1"]);
+    let t = sim(
+        dir.path(),
+        "t.csv",
+        &["--seed", "2", "--table-rate", "20", "--table-axis", "y"],
+    );
+    let h = sim(dir.path(), "h.csv", &["--seed", "3"]);
+    let model = dir.path().join("unit.json");
+    run_ok(
+        gyrotherm()
+            .args(["train", "--gyro-col", GYROS, "--temp-col", temps, "--out"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&s)
+            .arg("--input")
+            .arg(&t),
+    );
+    let trained: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let comp = dir.path().join("comp.csv");
+    run_ok(
+        gyrotherm()
+            .args(["compensate", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&h)
+            .arg("--out")
+            .arg(&comp),
+    );
+    let compare = |json: bool| {
+        let mut c = gyrotherm();
+        c.args(["compare", "--methods", "linear,thermal", "--tau-s", "100"])
+            .args(["--gyro-col", GYROS, "--temp-col", temps, "--train"])
+            .arg(&s)
+            .arg("--train")
+            .arg(&t)
+            .arg("--test")
+            .arg(&h);
+        if json {
+            c.arg("--json");
+        }
+        run_ok(&mut c)
+    };
+    let unit = json(&compare(true));
+    let mut several = false;
+    for (k, g) in ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"]
+        .iter()
+        .enumerate()
+    {
+        let a = &unit["axes"][k];
+        let m = &trained["axes"][k];
+        let u = &a["unit_fit"];
+        assert_eq!(u["temps"], m["temps"], "{g}: the trained model's sensors");
+        assert_eq!(a["temp"], m["temps"][0], "{g}: the one-sensor choice");
+        let n = m["temps"].as_array().unwrap().len();
+        several |= n > 1;
+        let label = u["label"].as_str().unwrap();
+        let sensors = if n == 1 { "sensor" } else { "sensors" };
+        assert!(label.contains(&format!("({n} {sensors}: ")), "{label}");
+        let holds_lstm = [&m["model"]["bias"], &m["model"]["scale"]]
+            .iter()
+            .any(|s| s.to_string().contains("\"lstm\"") || s.to_string().contains("residual"));
+        assert_eq!(label.to_lowercase().contains("lstm"), holds_lstm, "{label}");
+        let alone = json(&run_ok(
+            gyrotherm()
+                .args(["evaluate", "--json", "--tau-s", "100"])
+                .args([
+                    "--gyro-col",
+                    &format!("{g}_comp"),
+                    "--temp-col",
+                    "temp_case_c",
+                ])
+                .arg("--input")
+                .arg(&comp),
+        ));
+        let want = alone["bias_stability_dph"].as_f64().unwrap();
+        let got = u["performance"][0]["bias_stability_dph"].as_f64().unwrap();
+        assert!(
+            (got - want).abs() <= 1e-12 * want.abs(),
+            "{g}: compare {got} vs evaluate {want}"
+        );
+    }
+    eprintln!(
+        "unit fit sensors per axis: {}",
+        trained["axes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|a| a["temps"].to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    assert!(
+        several,
+        "no axis kept more than one sensor: the column is not tested"
+    );
+    let headers = unit["across_axes"]["headers"].as_array().unwrap();
+    assert!(
+        headers.iter().any(|h| h == "unit fit (axis's sensors)"),
+        "{headers:?}"
+    );
+    let text = String::from_utf8_lossy(&compare(false).stdout).into_owned();
+    assert_eq!(text.matches("the unit's fit on ").count(), 3, "{text}");
+    for a in unit["axes"].as_array().unwrap() {
+        let header = a["unit_fit"]["header"].as_str().unwrap();
+        assert!(text.contains(&format!("{header:>22}")), "{header}: {text}");
+    }
 }
 
 #[test]
@@ -246,12 +368,19 @@ fn report_has_a_page_across_axes_and_one_per_axis() {
     assert!(stdout.contains("across axes:"), "{stdout}");
     let page = std::fs::read_to_string(out_dir.join("index.html")).unwrap();
     assert!(page.contains("<table class=\"across-axes\">"), "{page}");
+    assert!(page.contains("unit fit (axis"), "{page}");
     for (k, g) in ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"]
         .iter()
         .enumerate()
     {
         assert!(
             page.contains(&format!("<h2>Axis {}: {g} (temperature temp_", k + 1)),
+            "{g}"
+        );
+        // Two sensors: the axis's table has the unit's own fit beside the methods.
+        assert!(
+            page.contains("; the unit&#39;s fit on temp_")
+                || page.contains("; the unit's fit on temp_"),
             "{g}"
         );
         let folder = out_dir.join(format!("axis{}", k + 1));
@@ -261,23 +390,200 @@ fn report_has_a_page_across_axes_and_one_per_axis() {
     }
 }
 
+fn write_spec(dir: &Path, name: &str, limits: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(
+        &p,
+        format!("name = \"unit acceptance\"\n[limits]\n{limits}"),
+    )
+    .unwrap();
+    p
+}
+
+/// The figure verdicts of a JSON verdict without the log's name (which is the path judged).
+fn figure_verdicts(v: &serde_json::Value) -> Vec<serde_json::Value> {
+    v["figures"]
+        .as_array()
+        .expect("figures")
+        .iter()
+        .map(|f| {
+            let mut f = f.clone();
+            f.as_object_mut().unwrap().remove("log");
+            f
+        })
+        .collect()
+}
+
+/// `evaluate --spec` with a unit model: each axis's verdict is the single-axis
+/// `evaluate --spec` verdict of the compensated column `compensate` wrote for it (figure,
+/// value, limits, pass, margin: an independent path through the reader and the single-axis
+/// command); the unit passes when every axis passes, and fails, naming the axis and exiting
+/// 1, when a limit sits between the axes' values so that one axis misses it.
 #[test]
-fn spec_with_a_list_is_refused_with_what_to_do() {
+fn evaluate_spec_judges_every_axis_and_the_unit_fails_when_one_axis_misses() {
+    let dir = tempfile::tempdir().unwrap();
+    let (model, _) = train(dir.path());
+    let held = sim(dir.path(), "h.csv", &["--seed", "3"]);
+    let comp = dir.path().join("comp.csv");
+    run_ok(
+        gyrotherm()
+            .args(["compensate", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&held)
+            .arg("--out")
+            .arg(&comp),
+    );
+    let loose = write_spec(
+        dir.path(),
+        "loose.toml",
+        "bias_dph = { min = -1e6, max = 1e6 }\nbias_stability_dph = { max = 1e6 }\n\
+         arw_deg_rt_h = { max = 1e6 }\n",
+    );
+    let unit_run = |spec: &Path| {
+        gyrotherm()
+            .args(["evaluate", "--json", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&held)
+            .arg("--spec")
+            .arg(spec)
+            .output()
+            .unwrap()
+    };
+    let out = unit_run(&loose);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let unit = json(&out);
+    assert_eq!(unit["verdict"]["pass"], true);
+    assert_eq!(unit["verdict"]["judged"], "compensated");
+    assert_eq!(unit["verdict"]["failed_axes"], serde_json::json!([]));
+    let gyros = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];
+    let mut stability = Vec::new();
+    for (a, g) in unit["axes"].as_array().unwrap().iter().zip(gyros) {
+        let alone = json(&run_ok(
+            gyrotherm()
+                .args(["evaluate", "--json", "--gyro-col", &format!("{g}_comp")])
+                .args(["--temp-col", "temp_case_c", "--input"])
+                .arg(&comp)
+                .arg("--spec")
+                .arg(&loose),
+        ));
+        let (u, s) = (
+            figure_verdicts(&a["verdict"]),
+            figure_verdicts(&alone["verdict"]),
+        );
+        assert_eq!(u.len(), 3, "{g}: {u:?}");
+        assert_eq!(u, s, "{g}");
+        assert_eq!(
+            a["verdict"]["figures"][0]["log"],
+            held.display().to_string()
+        );
+        stability.push(a["compensated"]["bias_stability_dph"].as_f64().unwrap());
+    }
+    // A limit between the worst axis and the next: that axis, and so the unit, fails.
+    let worst = (0..3)
+        .max_by(|&i, &j| stability[i].total_cmp(&stability[j]))
+        .unwrap();
+    let mut sorted = stability.clone();
+    sorted.sort_by(f64::total_cmp);
+    assert!(sorted[1] < sorted[2], "{stability:?}");
+    let tight = write_spec(
+        dir.path(),
+        "tight.toml",
+        &format!(
+            "bias_stability_dph = {{ max = {} }}\n",
+            (sorted[1] + sorted[2]) / 2.0
+        ),
+    );
+    let out = unit_run(&tight);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let unit = json(&out);
+    assert_eq!(unit["verdict"]["pass"], false);
+    assert_eq!(
+        unit["verdict"]["failed_axes"],
+        serde_json::json!([gyros[worst]])
+    );
+    for (k, a) in unit["axes"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(a["verdict"]["pass"], k != worst, "{}", gyros[k]);
+    }
+    // Text: each axis's verdict lines with units, then the unit's line naming the axis.
+    let out = gyrotherm()
+        .args(["evaluate", "--model"])
+        .arg(&model)
+        .arg("--input")
+        .arg(&held)
+        .arg("--spec")
+        .arg(&tight)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.matches("against the spec:").count(), 3, "{text}");
+    assert!(text.contains("°/h"), "{text}");
+    let last = text.lines().last().unwrap();
+    assert_eq!(
+        last,
+        format!(
+            "unit verdict: FAIL (spec unit acceptance, 3 axes, compensated output; failed: {})",
+            gyros[worst]
+        )
+    );
+    // Without a model the raw columns are judged, each as `evaluate --gyro-col G --spec`.
+    let raw = json(&run_ok(
+        gyrotherm()
+            .args(["evaluate", "--json", "--gyro-col", GYROS])
+            .args(["--temp-col", "temp_case_c", "--input"])
+            .arg(&held)
+            .arg("--spec")
+            .arg(&loose),
+    ));
+    assert_eq!(raw["verdict"]["judged"], "raw");
+    let alone = json(&run_ok(
+        gyrotherm()
+            .args(["evaluate", "--json", "--gyro-col", "gyro_y_dps"])
+            .args(["--temp-col", "temp_case_c", "--input"])
+            .arg(&held)
+            .arg("--spec")
+            .arg(&loose),
+    ));
+    assert_eq!(
+        figure_verdicts(&raw["axes"][1]["verdict"]),
+        figure_verdicts(&alone["verdict"])
+    );
+}
+
+/// A limit no axis's log can give (a scale-factor figure on a static run) is an error naming
+/// the axis and what to do, exit 2, never a silent pass.
+#[test]
+fn evaluate_spec_with_a_figure_the_log_cannot_give_names_the_axis() {
     let dir = tempfile::tempdir().unwrap();
     let h = sim(dir.path(), "h.csv", &["--seed", "3"]);
+    let spec = write_spec(
+        dir.path(),
+        "sf.toml",
+        "sf_thermal_error_ppm = { max = 30 }\n",
+    );
     let out = gyrotherm()
-        .args([
-            "evaluate",
-            "--gyro-col",
-            GYROS,
-            "--spec",
-            "x.toml",
-            "--input",
-        ])
+        .args(["evaluate", "--gyro-col", GYROS, "--temp-col", "temp_case_c"])
+        .arg("--spec")
+        .arg(&spec)
+        .arg("--input")
         .arg(&h)
         .output()
         .unwrap();
-    assert!(!out.status.success());
+    assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("--spec judges one column"), "{err}");
+    assert!(err.contains("axis gyro_x_dps (raw output)"), "{err}");
+    assert!(err.contains("add such a log or remove the limit"), "{err}");
+    assert!(err.contains(&h.display().to_string()), "{err}");
 }

@@ -82,6 +82,12 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // The library's defaults and name lists: Python states none of them itself.
     m.add("FIT_DEFAULTS", model::fit_defaults(py)?)?;
     m.add("READ_DEFAULTS", logs::read_defaults(py)?)?;
+    let evaluate = gyrotherm::settings::EvaluateSettings::default();
+    let evaluate_defaults = pyo3::types::PyDict::new(py);
+    evaluate_defaults.set_item("tau_s", evaluate.tau_s)?;
+    evaluate_defaults.set_item("settle_s", evaluate.settle_s)?;
+    evaluate_defaults.set_item("reference_scale", evaluate.reference_scale)?;
+    m.add("EVALUATE_DEFAULTS", evaluate_defaults)?;
     m.add("METHOD_NAMES", gyrotherm::settings::METHOD_NAMES.to_vec())?;
     m.add(
         "GYRO_UNIT_NAMES",

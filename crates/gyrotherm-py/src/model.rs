@@ -376,7 +376,13 @@ pub struct FitArgs {
 impl FitArgs {
     /// The library's fit configuration and what a deprecated spelling now means.
     pub(crate) fn config(&self) -> PyResult<(FitConfig, Option<String>)> {
-        let settings = FitSettings {
+        let (cfg, note) = self.settings()?.fit_config().map_err(py_err::<FitError>)?;
+        Ok((cfg, note.map(|n| n.to_string())))
+    }
+
+    /// The library's fit settings these arguments name.
+    pub(crate) fn settings(&self) -> PyResult<FitSettings> {
+        Ok(FitSettings {
             method: self.method.parse().map_err(py_err::<FitError>)?,
             recipe: self
                 .recipe
@@ -392,9 +398,7 @@ impl FitArgs {
             poly_rate_degree: self.poly_rate_degree,
             cross: self.cross,
             validate_on_runs: self.validate_on_runs,
-        };
-        let (cfg, note) = settings.fit_config().map_err(py_err::<FitError>)?;
-        Ok((cfg, note.map(|n| n.to_string())))
+        })
     }
 }
 

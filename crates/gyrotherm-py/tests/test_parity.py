@@ -163,3 +163,18 @@ def test_the_deprecated_recipe_names_the_method_in_both(cli, logs, tmp_path):
     assert m.method == "generic" == json.loads(a.read_text())["method"]
     m.save(b)
     assert a.read_bytes() == b.read_bytes()
+
+
+def test_unit_evaluate_and_compare_take_the_library_defaults(described):
+    # evaluate(): τ, settle time and reference scale as the library's `evaluate` settings.
+    evaluate = {s["name"]: s for s in described["evaluate"]}
+    params = inspect.signature(gt.evaluate).parameters
+    for name in ("tau_s", "settle_s", "reference_scale"):
+        default = params[name].default
+        assert default == gt.EVALUATE_DEFAULTS[name], name
+        assert default == as_python(evaluate[name]["default"], default), name
+    # compare(): every fit keyword of fit(), with fit()'s (the library's) defaults.
+    fit_params = inspect.signature(gt.fit).parameters
+    cmp_params = inspect.signature(gt.compare).parameters
+    for name in gt.FIT_DEFAULTS:
+        assert cmp_params[name].default == fit_params[name].default == gt.FIT_DEFAULTS[name]

@@ -9,22 +9,30 @@
 //! noise floor is the axis's own. The single-axis figures and comparison then apply as they
 //! are, so a one-axis figure and its per-axis counterpart are the same number.
 //!
-//! The comparison's sensor per axis is the one the unit's fit with the comparison's fit
-//! settings (`train` with the same lists) reads; every method of that axis is fitted on it,
-//! so the columns differ only by method.
+//! With several temperature columns the comparison fits the unit as `train` with the same
+//! lists and fit settings builds it ([`fit_imu_with_events`]): per axis the sensors
+//! cross-validation keeps. Each axis's table then holds every one-sensor method fitted on
+//! the sensor that axis's one-sensor choice picks (the sensor whose one-sensor fit has the
+//! lowest cross-validated RMS, the unit fit's first sensor; so the one-sensor columns differ
+//! only by method), and beside them the unit's own fit of the axis on all the sensors it
+//! keeps ([`UnitFitColumn`], named for what it holds and how many sensors it reads).
 
 use serde::Serialize;
 
 use crate::compare::{
-    compare, CompareConfig, CompareError, Comparison, ComparisonSummary, TableFigure,
+    compare, performance, CompareConfig, CompareError, Comparison, ComparisonSummary,
+    ComparisonTable, Performance, TableFigure,
 };
 use crate::csvlog::{ExtraColumn, ImuLog, TestLog, GYRO_COL};
 use crate::fit::{NamedLog, Target};
-use crate::imu_model::{compensate_imu, fit_imu_with_events, ImuError, ImuEvents, ImuModel};
+use crate::imu_model::{
+    compensate_imu, fit_imu_with_events, ImuAxis, ImuError, ImuEvents, ImuModel,
+};
 use crate::metrics::Evaluation;
 use crate::model::TempSensorDef;
 use crate::report::html::Table;
 use crate::settings::evaluate::{EvaluateError, EvaluateSettings, ResolvedTau};
+use crate::spec::{self, MeasureOptions, Spec, SpecError, Verdict};
 
 /// Why a unit's figures could not be computed.
 #[derive(Debug)]
@@ -38,6 +46,18 @@ pub enum ImuJudgeError {
     },
     /// The comparison of axis `gyro`.
     Compare { gyro: String, source: CompareError },
+    /// The unit fit's figures of axis `gyro` on held-out log `log`.
+    UnitFit {
+        gyro: String,
+        log: String,
+        source: crate::compare::PerformanceError,
+    },
+    /// The spec-sheet verdict of axis `gyro` (`output`: raw or compensated).
+    Spec {
+        gyro: String,
+        output: &'static str,
+        source: Box<SpecError>,
+    },
     /// The unit model (fitting it, or compensating with it).
     Unit(ImuError),
     /// The logs or settings do not fit together (the message says what to do).
@@ -51,6 +71,12 @@ impl std::fmt::Display for ImuJudgeError {
                 write!(f, "axis {gyro} ({output} output)")
             }
             ImuJudgeError::Compare { gyro, .. } => write!(f, "axis {gyro}"),
+            ImuJudgeError::UnitFit { gyro, log, .. } => {
+                write!(f, "axis {gyro}, the unit's fit on held-out log {log}")
+            }
+            ImuJudgeError::Spec { gyro, output, .. } => {
+                write!(f, "axis {gyro} ({output} output) against the spec sheet")
+            }
             ImuJudgeError::Unit(_) => write!(f, "the unit model"),
             ImuJudgeError::Layout(m) => write!(f, "{m}"),
         }
@@ -62,6 +88,8 @@ impl std::error::Error for ImuJudgeError {
         match self {
             ImuJudgeError::Evaluate { source, .. } => Some(source),
             ImuJudgeError::Compare { source, .. } => Some(source),
+            ImuJudgeError::UnitFit { source, .. } => Some(source),
+            ImuJudgeError::Spec { source, .. } => Some(source.as_ref()),
             ImuJudgeError::Unit(e) => Some(e),
             ImuJudgeError::Layout(_) => None,
         }
@@ -104,6 +132,92 @@ pub struct AxisEvaluation {
     pub temps: Vec<String>,
     pub raw: Evaluation,
     pub compensated: Option<Evaluation>,
+    /// The axis's verdict against a spec sheet ([`evaluate_imu_spec`]): of the compensated
+    /// output when a unit model was given, else of the raw column.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<Verdict>,
+}
+
+/// The unit's verdict against a spec sheet: it passes only when every axis passes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnitVerdict {
+    /// The spec sheet's name and SHA-256.
+    pub spec: String,
+    pub spec_sha256: String,
+    /// Which output was judged: `compensated` (with a unit model) or `raw`.
+    pub judged: &'static str,
+    /// True when every limited figure of every axis passes.
+    pub pass: bool,
+    /// The gyro columns of the axes that missed a limit, in column order.
+    pub failed_axes: Vec<String>,
+}
+
+impl UnitVerdict {
+    /// `PASS` or `FAIL`.
+    pub fn word(&self) -> &'static str {
+        if self.pass {
+            "PASS"
+        } else {
+            "FAIL"
+        }
+    }
+
+    /// The verdict as one text line.
+    pub fn line(&self, axes: usize) -> String {
+        let mut s = format!(
+            "unit verdict: {} (spec {}, {axes} axes, {} output",
+            self.word(),
+            self.spec,
+            self.judged
+        );
+        if !self.failed_axes.is_empty() {
+            s.push_str(&format!("; failed: {}", self.failed_axes.join(", ")));
+        }
+        s.push(')');
+        s
+    }
+}
+
+/// What [`evaluate_imu_spec`] returns: the axes' figures (each with its verdict when a spec
+/// sheet was given), the τ used, and the unit's verdict.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnitEvaluation {
+    pub axes: Vec<AxisEvaluation>,
+    pub tau: ResolvedTau,
+    pub verdict: Option<UnitVerdict>,
+}
+
+impl UnitEvaluation {
+    /// The form `gyrotherm evaluate --json` prints for a unit (and Python returns): `tau_s`,
+    /// `axes` (each with its `verdict` when judged, in the single-axis verdict's form) and,
+    /// when judged, the unit's `verdict` beside them.
+    pub fn to_json(&self) -> serde_json::Value {
+        let mut j = serde_json::json!({ "tau_s": self.tau.tau_s, "axes": self.axes });
+        if let (Some(v), Some(o)) = (&self.verdict, j.as_object_mut()) {
+            o.insert(
+                "verdict".into(),
+                serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
+            );
+        }
+        j
+    }
+}
+
+/// The bias-stability τ of a unit comparison when none was asked for: the single-axis rule
+/// ([`crate::compare::default_tau_s`]) on the first axis's view of the held-out logs (every
+/// axis shares the time column). Returns τ and, when it is not 100 s, the sample period it
+/// is a multiple of.
+pub fn default_tau_s(test: &[(String, ImuLog)]) -> (f64, Option<f64>) {
+    let axis0: Vec<(String, TestLog)> = test
+        .iter()
+        .filter(|(_, l)| !l.gyro.is_empty() && !l.temp.is_empty())
+        .map(|(n, l)| (n.clone(), axis_test_log(l, 0, 0)))
+        .collect();
+    let named: Vec<NamedLog> = axis0
+        .iter()
+        .map(|(n, l)| NamedLog { name: n, log: l })
+        .collect();
+    crate::compare::default_tau_s(&named)
 }
 
 /// `evaluate` on a unit log: the figures of each gyro column (raw, in °/s as read), and with
@@ -115,6 +229,22 @@ pub fn evaluate_imu(
     model: Option<&ImuModel>,
     settings: &EvaluateSettings,
 ) -> Result<(Vec<AxisEvaluation>, ResolvedTau), ImuJudgeError> {
+    let e = evaluate_imu_spec(log, model, settings, None, "")?;
+    Ok((e.axes, e.tau))
+}
+
+/// [`evaluate_imu`], and with `spec` each axis judged against the spec sheet as the
+/// single-axis `evaluate --spec` judges one column (the same figures, measured on the axis's
+/// single-axis log, [`axis_test_log`]): the compensated output when `model` is given (the
+/// unit as it is flown), else the raw gyro column. `log_name` names the log in the
+/// verdicts' lines. The unit passes only when every axis passes.
+pub fn evaluate_imu_spec(
+    log: &ImuLog,
+    model: Option<&ImuModel>,
+    settings: &EvaluateSettings,
+    spec: Option<&Spec>,
+    log_name: &str,
+) -> Result<UnitEvaluation, ImuJudgeError> {
     if settings.column != GYRO_COL {
         return Err(ImuJudgeError::Layout(format!(
             "column {:?}: a unit log is judged per gyro column (--gyro-col lists them); leave \
@@ -174,15 +304,125 @@ pub fn evaluate_imu(
             }
             _ => (None, Vec::new()),
         };
+        let verdict = match spec {
+            Some(sp) => {
+                let (values, output) = match (&comp, model) {
+                    (Some(c), Some(m)) => {
+                        let i = m.axes.iter().position(|a| a.gyro == g.name).unwrap_or(k);
+                        (c[i].gyro_comp_dps.as_slice(), "compensated")
+                    }
+                    _ => (g.values.as_slice(), "raw"),
+                };
+                Some(judge_axis(
+                    sp, &axis_log, values, settings, tau0_s, log_name, &g.name, output,
+                )?)
+            }
+            None => None,
+        };
         axes.push(AxisEvaluation {
             gyro: g.name.clone(),
             temps,
             raw,
             compensated,
+            verdict,
         });
     }
     let tau = tau.ok_or_else(|| ImuJudgeError::Layout("no gyro column".into()))?;
-    Ok((axes, tau))
+    let verdict = spec.map(|sp| {
+        let failed_axes: Vec<String> = axes
+            .iter()
+            .filter(|a| a.verdict.as_ref().is_some_and(|v| !v.pass))
+            .map(|a| a.gyro.clone())
+            .collect();
+        UnitVerdict {
+            spec: sp.name.clone(),
+            spec_sha256: sp.sha256.clone(),
+            judged: if model.is_some() {
+                "compensated"
+            } else {
+                "raw"
+            },
+            pass: failed_axes.is_empty(),
+            failed_axes,
+        }
+    });
+    Ok(UnitEvaluation { axes, tau, verdict })
+}
+
+/// One axis's output judged against `spec`, as `evaluate --spec` judges one column.
+#[allow(clippy::too_many_arguments)]
+fn judge_axis(
+    spec: &Spec,
+    axis_log: &TestLog,
+    values: &[f64],
+    settings: &EvaluateSettings,
+    tau0_s: f64,
+    log_name: &str,
+    gyro: &str,
+    output: &'static str,
+) -> Result<Verdict, ImuJudgeError> {
+    let (rate_dps, evaluation, _) =
+        settings
+            .prepare(values, tau0_s)
+            .map_err(|source| ImuJudgeError::Evaluate {
+                gyro: gyro.to_owned(),
+                output,
+                source,
+            })?;
+    let opts = MeasureOptions {
+        evaluation,
+        noise_terms: spec.needs_noise_terms(),
+    };
+    let spec_err = |source| ImuJudgeError::Spec {
+        gyro: gyro.to_owned(),
+        output,
+        source: Box::new(source),
+    };
+    let f = spec::measure(axis_log, &rate_dps, &opts).map_err(|source| {
+        spec_err(SpecError::Measure {
+            log: log_name.to_owned(),
+            source,
+        })
+    })?;
+    spec::judge(spec, &[(log_name.to_owned(), f)]).map_err(spec_err)
+}
+
+/// The unit's own fit of one axis in a comparison: the model `train` with the same lists
+/// builds for it, on every sensor cross-validation keeps.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnitFitColumn {
+    /// What the model holds and what it reads, e.g. `thermal-state LS (3 sensors: temp_x_c,
+    /// temp_case_c, temp_y_c)`.
+    pub label: String,
+    /// The column's short name in the tables, e.g. `thermal LS, 3 sensors`.
+    pub header: String,
+    /// The method the unit was fitted with.
+    pub method: &'static str,
+    /// The temperature columns the axis's model reads, the first sensor first.
+    pub temps: Vec<String>,
+    /// Its figures on each held-out log, in order.
+    pub performance: Vec<Performance>,
+}
+
+impl UnitFitColumn {
+    /// The column of `axis` (fitted with `method`) with its figures per held-out log.
+    pub fn new(axis: &ImuAxis, performance: Vec<Performance>) -> Self {
+        let n = axis.temps.len();
+        let what = axis.model.label();
+        let sensors = if n == 1 { "sensor" } else { "sensors" };
+        let short = if what == "thermal-state LS" {
+            "thermal LS"
+        } else {
+            what
+        };
+        UnitFitColumn {
+            label: format!("{what} ({n} {sensors}: {})", axis.temps.join(", ")),
+            header: format!("{short}, {n} {sensors}"),
+            method: axis.model.method.as_str(),
+            temps: axis.temps.clone(),
+            performance,
+        }
+    }
 }
 
 /// One axis of a unit comparison: the single-axis logs it was judged on and the comparison.
@@ -190,8 +430,11 @@ pub fn evaluate_imu(
 pub struct AxisComparison {
     /// The gyro column.
     pub gyro: String,
-    /// The temperature column every method of this axis reads.
+    /// The temperature column every one-sensor method of this axis reads.
     pub temp: String,
+    /// The unit's own fit of this axis on all the sensors it keeps (with several
+    /// temperature columns).
+    pub unit_fit: Option<UnitFitColumn>,
     /// The training logs as this axis saw them (name, log).
     pub train: Vec<(String, TestLog)>,
     /// The held-out logs as this axis saw them, in order.
@@ -214,6 +457,30 @@ impl AxisComparison {
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
             .collect()
+    }
+    /// The axis's results table: the single-axis table, and the unit fit's column beside
+    /// the one-sensor methods.
+    pub fn table(&self, cfg: &CompareConfig) -> ComparisonTable {
+        let mut t = self.comparison.table(cfg);
+        if let Some(u) = &self.unit_fit {
+            let floors: Vec<Option<f64>> =
+                self.comparison.tests.iter().map(|r| r.floor_dph).collect();
+            t.push_column(&u.header, &u.performance, &floors);
+        }
+        t
+    }
+
+    /// One line per fitted model, as the single-axis comparison prints them, then the unit
+    /// fit's line.
+    pub fn model_lines(&self) -> Vec<String> {
+        let mut lines = self.comparison.model_lines();
+        if let Some(u) = &self.unit_fit {
+            lines.push(format!(
+                "{:>16}: the unit's {} fit of this axis as train builds it: {}",
+                u.header, u.method, u.label
+            ));
+        }
+        lines
     }
 }
 
@@ -256,17 +523,32 @@ pub fn compare_imu(
             )));
         }
     }
-    let sensors: Vec<usize> = if temp_cols.len() == 1 {
-        vec![0; gyro_cols.len()]
+    let unit = if temp_cols.len() == 1 {
+        None
     } else {
-        fit_imu_with_events(train, &cfg.fit, temp_sensor, &|_, _, _, _, _| {}, events)
-            .map_err(ImuJudgeError::Unit)?
-            .sensor_index()
+        Some(
+            fit_imu_with_events(train, &cfg.fit, temp_sensor, &|_, _, _, _, _| {}, events)
+                .map_err(ImuJudgeError::Unit)?,
+        )
     };
+    let sensors: Vec<usize> = unit
+        .as_ref()
+        .map_or_else(|| vec![0; gyro_cols.len()], ImuModel::sensor_index);
+    // The unit's compensated output of every held-out log, all axes at once.
+    let unit_out = unit
+        .as_ref()
+        .map(|m| {
+            test.iter()
+                .map(|(_, l)| compensate_imu(m, l))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .transpose()
+        .map_err(ImuJudgeError::Unit)?;
     let axes: Vec<Result<AxisComparison, ImuJudgeError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..gyro_cols.len())
             .map(|k| {
                 let (gyro_cols, temp_cols, sensors) = (&gyro_cols, &temp_cols, &sensors);
+                let (unit, unit_out) = (&unit, &unit_out);
                 scope.spawn(move || {
                     let j = sensors[k];
                     let per_axis = |logs: &[(String, ImuLog)]| -> Vec<(String, TestLog)> {
@@ -291,9 +573,28 @@ pub fn compare_imu(
                             },
                         )?
                     };
+                    let unit_fit = match (unit.as_ref(), unit_out.as_ref()) {
+                        (Some(m), Some(outs)) => {
+                            let perf = test
+                                .iter()
+                                .zip(outs)
+                                .map(|((name, l), out)| {
+                                    performance(l, &out[k].gyro_comp_dps, cfg.tau_s, cfg.settle_s)
+                                        .map_err(|source| ImuJudgeError::UnitFit {
+                                            gyro: gyro_cols[k].clone(),
+                                            log: name.clone(),
+                                            source,
+                                        })
+                                })
+                                .collect::<Result<Vec<_>, _>>()?;
+                            Some(UnitFitColumn::new(&m.axes[k], perf))
+                        }
+                        _ => None,
+                    };
                     Ok(AxisComparison {
                         gyro: gyro_cols[k].clone(),
                         temp: temp_cols[j].clone(),
+                        unit_fit,
                         train,
                         test,
                         comparison,
@@ -314,12 +615,20 @@ pub fn compare_imu(
     })
 }
 
+/// The header of the unit fit's column in the table across axes.
+pub const UNIT_FIT_HEADER: &str = "unit fit (axis's sensors)";
+
 /// One axis in `gyrotherm compare --json` for a unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AxisSummary {
     pub gyro: String,
+    /// The sensor the one-sensor methods read.
     pub temp: String,
     pub comparison: ComparisonSummary,
+    /// The unit's own fit of the axis (several temperature columns): its label, sensors and
+    /// figures per held-out log (in the order of `comparison.tests`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unit_fit: Option<UnitFitColumn>,
 }
 
 /// A unit comparison as `gyrotherm compare --json` prints it: per axis the single-axis
@@ -349,6 +658,7 @@ impl ImuComparison {
                     gyro: a.gyro.clone(),
                     temp: a.temp.clone(),
                     comparison: a.comparison.summary(cfg),
+                    unit_fit: a.unit_fit.clone(),
                 })
                 .collect(),
             across_axes: AcrossAxes {
@@ -360,8 +670,9 @@ impl ImuComparison {
 
     /// The table across axes (axis × figure): per held-out log and figure (bias stability,
     /// × noise floor, scale-factor error, SF thermal error) one row per axis, with the raw
-    /// output, each method (columns named by method, the same for every axis) and the noise
-    /// floor. The per-rate output ranges stay in the axes' own tables.
+    /// output, each method (columns named by method, the same for every axis), the unit's own
+    /// fit when there is one ([`UNIT_FIT_HEADER`]: each axis's row reads that axis's sensors)
+    /// and the noise floor. The per-rate output ranges stay in the axes' own tables.
     pub fn across_axes(&self, cfg: &CompareConfig) -> Table {
         let mut headers = vec![
             "held-out log".to_owned(),
@@ -371,8 +682,12 @@ impl ImuComparison {
         ];
         let keys: Vec<&'static str> = cfg.candidates.iter().map(|c| c.key(&cfg.fit)).collect();
         headers.extend(keys.iter().map(|k| (*k).to_owned()));
+        // The unit's own fit reads each axis's own sensors (the axes' tables name them).
+        if self.axes.iter().any(|a| a.unit_fit.is_some()) {
+            headers.push(UNIT_FIT_HEADER.to_owned());
+        }
         headers.push("noise floor".to_owned());
-        let tables: Vec<_> = self.axes.iter().map(|a| a.comparison.table(cfg)).collect();
+        let tables: Vec<_> = self.axes.iter().map(|a| a.table(cfg)).collect();
         let mut rows = Vec::new();
         let n_tests = tables.iter().map(|t| t.blocks.len()).max().unwrap_or(0);
         for b in 0..n_tests {

@@ -21,11 +21,8 @@ use super::report::ReportArgs;
 /// `evaluate` on a unit log: each gyro column's figures; with `--model`, also each axis's
 /// compensated output.
 pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
-    anyhow::ensure!(
-        args.spec.is_none(),
-        "--spec judges one column; for a unit log judge an axis at a time (compensate, then \
-         evaluate --column G_comp with --gyro-col G), or leave --spec out"
-    );
+    // The sheet first: a bad sheet fails before the log is read.
+    let spec = super::verdict::load(args.spec.as_deref())?;
     let model = args
         .model
         .as_ref()
@@ -65,17 +62,21 @@ pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         settle_s: args.settle_s,
         reference_scale: args.reference_scale,
     };
-    let (axes, tau) = imu_judge::evaluate_imu(&log, model.as_ref(), &settings)
+    let input = args.input.display().to_string();
+    let unit = imu_judge::evaluate_imu_spec(&log, model.as_ref(), &settings, spec.as_ref(), &input)
         .map_err(anyhow::Error::new)
-        .with_context(|| args.input.display().to_string())?;
+        .with_context(|| input.clone())?;
+    let (axes, tau) = (&unit.axes, &unit.tau);
     if let Some(note) = tau.note(axes[0].raw.sample_period_s) {
         eprintln!("gyrotherm: {note}");
     }
+    let code = super::verdict::exit_code(unit.verdict.as_ref().is_none_or(|v| v.pass));
     let mut w = std::io::stdout().lock();
     if args.json {
-        let j = serde_json::json!({ "tau_s": tau.tau_s, "axes": axes });
-        writeln!(w, "{}", serde_json::to_string_pretty(&j)?)?;
-        return Ok(ExitCode::SUCCESS);
+        // Each axis carries its verdict as the single-axis output does; the unit's verdict
+        // sits beside the axes (`UnitEvaluation::to_json`).
+        writeln!(w, "{}", serde_json::to_string_pretty(&unit.to_json())?)?;
+        return Ok(code);
     }
     for (k, a) in axes.iter().enumerate() {
         if k > 0 {
@@ -100,8 +101,17 @@ pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
                 print_evaluation(&mut w, &a.raw)?;
             }
         }
+        if let Some(v) = &a.verdict {
+            writeln!(w)?;
+            writeln!(w, "axis {} ({}) against the spec:", k + 1, a.gyro)?;
+            super::verdict::print(&mut w, v)?;
+        }
     }
-    Ok(ExitCode::SUCCESS)
+    if let Some(v) = &unit.verdict {
+        writeln!(w)?;
+        writeln!(w, "{}", v.line(axes.len()))?;
+    }
+    Ok(code)
 }
 
 /// The comparison per axis (train and test logs read with the lists), with progress: the
@@ -182,8 +192,28 @@ fn print_unit_tables(
     cfg: &gyrotherm::compare::CompareConfig,
 ) -> std::io::Result<()> {
     for (k, a) in cmp.axes.iter().enumerate() {
-        writeln!(w, "axis {}: {} (temperature {})", k + 1, a.gyro, a.temp)?;
-        print_table(w, &a.comparison, cfg)?;
+        match &a.unit_fit {
+            None => {
+                writeln!(w, "axis {}: {} (temperature {})", k + 1, a.gyro, a.temp)?;
+                print_table(w, &a.comparison, cfg)?;
+            }
+            Some(u) => {
+                writeln!(
+                    w,
+                    "axis {}: {} (one-sensor methods on {}, the sensor whose one-sensor fit \
+                     cross-validates best; the unit's fit on {})",
+                    k + 1,
+                    a.gyro,
+                    a.temp,
+                    u.temps.join(", ")
+                )?;
+                for line in a.model_lines() {
+                    writeln!(w, "{line}")?;
+                }
+                writeln!(w)?;
+                a.table(cfg).write_text(w)?;
+            }
+        }
         writeln!(w)?;
     }
     writeln!(w, "across axes:")?;

@@ -8,7 +8,9 @@
 - Logs and models: ``read_log``, ``read_lot`` (a lot database of ``gyrotherm lot``), ``fit`` → ``Model`` (``save``, ``Model.load``,
   ``compensate``, ``summary``); model files are the CLI's JSON.
 - Inertial units: ``gyro_col``/``temp_col`` lists in ``read_log`` and ``fit`` (→ ``UnitModel``:
-  one file for the unit, ``compensate`` per axis), as the CLI's comma-separated lists.
+  one file for the unit, ``compensate`` per axis), as the CLI's comma-separated lists;
+  ``evaluate`` (figures and spec verdicts per axis) and ``compare`` (methods per axis, with
+  the unit's own multi-sensor fit) as ``gyrotherm evaluate``/``compare --json`` print them.
 
 Errors derive from ``GyrothermError`` (a ``ValueError`` and, as allantools raises for the
 same faults, a ``RuntimeError``) and carry the CLI's messages.
@@ -49,11 +51,14 @@ from ._model import (
     COVERAGE_NAMES,
     NO_COVERAGE,
     STATUS_NAMES,
+    EVALUATE_DEFAULTS,
     Compensation,
     CoverageVerdicts,
     GyrothermWarning,
     Model,
     UnitModel,
+    compare,
+    evaluate,
     fit,
 )
 
@@ -69,6 +74,7 @@ def settings():
 
 __all__ = [
     "DELIMITER_NAMES",
+    "EVALUATE_DEFAULTS",
     "FIT_DEFAULTS",
     "GYRO_UNIT_NAMES",
     "METHOD_NAMES",
@@ -94,9 +100,11 @@ __all__ = [
     "__version__",
     "adev",
     "bias_stability",
+    "compare",
     "confidence_interval",
     "deviation",
     "edf_greenhall",
+    "evaluate",
     "fit",
     "hdev",
     "mdev",

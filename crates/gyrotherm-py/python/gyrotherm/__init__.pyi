@@ -81,6 +81,7 @@ def scale_factor(
 
 # Logs
 FIT_DEFAULTS: Dict[str, Any]
+EVALUATE_DEFAULTS: Dict[str, Any]
 READ_DEFAULTS: Dict[str, Any]
 METHOD_NAMES: List[str]
 GYRO_UNIT_NAMES: List[str]
@@ -173,3 +174,33 @@ def fit(
     progress: Union[bool, Callable[..., Any], None] = False,
     **log_options: Any,
 ) -> Union[Model, UnitModel]: ...
+
+def evaluate(
+    log: PathLike,
+    model: Union[UnitModel, PathLike, None] = None,
+    *,
+    spec: Optional[PathLike] = None,
+    # Defaults: the library's (gyrotherm.EVALUATE_DEFAULTS), not restated here.
+    tau_s: Optional[float] = ...,
+    settle_s: float = ...,
+    reference_scale: Optional[float] = ...,
+    **log_options: Any,
+) -> Dict[str, Any]: ...
+def compare(
+    train: Union[PathLike, Iterable[PathLike]],
+    test: Union[PathLike, Iterable[PathLike]],
+    *,
+    methods: Optional[Iterable[str]] = None,
+    tau_s: Optional[float] = None,
+    method: str = ...,
+    recipe: Optional[str] = ...,
+    epochs: Optional[int] = ...,
+    seed: int = ...,
+    bias_window_s: float = ...,
+    settle_s: float = ...,
+    poly_temp_degree: int = ...,
+    poly_rate_degree: int = ...,
+    cross: bool = ...,
+    validate_on_runs: bool = ...,
+    **log_options: Any,
+) -> Dict[str, Any]: ...

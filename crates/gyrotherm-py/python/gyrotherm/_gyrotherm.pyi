@@ -12,6 +12,7 @@ ONE_SIGMA_CI: float
 BIAS_WINDOW_S: float
 SETTLE_S: float
 FIT_DEFAULTS: Dict[str, Any]
+EVALUATE_DEFAULTS: Dict[str, Any]
 READ_DEFAULTS: Dict[str, Any]
 METHOD_NAMES: List[str]
 GYRO_UNIT_NAMES: List[str]
@@ -54,6 +55,24 @@ def fit_unit(
     options: Dict[str, Any],
     progress: Optional[Any] = None,
 ) -> Tuple[RawUnitModel, Optional[str]]: ...
+
+def evaluate_unit(
+    path: str,
+    options: Dict[str, Any],
+    model: Optional[RawUnitModel] = None,
+    spec: Optional[str] = None,
+    tau_s: Optional[float] = None,
+    settle_s: Optional[float] = None,
+    reference_scale: Optional[float] = None,
+) -> Tuple[str, Optional[str]]: ...
+def compare_unit(
+    train: List[str],
+    test: List[str],
+    settings: Dict[str, Any],
+    options: Dict[str, Any],
+    methods: Optional[List[str]] = None,
+    tau_s: Optional[float] = None,
+) -> Tuple[str, List[str]]: ...
 
 class RawUnitModel:
     @staticmethod

@@ -412,3 +412,121 @@ def fit(
     raw = _g.fit(static_paths, table_paths, settings, options, callback)
     _warn(raw.load_warnings)
     return Model(raw)
+
+
+#: The library's defaults of ``gyrotherm evaluate`` (``--tau-s``, ``--settle-s``,
+#: ``--reference-scale``).
+EVALUATE_DEFAULTS: Dict[str, Any] = dict(_g.EVALUATE_DEFAULTS)
+
+
+def evaluate(
+    log: PathLike,
+    model: Union["UnitModel", PathLike, None] = None,
+    *,
+    spec: Optional[PathLike] = None,
+    tau_s: Optional[float] = EVALUATE_DEFAULTS["tau_s"],
+    settle_s: float = EVALUATE_DEFAULTS["settle_s"],
+    reference_scale: Optional[float] = EVALUATE_DEFAULTS["reference_scale"],
+    **log_options: Any,
+) -> Dict[str, Any]:
+    """An inertial unit's figures per axis, as ``gyrotherm evaluate --json`` prints them with
+    ``--gyro-col``/``--temp-col`` lists, or ``--model UNIT.json`` (whose columns are read).
+
+    Returns ``{"tau_s": …, "axes": [...]}``, one dict per gyro column in column order:
+    ``gyro``, ``temps`` (the sensors its model reads), ``raw`` and ``compensated`` (with a
+    model) figures under ``evaluate --json``'s keys. With ``spec`` (a spec sheet, TOML) each
+    axis has a ``verdict`` (of the compensated output with a model, else of the raw column,
+    per figure: value, unit, limits, pass, margin) and the result a ``"verdict"``: ``pass``
+    only when every axis passes, ``failed_axes``, ``judged``. A missed limit is no exception
+    (the CLI exits 1): read ``result["verdict"]["pass"]``. The GIL is released.
+    """
+    raw_model = None
+    if model is not None:
+        if not isinstance(model, UnitModel):
+            model = UnitModel.load(model)
+        raw_model = model._raw
+    options = read_options(log_options)
+    if raw_model is None and not is_unit(options):
+        raise _g.MetricsError(
+            "evaluate judges an inertial unit per axis: give gyro_col and temp_col lists or a "
+            "UnitModel; for one column use bias_stability/scale_factor or `gyrotherm evaluate`"
+        )
+    text, note = _g.evaluate_unit(
+        os.fspath(log),
+        options,
+        raw_model,
+        None if spec is None else os.fspath(spec),
+        None if tau_s is None else float(tau_s),
+        float(settle_s),
+        None if reference_scale is None else float(reference_scale),
+    )
+    if note is not None:
+        _warn([note])
+    import json
+
+    return json.loads(text)
+
+
+def compare(
+    train: Union[PathLike, Iterable[PathLike]],
+    test: Union[PathLike, Iterable[PathLike]],
+    *,
+    methods: Optional[Iterable[str]] = None,
+    tau_s: Optional[float] = None,
+    method: str = _FIT["method"],
+    recipe: Optional[str] = _FIT["recipe"],
+    epochs: Optional[int] = _FIT["epochs"],
+    seed: int = _FIT["seed"],
+    bias_window_s: float = _FIT["bias_window_s"],
+    settle_s: float = _FIT["settle_s"],
+    poly_temp_degree: int = _FIT["poly_temp_degree"],
+    poly_rate_degree: int = _FIT["poly_rate_degree"],
+    cross: bool = _FIT["cross"],
+    validate_on_runs: bool = _FIT["validate_on_runs"],
+    **log_options: Any,
+) -> Dict[str, Any]:
+    """Every method compared per axis on an inertial unit's logs, as ``gyrotherm compare
+    --json --gyro-col … --temp-col …`` prints it (``gyro_col``/``temp_col`` lists required).
+
+    ``train``: training logs (static and rate-table, in any order); ``test``: held-out logs.
+    ``methods``: names as ``compare --methods`` (default: the library's list); the fit
+    keywords as :func:`fit`. Returns ``{"axes": [...], "across_axes": {...}}``: per axis
+    ``gyro``, ``temp`` (the sensor the one-sensor methods read: the one whose one-sensor fit
+    cross-validates best), ``comparison`` (the single-axis summary) and, with several
+    sensors, ``unit_fit``: the unit's own fit of the axis as :func:`fit` builds it, on every
+    sensor it keeps (``label``, ``temps``, ``performance`` per held-out log). The GIL is
+    released.
+    """
+    options = read_options(log_options)
+    if not is_unit(options):
+        raise _g.FitError(
+            "compare here is per axis: give gyro_col and temp_col lists (for one gyro and one "
+            "sensor use `gyrotherm compare`)"
+        )
+    train_paths, test_paths = _paths(train, "train"), _paths(test, "test")
+    if not train_paths or not test_paths:
+        raise _g.FitError("give training logs (train=[...]) and held-out logs (test=[...])")
+    settings = {
+        "method": str(method),
+        "recipe": None if recipe is None else str(recipe),
+        "epochs": None if epochs is None else int(epochs),
+        "seed": int(seed),
+        "bias_window_s": float(bias_window_s),
+        "settle_s": float(settle_s),
+        "poly_temp_degree": int(poly_temp_degree),
+        "poly_rate_degree": int(poly_rate_degree),
+        "cross": bool(cross),
+        "validate_on_runs": bool(validate_on_runs),
+    }
+    text, notes = _g.compare_unit(
+        train_paths,
+        test_paths,
+        settings,
+        options,
+        None if methods is None else [str(m) for m in methods],
+        None if tau_s is None else float(tau_s),
+    )
+    _warn(notes)
+    import json
+
+    return json.loads(text)

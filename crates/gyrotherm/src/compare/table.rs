@@ -192,6 +192,35 @@ impl TableBlock {
 }
 
 impl ComparisonTable {
+    /// Adds a column named `header` after the others: `per_log[i]` holds its figures on the
+    /// log of block `i`, `floors[i]` that log's noise floor, °/h (the `× noise floor` row).
+    /// A figure the column lacks is `-`.
+    pub fn push_column(&mut self, header: &str, per_log: &[Performance], floors: &[Option<f64>]) {
+        self.columns.push(header.to_owned());
+        let empty = Performance::default();
+        for (i, b) in self.blocks.iter_mut().enumerate() {
+            let p = per_log.get(i).unwrap_or(&empty);
+            let floor = floors.get(i).copied().flatten();
+            for r in &mut b.rows {
+                let c = match r.figure {
+                    TableFigure::BiasStability { .. } => cell(p.bias_stability_dph, 5),
+                    TableFigure::TimesNoiseFloor => {
+                        cell(p.bias_stability_dph.zip(floor).map(|(b, f)| b / f), 2)
+                    }
+                    TableFigure::SfError => cell(p.sf_error_ppm, 1),
+                    TableFigure::SfThermalError => cell(p.sf_thermal_error_ppm, 1),
+                    TableFigure::OutputAt { table_dps } => p
+                        .rate_ranges
+                        .iter()
+                        .find(|r| r.table_dps == table_dps)
+                        .map(|r| format!("{:.5}..{:.5}", r.min_dps, r.max_dps))
+                        .unwrap_or_else(|| "-".into()),
+                };
+                r.cells.push(c);
+            }
+        }
+    }
+
     /// Plain text, fixed-width columns: per held-out log a title line, a header line and one
     /// line per figure, then a blank line.
     pub fn write_text(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {

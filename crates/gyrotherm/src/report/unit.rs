@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::html::{escape, push_table, CSS};
-use super::{comparison_table, grouped_warnings, write_full_report_with, ReportError};
+use super::{grouped_warnings, results_table, write_full_report_with, ReportError};
 use crate::atomic_file::write_bytes_atomically;
 use crate::compare::CompareConfig;
 use crate::imu_judge::ImuComparison;
@@ -87,14 +87,19 @@ pub fn write_unit_report(
     let mut n = 0;
     for (k, a) in cmp.axes.iter().enumerate() {
         let folder = axis_folder(k);
+        // With several sensors the one-sensor methods read `temp`, the unit's fit its own.
+        let unit_fit = a.unit_fit.as_ref().map_or(String::new(), |u| {
+            format!("; the unit's fit on {}", u.temps.join(", "))
+        });
         let _ = writeln!(
             h,
-            "<section class=\"axis\">\n<h2>Axis {}: {} (temperature {})</h2>",
+            "<section class=\"axis\">\n<h2>Axis {}: {} (temperature {}{})</h2>",
             k + 1,
             escape(&a.gyro),
-            escape(&a.temp)
+            escape(&a.temp),
+            escape(&unit_fit)
         );
-        push_table(&mut h, &comparison_table(&a.comparison, cfg), "comparison");
+        push_table(&mut h, &results_table(&a.table(cfg)), "comparison");
         for (stem, caption) in UNIT_PAGE_FIGURES {
             // An axis without the run a figure needs has no such file (its page says why).
             if !dir.join(&folder).join(format!("{stem}.png")).is_file() {

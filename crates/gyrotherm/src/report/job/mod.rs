@@ -20,7 +20,9 @@ mod warnings;
 
 pub use allan_figure::{allan_curve, noise_lines};
 pub use rate_table::{scale_factor_points, ScalePoints};
-pub use tables::{comparison_table, input_names, model_table, shared_settings, NOT_APPLICABLE};
+pub use tables::{
+    comparison_table, input_names, model_table, results_table, shared_settings, NOT_APPLICABLE,
+};
 pub use warnings::grouped_warnings;
 
 use allan_figure::allan_report_figure;

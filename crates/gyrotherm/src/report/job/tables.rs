@@ -11,7 +11,12 @@ use crate::report::html::Table;
 /// The comparison table of `gyrotherm compare` ([`Comparison::table`]) as the report's HTML
 /// table: one row per figure, the held-out log named on its first row, a noise-floor column.
 pub fn comparison_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
-    let t = cmp.table(cfg);
+    results_table(&cmp.table(cfg))
+}
+
+/// A results table (a comparison's, or a unit axis's with its unit-fit column) as the
+/// report's HTML table: held-out log, figure, the output columns, the noise floor.
+pub fn results_table(t: &crate::compare::ComparisonTable) -> Table {
     let mut headers = vec!["held-out log".to_owned(), "figure".to_owned()];
     headers.extend(t.columns.iter().cloned());
     headers.push("noise floor".to_owned());
