@@ -92,13 +92,15 @@ pub(super) struct Scorer<'a> {
 }
 
 impl<'a> Scorer<'a> {
-    /// A scorer of `runs` (each with labelled steps) over `terms` with `folds` folds and
-    /// `gap` steps either side; None when the terms are not the search's (a term in dT).
+    /// A scorer of `runs` (each with labelled steps, of which it scores every `every`-th)
+    /// over `terms` with `folds` folds and `gap` steps either side; None when the terms are
+    /// not the search's (a term in dT).
     pub(super) fn new(
         runs: &[RunData<'a>],
         terms: &'a Terms,
         folds: usize,
         gap: usize,
+        every: usize,
     ) -> Result<Option<Scorer<'a>>, ThermalError> {
         if terms
             .powers
@@ -113,8 +115,12 @@ impl<'a> Scorer<'a> {
             let table = extract_series(&r.log.time_s, &r.log.temp_c, &spec)
                 .map_err(|e| ThermalError::Features(e.to_string()))?;
             let n_steps = table.n_rows();
+            let every = every.max(1);
             let steps: Vec<usize> = (0..n_steps.min(r.mask.len()))
                 .filter(|&k| r.mask[k])
+                .enumerate()
+                .filter(|(i, _)| i % every == 0)
+                .map(|(_, k)| k)
                 .collect();
             let t_all: Vec<f64> = (0..n_steps).map(|k| table.row(k)[0]).collect();
             let t: Vec<f64> = steps.iter().map(|&k| t_all[k]).collect();
