@@ -28,8 +28,8 @@ use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
 use crate::model::{sha256_hex, ModelFile, ModelFileError, SubModel, TempSensorDef, CHECKSUM_KEY};
-pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
+pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
 use crate::CompensateError;
 
