@@ -28,6 +28,7 @@ use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
 use crate::model::{sha256_hex, ModelFile, ModelFileError, SubModel, TempSensorDef, CHECKSUM_KEY};
+use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
 use crate::CompensateError;
@@ -443,7 +444,10 @@ fn fit_axis_multi(
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
             .collect();
-        let id = crate::fit::identify(&named, cfg).map_err(|e| fit_err(j, e))?;
+        // A unit searches lags once per sensor and axis, so each search keeps a fifth of the
+        // labelled steps (`IMU_IDENTIFY_EVERY`, chosen on the design family).
+        let id = crate::fit::identify_every(&named, cfg, IMU_IDENTIFY_EVERY)
+            .map_err(|e| fit_err(j, e))?;
         let (mut bias, mut scale) = (Vec::new(), Vec::new());
         for (name, l) in &axis_logs {
             if targets::is_static(l) {

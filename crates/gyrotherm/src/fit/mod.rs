@@ -276,6 +276,24 @@ pub fn identify(logs: &[NamedLog], cfg: &FitConfig) -> Result<thermal::Identifie
     )?)
 }
 
+/// [`identify`] with the lag search on every `every`-th labelled step
+/// ([`thermal::identify_every`]).
+pub(crate) fn identify_every(
+    logs: &[NamedLog],
+    cfg: &FitConfig,
+    every: usize,
+) -> Result<thermal::Identified, FitError> {
+    let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
+    Ok(thermal::identify_every(
+        &named,
+        &cfg.thermal,
+        cfg.bias_window_s,
+        cfg.settle_s,
+        cfg.scale_window_s,
+        every,
+    )?)
+}
+
 /// [`fit_model`] with the identification already made ([`identify`] on the same logs and
 /// settings; None for methods without one).
 pub fn fit_model_identified(

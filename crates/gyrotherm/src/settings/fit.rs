@@ -26,6 +26,15 @@ pub const RECIPE_NAMES: [&str; 5] = ["thermal", "residual", "generic", "direct",
 /// per axis: docs/experiments/imu.md).
 pub const DEFAULT_IMU_MIN_GAIN: f64 = -1.0;
 
+/// An inertial unit's lag search (only the search: the sensor selection and the final fits
+/// use every labelled step) scores each candidate on every fifth labelled step of its
+/// one-sensor targets, a fifth of the search's work per sensor; the bias target is a 100 s
+/// moving average at 1 Hz, so neighbouring steps carry nearly the same information. Chosen
+/// on the design family against every step (same median and worst case within its noise)
+/// and every tenth step (a higher worst case): docs/experiments/imu.md. The one-axis fit
+/// searches on every step.
+pub const IMU_IDENTIFY_EVERY: usize = 5;
+
 /// Which temperature sensors each axis of an inertial unit may read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ImuSensors {

@@ -409,6 +409,22 @@ pub fn identify(
     settle_s: f64,
     scale_window_s: f64,
 ) -> Result<Identified, ThermalError> {
+    identify_every(logs, cfg, bias_window_s, settle_s, scale_window_s, 1)
+}
+
+/// [`identify`] with the lag search's statistics kept on every `every`-th labelled step (1:
+/// every step, as [`identify`]); the allowance (basis, folds) still comes from every step,
+/// the returned score and ridge strength from the thinned search (the final fits choose
+/// their own on every step). An inertial unit's fit searches this way
+/// ([`crate::settings::fit::IMU_IDENTIFY_EVERY`]).
+pub(crate) fn identify_every(
+    logs: &[(&str, &TestLog)],
+    cfg: &ThermalConfig,
+    bias_window_s: f64,
+    settle_s: f64,
+    scale_window_s: f64,
+    every: usize,
+) -> Result<Identified, ThermalError> {
     let bias_runs = run_data(logs, true, bias_window_s, settle_s, scale_window_s)?;
     let scale_runs = run_data(logs, false, bias_window_s, settle_s, scale_window_s)?;
     let (runs, on) = if bias_runs.is_empty() {
@@ -474,10 +490,10 @@ pub fn identify(
     // scorer does not take is scored from its design.
     let mut main_scorer = match al.folds {
         0 => None,
-        _ => search::Scorer::new(runs, &terms, al.folds, al.gap_steps)?,
+        _ => search::Scorer::new(runs, &terms, al.folds, al.gap_steps, every)?,
     };
     let mut scale_scorer = match &joint {
-        Some(ak) => search::Scorer::new(&scale_runs, &scale_terms, ak.folds, ak.gap_steps)?,
+        Some(ak) => search::Scorer::new(&scale_runs, &scale_terms, ak.folds, ak.gap_steps, every)?,
         None => None,
     };
     for sc in [&mut main_scorer, &mut scale_scorer].into_iter().flatten() {

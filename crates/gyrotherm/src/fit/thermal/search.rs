@@ -92,13 +92,15 @@ pub(super) struct Scorer<'a> {
 }
 
 impl<'a> Scorer<'a> {
-    /// A scorer of `runs` (each with labelled steps) over `terms` with `folds` folds and
-    /// `gap` steps either side; None when the terms are not the search's (a term in dT).
+    /// A scorer of `runs` (each with labelled steps, of which it scores every `every`-th)
+    /// over `terms` with `folds` folds and `gap` steps either side; None when the terms are
+    /// not the search's (a term in dT).
     pub(super) fn new(
         runs: &[RunData<'a>],
         terms: &'a Terms,
         folds: usize,
         gap: usize,
+        every: usize,
     ) -> Result<Option<Scorer<'a>>, ThermalError> {
         if terms
             .powers
@@ -113,8 +115,12 @@ impl<'a> Scorer<'a> {
             let table = extract_series(&r.log.time_s, &r.log.temp_c, &spec)
                 .map_err(|e| ThermalError::Features(e.to_string()))?;
             let n_steps = table.n_rows();
+            let every = every.max(1);
             let steps: Vec<usize> = (0..n_steps.min(r.mask.len()))
                 .filter(|&k| r.mask[k])
+                .enumerate()
+                .filter(|(i, _)| i % every == 0)
+                .map(|(_, k)| k)
                 .collect();
             let t_all: Vec<f64> = (0..n_steps).map(|k| table.row(k)[0]).collect();
             let t: Vec<f64> = steps.iter().map(|&k| t_all[k]).collect();
@@ -481,6 +487,48 @@ mod tests {
         }
     }
 
+    /// A scorer on every third labelled step scores as one on runs whose mask keeps only
+    /// those steps (the independent computation: the thinning done on the mask instead), to
+    /// the bit, and differs from the scorer on every step.
+    #[test]
+    fn thinned_scorer_is_the_thinned_masks() {
+        let logs = [log(4000), log(3000)];
+        let named: Vec<(&str, &TestLog)> = vec![("a", &logs[0]), ("b", &logs[1])];
+        let runs = run_data(&named, true, 100.0, 10.0, 60.0).unwrap();
+        let thinned: Vec<RunData> = runs
+            .iter()
+            .map(|r| {
+                let mut seen = 0usize;
+                let mask = r
+                    .mask
+                    .iter()
+                    .map(|&m| {
+                        let keep = m && seen % 3 == 0;
+                        seen += usize::from(m);
+                        keep
+                    })
+                    .collect();
+                RunData {
+                    log: r.log,
+                    target: r.target.clone(),
+                    mask,
+                }
+            })
+            .collect();
+        let lambdas: Vec<f64> = (0..=9).map(|k| 10f64.powi(-9 + k)).collect();
+        let terms = basis(Basis::Lean, 2);
+        let mut every3 = Scorer::new(&runs, &terms, 5, 200, 3).unwrap().unwrap();
+        let mut masked = Scorer::new(&thinned, &terms, 5, 200, 1).unwrap().unwrap();
+        let mut all = Scorer::new(&runs, &terms, 5, 200, 1).unwrap().unwrap();
+        for lags in [[100.0, 700.0], [80.0, 2500.0]] {
+            let got = every3.scores(&lags, &lambdas).unwrap();
+            let want = masked.scores(&lags, &lambdas).unwrap();
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "{lags:?}");
+            assert_ne!(bits(&got), bits(&all.scores(&lags, &lambdas).unwrap()));
+        }
+    }
+
     /// The scorer's scores, and those from the design's per-segment statistics
     /// ([`cv_scores`]), are those from the design's rows (`cv_scores_rows`, the direct
     /// computation) to rounding: the same ridge strength wins.
@@ -493,7 +541,7 @@ mod tests {
         for kind in [Basis::Lean, Basis::Full] {
             let terms = basis(kind, 3);
             let nc = terms.len() - 1;
-            let mut scorer = Scorer::new(&runs, &terms, 5, 200).unwrap().unwrap();
+            let mut scorer = Scorer::new(&runs, &terms, 5, 200, 1).unwrap().unwrap();
             for lags in [
                 [100.0, 400.0, 1500.0],
                 [100.0, 700.0, 2500.0],
