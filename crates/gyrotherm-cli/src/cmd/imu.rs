@@ -89,16 +89,20 @@ pub fn train(args: TrainArgs) -> anyhow::Result<ExitCode> {
         started.elapsed().as_secs_f64()
     );
     for a in &model.axes {
+        // The scores are on the bias (°/s) when the axis had a static run, else on the
+        // scale factor (dimensionless): printed in the units a gyro engineer reads.
+        let on_bias = a.model.bias.is_some();
         let scores: Vec<String> = a
             .scores
             .iter()
             .map(|s| match s.cv_rms {
-                Some(r) => format!("{} {r:.3e}", s.temp),
+                Some(r) if on_bias => format!("{} {:.4} °/h", s.temp, r * 3600.0),
+                Some(r) => format!("{} {:.2} ppm", s.temp, r * 1e6),
                 None => format!("{} -", s.temp),
             })
             .collect();
         eprintln!(
-            "  {}: reads {} (bias: {}, scale factor: {}); cross-validated RMS per sensor: {}",
+            "  {}: reads {} (bias: {}, scale factor: {}); one-sensor cross-validated RMS of the {}: {}",
             a.gyro,
             a.temps.join(", "),
             if a.model.bias.is_some() {
@@ -111,6 +115,7 @@ pub fn train(args: TrainArgs) -> anyhow::Result<ExitCode> {
             } else {
                 "none"
             },
+            if on_bias { "bias" } else { "scale factor" },
             scores.join(", ")
         );
     }
