@@ -587,3 +587,125 @@ fn evaluate_spec_with_a_figure_the_log_cannot_give_names_the_axis() {
     assert!(err.contains("add such a log or remove the limit"), "{err}");
     assert!(err.contains(&h.display().to_string()), "{err}");
 }
+
+/// `compare --spec` with column lists: the unit fit's verdict on each axis equals
+/// `evaluate --model UNIT.json --spec` of the unit `train` builds with the same lists (the
+/// same fit reached by another command, judged through another path), each one-sensor
+/// column gets its own verdict, and a limit between the columns' values fails the run
+/// (exit 1) while loose limits pass it (exit 0).
+#[test]
+fn compare_spec_judges_every_column_of_every_axis() {
+    let dir = tempfile::tempdir().unwrap();
+    let temps = "temp_case_c,temp_x_c,temp_y_c,temp_z_c";
+    let s = sim(dir.path(), "s.csv", &["--seed", "1"]);
+    let t = sim(
+        dir.path(),
+        "t.csv",
+        &["--seed", "2", "--table-rate", "20", "--table-axis", "y"],
+    );
+    let h = sim(dir.path(), "h.csv", &["--seed", "3"]);
+    let model = dir.path().join("unit.json");
+    run_ok(
+        gyrotherm()
+            .args(["train", "--gyro-col", GYROS, "--temp-col", temps, "--out"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&s)
+            .arg("--input")
+            .arg(&t),
+    );
+    let loose = write_spec(
+        dir.path(),
+        "loose.toml",
+        "bias_stability_dph = { max = 1e6 }\narw_deg_rt_h = { max = 1e6 }\n",
+    );
+    let compare = |spec: &Path| {
+        gyrotherm()
+            .args(["compare", "--json", "--methods", "linear,thermal"])
+            .args(["--gyro-col", GYROS, "--temp-col", temps, "--train"])
+            .arg(&s)
+            .arg("--train")
+            .arg(&t)
+            .arg("--test")
+            .arg(&h)
+            .arg("--spec")
+            .arg(spec)
+            .output()
+            .unwrap()
+    };
+    let out = compare(&loose);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let cmp = json(&out);
+    let evaluated = json(&run_ok(
+        gyrotherm()
+            .args(["evaluate", "--json", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&h)
+            .arg("--spec")
+            .arg(&loose),
+    ));
+    let axes = cmp["verdicts"].as_array().expect("verdicts per axis");
+    assert_eq!(axes.len(), 3);
+    let mut stability = Vec::new();
+    for (a, e) in axes.iter().zip(evaluated["axes"].as_array().unwrap()) {
+        let cols = a["columns"].as_array().unwrap();
+        assert_eq!(cols.len(), 2, "linear and thermal: {a}");
+        let unit = &a["unit_fit"];
+        assert!(unit[0].as_str().unwrap().contains("sensor"), "{unit}");
+        assert_eq!(
+            figure_verdicts(&unit[1]),
+            figure_verdicts(&e["verdict"]),
+            "{}",
+            a["gyro"]
+        );
+        for c in cols {
+            stability.push(
+                c["verdict"]["figures"][0]["value"]
+                    .as_f64()
+                    .expect("bias stability value"),
+            );
+        }
+    }
+    // A limit between the smallest and the largest column value: some column misses it.
+    let (lo, hi) = stability
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
+    assert!(lo < hi, "{stability:?}");
+    let tight = write_spec(
+        dir.path(),
+        "tight.toml",
+        &format!("bias_stability_dph = {{ max = {} }}\n", (lo + hi) / 2.0),
+    );
+    let out = compare(&tight);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = run_text_compare(&s, &t, &h, temps, &tight);
+    assert!(text.contains("across the axes:"), "{text}");
+    assert!(text.contains(": FAIL on "), "{text}");
+}
+
+fn run_text_compare(s: &Path, t: &Path, h: &Path, temps: &str, spec: &Path) -> String {
+    let out = gyrotherm()
+        .args(["compare", "--methods", "linear,thermal"])
+        .args(["--gyro-col", GYROS, "--temp-col", temps, "--train"])
+        .arg(s)
+        .arg("--train")
+        .arg(t)
+        .arg("--test")
+        .arg(h)
+        .arg("--spec")
+        .arg(spec)
+        .output()
+        .unwrap();
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}

@@ -402,11 +402,19 @@ pub struct UnitFitColumn {
     pub temps: Vec<String>,
     /// Its figures on each held-out log, in order.
     pub performance: Vec<Performance>,
+    /// Its compensated rate, °/s, on each held-out log, in order (for a spec verdict; not in
+    /// the JSON summary).
+    #[serde(skip)]
+    pub compensated_dps: Vec<Vec<f64>>,
 }
 
 impl UnitFitColumn {
     /// The column of `axis` (fitted with `method`) with its figures per held-out log.
-    pub fn new(axis: &ImuAxis, performance: Vec<Performance>) -> Self {
+    pub fn new(
+        axis: &ImuAxis,
+        performance: Vec<Performance>,
+        compensated_dps: Vec<Vec<f64>>,
+    ) -> Self {
         let n = axis.temps.len();
         let what = axis.model.label();
         let sensors = if n == 1 { "sensor" } else { "sensors" };
@@ -421,6 +429,7 @@ impl UnitFitColumn {
             method: axis.model.method.as_str(),
             temps: axis.temps.clone(),
             performance,
+            compensated_dps,
         }
     }
 }
@@ -587,7 +596,8 @@ pub fn compare_imu(
                                         })
                                 })
                                 .collect::<Result<Vec<_>, _>>()?;
-                            Some(UnitFitColumn::new(&m.axes[k], perf))
+                            let comp = outs.iter().map(|o| o[k].gyro_comp_dps.clone()).collect();
+                            Some(UnitFitColumn::new(&m.axes[k], perf, comp))
                         }
                         _ => None,
                     };
@@ -613,6 +623,120 @@ pub fn compare_imu(
     Ok(ImuComparison {
         axes: axes.into_iter().collect::<Result<Vec<_>, _>>()?,
     })
+}
+
+/// One axis of a unit comparison judged against a spec sheet: each method's column and the
+/// unit's own fit, on the axis's held-out logs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisVerdicts {
+    pub gyro: String,
+    /// The one-sensor methods' columns, as `compare --spec` judges a single axis.
+    pub columns: Vec<spec::ColumnVerdict>,
+    /// The unit's own fit (its label and verdict), when the unit reads several sensors.
+    pub unit_fit: Option<(String, Verdict)>,
+}
+
+impl AxisVerdicts {
+    /// Whether every judged column of the axis meets every limit.
+    pub fn pass(&self) -> bool {
+        self.columns.iter().all(|c| c.verdict.pass)
+            && self.unit_fit.as_ref().is_none_or(|(_, v)| v.pass)
+    }
+}
+
+/// One line per judged column across the axes: `linear: FAIL on gyro_x_dps, gyro_z_dps`,
+/// `unit fit: PASS on every axis` (the columns in the order of the tables).
+pub fn verdicts_across_axes(axes: &[AxisVerdicts]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    let mut failed: Vec<Vec<&str>> = Vec::new();
+    for a in axes {
+        let mut cols: Vec<(String, bool)> = a
+            .columns
+            .iter()
+            .map(|c| (c.label.to_owned(), c.verdict.pass))
+            .collect();
+        if let Some((_, v)) = &a.unit_fit {
+            cols.push(("unit fit".to_owned(), v.pass));
+        }
+        for (name, pass) in cols {
+            let i = match names.iter().position(|n| *n == name) {
+                Some(i) => i,
+                None => {
+                    names.push(name);
+                    failed.push(Vec::new());
+                    names.len() - 1
+                }
+            };
+            if !pass {
+                failed[i].push(a.gyro.as_str());
+            }
+        }
+    }
+    names
+        .into_iter()
+        .zip(failed)
+        .map(|(n, f)| {
+            if f.is_empty() {
+                format!("{n}: PASS on every axis")
+            } else {
+                format!("{n}: FAIL on {}", f.join(", "))
+            }
+        })
+        .collect()
+}
+
+/// Every axis of a unit comparison judged against `spec`: each column's compensated output on
+/// each held-out log, with the comparison's τ and settle time (the single-axis rule,
+/// [`spec::judge_comparison`]).
+pub fn judge_unit_comparison(
+    spec: &Spec,
+    cmp: &ImuComparison,
+    cfg: &CompareConfig,
+) -> Result<Vec<AxisVerdicts>, ImuJudgeError> {
+    let opts = MeasureOptions {
+        evaluation: crate::metrics::EvaluationOptions {
+            tau_s: cfg.tau_s,
+            settle_s: cfg.settle_s,
+            reference_scale: None,
+        },
+        noise_terms: spec.needs_noise_terms(),
+    };
+    let mut out = Vec::with_capacity(cmp.axes.len());
+    for a in &cmp.axes {
+        let spec_err = |output: &'static str, source| ImuJudgeError::Spec {
+            gyro: a.gyro.clone(),
+            output,
+            source: Box::new(source),
+        };
+        let columns = spec::judge_comparison(spec, &a.comparison, &a.test_named(), cfg)
+            .map_err(|e| spec_err("compensated", e))?;
+        let unit_fit = match &a.unit_fit {
+            Some(u) => {
+                let mut measured = Vec::with_capacity(a.test.len());
+                for ((name, log), rate) in a.test.iter().zip(&u.compensated_dps) {
+                    let f = spec::measure(log, rate, &opts).map_err(|source| {
+                        spec_err(
+                            "compensated",
+                            SpecError::Measure {
+                                log: name.clone(),
+                                source,
+                            },
+                        )
+                    })?;
+                    measured.push((name.clone(), f));
+                }
+                let v = spec::judge(spec, &measured).map_err(|e| spec_err("compensated", e))?;
+                Some((u.label.clone(), v))
+            }
+            None => None,
+        };
+        out.push(AxisVerdicts {
+            gyro: a.gyro.clone(),
+            columns,
+            unit_fit,
+        });
+    }
+    Ok(out)
 }
 
 /// The header of the unit fit's column in the table across axes.

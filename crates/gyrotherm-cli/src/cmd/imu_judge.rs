@@ -234,15 +234,16 @@ fn unit_warnings(cmp: &ImuComparison) -> Vec<String> {
 fn refuse_spec(spec: &Option<std::path::PathBuf>) -> anyhow::Result<()> {
     anyhow::ensure!(
         spec.is_none(),
-        "--spec is judged on single-axis columns; with --gyro-col/--temp-col lists leave it out \
-         (compare or report one axis with --gyro-col G --temp-col T to judge it)"
+        "`report --spec` judges single-axis columns; with --gyro-col/--temp-col lists use \
+         `compare --spec` or `evaluate --model UNIT.json --spec` (per axis and the unit), or \
+         report one axis with --gyro-col G --temp-col T"
     );
     Ok(())
 }
 
-/// `compare` with column lists.
+/// `compare` with column lists (with `--spec`, every column of every axis judged).
 pub fn compare(args: CompareArgs) -> anyhow::Result<ExitCode> {
-    refuse_spec(&args.spec)?;
+    let spec = super::verdict::load(args.spec.as_deref())?;
     let (cmp, cfg) = run_unit_comparison(
         &args.train,
         &args.test,
@@ -251,16 +252,40 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<ExitCode> {
         &args.fit,
         &args.log,
     )?;
+    let verdicts = spec
+        .as_ref()
+        .map(|s| imu_judge::judge_unit_comparison(s, &cmp, &cfg))
+        .transpose()?;
     let mut out = std::io::stdout().lock();
     if args.json {
-        writeln!(out, "{}", serde_json::to_string_pretty(&cmp.summary(&cfg))?)?;
+        let mut j = serde_json::to_value(cmp.summary(&cfg))?;
+        if let (Some(v), Some(o)) = (&verdicts, j.as_object_mut()) {
+            o.insert("verdicts".into(), serde_json::to_value(v)?);
+        }
+        writeln!(out, "{}", serde_json::to_string_pretty(&j)?)?;
     } else {
         print_unit_tables(&mut out, &cmp, &cfg)?;
+        for (k, a) in verdicts.iter().flatten().enumerate() {
+            writeln!(out, "\naxis {} ({}) against the spec:", k + 1, a.gyro)?;
+            super::verdict::print_columns(&mut out, &a.columns)?;
+            if let Some((label, v)) = &a.unit_fit {
+                writeln!(out, "\n{label} (unit fit):")?;
+                super::verdict::print(&mut out, v)?;
+            }
+        }
+        if let (Some(vs), Some(s)) = (&verdicts, &spec) {
+            writeln!(out, "\nspec {} across the axes:", s.name)?;
+            for line in imu_judge::verdicts_across_axes(vs) {
+                writeln!(out, "  {line}")?;
+            }
+        }
     }
     for w in unit_warnings(&cmp) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(super::verdict::exit_code(
+        verdicts.iter().flatten().all(|a| a.pass()),
+    ))
 }
 
 /// `report` with column lists: the unit page and a full page per axis.
