@@ -421,7 +421,8 @@ fn evaluate_unit(
 /// `compare --methods` (None: the library's default list). Returns the JSON text and
 /// deprecation notes.
 #[pyfunction]
-#[pyo3(signature = (train, test, settings, options, methods=None, tau_s=None))]
+#[pyo3(signature = (train, test, settings, options, methods=None, tau_s=None, spec=None))]
+#[allow(clippy::too_many_arguments)]
 fn compare_unit(
     py: Python<'_>,
     train: Vec<PathBuf>,
@@ -430,7 +431,12 @@ fn compare_unit(
     options: LogOptions,
     methods: Option<Vec<String>>,
     tau_s: Option<f64>,
+    spec: Option<PathBuf>,
 ) -> PyResult<(String, Vec<String>)> {
+    let spec = spec
+        .map(|p| gyrotherm::spec::Spec::load(&p))
+        .transpose()
+        .map_err(py_err::<MetricsError>)?;
     let methods: Option<Vec<gyrotherm::model::Method>> = methods
         .map(|m| m.iter().map(|n| n.parse()).collect::<Result<_, _>>())
         .transpose()
@@ -473,8 +479,20 @@ fn compare_unit(
         .map_err(|e| {
             FitError::new_err(format!("comparison failed: {}", gyrotherm::error_chain(&e)))
         })?;
-        let j = serde_json::to_string(&cmp.summary(&cfg))
+        let mut j = serde_json::to_value(cmp.summary(&cfg))
             .map_err(|e| FitError::new_err(e.to_string()))?;
+        if let Some(s) = &spec {
+            let v = gyrotherm::imu_judge::judge_unit_comparison(s, &cmp, &cfg).map_err(|e| {
+                MetricsError::new_err(format!("spec {}: {}", s.name, gyrotherm::error_chain(&e)))
+            })?;
+            if let Some(o) = j.as_object_mut() {
+                o.insert(
+                    "verdicts".into(),
+                    serde_json::to_value(v).map_err(|e| FitError::new_err(e.to_string()))?,
+                );
+            }
+        }
+        let j = serde_json::to_string(&j).map_err(|e| FitError::new_err(e.to_string()))?;
         Ok((j, notes))
     })
 }

@@ -104,3 +104,29 @@ def test_compare_per_axis_is_the_cli_json(cli, unit_logs):  # noqa: F811
         assert "lstm" not in u["label"].lower()
     with pytest.raises(gt.FitError, match="gyro_col and temp_col lists"):
         gt.compare(train=unit_logs["static"], test=unit_logs["heldout"])
+
+
+def test_compare_spec_is_the_cli_json_and_fails_a_column(cli, unit_logs, tmp_path):  # noqa: F811
+    # The verdicts equal `compare --spec --json`'s (the CLI's path); a limit between the
+    # columns' bias stabilities fails some column and passes another.
+    train = [unit_logs["static"], unit_logs["table"]]
+    args = dict(methods=["linear", "thermal"], gyro_col=GYROS, temp_col=TEMPS)
+    loose = spec_file(tmp_path, "loose.toml", "bias_stability_dph = { max = 1e6 }\n")
+    got = gt.compare(train=train, test=unit_logs["heldout"], spec=loose, **args)
+    want = json.loads(
+        cli("compare", "--json", "--methods", "linear,thermal", "--gyro-col", ",".join(GYROS),
+            "--temp-col", ",".join(TEMPS), "--train", unit_logs["static"], "--train",
+            unit_logs["table"], "--test", unit_logs["heldout"], "--spec", loose).stdout
+    )
+    assert got == want
+    values = []
+    for a in got["verdicts"]:
+        values += [c["verdict"]["figures"][0]["value"] for c in a["columns"]]
+        values.append(a["unit_fit"][1]["figures"][0]["value"])
+        assert all(c["verdict"]["pass"] for c in a["columns"]) and a["unit_fit"][1]["pass"]
+    mid = (min(values) + max(values)) / 2
+    tight = spec_file(tmp_path, "tight.toml", f"bias_stability_dph = {{ max = {mid} }}\n")
+    got = gt.compare(train=train, test=unit_logs["heldout"], spec=tight, **args)
+    passes = [c["verdict"]["pass"] for a in got["verdicts"] for c in a["columns"]]
+    passes += [a["unit_fit"][1]["pass"] for a in got["verdicts"]]
+    assert True in passes and False in passes

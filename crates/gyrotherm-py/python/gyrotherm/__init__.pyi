@@ -192,6 +192,7 @@ def compare(
     *,
     methods: Optional[Iterable[str]] = None,
     tau_s: Optional[float] = None,
+    spec: Optional[PathLike] = None,
     method: str = ...,
     recipe: Optional[str] = ...,
     epochs: Optional[int] = ...,

@@ -72,6 +72,7 @@ def compare_unit(
     options: Dict[str, Any],
     methods: Optional[List[str]] = None,
     tau_s: Optional[float] = None,
+    spec: Optional[str] = None,
 ) -> Tuple[str, List[str]]: ...
 
 class RawUnitModel:

@@ -473,6 +473,7 @@ def compare(
     *,
     methods: Optional[Iterable[str]] = None,
     tau_s: Optional[float] = None,
+    spec: Optional[PathLike] = None,
     method: str = _FIT["method"],
     recipe: Optional[str] = _FIT["recipe"],
     epochs: Optional[int] = _FIT["epochs"],
@@ -494,8 +495,10 @@ def compare(
     ``gyro``, ``temp`` (the sensor the one-sensor methods read: the one whose one-sensor fit
     cross-validates best), ``comparison`` (the single-axis summary) and, with several
     sensors, ``unit_fit``: the unit's own fit of the axis as :func:`fit` builds it, on every
-    sensor it keeps (``label``, ``temps``, ``performance`` per held-out log). The GIL is
-    released.
+    sensor it keeps (``label``, ``temps``, ``performance`` per held-out log). With ``spec`` (a
+    spec sheet, TOML) also ``verdicts``: per axis ``gyro``, ``columns`` (each one-sensor
+    method's verdict) and ``unit_fit`` (label, verdict), as ``compare --spec --json``; a
+    missed limit is ``verdict["pass"] == False``, not an exception. The GIL is released.
     """
     options = read_options(log_options)
     if not is_unit(options):
@@ -525,6 +528,7 @@ def compare(
         options,
         None if methods is None else [str(m) for m in methods],
         None if tau_s is None else float(tau_s),
+        None if spec is None else os.fspath(spec),
     )
     _warn(notes)
     import json
