@@ -528,7 +528,12 @@ fn fit_axis_multi(
     }
     let data: Vec<SensorData> = per_sensor
         .iter()
-        .map(|(_, id, bias, scale)| SensorData { id, bias, scale })
+        .map(|(_, id, bias, scale)| SensorData {
+            id,
+            bias,
+            scale,
+            blocks: multi::Blocks::default(),
+        })
         .collect();
     let (order, single) = multi::select(
         &data,
