@@ -433,6 +433,7 @@ fn fit_axis(
 /// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
 /// the sensors chosen by cross-validation, one fit over the chosen sensors.
 #[allow(clippy::too_many_arguments)]
+
 #[allow(clippy::too_many_arguments)]
 fn fit_axis_multi(
     logs: &[(String, ImuLog)],

@@ -193,9 +193,7 @@ impl<'a> Scorer<'a> {
     /// Make the lag differences of `taus` ahead of the candidates that use them (one pass
     /// over each run for all of them).
     pub(super) fn make_lags(&mut self, taus: &[f64]) -> Result<(), ThermalError> {
-        self.runs
-            .iter_mut()
-            .try_for_each(|r| r.make_lags(taus, true))
+        self.runs.iter_mut().try_for_each(|r| r.make_lags(taus, true))
     }
 
     /// The cross-validated score of each ridge strength at `lags` (as [`cv_scores`] of the
@@ -296,10 +294,9 @@ impl Run<'_> {
                     .copied()
                     .filter(|t| !held.contains_key(&t.to_bits()))
                     .collect();
-                for (tau, all) in
-                    missing
-                        .iter()
-                        .zip(lag_differences(&self.t_all, &self.gaps, p, &missing))
+                for (tau, all) in missing
+                    .iter()
+                    .zip(lag_differences(&self.t_all, &self.gaps, p, &missing))
                 {
                     held.insert(tau.to_bits(), std::sync::Arc::new(all));
                 }
