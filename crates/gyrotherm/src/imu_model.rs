@@ -528,12 +528,7 @@ fn fit_axis_multi(
     }
     let data: Vec<SensorData> = per_sensor
         .iter()
-        .map(|(_, id, bias, scale)| SensorData {
-            id,
-            bias,
-            scale,
-            blocks: multi::Blocks::default(),
-        })
+        .map(|(_, id, bias, scale)| SensorData { id, bias, scale })
         .collect();
     let (order, single) = multi::select(
         &data,

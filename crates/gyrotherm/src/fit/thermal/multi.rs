@@ -43,44 +43,6 @@ pub struct SensorData<'a> {
     pub id: &'a Identified,
     pub bias: &'a [TargetSet],
     pub scale: &'a [TargetSet],
-    /// This sensor's design columns, made by the first trial that needs them.
-    pub blocks: Blocks,
-}
-
-/// A sensor's design columns at every step of each run, for each target and each place (first
-/// sensor or further sensor), kept between the orders the selection tries (each trial takes
-/// the rows it needs: the same values as making them again).
-#[derive(Default)]
-pub struct Blocks([std::cell::OnceCell<(Vec<Vec<f64>>, usize)>; 4]);
-
-impl SensorData<'_> {
-    /// The columns of this sensor's terms as first sensor (`first`, no constant) or as a
-    /// further one ([`extra_terms`]) for one target: per run, row-major over every step, and
-    /// the number of columns. `cfg` is the same in every call for one axis.
-    fn block(&self, cfg: &ThermalConfig, scale: bool, first: bool) -> (&[Vec<f64>], usize) {
-        let (v, w) = self.blocks.0[usize::from(scale) * 2 + usize::from(first)].get_or_init(|| {
-            let sets = target_sets(self, scale);
-            let terms = if first {
-                first_terms(sets, cfg, self.id, scale)
-            } else {
-                extra_terms(self.id.report.lags_s.len())
-            };
-            let from = usize::from(first);
-            let w = terms.len() - from;
-            let v = sets
-                .iter()
-                .map(|s| {
-                    let mut v = Vec::with_capacity(s.table.n_rows() * w);
-                    for k in 0..s.table.n_rows() {
-                        terms.extend_design_row(s.table.row(k), from, &mut v);
-                    }
-                    v
-                })
-                .collect();
-            (v, w)
-        });
-        (v, *w)
-    }
 }
 
 /// The further sensor's terms: `T` and each lag difference, linearly, no constant.
@@ -113,10 +75,13 @@ pub fn first_terms(sets: &[TargetSet], cfg: &ThermalConfig, id: &Identified, sca
     basis(kind, lags)
 }
 
-/// The design over the first sensor's terms (no constant) and each further sensor's: per
-/// part its training sets and its columns ([`SensorData::block`]).
-fn combined(parts: &[(&[TargetSet], (&[Vec<f64>], usize))]) -> (Design, usize) {
-    let nc: usize = parts.iter().map(|(_, (_, w))| w).sum();
+/// The design over the first sensor's terms (no constant) and each further sensor's.
+fn combined(parts: &[(&[TargetSet], &Terms)]) -> (Design, usize) {
+    let nc: usize = parts
+        .iter()
+        .enumerate()
+        .map(|(i, (_, t))| t.len() - usize::from(i == 0))
+        .sum();
     let mut d = Design {
         x: Vec::new(),
         y: Vec::new(),
@@ -127,21 +92,22 @@ fn combined(parts: &[(&[TargetSet], (&[Vec<f64>], usize))]) -> (Design, usize) {
         return (d, 0);
     };
     for (r, s) in first.iter().enumerate() {
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        let mut step = Vec::new();
         let n_rows = parts
             .iter()
             .map(|(sets, _)| sets[r].table.n_rows())
             .min()
             .unwrap_or(0);
-        let step: Vec<usize> = (0..n_rows)
-            .filter(|&k| s.mask[k] && s.target[k].is_finite())
-            .collect();
-        let mut x = Vec::with_capacity(step.len() * nc);
-        let mut y = Vec::with_capacity(step.len());
-        for &k in &step {
-            for (_, (block, w)) in parts {
-                x.extend_from_slice(&block[r][k * w..(k + 1) * w]);
+        for k in 0..n_rows {
+            if s.mask[k] && s.target[k].is_finite() {
+                for (i, (sets, terms)) in parts.iter().enumerate() {
+                    terms.extend_design_row(sets[r].table.row(k), usize::from(i == 0), &mut x);
+                }
+                y.push(s.target[k]);
+                step.push(k);
             }
-            y.push(s.target[k]);
         }
         d.x.push(x);
         d.y.push(y);
@@ -168,23 +134,6 @@ fn folds_for(d: &Design, id: &Identified) -> usize {
     }
 }
 
-/// The parts of [`combined`] for the sensors `order` (first sensor first).
-fn parts<'s, 'a>(
-    sensors: &'s [SensorData<'a>],
-    order: &[usize],
-    cfg: &ThermalConfig,
-    scale: bool,
-) -> Vec<(&'a [TargetSet], (&'s [Vec<f64>], usize))> {
-    order
-        .iter()
-        .enumerate()
-        .map(|(i, &j)| {
-            let s = &sensors[j];
-            (target_sets(s, scale), s.block(cfg, scale, i == 0))
-        })
-        .collect()
-}
-
 /// Cross-validated RMS of one target on the sensors `order` (first sensor first); None
 /// when the runs are too short to cross-validate.
 pub fn cv_rms<'a>(
@@ -195,10 +144,19 @@ pub fn cv_rms<'a>(
 ) -> Option<f64> {
     let first = &sensors[order[0]];
     let sets = |s: &SensorData<'a>| target_sets(s, scale);
+    let t0 = first_terms(sets(first), cfg, first.id, scale);
+    let extra: Vec<Terms> = order[1..]
+        .iter()
+        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len()))
+        .collect();
+    let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
+    for (&j, t) in order[1..].iter().zip(&extra) {
+        parts.push((sets(&sensors[j]), t));
+    }
     if sets(first).is_empty() {
         return None;
     }
-    let (d, nc) = combined(&parts(sensors, order, cfg, scale));
+    let (d, nc) = combined(&parts);
     let folds = folds_for(&d, first.id);
     if folds == 0 {
         return None;
@@ -274,7 +232,11 @@ pub fn fit_multi<'a>(
         .iter()
         .map(|&j| extra_terms(sensors[j].id.report.lags_s.len()))
         .collect();
-    let (d, nc) = combined(&parts(sensors, order, cfg, scale));
+    let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
+    for (&j, t) in order[1..].iter().zip(&extra) {
+        parts.push((sets(&sensors[j]), t));
+    }
+    let (d, nc) = combined(&parts);
     let labelled: usize = d.y.iter().map(Vec::len).sum();
     let needed = nc + 1 + d.y.len();
     if labelled < needed {
