@@ -26,7 +26,6 @@ use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 use crate::compensate::compensator;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
-use crate::fit::thermal::SharedRun;
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
 use crate::model::{sha256_hex, ModelFile, ModelFileError, SubModel, TempSensorDef, CHECKSUM_KEY};
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
@@ -277,14 +276,14 @@ pub fn fit_imu_full(
     let multi_path = settings.sensors == ImuSensors::All && uses_identification(cfg);
     // What the lag search takes of each temperature column depends on no axis: made once per
     // sensor and run (a thread per sensor) for all the axes that read it.
-    let shared: Vec<Vec<Option<SharedRun>>> = if multi_path {
+    let shared: Vec<Vec<Option<SharedTables>>> = if multi_path {
         std::thread::scope(|scope| {
             let handles: Vec<_> = (0..temp_cols.len())
                 .map(|j| {
                     scope.spawn(move || {
                         logs.iter()
                             .map(|(_, l)| {
-                                crate::fit::thermal::shared_run(&l.time_s, &l.temp[j].values)
+                                crate::fit::thermal::shared_tables(&l.time_s, &l.temp[j].values)
                             })
                             .collect::<Vec<_>>()
                     })
@@ -433,11 +432,13 @@ fn fit_axis(
 /// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
 /// the sensors chosen by cross-validation, one fit over the chosen sensors.
 #[allow(clippy::too_many_arguments)]
+/// A temperature column's features for the lag search (published spec, no lags).
+type SharedTables = (crate::features::FeatureTable, crate::features::FeatureTable);
 
 #[allow(clippy::too_many_arguments)]
 fn fit_axis_multi(
     logs: &[(String, ImuLog)],
-    shared: &[Vec<Option<SharedRun>>],
+    shared: &[Vec<Option<SharedTables>>],
     k: usize,
     gyro_cols: &[String],
     temp_cols: &[String],
@@ -497,9 +498,11 @@ fn fit_axis_multi(
             .flatten()
             .zip(&samples)
             .map(|(t, (_, s))| match (t, s) {
-                (Some(shared), Ok(samples)) => {
-                    Some(crate::fit::thermal::Prepared { samples, shared })
-                }
+                (Some((published, base)), Ok(samples)) => Some(crate::fit::thermal::Prepared {
+                    samples,
+                    published,
+                    base,
+                }),
                 _ => None,
             })
             .collect();

@@ -317,9 +317,8 @@ struct RunData<'a> {
     log: &'a TestLog,
     target: Vec<f64>,
     mask: Vec<bool>,
-    /// The run's features without lags (the search's temperature steps) and the search
-    /// grid's lag differences, when shared with other gyro columns.
-    base: Option<(&'a FeatureTable, &'a search::LagCache)>,
+    /// The run's features without lags (the search's temperature steps), when made ahead.
+    base: Option<&'a FeatureTable>,
 }
 
 /// Per-run design matrices (labelled rows only) for given lags and a term set.
@@ -435,30 +434,21 @@ pub(crate) fn identify_every(
 }
 
 /// What [`identify_shared`] takes of one run made ahead: the per-sample targets of its gyro
-/// column, and what depends only on its temperature column ([`SharedRun`]).
+/// column, and the features of its temperature column at the published spec and without
+/// lags (the same for every gyro column that reads this temperature column).
 pub(crate) struct Prepared<'a> {
     pub samples: &'a targets::GyroSamples,
-    pub shared: &'a SharedRun,
+    pub published: &'a FeatureTable,
+    pub base: &'a FeatureTable,
 }
 
-/// What the lag search takes of a run's temperature column, the same for every gyro column
-/// that reads it: its features at the published spec and without lags, and the lag
-/// differences of the search's grid at every step, kept as the first search that needs them
-/// makes them.
-pub(crate) struct SharedRun {
-    published: FeatureTable,
-    base: FeatureTable,
-    lags: search::LagCache,
-}
-
-/// The [`SharedRun`] of a temperature column; None when its features cannot be made
-/// ([`identify_every`] then reports why).
-pub(crate) fn shared_run(time_s: &[f64], temp_c: &[f64]) -> Option<SharedRun> {
-    Some(SharedRun {
-        published: extract_series(time_s, temp_c, &FeatureSpec::PUBLISHED).ok()?,
-        base: extract_series(time_s, temp_c, &search::base_spec().ok()?).ok()?,
-        lags: search::LagCache::default(),
-    })
+/// The features [`identify_shared`] takes of a temperature column, in its order (published
+/// spec, no lags); None when either cannot be made ([`identify_every`] then reports why).
+pub(crate) fn shared_tables(time_s: &[f64], temp_c: &[f64]) -> Option<(FeatureTable, FeatureTable)> {
+    Some((
+        extract_series(time_s, temp_c, &FeatureSpec::PUBLISHED).ok()?,
+        extract_series(time_s, temp_c, &search::base_spec().ok()?).ok()?,
+    ))
 }
 
 /// [`identify_every`] with each run's targets and temperature features made ahead
@@ -475,13 +465,13 @@ pub(crate) fn identify_shared(
             if targets::is_static(log) != bias {
                 continue;
             }
-            let (target, mask) = p.samples.pick(&p.shared.published.sample_index);
+            let (target, mask) = p.samples.pick(&p.published.sample_index);
             if mask.iter().any(|m| *m) {
                 out.push(RunData {
                     log: *log,
                     target,
                     mask,
-                    base: Some((&p.shared.base, &p.shared.lags)),
+                    base: Some(p.base),
                 });
             }
         }

@@ -62,7 +62,7 @@ struct ColSums {
 }
 
 /// One run's labelled steps and what the candidates so far left behind.
-struct Run<'a> {
+struct Run {
     /// `T` at every step, and the steps since the previous one (0 for the first).
     t_all: Vec<f64>,
     gaps: Vec<u64>,
@@ -77,20 +77,12 @@ struct Run<'a> {
     seg: Vec<(f64, f64, f64)>,
     /// `D(τ)` at the labelled steps, by τ's bits.
     lag: HashMap<u64, Vec<f64>>,
-    /// The search grid's `D(τ)` at every step, shared with the other gyro columns that read
-    /// this temperature column.
-    shared: Option<&'a LagCache>,
     cols: HashMap<Col, ColSums>,
     /// Buffers of the centred columns, kept from one candidate to the next.
     pool: Vec<Vec<f64>>,
     /// Per-segment Σx_i·x_j of centred columns, by the pair (in order).
     cross: HashMap<(Col, Col), Vec<f64>>,
 }
-
-/// Lag differences `T − lag_τ(T)` at every step of one run's temperature column, by τ's
-/// bits (each the same whichever search makes it: one τ's chain reads no other).
-#[derive(Default)]
-pub(crate) struct LagCache(std::sync::Mutex<HashMap<u64, std::sync::Arc<Vec<f64>>>>);
 
 /// The spec of the search's temperature steps: the published spec without lags.
 pub(super) fn base_spec() -> Result<FeatureSpec, ThermalError> {
@@ -99,7 +91,7 @@ pub(super) fn base_spec() -> Result<FeatureSpec, ThermalError> {
 
 /// The scorer of one target's runs for one term set.
 pub(super) struct Scorer<'a> {
-    runs: Vec<Run<'a>>,
+    runs: Vec<Run>,
     terms: &'a Terms,
     folds: usize,
 }
@@ -127,7 +119,7 @@ impl<'a> Scorer<'a> {
         for r in runs {
             let made;
             let table = match r.base {
-                Some((t, _)) => t,
+                Some(t) => t,
                 None => {
                     made = extract_series(&r.log.time_s, &r.log.temp_c, &spec)
                         .map_err(|e| ThermalError::Features(e.to_string()))?;
@@ -177,7 +169,6 @@ impl<'a> Scorer<'a> {
                 layout,
                 seg,
                 lag: HashMap::new(),
-                shared: r.base.map(|b| b.1),
                 cols: HashMap::new(),
                 pool: Vec::new(),
                 cross: HashMap::new(),
@@ -193,7 +184,7 @@ impl<'a> Scorer<'a> {
     /// Make the lag differences of `taus` ahead of the candidates that use them (one pass
     /// over each run for all of them).
     pub(super) fn make_lags(&mut self, taus: &[f64]) -> Result<(), ThermalError> {
-        self.runs.iter_mut().try_for_each(|r| r.make_lags(taus, true))
+        self.runs.iter_mut().try_for_each(|r| r.make_lags(taus))
     }
 
     /// The cross-validated score of each ridge strength at `lags` (as [`cv_scores`] of the
@@ -271,11 +262,9 @@ fn lag_lanes<const W: usize>(t: &[f64], gaps: &[u64], p: f64, tau: &[f64], dst: 
     }
 }
 
-impl Run<'_> {
+impl Run {
     /// Make the lag differences of `taus` this run does not hold yet (all in one pass).
-    /// With `share`, through the shared cache when the run has one (the grid: the lags every
-    /// search of this temperature column makes).
-    fn make_lags(&mut self, taus: &[f64], share: bool) -> Result<(), ThermalError> {
+    fn make_lags(&mut self, taus: &[f64]) -> Result<(), ThermalError> {
         let mut new: Vec<f64> = Vec::new();
         for &tau in taus {
             if !self.lag.contains_key(&tau.to_bits()) && !new.contains(&tau) {
@@ -285,43 +274,19 @@ impl Run<'_> {
             }
         }
         let p = FeatureSpec::THERMAL_STATE.step_period_s;
-        match self.shared.filter(|_| share) {
-            Some(cache) => {
-                // Held while the missing ones are made: a search that waits finds them made.
-                let mut held = cache.0.lock().unwrap_or_else(|e| e.into_inner());
-                let missing: Vec<f64> = new
-                    .iter()
-                    .copied()
-                    .filter(|t| !held.contains_key(&t.to_bits()))
-                    .collect();
-                for (tau, all) in missing
-                    .iter()
-                    .zip(lag_differences(&self.t_all, &self.gaps, p, &missing))
-                {
-                    held.insert(tau.to_bits(), std::sync::Arc::new(all));
-                }
-                for tau in &new {
-                    let all = &held[&tau.to_bits()];
-                    let d = self.steps.iter().map(|&k| all[k]).collect();
-                    self.lag.insert(tau.to_bits(), d);
-                }
-            }
-            None => {
-                for (tau, all) in new
-                    .iter()
-                    .zip(lag_differences(&self.t_all, &self.gaps, p, &new))
-                {
-                    let d = self.steps.iter().map(|&k| all[k]).collect();
-                    self.lag.insert(tau.to_bits(), d);
-                }
-            }
+        for (tau, all) in new
+            .iter()
+            .zip(lag_differences(&self.t_all, &self.gaps, p, &new))
+        {
+            let d = self.steps.iter().map(|&k| all[k]).collect();
+            self.lag.insert(tau.to_bits(), d);
         }
         Ok(())
     }
 
     /// Make every sum the columns `cols` at `lags` need and this run does not hold yet.
     fn prepare(&mut self, lags: &[f64], cols: &[Col]) -> Result<(), ThermalError> {
-        self.make_lags(lags, false)?;
+        self.make_lags(lags)?;
         // Centred values of the columns some missing sum needs, for this candidate only.
         let mut values: HashMap<Col, Vec<f64>> = HashMap::new();
         let mut missing = Vec::new();
