@@ -444,7 +444,10 @@ pub(crate) struct Prepared<'a> {
 
 /// The features [`identify_shared`] takes of a temperature column, in its order (published
 /// spec, no lags); None when either cannot be made ([`identify_every`] then reports why).
-pub(crate) fn shared_tables(time_s: &[f64], temp_c: &[f64]) -> Option<(FeatureTable, FeatureTable)> {
+pub(crate) fn shared_tables(
+    time_s: &[f64],
+    temp_c: &[f64],
+) -> Option<(FeatureTable, FeatureTable)> {
     Some((
         extract_series(time_s, temp_c, &FeatureSpec::PUBLISHED).ok()?,
         extract_series(time_s, temp_c, &search::base_spec().ok()?).ok()?,
