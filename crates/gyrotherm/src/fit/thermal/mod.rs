@@ -471,7 +471,7 @@ pub(crate) fn identify_shared(
             let (target, mask) = p.samples.pick(&p.published.sample_index);
             if mask.iter().any(|m| *m) {
                 out.push(RunData {
-                    log: *log,
+                    log,
                     target,
                     mask,
                     base: Some(p.base),
