@@ -429,12 +429,12 @@ fn fit_axis(
     })
 }
 
-/// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
-/// the sensors chosen by cross-validation, one fit over the chosen sensors.
-#[allow(clippy::too_many_arguments)]
 /// A temperature column's features for the lag search (published spec, no lags).
 type SharedTables = (crate::features::FeatureTable, crate::features::FeatureTable);
 
+/// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
+/// the sensors chosen by cross-validation, one fit over the chosen sensors; `shared` the
+/// temperature columns' search features per sensor and run (empty: made here).
 #[allow(clippy::too_many_arguments)]
 fn fit_axis_multi(
     logs: &[(String, ImuLog)],
