@@ -273,14 +273,39 @@ pub fn fit_imu_full(
             )));
         }
     }
+    let multi_path = settings.sensors == ImuSensors::All && uses_identification(cfg);
+    // What the lag search takes of each temperature column depends on no axis: made once per
+    // sensor and run (a thread per sensor) for all the axes that read it.
+    let shared: Vec<Vec<Option<SharedTables>>> = if multi_path {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..temp_cols.len())
+                .map(|j| {
+                    scope.spawn(move || {
+                        logs.iter()
+                            .map(|(_, l)| {
+                                crate::fit::thermal::shared_tables(&l.time_s, &l.temp[j].values)
+                            })
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        })
+    } else {
+        Vec::new()
+    };
     let axes: Vec<Result<ImuAxis, ImuError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..gyro_cols.len())
             .map(|k| {
-                let (gyro_cols, temp_cols) = (&gyro_cols, &temp_cols);
+                let (gyro_cols, temp_cols, shared) = (&gyro_cols, &temp_cols, &shared);
                 scope.spawn(move || {
-                    if settings.sensors == ImuSensors::All && uses_identification(cfg) {
+                    if multi_path {
                         fit_axis_multi(
                             logs,
+                            shared,
                             k,
                             gyro_cols,
                             temp_cols,
@@ -404,11 +429,16 @@ fn fit_axis(
     })
 }
 
+/// A temperature column's features for the lag search (published spec, no lags).
+type SharedTables = (crate::features::FeatureTable, crate::features::FeatureTable);
+
 /// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
-/// the sensors chosen by cross-validation, one fit over the chosen sensors.
+/// the sensors chosen by cross-validation, one fit over the chosen sensors; `shared` the
+/// temperature columns' search features per sensor and run (empty: made here).
 #[allow(clippy::too_many_arguments)]
 fn fit_axis_multi(
     logs: &[(String, ImuLog)],
+    shared: &[Vec<Option<SharedTables>>],
     k: usize,
     gyro_cols: &[String],
     temp_cols: &[String],
@@ -433,6 +463,22 @@ fn fit_axis_multi(
             },
         )
     };
+    // The targets' per-sample part reads the axis's gyro column, not the sensor: made once per
+    // run for the four sensors.
+    let samples: Vec<(bool, Result<targets::GyroSamples, targets::TargetError>)> = logs
+        .iter()
+        .map(|(_, l)| {
+            let a = l.axis_data(k, 0);
+            if targets::is_static(&a) {
+                (false, targets::bias_samples(&a, cfg.bias_window_s))
+            } else {
+                (
+                    true,
+                    targets::scale_samples(&a, cfg.settle_s, cfg.scale_window_s),
+                )
+            }
+        })
+        .collect();
     let mut per_sensor = Vec::with_capacity(temp_cols.len());
     for j in 0..temp_cols.len() {
         events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
@@ -446,20 +492,39 @@ fn fit_axis_multi(
             .collect();
         // A unit searches lags once per sensor and axis, so each search keeps a fifth of the
         // labelled steps (`IMU_IDENTIFY_EVERY`, chosen on the design family).
-        let id = crate::fit::identify_every(&named, cfg, IMU_IDENTIFY_EVERY)
-            .map_err(|e| fit_err(j, e))?;
+        let prepared: Option<Vec<crate::fit::thermal::Prepared>> = shared
+            .get(j)
+            .into_iter()
+            .flatten()
+            .zip(&samples)
+            .map(|(t, (_, s))| match (t, s) {
+                (Some((published, base)), Ok(samples)) => Some(crate::fit::thermal::Prepared {
+                    samples,
+                    published,
+                    base,
+                }),
+                _ => None,
+            })
+            .collect();
+        let id = match prepared.filter(|p| p.len() == logs.len()) {
+            Some(p) => {
+                let runs: Vec<(&str, &TestLog)> =
+                    axis_logs.iter().map(|(n, l)| (n.as_str(), l)).collect();
+                crate::fit::thermal::identify_shared(&runs, &p, &cfg.thermal, IMU_IDENTIFY_EVERY)
+                    .map_err(|e| fit_err(j, FitError::from(e)))?
+            }
+            // Something could not be made ahead: the search on its own says what.
+            None => crate::fit::identify_every(&named, cfg, IMU_IDENTIFY_EVERY)
+                .map_err(|e| fit_err(j, e))?,
+        };
         let (mut bias, mut scale) = (Vec::new(), Vec::new());
-        for (name, l) in &axis_logs {
-            if targets::is_static(l) {
-                bias.push(
-                    targets::bias_targets(l, &id.spec, cfg.bias_window_s)
-                        .map_err(|e| target_err(j, name, e))?,
-                );
+        for ((name, l), (is_scale, s)) in axis_logs.iter().zip(&samples) {
+            let t = targets::targets_from(l, &id.spec, s, *is_scale)
+                .map_err(|e| target_err(j, name, e))?;
+            if *is_scale {
+                scale.push(t);
             } else {
-                scale.push(
-                    targets::scale_targets(l, &id.spec, cfg.settle_s, cfg.scale_window_s)
-                        .map_err(|e| target_err(j, name, e))?,
-                );
+                bias.push(t);
             }
         }
         per_sensor.push((axis_logs, id, bias, scale));

@@ -92,23 +92,70 @@ pub fn bias_targets(
     window_s: f64,
 ) -> Result<TargetSet, TargetError> {
     let table = extract(log, spec).map_err(TargetError::Features)?;
+    Ok(bias_samples(log, window_s)?.at_steps(table))
+}
+
+/// A target per sample of a log, from its gyro column (and table rate) only: NaN where
+/// unlabelled. The features' steps pick from it ([`GyroSamples::at_steps`]), so a log read
+/// with several temperature columns smooths its gyro column once.
+#[derive(Debug, Clone)]
+pub(crate) struct GyroSamples {
+    target: Vec<f64>,
+    ok: Vec<bool>,
+}
+
+impl GyroSamples {
+    /// The target set at `table`'s steps.
+    pub(crate) fn at_steps(&self, table: FeatureTable) -> TargetSet {
+        let (target, mask) = self.pick(&table.sample_index);
+        TargetSet {
+            table,
+            target,
+            mask,
+        }
+    }
+
+    /// Target and mask at the samples `index`.
+    pub(crate) fn pick(&self, index: &[usize]) -> (Vec<f64>, Vec<bool>) {
+        (
+            index.iter().map(|&i| self.target[i]).collect(),
+            index.iter().map(|&i| self.ok[i]).collect(),
+        )
+    }
+}
+
+/// [`bias_targets`] (`scale` false) or [`scale_targets`] (`scale` true) with the per-sample
+/// part made ahead ([`bias_samples`] or [`scale_samples`] of the same gyro column and
+/// settings): the same result, the same error first.
+pub(crate) fn targets_from(
+    log: &TestLog,
+    spec: &FeatureSpec,
+    samples: &Result<GyroSamples, TargetError>,
+    scale: bool,
+) -> Result<TargetSet, TargetError> {
+    if scale && log.table_dps.is_none() {
+        return Err(TargetError::NoTable);
+    }
+    let table = extract(log, spec).map_err(TargetError::Features)?;
+    Ok(samples.as_ref().map_err(Clone::clone)?.at_steps(table))
+}
+
+/// [`bias_targets`]' per-sample part: the centred moving average of the gyro column.
+pub(crate) fn bias_samples(log: &TestLog, window_s: f64) -> Result<GyroSamples, TargetError> {
     let smoothed = centred_moving_average(&log.time_s, &log.gyro_dps, window_s)
         .map_err(TargetError::Smoothing)?;
-    let mut target = Vec::with_capacity(table.n_rows());
-    let mut mask = Vec::with_capacity(table.n_rows());
-    for &i in &table.sample_index {
-        let ok = smoothed.full_window[i];
-        target.push(if ok { smoothed.values[i] } else { f64::NAN });
-        mask.push(ok);
-    }
-    Ok(TargetSet {
-        table,
+    let target = smoothed
+        .values
+        .iter()
+        .zip(&smoothed.full_window)
+        .map(|(v, ok)| if *ok { *v } else { f64::NAN })
+        .collect();
+    Ok(GyroSamples {
         target,
-        mask,
+        ok: smoothed.full_window,
     })
 }
 
-/// First sample of `seg` at least `settle_s` after its start.
 fn settled_start(log: &TestLog, seg: &Segment, settle_s: f64) -> usize {
     let t0 = log.time_s[seg.start];
     (seg.start..seg.end)
@@ -123,10 +170,23 @@ pub fn scale_targets(
     settle_s: f64,
     window_s: f64,
 ) -> Result<TargetSet, TargetError> {
+    if log.table_dps.is_none() {
+        return Err(TargetError::NoTable);
+    }
+    let table = extract(log, spec).map_err(TargetError::Features)?;
+    Ok(scale_samples(log, settle_s, window_s)?.at_steps(table))
+}
+
+/// [`scale_targets`]' per-sample part: the scale factor from the gyro column and the table
+/// rate.
+pub(crate) fn scale_samples(
+    log: &TestLog,
+    settle_s: f64,
+    window_s: f64,
+) -> Result<GyroSamples, TargetError> {
     let Some(table_dps) = &log.table_dps else {
         return Err(TargetError::NoTable);
     };
-    let table = extract(log, spec).map_err(TargetError::Features)?;
     let segs = segments(table_dps, RATE_TOLERANCE_DPS);
     // Stop segments: (centre time, mean output).
     let stops: Vec<(f64, f64)> = segs
@@ -168,12 +228,10 @@ pub fn scale_targets(
             }
         }
     }
-    let target: Vec<f64> = table.sample_index.iter().map(|&i| k_sample[i]).collect();
-    let mask = target.iter().map(|v| v.is_finite()).collect();
-    Ok(TargetSet {
-        table,
-        target,
-        mask,
+    let ok = k_sample.iter().map(|v| v.is_finite()).collect();
+    Ok(GyroSamples {
+        target: k_sample,
+        ok,
     })
 }
 

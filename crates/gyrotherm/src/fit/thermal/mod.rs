@@ -32,7 +32,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::baseline::Terms;
 use crate::csvlog::TestLog;
-use crate::features::{extract_series, FeatureSpec, LagOutputs};
+use crate::features::{extract_series, FeatureSpec, FeatureTable, LagOutputs};
 use crate::model::SubModel;
 use crate::targets::{self, TargetSet};
 
@@ -317,6 +317,8 @@ struct RunData<'a> {
     log: &'a TestLog,
     target: Vec<f64>,
     mask: Vec<bool>,
+    /// The run's features without lags (the search's temperature steps), when made ahead.
+    base: Option<&'a FeatureTable>,
 }
 
 /// Per-run design matrices (labelled rows only) for given lags and a term set.
@@ -394,6 +396,7 @@ fn run_data<'a>(
                 log,
                 target: t.target,
                 mask: t.mask,
+                base: None,
             });
         }
     }
@@ -427,6 +430,65 @@ pub(crate) fn identify_every(
 ) -> Result<Identified, ThermalError> {
     let bias_runs = run_data(logs, true, bias_window_s, settle_s, scale_window_s)?;
     let scale_runs = run_data(logs, false, bias_window_s, settle_s, scale_window_s)?;
+    identify_runs(bias_runs, scale_runs, cfg, every)
+}
+
+/// What [`identify_shared`] takes of one run made ahead: the per-sample targets of its gyro
+/// column, and the features of its temperature column at the published spec and without
+/// lags (the same for every gyro column that reads this temperature column).
+pub(crate) struct Prepared<'a> {
+    pub samples: &'a targets::GyroSamples,
+    pub published: &'a FeatureTable,
+    pub base: &'a FeatureTable,
+}
+
+/// The features [`identify_shared`] takes of a temperature column, in its order (published
+/// spec, no lags); None when either cannot be made ([`identify_every`] then reports why).
+pub(crate) fn shared_tables(
+    time_s: &[f64],
+    temp_c: &[f64],
+) -> Option<(FeatureTable, FeatureTable)> {
+    Some((
+        extract_series(time_s, temp_c, &FeatureSpec::PUBLISHED).ok()?,
+        extract_series(time_s, temp_c, &search::base_spec().ok()?).ok()?,
+    ))
+}
+
+/// [`identify_every`] with each run's targets and temperature features made ahead
+/// (`prepared`, one per log, all made without error): the same result.
+pub(crate) fn identify_shared(
+    logs: &[(&str, &TestLog)],
+    prepared: &[Prepared<'_>],
+    cfg: &ThermalConfig,
+    every: usize,
+) -> Result<Identified, ThermalError> {
+    let runs = |bias: bool| {
+        let mut out = Vec::new();
+        for ((_, log), p) in logs.iter().zip(prepared) {
+            if targets::is_static(log) != bias {
+                continue;
+            }
+            let (target, mask) = p.samples.pick(&p.published.sample_index);
+            if mask.iter().any(|m| *m) {
+                out.push(RunData {
+                    log,
+                    target,
+                    mask,
+                    base: Some(p.base),
+                });
+            }
+        }
+        out
+    };
+    identify_runs(runs(true), runs(false), cfg, every)
+}
+
+fn identify_runs(
+    bias_runs: Vec<RunData<'_>>,
+    scale_runs: Vec<RunData<'_>>,
+    cfg: &ThermalConfig,
+    every: usize,
+) -> Result<Identified, ThermalError> {
     let (runs, on) = if bias_runs.is_empty() {
         (&scale_runs, "scale factor")
     } else {

@@ -84,6 +84,11 @@ struct Run {
     cross: HashMap<(Col, Col), Vec<f64>>,
 }
 
+/// The spec of the search's temperature steps: the published spec without lags.
+pub(super) fn base_spec() -> Result<FeatureSpec, ThermalError> {
+    spec_with(&[])
+}
+
 /// The scorer of one target's runs for one term set.
 pub(super) struct Scorer<'a> {
     runs: Vec<Run>,
@@ -109,11 +114,18 @@ impl<'a> Scorer<'a> {
         {
             return Ok(None);
         }
-        let spec = spec_with(&[])?;
+        let spec = base_spec()?;
         let mut out = Vec::with_capacity(runs.len());
         for r in runs {
-            let table = extract_series(&r.log.time_s, &r.log.temp_c, &spec)
-                .map_err(|e| ThermalError::Features(e.to_string()))?;
+            let made;
+            let table = match r.base {
+                Some(t) => t,
+                None => {
+                    made = extract_series(&r.log.time_s, &r.log.temp_c, &spec)
+                        .map_err(|e| ThermalError::Features(e.to_string()))?;
+                    &made
+                }
+            };
             let n_steps = table.n_rows();
             let every = every.max(1);
             let steps: Vec<usize> = (0..n_steps.min(r.mask.len()))
@@ -512,6 +524,7 @@ mod tests {
                     log: r.log,
                     target: r.target.clone(),
                     mask,
+                    base: r.base,
                 }
             })
             .collect();
