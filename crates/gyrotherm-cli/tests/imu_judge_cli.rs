@@ -231,24 +231,8 @@ fn compare_per_axis_matches_each_axis_compared_alone() {
 #[test]
 fn compare_per_axis_holds_the_unit_fit_on_all_its_sensors() {
     let dir = tempfile::tempdir().unwrap();
-    let temps = "temp_case_c,temp_x_c,temp_y_c,temp_z_c";
-    let s = sim(dir.path(), "s.csv", &["--seed", "1"]);
-    let t = sim(
-        dir.path(),
-        "t.csv",
-        &["--seed", "2", "--table-rate", "20", "--table-axis", "y"],
-    );
-    let h = sim(dir.path(), "h.csv", &["--seed", "3"]);
-    let model = dir.path().join("unit.json");
-    run_ok(
-        gyrotherm()
-            .args(["train", "--gyro-col", GYROS, "--temp-col", temps, "--out"])
-            .arg(&model)
-            .arg("--input")
-            .arg(&s)
-            .arg("--input")
-            .arg(&t),
-    );
+    let temps = ALL_TEMPS;
+    let (s, t, h, model) = unit_on_all_sensors(dir.path());
     let trained: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     let comp = dir.path().join("comp.csv");
@@ -388,6 +372,39 @@ fn report_has_a_page_across_axes_and_one_per_axis() {
         assert!(folder.join("fig7_compensation.png").is_file());
         assert!(page.contains(&format!("src=\"axis{}/fig7_compensation.png\"", k + 1)));
     }
+}
+
+/// Every temperature column of the simulated unit, the case sensor first.
+const ALL_TEMPS: &str = "temp_case_c,temp_x_c,temp_y_c,temp_z_c";
+
+/// A static, a table (on y) and a held-out run, and the default (`thermal`) unit model
+/// `train` builds on the first two with every sensor: (static, table, held-out, model).
+fn unit_on_all_sensors(dir: &Path) -> (PathBuf, PathBuf, PathBuf, PathBuf) {
+    let s = sim(dir, "s.csv", &["--seed", "1"]);
+    let t = sim(
+        dir,
+        "t.csv",
+        &["--seed", "2", "--table-rate", "20", "--table-axis", "y"],
+    );
+    let h = sim(dir, "h.csv", &["--seed", "3"]);
+    let model = dir.join("unit.json");
+    run_ok(
+        gyrotherm()
+            .args([
+                "train",
+                "--gyro-col",
+                GYROS,
+                "--temp-col",
+                ALL_TEMPS,
+                "--out",
+            ])
+            .arg(&model)
+            .arg("--input")
+            .arg(&s)
+            .arg("--input")
+            .arg(&t),
+    );
+    (s, t, h, model)
 }
 
 fn write_spec(dir: &Path, name: &str, limits: &str) -> PathBuf {
@@ -596,24 +613,8 @@ fn evaluate_spec_with_a_figure_the_log_cannot_give_names_the_axis() {
 #[test]
 fn compare_spec_judges_every_column_of_every_axis() {
     let dir = tempfile::tempdir().unwrap();
-    let temps = "temp_case_c,temp_x_c,temp_y_c,temp_z_c";
-    let s = sim(dir.path(), "s.csv", &["--seed", "1"]);
-    let t = sim(
-        dir.path(),
-        "t.csv",
-        &["--seed", "2", "--table-rate", "20", "--table-axis", "y"],
-    );
-    let h = sim(dir.path(), "h.csv", &["--seed", "3"]);
-    let model = dir.path().join("unit.json");
-    run_ok(
-        gyrotherm()
-            .args(["train", "--gyro-col", GYROS, "--temp-col", temps, "--out"])
-            .arg(&model)
-            .arg("--input")
-            .arg(&s)
-            .arg("--input")
-            .arg(&t),
-    );
+    let temps = ALL_TEMPS;
+    let (s, t, h, model) = unit_on_all_sensors(dir.path());
     let loose = write_spec(
         dir.path(),
         "loose.toml",

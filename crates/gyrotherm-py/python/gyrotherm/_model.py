@@ -375,18 +375,10 @@ def fit(
     table_paths = _paths(table, "table")
     if not static_paths and not table_paths:
         raise _g.FitError("no training logs given; pass static=[...] and/or table=[...]")
-    settings = {
-        "method": str(method),
-        "recipe": None if recipe is None else str(recipe),
-        "epochs": None if epochs is None else int(epochs),
-        "seed": int(seed),
-        "bias_window_s": float(bias_window_s),
-        "settle_s": float(settle_s),
-        "poly_temp_degree": int(poly_temp_degree),
-        "poly_rate_degree": int(poly_rate_degree),
-        "cross": bool(cross),
-        "validate_on_runs": bool(validate_on_runs),
-    }
+    settings = _fit_settings(
+        method, recipe, epochs, seed, bias_window_s, settle_s, poly_temp_degree,
+        poly_rate_degree, cross, validate_on_runs,
+    )
     options = read_options(log_options)
     if is_unit(options):
         if progress is True:
@@ -467,6 +459,25 @@ def evaluate(
     return json.loads(text)
 
 
+def _fit_settings(
+    method, recipe, epochs, seed, bias_window_s, settle_s, poly_temp_degree, poly_rate_degree,
+    cross, validate_on_runs,
+) -> Dict[str, Any]:
+    """The fit keywords of :func:`fit` and :func:`compare` as the binding's settings."""
+    return {
+        "method": str(method),
+        "recipe": None if recipe is None else str(recipe),
+        "epochs": None if epochs is None else int(epochs),
+        "seed": int(seed),
+        "bias_window_s": float(bias_window_s),
+        "settle_s": float(settle_s),
+        "poly_temp_degree": int(poly_temp_degree),
+        "poly_rate_degree": int(poly_rate_degree),
+        "cross": bool(cross),
+        "validate_on_runs": bool(validate_on_runs),
+    }
+
+
 def compare(
     train: Union[PathLike, Iterable[PathLike]],
     test: Union[PathLike, Iterable[PathLike]],
@@ -509,18 +520,10 @@ def compare(
     train_paths, test_paths = _paths(train, "train"), _paths(test, "test")
     if not train_paths or not test_paths:
         raise _g.FitError("give training logs (train=[...]) and held-out logs (test=[...])")
-    settings = {
-        "method": str(method),
-        "recipe": None if recipe is None else str(recipe),
-        "epochs": None if epochs is None else int(epochs),
-        "seed": int(seed),
-        "bias_window_s": float(bias_window_s),
-        "settle_s": float(settle_s),
-        "poly_temp_degree": int(poly_temp_degree),
-        "poly_rate_degree": int(poly_rate_degree),
-        "cross": bool(cross),
-        "validate_on_runs": bool(validate_on_runs),
-    }
+    settings = _fit_settings(
+        method, recipe, epochs, seed, bias_window_s, settle_s, poly_temp_degree,
+        poly_rate_degree, cross, validate_on_runs,
+    )
     text, notes = _g.compare_unit(
         train_paths,
         test_paths,
