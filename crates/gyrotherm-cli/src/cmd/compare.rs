@@ -69,10 +69,16 @@ impl ColumnArgs {
 /// `--tau` if given, else the default for the held-out logs
 /// ([`gyrotherm::compare::default_tau_s`]), said on stderr when it is not 100 s.
 pub fn resolve_tau(tau: Option<f64>, test: &[NamedLog]) -> f64 {
+    tau_or_default(tau, || gyrotherm::compare::default_tau_s(test))
+}
+
+/// `tau`, or the library's default (`(τ, the sample period it was adjusted to)`), saying
+/// on stderr when 100 s was not a multiple of the sample period.
+pub fn tau_or_default(tau: Option<f64>, default: impl FnOnce() -> (f64, Option<f64>)) -> f64 {
     if let Some(t) = tau {
         return t;
     }
-    let (t, adjusted_to) = gyrotherm::compare::default_tau_s(test);
+    let (t, adjusted_to) = default();
     if let Some(period) = adjusted_to {
         eprintln!(
             "gyrotherm: τ = {t} s, the multiple of the {period} s sample period nearest 100 s \

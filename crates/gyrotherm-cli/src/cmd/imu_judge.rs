@@ -126,13 +126,7 @@ fn run_unit_comparison(
 ) -> anyhow::Result<(ImuComparison, gyrotherm::compare::CompareConfig)> {
     let train = read_imu_logs(train, log)?;
     let test = read_imu_logs(test, log)?;
-    // The default τ is the single-axis rule on the first axis's view of the held-out logs
-    // (every axis shares the time column).
-    let axis0: Vec<(String, csvlog::TestLog)> = test
-        .iter()
-        .map(|(n, l)| (n.clone(), imu_judge::axis_test_log(l, 0, 0)))
-        .collect();
-    let tau_s = super::compare::resolve_tau(tau, &super::common::named(&axis0));
+    let tau_s = super::compare::tau_or_default(tau, || imu_judge::default_tau_s(&test));
     let cfg = columns.compare_config(fit, tau_s)?;
     let started = std::time::Instant::now();
     let sensors = train.first().map_or(0, |(_, l)| l.temp.len());
