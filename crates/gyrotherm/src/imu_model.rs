@@ -533,9 +533,17 @@ fn fit_axis_multi(
         .iter()
         .map(|(_, id, bias, scale)| SensorData { id, bias, scale })
         .collect();
+    // The several-sensor fits' ridge strengths (an experiment's override of the grid).
+    let multi_thermal = match settings.multi_ridge_decades {
+        None => std::borrow::Cow::Borrowed(&cfg.thermal),
+        Some((lo, hi)) => std::borrow::Cow::Owned(crate::fit::thermal::ThermalConfig {
+            ridge_grid: (lo..=hi).map(|k| 10f64.powi(k)).collect(),
+            ..cfg.thermal.clone()
+        }),
+    };
     let (order, single) = multi::select(
         &data,
-        &cfg.thermal,
+        &multi_thermal,
         &MultiConfig {
             min_gain: settings.min_gain,
         },
@@ -577,13 +585,14 @@ fn fit_axis_multi(
         let thermal_err = |e: crate::fit::thermal::ThermalError| fit_err(j0, FitError::from(e));
         let has_scale = data.iter().all(|d| !d.scale.is_empty());
         let bias = has_bias
-            .then(|| multi::fit_multi(&data, &order, &cfg.thermal, false))
+            .then(|| multi::fit_multi(&data, &order, &multi_thermal, false))
             .transpose()
             .map_err(thermal_err)?;
         // The scale factor reads the further sensors only when they help it too.
         let scale = if has_scale {
-            let one = multi::cv_rms(&data, &order[..1], &cfg.thermal, true);
-            let all = multi::fit_multi(&data, &order, &cfg.thermal, true).map_err(thermal_err)?;
+            let one = multi::cv_rms(&data, &order[..1], &multi_thermal, true);
+            let all =
+                multi::fit_multi(&data, &order, &multi_thermal, true).map_err(thermal_err)?;
             match (one, all.cv_rms) {
                 (Some(o), Some(a)) if a < o * (1.0 - settings.min_gain) => Some(all),
                 _ => None,
@@ -591,6 +600,7 @@ fn fit_axis_multi(
         } else {
             None
         };
+        let bias = bias.map(|b| blend_with_one(b, outcome.model.bias.as_ref(), settings.blend));
         if let Some(b) = &bias {
             outcome.model.bias = Some(b.first.clone());
             multi_cv_rms = b.cv_rms;
@@ -620,6 +630,42 @@ fn fit_axis_multi(
         more,
         multi_cv_rms,
     })
+}
+
+/// The several-sensor fit averaged with the first sensor's one-sensor fit `one`, weight `w`
+/// on `one`: the first sensor's coefficients averaged (same terms), each further sensor's
+/// scaled by `1 − w`. Unchanged when `w` is 0 or the terms differ.
+fn blend_with_one(mut b: multi::MultiFit, one: Option<&SubModel>, w: f64) -> multi::MultiFit {
+    if w == 0.0 {
+        return b;
+    }
+    let (
+        Some(SubModel::Baseline {
+            terms: t1,
+            coefficients: c1,
+        }),
+        SubModel::Baseline {
+            terms: tm,
+            coefficients: cm,
+        },
+    ) = (one, &mut b.first)
+    else {
+        return b;
+    };
+    if t1 != tm || c1.len() != cm.len() {
+        return b;
+    }
+    for (m, o) in cm.iter_mut().zip(c1) {
+        *m = w * o + (1.0 - w) * *m;
+    }
+    for e in &mut b.extra {
+        if let SubModel::Baseline { coefficients, .. } = e {
+            for c in coefficients.iter_mut() {
+                *c *= 1.0 - w;
+            }
+        }
+    }
+    b
 }
 
 impl ImuModel {

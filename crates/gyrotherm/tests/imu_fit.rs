@@ -106,6 +106,7 @@ fn every_sensor_when_cross_validation_keeps_it() {
     let all = ImuFitSettings {
         sensors: ImuSensors::All,
         min_gain: -1.0,
+        ..ImuFitSettings::default()
     };
     let model = fit_imu_with(
         &training(),
@@ -166,6 +167,7 @@ fn the_stream_runs_an_axis_on_several_sensors_as_compensate_imu_does() {
     let all = ImuFitSettings {
         sensors: ImuSensors::All,
         min_gain: -1.0,
+        ..ImuFitSettings::default()
     };
     let model = fit_imu_with(
         &training(),

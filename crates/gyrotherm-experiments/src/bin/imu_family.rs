@@ -43,6 +43,11 @@
 //! them). `--tau-max S`, `--max-tau-fraction F`, `--basis lean|linear|small|full`: the
 //! thermal recipe's longest lag searched, its bound as a fraction of the longest run, and
 //! the bias basis (defaults: the recipe's).
+//!
+//! Further fit overrides (experiment, docs/experiments/imu-worst-model.md): `--folds N`,
+//! `--ridge-tolerance X`, `--n-lags N` (the recipe's), `--blend W` (the weight of each axis's
+//! first-sensor one-sensor bias model averaged with the several-sensor one), `--multi-ridge
+//! LO:HI` (the ridge strengths 10^LO..10^HI of the several-sensor fits and the selection).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -186,6 +191,14 @@ struct Job<'a> {
     tau_max_s: Option<f64>,
     max_tau_fraction: Option<f64>,
     basis: Option<gyrotherm::fit::thermal::Basis>,
+    /// Further overrides (experiment, docs/experiments/imu-worst-model.md): the recipe's
+    /// folds, ridge tolerance, lag count; the unit's blend weight and several-sensor ridge
+    /// decades.
+    folds: Option<usize>,
+    ridge_tolerance: Option<f64>,
+    n_lags: Option<usize>,
+    blend: Option<f64>,
+    multi_ridge: Option<(i32, i32)>,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -614,15 +627,30 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     if let Some(b) = job.basis {
         cfg.thermal.basis = b;
     }
+    if let Some(f) = job.folds {
+        cfg.thermal.folds = f;
+    }
+    if let Some(t) = job.ridge_tolerance {
+        cfg.thermal.ridge_tolerance = t;
+    }
+    if let Some(n) = job.n_lags {
+        cfg.thermal.n_lags = n;
+    }
     let sensor = TempSensorDef::default();
     let one = ImuFitSettings {
         sensors: ImuSensors::ChooseOne,
         ..ImuFitSettings::default()
     };
-    let all = ImuFitSettings {
+    let mut all = ImuFitSettings {
         min_gain: job.min_gain,
         ..ImuFitSettings::default()
     };
+    if let Some(w) = job.blend {
+        all.blend = w;
+    }
+    if job.multi_ridge.is_some() {
+        all.multi_ridge_decades = job.multi_ridge;
+    }
     let mut out = Vec::new();
     for setting in settings {
         let t0 = Instant::now();
@@ -817,6 +845,29 @@ fn run() -> Result<(), String> {
             Some("full") => Some(gyrotherm::fit::thermal::Basis::Full),
             Some(v) => return Err(format!("--basis {v:?}: use lean, linear, small or full")),
         },
+        folds: get("--folds")
+            .map(|v| v.parse().map_err(|e| format!("--folds: {e}")))
+            .transpose()?,
+        ridge_tolerance: get("--ridge-tolerance")
+            .map(|v| v.parse().map_err(|e| format!("--ridge-tolerance: {e}")))
+            .transpose()?,
+        n_lags: get("--n-lags")
+            .map(|v| v.parse().map_err(|e| format!("--n-lags: {e}")))
+            .transpose()?,
+        blend: get("--blend")
+            .map(|v| v.parse().map_err(|e| format!("--blend: {e}")))
+            .transpose()?,
+        multi_ridge: get("--multi-ridge")
+            .map(|v| {
+                let (a, b) = v
+                    .split_once(':')
+                    .ok_or_else(|| format!("--multi-ridge {v:?}: give LO:HI (powers of ten)"))?;
+                Ok::<_, String>((
+                    a.parse().map_err(|e| format!("--multi-ridge: {e}"))?,
+                    b.parse().map_err(|e| format!("--multi-ridge: {e}"))?,
+                ))
+            })
+            .transpose()?,
     };
     let seeds: Vec<u64> = (first..first + units).map(|i| base + i).collect();
     eprintln!(

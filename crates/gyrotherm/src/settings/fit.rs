@@ -53,6 +53,12 @@ pub struct ImuFitSettings {
     /// Least relative drop of the cross-validated RMS for a further sensor to join
     /// (negative: the rise it may cause, −1 allowing up to double).
     pub min_gain: f64,
+    /// Experiment (0: off): the weight of the first sensor's one-sensor bias model in an
+    /// average with the several-sensor bias model.
+    pub blend: f64,
+    /// Experiment (None: the recipe's grid): the decades (lowest, highest power of ten) of
+    /// the ridge strengths the several-sensor fits and the sensor selection try.
+    pub multi_ridge_decades: Option<(i32, i32)>,
 }
 
 impl Default for ImuFitSettings {
@@ -60,6 +66,8 @@ impl Default for ImuFitSettings {
         ImuFitSettings {
             sensors: ImuSensors::default(),
             min_gain: DEFAULT_IMU_MIN_GAIN,
+            blend: 0.0,
+            multi_ridge_decades: None,
         }
     }
 }
