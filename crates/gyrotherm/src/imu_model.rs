@@ -541,12 +541,15 @@ fn fit_axis_multi(
             ..cfg.thermal.clone()
         }),
     };
+    let mc = MultiConfig {
+        min_gain: settings.min_gain,
+        extra: settings.multi_extra,
+        first: settings.multi_first,
+    };
     let (order, single) = multi::select(
         &data,
         &multi_thermal,
-        &MultiConfig {
-            min_gain: settings.min_gain,
-        },
+        &mc,
     );
     let scores: Vec<SensorScore> = temp_cols
         .iter()
@@ -585,14 +588,14 @@ fn fit_axis_multi(
         let thermal_err = |e: crate::fit::thermal::ThermalError| fit_err(j0, FitError::from(e));
         let has_scale = data.iter().all(|d| !d.scale.is_empty());
         let bias = has_bias
-            .then(|| multi::fit_multi(&data, &order, &multi_thermal, false))
+            .then(|| multi::fit_multi(&data, &order, &multi_thermal, &mc, false))
             .transpose()
             .map_err(thermal_err)?;
         // The scale factor reads the further sensors only when they help it too.
         let scale = if has_scale {
-            let one = multi::cv_rms(&data, &order[..1], &multi_thermal, true);
+            let one = multi::cv_rms(&data, &order[..1], &multi_thermal, &mc, true);
             let all =
-                multi::fit_multi(&data, &order, &multi_thermal, true).map_err(thermal_err)?;
+                multi::fit_multi(&data, &order, &multi_thermal, &mc, true).map_err(thermal_err)?;
             match (one, all.cv_rms) {
                 (Some(o), Some(a)) if a < o * (1.0 - settings.min_gain) => Some(all),
                 _ => None,

@@ -47,7 +47,10 @@
 //! Further fit overrides (experiment, docs/experiments/imu-worst-model.md): `--folds N`,
 //! `--ridge-tolerance X`, `--n-lags N` (the recipe's), `--blend W` (the weight of each axis's
 //! first-sensor one-sensor bias model averaged with the several-sensor one), `--multi-ridge
-//! LO:HI` (the ridge strengths 10^LO..10^HI of the several-sensor fits and the selection).
+//! LO:HI` (the ridge strengths 10^LO..10^HI of the several-sensor fits and the selection),
+//! `--multi-extra linear|temp|temp-fast|cubic` (the further sensors' terms), `--multi-first
+//! single|combined` (the first sensor by its one-sensor score or by the score of the model
+//! on every sensor with it first).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -199,6 +202,8 @@ struct Job<'a> {
     n_lags: Option<usize>,
     blend: Option<f64>,
     multi_ridge: Option<(i32, i32)>,
+    multi_extra: Option<gyrotherm::fit::thermal::multi::ExtraTerms>,
+    first_combined: bool,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -651,6 +656,12 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     if job.multi_ridge.is_some() {
         all.multi_ridge_decades = job.multi_ridge;
     }
+    if let Some(e) = job.multi_extra {
+        all.multi_extra = e;
+    }
+    if job.first_combined {
+        all.multi_first = gyrotherm::fit::thermal::multi::FirstBy::Combined;
+    }
     let mut out = Vec::new();
     for setting in settings {
         let t0 = Instant::now();
@@ -843,7 +854,12 @@ fn run() -> Result<(), String> {
             Some("linear") => Some(gyrotherm::fit::thermal::Basis::Linear),
             Some("small") => Some(gyrotherm::fit::thermal::Basis::Small),
             Some("full") => Some(gyrotherm::fit::thermal::Basis::Full),
-            Some(v) => return Err(format!("--basis {v:?}: use lean, linear, small or full")),
+            Some("minimal") => Some(gyrotherm::fit::thermal::Basis::Minimal),
+            Some(v) => {
+                return Err(format!(
+                    "--basis {v:?}: use minimal, lean, linear, small or full"
+                ))
+            }
         },
         folds: get("--folds")
             .map(|v| v.parse().map_err(|e| format!("--folds: {e}")))
@@ -857,6 +873,23 @@ fn run() -> Result<(), String> {
         blend: get("--blend")
             .map(|v| v.parse().map_err(|e| format!("--blend: {e}")))
             .transpose()?,
+        multi_extra: match get("--multi-extra").as_deref() {
+            None => None,
+            Some("linear") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::Linear),
+            Some("temp") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::Temp),
+            Some("temp-fast") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::TempFast),
+            Some("cubic") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::Cubic),
+            Some(v) => {
+                return Err(format!(
+                    "--multi-extra {v:?}: use linear, temp, temp-fast or cubic"
+                ))
+            }
+        },
+        first_combined: match get("--multi-first").as_deref() {
+            None | Some("single") => false,
+            Some("combined") => true,
+            Some(v) => return Err(format!("--multi-first {v:?}: use single or combined")),
+        },
         multi_ridge: get("--multi-ridge")
             .map(|v| {
                 let (a, b) = v

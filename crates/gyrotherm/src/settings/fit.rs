@@ -59,6 +59,10 @@ pub struct ImuFitSettings {
     /// Experiment (None: the recipe's grid): the decades (lowest, highest power of ten) of
     /// the ridge strengths the several-sensor fits and the sensor selection try.
     pub multi_ridge_decades: Option<(i32, i32)>,
+    /// Experiment: the further sensors' terms.
+    pub multi_extra: crate::fit::thermal::multi::ExtraTerms,
+    /// Experiment: how the first sensor is chosen.
+    pub multi_first: crate::fit::thermal::multi::FirstBy,
 }
 
 impl Default for ImuFitSettings {
@@ -68,6 +72,8 @@ impl Default for ImuFitSettings {
             min_gain: DEFAULT_IMU_MIN_GAIN,
             blend: 0.0,
             multi_ridge_decades: None,
+            multi_extra: Default::default(),
+            multi_first: Default::default(),
         }
     }
 }

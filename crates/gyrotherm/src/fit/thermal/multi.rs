@@ -27,14 +27,44 @@ use crate::targets::TargetSet;
 pub struct MultiConfig {
     /// Least relative drop of the cross-validated RMS for a sensor to join.
     pub min_gain: f64,
+    /// The further sensors' terms.
+    pub extra: ExtraTerms,
+    /// How the first sensor is chosen.
+    pub first: FirstBy,
 }
 
 impl Default for MultiConfig {
     fn default() -> Self {
         MultiConfig {
             min_gain: crate::settings::fit::DEFAULT_IMU_MIN_GAIN,
+            extra: ExtraTerms::Linear,
+            first: FirstBy::Single,
         }
     }
+}
+
+/// The terms a further sensor adds ([`extra_terms`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ExtraTerms {
+    /// `T` and each lag difference, linearly.
+    #[default]
+    Linear,
+    /// `T` alone.
+    Temp,
+    /// `T` and the fastest lag difference.
+    TempFast,
+    /// `T, T², T³` and each lag difference.
+    Cubic,
+}
+
+/// Which sensor comes first (gets the full basis).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FirstBy {
+    /// The lowest one-sensor cross-validated RMS.
+    #[default]
+    Single,
+    /// The lowest cross-validated RMS of the model on every sensor with it first.
+    Combined,
 }
 
 /// One sensor's data for one axis: its identification and its training sets (features of
@@ -45,11 +75,21 @@ pub struct SensorData<'a> {
     pub scale: &'a [TargetSet],
 }
 
-/// The further sensor's terms: `T` and each lag difference, linearly, no constant.
-pub fn extra_terms(lags: usize) -> Terms {
+/// The further sensor's terms: `T` and each lag difference, linearly, no constant (other
+/// sets as `kind` says).
+pub fn extra_terms(lags: usize, kind: ExtraTerms) -> Terms {
     let n = 2 + lags;
     let mut powers = vec![term(n, &[(0, 1)])];
-    for j in 0..lags {
+    if kind == ExtraTerms::Cubic {
+        powers.push(term(n, &[(0, 2)]));
+        powers.push(term(n, &[(0, 3)]));
+    }
+    let used = match kind {
+        ExtraTerms::Temp => 0,
+        ExtraTerms::TempFast => lags.min(1),
+        _ => lags,
+    };
+    for j in 0..used {
         powers.push(term(n, &[(2 + j, 1)]));
     }
     Terms {
@@ -140,6 +180,7 @@ pub fn cv_rms<'a>(
     sensors: &[SensorData<'a>],
     order: &[usize],
     cfg: &ThermalConfig,
+    multi: &MultiConfig,
     scale: bool,
 ) -> Option<f64> {
     let first = &sensors[order[0]];
@@ -147,7 +188,7 @@ pub fn cv_rms<'a>(
     let t0 = first_terms(sets(first), cfg, first.id, scale);
     let extra: Vec<Terms> = order[1..]
         .iter()
-        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len()))
+        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
         .collect();
     let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
     for (&j, t) in order[1..].iter().zip(&extra) {
@@ -181,13 +222,32 @@ pub fn select(
 ) -> (Vec<usize>, Vec<Option<f64>>) {
     let scale = sensors.iter().all(|s| s.bias.is_empty());
     let single: Vec<Option<f64>> = (0..sensors.len())
-        .map(|j| cv_rms(sensors, &[j], cfg, scale))
+        .map(|j| cv_rms(sensors, &[j], cfg, multi, scale))
         .collect();
     let mut ranked: Vec<usize> = (0..sensors.len()).collect();
     ranked.sort_by(|&a, &b| {
         let key = |j: usize| single[j].unwrap_or(f64::INFINITY);
         key(a).total_cmp(&key(b)).then(a.cmp(&b))
     });
+    if multi.first == FirstBy::Combined && ranked.len() > 1 {
+        // Each sensor first, the others after it in their ranking: the lowest score of the
+        // model on every sensor decides which comes first.
+        let n = ranked.len().min(gyrotherm_core::multi::MAX_SENSORS);
+        let mut best: Option<(f64, usize)> = None;
+        for (i, &j) in ranked.iter().enumerate() {
+            let mut trial = vec![j];
+            trial.extend(ranked.iter().copied().filter(|&o| o != j).take(n - 1));
+            if let Some(s) = cv_rms(sensors, &trial, cfg, multi, scale) {
+                if best.is_none_or(|(b, _)| s < b) {
+                    best = Some((s, i));
+                }
+            }
+        }
+        if let Some((_, i)) = best {
+            let j = ranked.remove(i);
+            ranked.insert(0, j);
+        }
+    }
     let mut order = vec![ranked[0]];
     let Some(mut best) = single[ranked[0]] else {
         return (order, single);
@@ -198,7 +258,7 @@ pub fn select(
         }
         let mut trial = order.clone();
         trial.push(j);
-        if let Some(s) = cv_rms(sensors, &trial, cfg, scale) {
+        if let Some(s) = cv_rms(sensors, &trial, cfg, multi, scale) {
             if s < best * (1.0 - multi.min_gain) {
                 best = s;
                 order = trial;
@@ -223,6 +283,7 @@ pub fn fit_multi<'a>(
     sensors: &[SensorData<'a>],
     order: &[usize],
     cfg: &ThermalConfig,
+    multi: &MultiConfig,
     scale: bool,
 ) -> Result<MultiFit, ThermalError> {
     let first = &sensors[order[0]];
@@ -230,7 +291,7 @@ pub fn fit_multi<'a>(
     let t0 = first_terms(sets(first), cfg, first.id, scale);
     let extra: Vec<Terms> = order[1..]
         .iter()
-        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len()))
+        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
         .collect();
     let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
     for (&j, t) in order[1..].iter().zip(&extra) {
