@@ -588,7 +588,13 @@ fn fit_axis_multi(
         let thermal_err = |e: crate::fit::thermal::ThermalError| fit_err(j0, FitError::from(e));
         let has_scale = data.iter().all(|d| !d.scale.is_empty());
         let bias = has_bias
-            .then(|| multi::fit_multi(&data, &order, &multi_thermal, &mc, false))
+            .then(|| {
+                if mc.first == multi::FirstBy::Average {
+                    multi::fit_multi_averaged(&data, &order, &multi_thermal, &mc, false)
+                } else {
+                    multi::fit_multi(&data, &order, &multi_thermal, &mc, false)
+                }
+            })
             .transpose()
             .map_err(thermal_err)?;
         // The scale factor reads the further sensors only when they help it too.

@@ -49,8 +49,8 @@
 //! first-sensor one-sensor bias model averaged with the several-sensor one), `--multi-ridge
 //! LO:HI` (the ridge strengths 10^LO..10^HI of the several-sensor fits and the selection),
 //! `--multi-extra linear|temp|temp-fast|cubic` (the further sensors' terms), `--multi-first
-//! single|combined` (the first sensor by its one-sensor score or by the score of the model
-//! on every sensor with it first).
+//! single|combined|average` (the first sensor by its one-sensor score, by the score of the
+//! model on every sensor with it first, or the bias model averaged over each sensor first).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -203,7 +203,7 @@ struct Job<'a> {
     blend: Option<f64>,
     multi_ridge: Option<(i32, i32)>,
     multi_extra: Option<gyrotherm::fit::thermal::multi::ExtraTerms>,
-    first_combined: bool,
+    multi_first: Option<gyrotherm::fit::thermal::multi::FirstBy>,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -659,8 +659,8 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     if let Some(e) = job.multi_extra {
         all.multi_extra = e;
     }
-    if job.first_combined {
-        all.multi_first = gyrotherm::fit::thermal::multi::FirstBy::Combined;
+    if let Some(f) = job.multi_first {
+        all.multi_first = f;
     }
     let mut out = Vec::new();
     for setting in settings {
@@ -885,10 +885,16 @@ fn run() -> Result<(), String> {
                 ))
             }
         },
-        first_combined: match get("--multi-first").as_deref() {
-            None | Some("single") => false,
-            Some("combined") => true,
-            Some(v) => return Err(format!("--multi-first {v:?}: use single or combined")),
+        multi_first: match get("--multi-first").as_deref() {
+            None => None,
+            Some("single") => Some(gyrotherm::fit::thermal::multi::FirstBy::Single),
+            Some("combined") => Some(gyrotherm::fit::thermal::multi::FirstBy::Combined),
+            Some("average") => Some(gyrotherm::fit::thermal::multi::FirstBy::Average),
+            Some(v) => {
+                return Err(format!(
+                    "--multi-first {v:?}: use single, combined or average"
+                ))
+            }
         },
         multi_ridge: get("--multi-ridge")
             .map(|v| {

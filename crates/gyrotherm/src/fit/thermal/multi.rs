@@ -65,6 +65,9 @@ pub enum FirstBy {
     Single,
     /// The lowest cross-validated RMS of the model on every sensor with it first.
     Combined,
+    /// The bias model is the average of the fits with each chosen sensor first
+    /// ([`fit_multi_averaged`]); the order (and the scale factor) as `Single`.
+    Average,
 }
 
 /// One sensor's data for one axis: its identification and its training sets (features of
@@ -334,5 +337,79 @@ pub fn fit_multi<'a>(
         extra: extra_models,
         cv_rms: cv,
         ridge: lambda,
+    })
+}
+
+/// The average of [`fit_multi`] over each sensor of `order` first (the others after it in
+/// their order): every sensor's terms are its first-sensor terms (the constant on the first
+/// sensor of `order`), each coefficient the mean of the fits'. A model averaged over which
+/// sensor gets the nonlinear terms, instead of one chosen by a cross-validation that cannot
+/// tell them apart on chamber runs. Its `cv_rms` is the mean of the fits' (an upper bound of
+/// the average's own on the same folds), `ridge` the first fit's.
+pub fn fit_multi_averaged<'a>(
+    sensors: &[SensorData<'a>],
+    order: &[usize],
+    cfg: &ThermalConfig,
+    multi: &MultiConfig,
+    scale: bool,
+) -> Result<MultiFit, ThermalError> {
+    if order.len() < 2 {
+        return fit_multi(sensors, order, cfg, multi, scale);
+    }
+    // Per sensor of `order`: its terms in the average and their coefficients.
+    let mut terms: Vec<Terms> = order
+        .iter()
+        .map(|&j| {
+            let s = &sensors[j];
+            first_terms(target_sets(s, scale), cfg, s.id, scale)
+        })
+        .collect();
+    for t in terms.iter_mut().skip(1) {
+        // The further sensors carry no constant.
+        t.powers.remove(0);
+    }
+    let mut coef: Vec<Vec<f64>> = terms.iter().map(|t| vec![0.0; t.len()]).collect();
+    let (mut cv, mut ridge) = (Some(0.0), f64::NAN);
+    let m = order.len() as f64;
+    for i in 0..order.len() {
+        let mut rot = vec![order[i]];
+        rot.extend(order.iter().enumerate().filter(|(k, _)| *k != i).map(|(_, &j)| j));
+        let fit = fit_multi(sensors, &rot, cfg, multi, scale)?;
+        if i == 0 {
+            ridge = fit.ridge;
+        }
+        cv = cv.zip(fit.cv_rms).map(|(a, b)| a + b / m);
+        for (pos, sub) in std::iter::once(&fit.first).chain(&fit.extra).enumerate() {
+            let SubModel::Baseline {
+                terms: t,
+                coefficients: c,
+            } = sub
+            else {
+                return fit_multi(sensors, order, cfg, multi, scale);
+            };
+            let k = order.iter().position(|&j| j == rot[pos]).unwrap_or(0);
+            for (p, v) in t.powers.iter().zip(c) {
+                if p.iter().all(|&q| q == 0) {
+                    // The constant: the first sensor of `order` carries it.
+                    coef[0][0] += v / m;
+                    continue;
+                }
+                match terms[k].powers.iter().position(|q| q == p) {
+                    Some(at) => coef[k][at] += v / m,
+                    None => return fit_multi(sensors, order, cfg, multi, scale),
+                }
+            }
+        }
+    }
+    let mut parts = terms.into_iter().zip(coef).map(|(t, c)| SubModel::Baseline {
+        terms: t,
+        coefficients: c,
+    });
+    let first = parts.next().ok_or(ThermalError::NoTargets)?;
+    Ok(MultiFit {
+        first,
+        extra: parts.collect(),
+        cv_rms: cv,
+        ridge,
     })
 }
