@@ -48,7 +48,8 @@
 //! `--ridge-tolerance X`, `--n-lags N` (the recipe's), `--blend W` (the weight of each axis's
 //! first-sensor one-sensor bias model averaged with the several-sensor one), `--multi-ridge
 //! LO:HI` (the ridge strengths 10^LO..10^HI of the several-sensor fits and the selection),
-//! `--multi-extra linear|temp|temp-fast|cubic` (the further sensors' terms), `--multi-first
+//! `--multi-extra linear|temp|temp-fast|cubic|same` (the further sensors' terms; `same`:
+//! the first sensor's basis), `--multi-first
 //! single|combined|average` (the first sensor by its one-sensor score, by the score of the
 //! model on every sensor with it first, or the bias model averaged over each sensor first).
 
@@ -879,9 +880,10 @@ fn run() -> Result<(), String> {
             Some("temp") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::Temp),
             Some("temp-fast") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::TempFast),
             Some("cubic") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::Cubic),
+            Some("same") => Some(gyrotherm::fit::thermal::multi::ExtraTerms::Same),
             Some(v) => {
                 return Err(format!(
-                    "--multi-extra {v:?}: use linear, temp, temp-fast or cubic"
+                    "--multi-extra {v:?}: use linear, temp, temp-fast, cubic or same"
                 ))
             }
         },

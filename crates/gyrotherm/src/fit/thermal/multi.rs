@@ -55,6 +55,8 @@ pub enum ExtraTerms {
     TempFast,
     /// `T, T², T³` and each lag difference.
     Cubic,
+    /// The first sensor's basis less its constant (`T, T², T³, Dj, T·D1` with `lean`).
+    Same,
 }
 
 /// Which sensor comes first (gets the full basis).
@@ -116,6 +118,30 @@ pub fn first_terms(sets: &[TargetSet], cfg: &ThermalConfig, id: &Identified, sca
         };
     }
     basis(kind, lags)
+}
+
+/// With [`ExtraTerms::Same`], each further sensor's first-sensor terms less the constant;
+/// otherwise `extra` as it is.
+fn same_terms(
+    sensors: &[SensorData],
+    order: &[usize],
+    cfg: &ThermalConfig,
+    multi: &MultiConfig,
+    scale: bool,
+    extra: Vec<Terms>,
+) -> Vec<Terms> {
+    if multi.extra != ExtraTerms::Same {
+        return extra;
+    }
+    order[1..]
+        .iter()
+        .map(|&j| {
+            let s = &sensors[j];
+            let mut t = first_terms(target_sets(s, scale), cfg, s.id, scale);
+            t.powers.remove(0);
+            t
+        })
+        .collect()
 }
 
 /// The design over the first sensor's terms (no constant) and each further sensor's.
@@ -193,6 +219,7 @@ pub fn cv_rms<'a>(
         .iter()
         .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
         .collect();
+    let extra = same_terms(sensors, order, cfg, multi, scale, extra);
     let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
     for (&j, t) in order[1..].iter().zip(&extra) {
         parts.push((sets(&sensors[j]), t));
@@ -296,6 +323,7 @@ pub fn fit_multi<'a>(
         .iter()
         .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
         .collect();
+    let extra = same_terms(sensors, order, cfg, multi, scale, extra);
     let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
     for (&j, t) in order[1..].iter().zip(&extra) {
         parts.push((sets(&sensors[j]), t));
