@@ -545,6 +545,7 @@ fn fit_axis_multi(
         min_gain: settings.min_gain,
         extra: settings.multi_extra,
         first: settings.multi_first,
+        select_folds: settings.multi_select_folds,
     };
     let (order, single) = multi::select(
         &data,

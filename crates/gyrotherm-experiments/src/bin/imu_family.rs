@@ -51,7 +51,8 @@
 //! `--multi-extra linear|temp|temp-fast|cubic|same` (the further sensors' terms; `same`:
 //! the first sensor's basis), `--multi-first
 //! single|combined|average` (the first sensor by its one-sensor score, by the score of the
-//! model on every sensor with it first, or the bias model averaged over each sensor first).
+//! model on every sensor with it first, or the bias model averaged over each sensor first),
+//! `--select-folds N` (the folds of the sensor selection's cross-validation).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -205,6 +206,7 @@ struct Job<'a> {
     multi_ridge: Option<(i32, i32)>,
     multi_extra: Option<gyrotherm::fit::thermal::multi::ExtraTerms>,
     multi_first: Option<gyrotherm::fit::thermal::multi::FirstBy>,
+    select_folds: Option<usize>,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -663,6 +665,9 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     if let Some(f) = job.multi_first {
         all.multi_first = f;
     }
+    if let Some(f) = job.select_folds {
+        all.multi_select_folds = f;
+    }
     let mut out = Vec::new();
     for setting in settings {
         let t0 = Instant::now();
@@ -898,6 +903,9 @@ fn run() -> Result<(), String> {
                 ))
             }
         },
+        select_folds: get("--select-folds")
+            .map(|v| v.parse().map_err(|e| format!("--select-folds: {e}")))
+            .transpose()?,
         multi_ridge: get("--multi-ridge")
             .map(|v| {
                 let (a, b) = v

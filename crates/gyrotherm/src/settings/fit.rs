@@ -63,6 +63,9 @@ pub struct ImuFitSettings {
     pub multi_extra: crate::fit::thermal::multi::ExtraTerms,
     /// Experiment: how the first sensor is chosen.
     pub multi_first: crate::fit::thermal::multi::FirstBy,
+    /// Experiment (0: the identification's): folds of the sensor selection's
+    /// cross-validation.
+    pub multi_select_folds: usize,
 }
 
 impl Default for ImuFitSettings {
@@ -74,6 +77,7 @@ impl Default for ImuFitSettings {
             multi_ridge_decades: None,
             multi_extra: Default::default(),
             multi_first: Default::default(),
+            multi_select_folds: 0,
         }
     }
 }

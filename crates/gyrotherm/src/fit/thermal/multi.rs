@@ -31,6 +31,8 @@ pub struct MultiConfig {
     pub extra: ExtraTerms,
     /// How the first sensor is chosen.
     pub first: FirstBy,
+    /// Folds of the selection's cross-validation (0: the identification's).
+    pub select_folds: usize,
 }
 
 impl Default for MultiConfig {
@@ -39,6 +41,7 @@ impl Default for MultiConfig {
             min_gain: crate::settings::fit::DEFAULT_IMU_MIN_GAIN,
             extra: ExtraTerms::Linear,
             first: FirstBy::Single,
+            select_folds: 0,
         }
     }
 }
@@ -228,9 +231,12 @@ pub fn cv_rms<'a>(
         return None;
     }
     let (d, nc) = combined(&parts);
-    let folds = folds_for(&d, first.id);
+    let mut folds = folds_for(&d, first.id);
     if folds == 0 {
         return None;
+    }
+    if multi.select_folds > 0 {
+        folds = multi.select_folds;
     }
     let (s, _) = best_ridge(
         &d,
