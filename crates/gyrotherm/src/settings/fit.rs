@@ -4,6 +4,7 @@
 use super::{check, Method, Rule, SettingError, DEFAULT_METHOD};
 use crate::baseline::PolyDegrees;
 use crate::compare::{Candidate, CompareConfig};
+use crate::fit::thermal::multi::{ExtraTerms, FirstBy};
 use crate::fit::{FitConfig, RecipeKind, RecipeSettings};
 use crate::targets;
 
@@ -25,6 +26,19 @@ pub const RECIPE_NAMES: [&str; 5] = ["thermal", "residual", "generic", "direct",
 /// cross-validated RMS (chosen on the design family against +0.02, which kept one sensor
 /// per axis: docs/experiments/imu.md).
 pub const DEFAULT_IMU_MIN_GAIN: f64 = -1.0;
+
+/// The terms each further sensor of an inertial-unit axis adds: `T, T², T³` and its lag
+/// differences, so that the temperature polynomial is not tied to the one sensor that
+/// comes first. Chosen on the design family with [`DEFAULT_IMU_FIRST`] against `T` and the
+/// lag differences alone (worst case 5.88 → 4.41× the noise floor, median 1.28 → 1.30):
+/// docs/experiments/imu-worst-model.md.
+pub const DEFAULT_IMU_EXTRA_TERMS: ExtraTerms = ExtraTerms::Cubic;
+
+/// How an inertial-unit axis chooses the sensor that comes first (with the full basis): the
+/// lowest cross-validated RMS of the model on every sensor with it first, rather than the
+/// lowest one-sensor score (chosen with [`DEFAULT_IMU_EXTRA_TERMS`]:
+/// docs/experiments/imu-worst-model.md).
+pub const DEFAULT_IMU_FIRST: FirstBy = FirstBy::Combined;
 
 /// An inertial unit's lag search (only the search: the sensor selection and the final fits
 /// use every labelled step) scores each candidate on every fifth labelled step of its
@@ -59,10 +73,10 @@ pub struct ImuFitSettings {
     /// Experiment (None: the recipe's grid): the decades (lowest, highest power of ten) of
     /// the ridge strengths the several-sensor fits and the sensor selection try.
     pub multi_ridge_decades: Option<(i32, i32)>,
-    /// Experiment: the further sensors' terms.
-    pub multi_extra: crate::fit::thermal::multi::ExtraTerms,
-    /// Experiment: how the first sensor is chosen.
-    pub multi_first: crate::fit::thermal::multi::FirstBy,
+    /// The further sensors' terms ([`DEFAULT_IMU_EXTRA_TERMS`]).
+    pub multi_extra: ExtraTerms,
+    /// How the first sensor is chosen ([`DEFAULT_IMU_FIRST`]).
+    pub multi_first: FirstBy,
     /// Experiment (0: the identification's): folds of the sensor selection's
     /// cross-validation.
     pub multi_select_folds: usize,
@@ -75,8 +89,8 @@ impl Default for ImuFitSettings {
             min_gain: DEFAULT_IMU_MIN_GAIN,
             blend: 0.0,
             multi_ridge_decades: None,
-            multi_extra: Default::default(),
-            multi_first: Default::default(),
+            multi_extra: DEFAULT_IMU_EXTRA_TERMS,
+            multi_first: DEFAULT_IMU_FIRST,
             multi_select_folds: 0,
         }
     }
