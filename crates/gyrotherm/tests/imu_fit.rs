@@ -132,7 +132,10 @@ fn every_sensor_when_cross_validation_keeps_it() {
     let mut want = vec![power(0, 1), power(0, 2), power(0, 3)];
     want.extend((0..lags).map(|j| power(2 + j, 1)));
     match a.more[0].bias.as_ref() {
-        Some(gyrotherm::model::SubModel::Baseline { terms, coefficients }) => {
+        Some(gyrotherm::model::SubModel::Baseline {
+            terms,
+            coefficients,
+        }) => {
             assert_eq!(terms.powers, want);
             assert_eq!(coefficients.len(), want.len());
         }

@@ -13,11 +13,11 @@
 //! has the lowest cross-validated RMS is kept. Each other sensor, in that order, joins when
 //! the cross-validated RMS of the bias (of the scale factor when the axis has no static run)
 //! drops below `(1 − min_gain)` times the best so far (at first the first sensor's
-//! one-sensor score; [`MultiConfig::min_gain`]). The scale-factor model reads the further sensors only when
-//! its own cross-validated RMS passes the same test. On the design family the first sensor
-//! chosen by its one-sensor score was often the case sensor, and the worst held-out cases
-//! (airborne climbs) came from that: the cubic on the case temperature with the coil's
-//! polynomial and memory carried by lags (docs/experiments/imu-worst-model.md).
+//! one-sensor score; [`MultiConfig::min_gain`]). The scale-factor model reads the further
+//! sensors only when its own cross-validated RMS passes the same test. On the design family
+//! the first sensor chosen by its one-sensor score was often the case sensor, and the worst
+//! held-out cases (airborne climbs) came from that: the cubic on the case temperature, the
+//! coil's polynomial and memory carried by lags (docs/experiments/imu-worst-model.md).
 //!
 //! The default `min_gain` is −1: a sensor joins unless it doubles the cross-validated RMS.
 //! On the design family the blocked cross-validation within the chamber runs scored further
@@ -414,7 +414,13 @@ pub fn fit_multi_averaged<'a>(
     let m = order.len() as f64;
     for i in 0..order.len() {
         let mut rot = vec![order[i]];
-        rot.extend(order.iter().enumerate().filter(|(k, _)| *k != i).map(|(_, &j)| j));
+        rot.extend(
+            order
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| *k != i)
+                .map(|(_, &j)| j),
+        );
         let fit = fit_multi(sensors, &rot, cfg, multi, scale)?;
         if i == 0 {
             ridge = fit.ridge;
@@ -442,10 +448,13 @@ pub fn fit_multi_averaged<'a>(
             }
         }
     }
-    let mut parts = terms.into_iter().zip(coef).map(|(t, c)| SubModel::Baseline {
-        terms: t,
-        coefficients: c,
-    });
+    let mut parts = terms
+        .into_iter()
+        .zip(coef)
+        .map(|(t, c)| SubModel::Baseline {
+            terms: t,
+            coefficients: c,
+        });
     let first = parts.next().ok_or(ThermalError::NoTargets)?;
     Ok(MultiFit {
         first,
