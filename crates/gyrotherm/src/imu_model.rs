@@ -739,6 +739,13 @@ impl ImuModel {
         ))
     }
 
+    /// The `content_sha256` of the model: SHA-256 of its compact JSON content (how the file
+    /// is formatted does not change it).
+    pub fn content_digest(&self) -> Result<String, ImuError> {
+        let compact = serde_json::to_string(self).map_err(ImuError::Json)?;
+        Ok(sha256_hex(compact.as_bytes()))
+    }
+
     /// Parse and check the text (the checksum, when present, must match).
     pub fn from_json(text: &str) -> Result<ImuModel, ImuError> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
