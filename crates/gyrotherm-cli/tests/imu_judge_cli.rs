@@ -817,8 +817,15 @@ fn lot_add_records_each_axis_and_the_unit_as_evaluate_judges_them() {
     let gyros = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];
     for (k, g) in gyros.iter().enumerate() {
         let a = &run["axes"][k];
-        assert_eq!((a["axis"].as_u64(), a["gyro"].as_str()), (Some(k as u64), Some(*g)));
-        assert_eq!(a["verdict"], if k == worst { "fail" } else { "pass" }, "{g}");
+        assert_eq!(
+            (a["axis"].as_u64(), a["gyro"].as_str()),
+            (Some(k as u64), Some(*g))
+        );
+        assert_eq!(
+            a["verdict"],
+            if k == worst { "fail" } else { "pass" },
+            "{g}"
+        );
         assert_eq!(ev_tight["axes"][k]["verdict"]["pass"], k != worst);
         // Each limited figure of the axis: value, pass and margin as evaluate gives them.
         let recorded: Vec<(String, f64, bool, f64)> = run["figures"]
@@ -854,11 +861,7 @@ fn lot_add_records_each_axis_and_the_unit_as_evaluate_judges_them() {
     let list = run_ok(gyrotherm().args(["lot", "list", "--db", db_s]));
     let list = String::from_utf8_lossy(&list.stdout);
     assert!(
-        list.contains(&format!(
-            "axis {}: {} (temp_",
-            worst + 1,
-            gyros[worst]
-        )),
+        list.contains(&format!("axis {}: {} (temp_", worst + 1, gyros[worst])),
         "{list}"
     );
     assert!(list.contains("2 units: 1 passed, 1 failed"), "{list}");
@@ -869,13 +872,16 @@ fn lot_add_records_each_axis_and_the_unit_as_evaluate_judges_them() {
             .arg(&rep),
     );
     let out = String::from_utf8_lossy(&out.stdout);
-    assert!(out.contains("2 units (2 runs): 1 passed, 1 failed"), "{out}");
+    assert!(
+        out.contains("2 units (2 runs): 1 passed, 1 failed"),
+        "{out}"
+    );
     let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
     assert!(page.contains("<table id=\"axes\">"), "{page}");
     let csv = std::fs::read_to_string(rep.join("lot.csv")).unwrap();
     assert!(
-        csv.lines()
-            .any(|l| l.contains(",bias_stability_dph,") && l.ends_with(&format!(",{},fail", gyros[worst]))),
+        csv.lines().any(|l| l.contains(",bias_stability_dph,")
+            && l.ends_with(&format!(",{},fail", gyros[worst]))),
         "{csv}"
     );
 
@@ -997,7 +1003,9 @@ fn report_spec_with_lists_gives_each_axis_and_the_unit_as_evaluate_does() {
     let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
     assert!(page.contains("<table class=\"unit-verdicts\">"), "{page}");
     assert!(
-        page.contains("<tr><td>unit fit</td><td>PASS</td><td>PASS</td><td>PASS</td><td>PASS</td></tr>"),
+        page.contains(
+            "<tr><td>unit fit</td><td>PASS</td><td>PASS</td><td>PASS</td><td>PASS</td></tr>"
+        ),
         "{page}"
     );
     for k in 1..=3 {
@@ -1042,7 +1050,13 @@ fn report_spec_with_lists_gives_each_axis_and_the_unit_as_evaluate_does() {
     );
     let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
     let cells: String = (0..3)
-        .map(|k| if k == worst { "<td>FAIL</td>" } else { "<td>PASS</td>" })
+        .map(|k| {
+            if k == worst {
+                "<td>FAIL</td>"
+            } else {
+                "<td>PASS</td>"
+            }
+        })
         .collect();
     assert!(
         page.contains(&format!("<tr><td>unit fit</td>{cells}<td>FAIL</td></tr>")),

@@ -562,8 +562,7 @@ pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>),
             },
         });
     }
-    let measured =
-        crate::imu_judge::measure_unit(&model, &named, &opts).map_err(LotError::Unit)?;
+    let measured = crate::imu_judge::measure_unit(&model, &named, &opts).map_err(LotError::Unit)?;
     let verdict = match u.spec {
         Some(s) => {
             let (axes, unit) =

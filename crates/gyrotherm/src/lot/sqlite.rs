@@ -145,15 +145,16 @@ impl SqliteStore {
         };
         for (i, step) in SQLITE_MIGRATIONS.iter().enumerate().skip(from as usize - 1) {
             // A failed step drops the transaction, which rolls every step back.
-            tx.execute_batch(step).map_err(|e| match db_error(&db, e, self.busy_timeout_ms) {
-                LotError::Database { db, detail } => LotError::Migration {
-                    db,
-                    from,
-                    to: i as i64 + 2,
-                    detail,
-                },
-                other => other,
-            })?;
+            tx.execute_batch(step)
+                .map_err(|e| match db_error(&db, e, self.busy_timeout_ms) {
+                    LotError::Database { db, detail } => LotError::Migration {
+                        db,
+                        from,
+                        to: i as i64 + 2,
+                        detail,
+                    },
+                    other => other,
+                })?;
         }
         tx.execute(
             "UPDATE schema_version SET version = ?1",
@@ -353,9 +354,8 @@ impl LotStore for SqliteStore {
                     axis: r.get(1).map_err(e)?,
                     gyro: r.get(2).map_err(e)?,
                     temps: temps.split(',').map(str::to_owned).collect(),
-                    verdict: RunVerdict::parse(&verdict).ok_or_else(|| {
-                        bad(format!("run {id}: axis verdict {verdict:?}"))
-                    })?,
+                    verdict: RunVerdict::parse(&verdict)
+                        .ok_or_else(|| bad(format!("run {id}: axis verdict {verdict:?}")))?,
                 });
             }
         }

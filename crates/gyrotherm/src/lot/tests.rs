@@ -484,11 +484,15 @@ pub(crate) fn exercise_unit_store(s: &mut dyn LotStore) {
     );
     let csv = String::from_utf8(report::lot_csv(&runs).unwrap()).unwrap();
     assert_eq!(csv.lines().count(), 1 + 4 + 12 + 12);
-    assert!(csv.lines().next().unwrap().ends_with(",margin,axis,axis_verdict"));
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with(",margin,axis,axis_verdict"));
     assert!(
-        csv.lines()
-            .any(|l| l.starts_with("3,IMU-2,") && l.contains(",bias_stability_dph,")
-                && l.ends_with(",gyro_y_dps,fail")),
+        csv.lines().any(|l| l.starts_with("3,IMU-2,")
+            && l.contains(",bias_stability_dph,")
+            && l.ends_with(",gyro_y_dps,fail")),
         "{csv}"
     );
     // Single-axis rows leave the axis columns empty.
@@ -504,11 +508,8 @@ fn sqlite_store_holds_inertial_units() {
     // A unit's verdict that its axes do not give (edited by hand) is refused on reading.
     drop(s);
     let c = rusqlite::Connection::open(&db).unwrap();
-    c.execute(
-        "UPDATE runs SET verdict = 'pass' WHERE unit = 'IMU-2'",
-        [],
-    )
-    .unwrap();
+    c.execute("UPDATE runs SET verdict = 'pass' WHERE unit = 'IMU-2'", [])
+        .unwrap();
     drop(c);
     let e = SqliteStore::open(&db, false, 5000)
         .unwrap()
@@ -760,7 +761,8 @@ fn postgres_store_holds_units_and_upgrades_version_1() {
     let url = pg.create_db("lot_v1_blocked");
     write_v1_pg(&url, &old[..1]);
     let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
-    c.batch_execute("CREATE TABLE run_axes (note TEXT)").unwrap();
+    c.batch_execute("CREATE TABLE run_axes (note TEXT)")
+        .unwrap();
     let e = open_store(&url, true, 0).err().unwrap();
     assert!(
         matches!(e, LotError::Migration { from: 1, to: 2, .. }),

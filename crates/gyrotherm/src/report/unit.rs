@@ -61,7 +61,14 @@ pub fn unit_verdict_table(spec: &Spec, verdicts: &[AxisVerdicts]) -> Table {
 /// One axis's verdicts: a row per judged column, figure and held-out log.
 pub fn axis_verdict_table(a: &AxisVerdicts) -> Table {
     let headers = [
-        "column", "figure", "held-out log", "value", "unit", "limit", "verdict", "margin",
+        "column",
+        "figure",
+        "held-out log",
+        "value",
+        "unit",
+        "limit",
+        "verdict",
+        "margin",
     ]
     .map(str::to_owned)
     .to_vec();
