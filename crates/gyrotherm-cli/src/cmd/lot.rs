@@ -168,11 +168,7 @@ fn add_unit(a: AddArgs, spec: Option<gyrotherm::spec::Spec>) -> anyhow::Result<E
         .map_err(anyhow::Error::new)
         .with_context(|| format!("cannot use model {}", a.model.display()))?;
     let opts = model.read_options(&a.log.read_options());
-    let tests: Vec<(PathBuf, gyrotherm::csvlog::ImuLog)> =
-        super::imu::read_imu_logs_with(&a.test, &a.log, &opts)?
-            .into_iter()
-            .map(|(name, log)| (PathBuf::from(name), log))
-            .collect();
+    let tests = super::imu::read_imu_logs_with(&a.test, &a.log, &opts)?;
     let station = a.station.clone().unwrap_or_else(lot::default_station);
     // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
     let (mut run, verdict) = lot::judge_imu_unit(&lot::ImuUnitInputs {

@@ -497,9 +497,9 @@ pub struct ImuUnitInputs<'a> {
     pub unit: &'a str,
     pub station: &'a str,
     pub model_path: &'a Path,
-    /// The held-out logs, read with the model's columns ([`ImuModel::read_options`]), with
-    /// the paths they were read from.
-    pub tests: &'a [(PathBuf, ImuLog)],
+    /// The held-out logs, read with the model's columns ([`ImuModel::read_options`]), each
+    /// with the path it was read from.
+    pub tests: &'a [(String, ImuLog)],
     pub spec: Option<&'a Spec>,
     /// Bias-stability τ, s (None: the unit `compare`'s default for these logs,
     /// [`crate::imu_judge::default_tau_s`]).
@@ -533,14 +533,9 @@ pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>),
     let model_sha256 = format!("{:x}", Sha256::digest(text.as_bytes()));
     let model = ImuModel::from_json(&text).map_err(|e| model_err(e.into()))?;
     let content = model.content_digest().map_err(|e| model_err(e.into()))?;
-    let named: Vec<(String, ImuLog)> = u
-        .tests
-        .iter()
-        .map(|(p, l)| (p.display().to_string(), l.clone()))
-        .collect();
     let tau_s = u
         .tau_s
-        .unwrap_or_else(|| crate::imu_judge::default_tau_s(&named).0);
+        .unwrap_or_else(|| crate::imu_judge::default_tau_s(u.tests).0);
     let opts = MeasureOptions {
         evaluation: EvaluationOptions {
             tau_s,
@@ -553,8 +548,8 @@ pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>),
     for (i, (path, log)) in u.tests.iter().enumerate() {
         inputs.push(Input {
             position: i as u32,
-            path: path.display().to_string(),
-            sha256: file_sha256(path)?,
+            path: path.clone(),
+            sha256: file_sha256(Path::new(path))?,
             kind: if log.table.is_none() {
                 "static"
             } else {
@@ -562,7 +557,8 @@ pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>),
             },
         });
     }
-    let measured = crate::imu_judge::measure_unit(&model, &named, &opts).map_err(LotError::Unit)?;
+    let measured =
+        crate::imu_judge::measure_unit(&model, u.tests, &opts).map_err(LotError::Unit)?;
     let verdict = match u.spec {
         Some(s) => {
             let (axes, unit) =
