@@ -594,6 +594,22 @@ fn sqlite_version_1_lot_is_upgraded_and_keeps_every_run() {
         synthetic_run("B-002", 2, 1_700_000_100_000),
     ];
     write_v1_sqlite(&db, &old);
+    // The fixture is a version 1 lot: its version row, and figures without an axis.
+    {
+        let c = rusqlite::Connection::open(&db).unwrap();
+        let v: i64 = c
+            .query_row("SELECT version FROM schema_version", [], |r| r.get(0))
+            .unwrap();
+        let cols: Vec<String> = c
+            .prepare("SELECT name FROM pragma_table_info('figures')")
+            .unwrap()
+            .query_map([], |r| r.get(0))
+            .unwrap()
+            .map(Result::unwrap)
+            .collect();
+        assert_eq!(v, 1);
+        assert!(!cols.iter().any(|c| c == "axis"), "{cols:?}");
+    }
     // A reader (lot list, lot report) opens it: upgraded in place.
     let mut s = SqliteStore::open(&db, false, 5000).unwrap();
     assert_eq!(s.schema_version().unwrap(), 2);
