@@ -146,3 +146,31 @@ fn one_name_each_reads_a_single_axis_log_as_read_log_does() {
     let (imu_log, _) = read_imu_log(&path, &ReadOptions::default(), None).unwrap();
     assert_eq!(imu_log.axis_log(0, 0), single);
 }
+
+#[test]
+fn several_logs_read_at_once_give_each_file_s_own_result_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+    write_imu_log(&a, &imu::simulate_imu(&config(Some(2))).unwrap()).unwrap();
+    write_imu_log(&b, &imu::simulate_imu(&config(None)).unwrap()).unwrap();
+    let missing = dir.path().join("missing.csv");
+    let opts = ReadOptions {
+        gyro_col: "gyro_x_dps,gyro_y_dps,gyro_z_dps".into(),
+        temp_col: "temp_case_c,temp_x_c".into(),
+        ..ReadOptions::default()
+    };
+    let paths = [&b, &missing, &a];
+    let all = csvlog::read_imu_logs(&paths, &opts, None);
+    assert_eq!(all.len(), 3);
+    // Each result is the one-file read of the path at its place.
+    for (p, r) in paths.iter().zip(&all) {
+        match (read_imu_log(p, &opts, None), r) {
+            (Ok((one, _)), Ok((got, _))) => assert_eq!(&one, got),
+            (Err(one), Err(got)) => assert_eq!(one.to_string(), got.to_string()),
+            (one, got) => panic!("{}: {one:?} against {got:?}", p.display()),
+        }
+    }
+    assert!(all[1].is_err());
+    assert!(all[0].as_ref().unwrap().0.table.is_none());
+    assert!(all[2].as_ref().unwrap().0.table.is_some());
+}

@@ -235,6 +235,26 @@ pub fn read_imu_log(
     ))
 }
 
+/// [`read_imu_log`] of each path with the same options, one thread per file (the files are
+/// independent; a unit's training reads several, and much of a read is one thread's work):
+/// the results in the order of `paths`, each as [`read_imu_log`] gives it.
+pub fn read_imu_logs<P: AsRef<Path> + Sync>(
+    paths: &[P],
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+) -> Vec<Result<(ImuLog, ReadReport), LogError>> {
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = paths
+            .iter()
+            .map(|p| scope.spawn(move || read_imu_log(p.as_ref(), opts, table_axis)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
+}
+
 /// Parse a further column: every field a finite number (times `scale`); empty fields, which
 /// only gap filling makes, interpolated linearly in time between the real rows around them.
 fn parse_column(

@@ -27,7 +27,7 @@ mod writer;
 
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
-pub use imu::{read_imu_log, write_imu_log, ImuLog, NamedSeries};
+pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
 pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
