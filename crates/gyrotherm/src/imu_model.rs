@@ -533,7 +533,7 @@ fn fit_axis_multi(
         .iter()
         .map(|(_, id, bias, scale)| SensorData { id, bias, scale })
         .collect();
-    let (order, single) = multi::select(
+    let (order, single, shared) = multi::select_shared(
         &data,
         &cfg.thermal,
         &MultiConfig {
@@ -577,13 +577,19 @@ fn fit_axis_multi(
         let thermal_err = |e: crate::fit::thermal::ThermalError| fit_err(j0, FitError::from(e));
         let has_scale = data.iter().all(|d| !d.scale.is_empty());
         let bias = has_bias
-            .then(|| multi::fit_multi(&data, &order, &cfg.thermal, false))
+            .then(|| multi::fit_multi_with(&data, &order, &cfg.thermal, false, shared.as_ref()))
             .transpose()
             .map_err(thermal_err)?;
         // The scale factor reads the further sensors only when they help it too.
         let scale = if has_scale {
-            let one = multi::cv_rms(&data, &order[..1], &cfg.thermal, true);
-            let all = multi::fit_multi(&data, &order, &cfg.thermal, true).map_err(thermal_err)?;
+            // The selection's statistics are the bias's when the axis has a static run.
+            let own = has_bias
+                .then(|| multi::shared(&data, order[0], &order[1..], &cfg.thermal, true))
+                .flatten();
+            let sh = own.as_ref().or(shared.as_ref());
+            let one = multi::cv_rms_with(&data, &order[..1], &cfg.thermal, true, sh);
+            let all = multi::fit_multi_with(&data, &order, &cfg.thermal, true, sh)
+                .map_err(thermal_err)?;
             match (one, all.cv_rms) {
                 (Some(o), Some(a)) if a < o * (1.0 - settings.min_gain) => Some(all),
                 _ => None,
