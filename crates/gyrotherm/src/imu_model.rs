@@ -465,16 +465,27 @@ fn fit_axis_multi(
     };
     // The targets' per-sample part reads the axis's gyro column, not the sensor: made once per
     // run for the four sensors.
-    let samples: Vec<(bool, Result<targets::GyroSamples, targets::TargetError>)> = logs
+    // One copy of each run's columns for this axis; each sensor in turn puts its temperature
+    // column in place (the rest is the same for every sensor).
+    let mut axis_logs: Vec<(String, TestLog)> = logs
         .iter()
-        .map(|(_, l)| {
-            let a = l.axis_data(k, 0);
-            if targets::is_static(&a) {
-                (false, targets::bias_samples(&a, cfg.bias_window_s))
+        .map(|(n, l)| (n.clone(), l.axis_data(k, 0)))
+        .collect();
+    let use_sensor = |axis_logs: &mut [(String, TestLog)], j: usize| {
+        for ((_, a), (_, l)) in axis_logs.iter_mut().zip(logs) {
+            a.temp_c.clear();
+            a.temp_c.extend_from_slice(&l.temp[j].values);
+        }
+    };
+    let samples: Vec<(bool, Result<targets::GyroSamples, targets::TargetError>)> = axis_logs
+        .iter()
+        .map(|(_, a)| {
+            if targets::is_static(a) {
+                (false, targets::bias_samples(a, cfg.bias_window_s))
             } else {
                 (
                     true,
-                    targets::scale_samples(&a, cfg.settle_s, cfg.scale_window_s),
+                    targets::scale_samples(a, cfg.settle_s, cfg.scale_window_s),
                 )
             }
         })
@@ -482,10 +493,7 @@ fn fit_axis_multi(
     let mut per_sensor = Vec::with_capacity(temp_cols.len());
     for j in 0..temp_cols.len() {
         events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
-        let axis_logs: Vec<(String, TestLog)> = logs
-            .iter()
-            .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
-            .collect();
+        use_sensor(&mut axis_logs, j);
         let named: Vec<NamedLog> = axis_logs
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
@@ -527,11 +535,11 @@ fn fit_axis_multi(
                 bias.push(t);
             }
         }
-        per_sensor.push((axis_logs, id, bias, scale));
+        per_sensor.push((id, bias, scale));
     }
     let data: Vec<SensorData> = per_sensor
         .iter()
-        .map(|(_, id, bias, scale)| SensorData { id, bias, scale })
+        .map(|(id, bias, scale)| SensorData { id, bias, scale })
         .collect();
     let (order, single, shared) = multi::select_shared(
         &data,
@@ -557,7 +565,8 @@ fn fit_axis_multi(
         });
     }
     let j0 = order[0];
-    let (axis_logs, id0, _, _) = &per_sensor[j0];
+    let (id0, _, _) = &per_sensor[j0];
+    use_sensor(&mut axis_logs, j0);
     let named: Vec<NamedLog> = axis_logs
         .iter()
         .map(|(n, l)| NamedLog { name: n, log: l })
