@@ -219,32 +219,53 @@ impl<'a> Scorer<'a> {
 /// same arithmetic (`gyrotherm_core::features`), without its other features. Eight lags go
 /// through the run together: each is a chain of dependent steps, and eight chains keep the
 /// processor busy where one waits on each step.
+#[cfg(test)]
 fn lag_differences(t: &[f64], gaps: &[u64], p: f64, taus: &[f64]) -> Vec<Vec<f64>> {
-    let mut out: Vec<Vec<f64>> = taus.iter().map(|_| vec![0.0; t.len()]).collect();
+    let every: Vec<usize> = (0..t.len()).collect();
+    lag_differences_at(t, gaps, p, taus, &every)
+}
+
+/// [`lag_differences`] kept only at the steps `keep` (increasing): the lags still run through
+/// every step, but a search that reads a few steps stores only those.
+fn lag_differences_at(
+    t: &[f64],
+    gaps: &[u64],
+    p: f64,
+    taus: &[f64],
+    keep: &[usize],
+) -> Vec<Vec<f64>> {
+    let mut out: Vec<Vec<f64>> = taus.iter().map(|_| vec![0.0; keep.len()]).collect();
     for (tau, dst) in taus.chunks(8).zip(out.chunks_mut(8)) {
         match tau.len() {
-            1 => lag_lanes::<1>(t, gaps, p, tau, dst),
-            2 => lag_lanes::<2>(t, gaps, p, tau, dst),
-            3 | 4 => lag_lanes::<4>(t, gaps, p, tau, dst),
-            _ => lag_lanes::<8>(t, gaps, p, tau, dst),
+            1 => lag_lanes::<1>(t, gaps, p, tau, keep, dst),
+            2 => lag_lanes::<2>(t, gaps, p, tau, keep, dst),
+            3 | 4 => lag_lanes::<4>(t, gaps, p, tau, keep, dst),
+            _ => lag_lanes::<8>(t, gaps, p, tau, keep, dst),
         }
     }
     out
 }
 
-/// [`lag_differences`] of up to `W` lags (`dst` one output per lag), in `W` lanes; unused
+/// [`lag_differences_at`] of up to `W` lags (`dst` one output per lag), in `W` lanes; unused
 /// lanes run a τ of 1 s and are dropped.
-fn lag_lanes<const W: usize>(t: &[f64], gaps: &[u64], p: f64, tau: &[f64], dst: &mut [Vec<f64>]) {
+fn lag_lanes<const W: usize>(
+    t: &[f64],
+    gaps: &[u64],
+    p: f64,
+    tau: &[f64],
+    keep: &[usize],
+    dst: &mut [Vec<f64>],
+) {
     let mut lane = [1.0; W];
     lane[..tau.len()].copy_from_slice(tau);
     let g1 = lane.map(|tau| -libm::expm1(-p / tau));
     let mut c = [t.first().copied().unwrap_or(0.0); W];
-    let mut d = vec![[0.0; W]; t.len()];
-    for ((&v, &n), dk) in t.iter().zip(gaps).zip(&mut d) {
+    let mut d = vec![[0.0; W]; keep.len()];
+    let mut next = 0;
+    for (k, (&v, &n)) in t.iter().zip(gaps).enumerate() {
         if n == 1 {
             for i in 0..W {
                 c[i] += g1[i] * (v - c[i]);
-                dk[i] = v - c[i];
             }
         } else {
             for i in 0..W {
@@ -253,8 +274,13 @@ fn lag_lanes<const W: usize>(t: &[f64], gaps: &[u64], p: f64, tau: &[f64], dst: 
                     _ => -libm::expm1(-(n as f64) * p / lane[i]),
                 };
                 c[i] += gain * (v - c[i]);
-                dk[i] = v - c[i];
             }
+        }
+        if keep.get(next) == Some(&k) {
+            for i in 0..W {
+                d[next][i] = v - c[i];
+            }
+            next += 1;
         }
     }
     for (i, o) in dst.iter_mut().enumerate() {
@@ -274,11 +300,13 @@ impl Run {
             }
         }
         let p = FeatureSpec::THERMAL_STATE.step_period_s;
-        for (tau, all) in new
-            .iter()
-            .zip(lag_differences(&self.t_all, &self.gaps, p, &new))
-        {
-            let d = self.steps.iter().map(|&k| all[k]).collect();
+        for (tau, d) in new.iter().zip(lag_differences_at(
+            &self.t_all,
+            &self.gaps,
+            p,
+            &new,
+            &self.steps,
+        )) {
             self.lag.insert(tau.to_bits(), d);
         }
         Ok(())
