@@ -92,16 +92,19 @@ fn combined(parts: &[(&[TargetSet], &Terms)]) -> (Design, usize) {
         return (d, 0);
     };
     for (r, s) in first.iter().enumerate() {
-        let mut x = Vec::new();
-        let mut y = Vec::new();
-        let mut step = Vec::new();
         let n_rows = parts
             .iter()
             .map(|(sets, _)| sets[r].table.n_rows())
             .min()
             .unwrap_or(0);
+        let used = |k: usize| s.mask[k] && s.target[k].is_finite();
+        // Sized ahead: a design grown row by row copies itself over and over.
+        let rows = (0..n_rows).filter(|&k| used(k)).count();
+        let mut x = Vec::with_capacity(rows * nc);
+        let mut y = Vec::with_capacity(rows);
+        let mut step = Vec::with_capacity(rows);
         for k in 0..n_rows {
-            if s.mask[k] && s.target[k].is_finite() {
+            if used(k) {
                 for (i, (sets, terms)) in parts.iter().enumerate() {
                     terms.extend_design_row(sets[r].table.row(k), usize::from(i == 0), &mut x);
                 }
