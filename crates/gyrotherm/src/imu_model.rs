@@ -582,10 +582,12 @@ fn fit_axis_multi(
         .map(|(n, l)| NamedLog { name: n, log: l })
         .collect();
     let has_bias = data.iter().all(|d| !d.bias.is_empty());
-    // Several sensors replace the bias model, and with it the one-sensor coverage map.
-    let coverage = !(order.len() > 1 && has_bias);
+    // Several sensors replace the bias model, and with it the one-sensor coverage map: the
+    // one-sensor bias is not fitted, and the axis's model is checked once complete (with the
+    // unit's checks).
+    let own_bias = !(order.len() > 1 && has_bias);
     let mut outcome =
-        crate::fit::fit_model_with(&named, cfg, Some(id0.clone()), coverage, &|t, e, loss| {
+        crate::fit::fit_model_with(&named, cfg, Some(id0.clone()), own_bias, &|t, e, loss| {
             progress(k, j0, t, e, loss)
         })
         .map_err(|e| fit_err(j0, e))?;

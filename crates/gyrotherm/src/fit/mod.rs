@@ -305,15 +305,19 @@ pub fn fit_model_identified(
     fit_model_with(logs, cfg, identified, true, progress)
 }
 
-/// [`fit_model_identified`], the coverage map made only with `coverage` (a caller that
-/// replaces the bias model has no use for the one-sensor model's map).
+/// [`fit_model_identified`]; with `own_bias` false, for a caller that replaces the bias model,
+/// no bias model is fitted (unless an LSTM on it would tell the training summary), no coverage
+/// map made, and the model is left unchecked: the caller completes and checks it.
 pub(crate) fn fit_model_with(
     logs: &[NamedLog],
     cfg: &FitConfig,
     identified: Option<thermal::Identified>,
-    coverage: bool,
+    own_bias: bool,
     progress: &(dyn Fn(Target, usize, f64) + Sync),
 ) -> Result<FitOutcome, FitError> {
+    let coverage = own_bias;
+    // A residual LSTM's summary goes into the model's training record: fitted as before.
+    let fit_bias = own_bias || (cfg.thermal.residual_lstm && cfg.recipe.epochs > 0);
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
@@ -351,7 +355,7 @@ pub(crate) fn fit_model_with(
     }
     let (bias, scale) = std::thread::scope(|s| {
         let bias = s.spawn(|| {
-            (!bias_sets.is_empty())
+            (!bias_sets.is_empty() && fit_bias)
                 .then(|| {
                     fit_one(
                         &bias_sets,
@@ -394,9 +398,13 @@ pub(crate) fn fit_model_with(
         .collect();
     let (temp_range_c, rate_range_c_per_s) =
         model::training_ranges(&tables).ok_or(FitError::NoFeatureSteps)?;
+    // A bias left to the caller would have told the thermal recipe's summary without an LSTM
+    // (no epochs, no loss): the training record says the same as when it is fitted here.
+    let unfitted = TrainSummary::default();
     let lstm_summary = bias
         .as_ref()
         .and_then(|b| b.1.as_ref())
+        .or((identified.is_some() && !fit_bias && !bias_sets.is_empty()).then_some(&unfitted))
         .or(scale.as_ref().and_then(|s| s.1.as_ref()));
     let all_logs: Vec<&TestLog> = logs.iter().map(|l| l.log).collect();
     let training = TrainingInfo {
@@ -440,7 +448,9 @@ pub(crate) fn fit_model_with(
         None => (None, Some("no bias model: no coverage map".to_owned())),
     };
     let model = ModelFile { coverage, ..model };
-    model.validate()?;
+    if own_bias {
+        model.validate()?;
+    }
     Ok(FitOutcome {
         model,
         bias_training,
