@@ -575,7 +575,7 @@ fn fit_axis_multi(
         });
     }
     let j0 = order[0];
-    let (id0, _, _) = &per_sensor[j0];
+    let (id0, bias0, scale0) = &per_sensor[j0];
     use_sensor(&mut axis_logs, j0);
     let named: Vec<NamedLog> = axis_logs
         .iter()
@@ -586,11 +586,16 @@ fn fit_axis_multi(
     // one-sensor bias is not fitted, and the axis's model is checked once complete (with the
     // unit's checks).
     let own_bias = !(order.len() > 1 && has_bias);
-    let mut outcome =
-        crate::fit::fit_model_with(&named, cfg, Some(id0.clone()), own_bias, &|t, e, loss| {
-            progress(k, j0, t, e, loss)
-        })
-        .map_err(|e| fit_err(j0, e))?;
+    // Its training sets are the ones made for the selection.
+    let mut outcome = crate::fit::fit_model_with(
+        &named,
+        cfg,
+        Some(id0.clone()),
+        own_bias,
+        Some((bias0, scale0)),
+        &|t, e, loss| progress(k, j0, t, e, loss),
+    )
+    .map_err(|e| fit_err(j0, e))?;
     outcome.model.features.temp_sensor = *temp_sensor;
     let mut more = Vec::new();
     let mut multi_cv_rms = None;
