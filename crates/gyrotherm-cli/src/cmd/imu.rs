@@ -33,10 +33,10 @@ pub fn read_imu_logs_with(
 ) -> anyhow::Result<Vec<(String, ImuLog)>> {
     let mut out = Vec::new();
     let mut failed = 0;
-    for p in paths {
-        match csvlog::read_imu_log(p, opts, args.table_axis.as_deref())
-            .with_context(|| format!("cannot use log {}", p.display()))
-        {
+    // The files are read at once, each on its own thread; what each gave is told in order.
+    let read = csvlog::read_imu_logs(paths, opts, args.table_axis.as_deref());
+    for (p, r) in paths.iter().zip(read) {
+        match r.with_context(|| format!("cannot use log {}", p.display())) {
             Ok((log, report)) => {
                 if report.filled_gaps > 0 {
                     eprintln!(
