@@ -710,3 +710,356 @@ fn run_text_compare(s: &Path, t: &Path, h: &Path, temps: &str, spec: &Path) -> S
         .unwrap();
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
+
+/// The bias stability each axis's verdict holds (the first `bias_stability_dph` figure).
+fn stability_per_axis(unit: &serde_json::Value) -> Vec<f64> {
+    unit["axes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| {
+            a["verdict"]["figures"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|f| f["figure"] == "bias_stability_dph")
+                .and_then(|f| f["value"].as_f64())
+                .expect("bias stability in the axis's verdict")
+        })
+        .collect()
+}
+
+/// A limit halfway between the largest of `v` and the next: exactly the worst one misses it.
+/// Returns (limit, index of the worst).
+fn limit_failing_the_worst(v: &[f64]) -> (f64, usize) {
+    let worst = (0..v.len()).max_by(|&i, &j| v[i].total_cmp(&v[j])).unwrap();
+    let mut sorted = v.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    assert!(sorted[n - 2] < sorted[n - 1], "{v:?}");
+    ((sorted[n - 2] + sorted[n - 1]) / 2.0, worst)
+}
+
+/// `lot add` with a unit model records a verdict per axis and the unit's, each axis's figures
+/// equal to what `evaluate --model UNIT.json --spec` measures and judges on the same log (an
+/// independent path: the evaluate command), the unit failing when one axis misses; `lot list`
+/// and `lot report` show the axes and count the unit as passed only when every axis passed.
+#[test]
+fn lot_add_records_each_axis_and_the_unit_as_evaluate_judges_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (model, _) = train(d);
+    let held = sim(d, "h.csv", &["--seed", "3"]);
+    let loose = write_spec(
+        d,
+        "loose.toml",
+        "bias_stability_dph = { max = 1e6 }\narw_deg_rt_h = { max = 1e6 }\n",
+    );
+    let evaluate = |spec: &Path| {
+        let out = gyrotherm()
+            .args(["evaluate", "--json", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&held)
+            .arg("--spec")
+            .arg(spec)
+            .output()
+            .unwrap();
+        (out.status.code(), json(&out))
+    };
+    let (_, ev) = evaluate(&loose);
+    let (limit, worst) = limit_failing_the_worst(&stability_per_axis(&ev));
+    let tight = write_spec(
+        d,
+        "tight.toml",
+        &format!("bias_stability_dph = {{ max = {limit} }}\n"),
+    );
+    let (code, ev_tight) = evaluate(&tight);
+    assert_eq!(code, Some(1));
+    let db = d.join("lot.sqlite");
+    let add = |serial: &str, spec: &Path, json_out: bool| {
+        let mut c = gyrotherm();
+        c.args(["lot", "add", "--db"])
+            .arg(&db)
+            .args(["--unit", serial, "--model"])
+            .arg(&model)
+            .arg("--test")
+            .arg(&held)
+            .arg("--spec")
+            .arg(spec);
+        if json_out {
+            c.arg("--json");
+        }
+        c.output().unwrap()
+    };
+    let out = add("IMU-1", &loose, false);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.matches("against the spec:").count(), 3, "{text}");
+    assert!(
+        text.contains("unit verdict: PASS (spec unit acceptance, 3 axes, compensated output)"),
+        "{text}"
+    );
+    let out = add("IMU-2", &tight, true);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run = json(&out);
+    assert_eq!(run["verdict"], "fail");
+    let gyros = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];
+    for (k, g) in gyros.iter().enumerate() {
+        let a = &run["axes"][k];
+        assert_eq!(
+            (a["axis"].as_u64(), a["gyro"].as_str()),
+            (Some(k as u64), Some(*g))
+        );
+        assert_eq!(
+            a["verdict"],
+            if k == worst { "fail" } else { "pass" },
+            "{g}"
+        );
+        assert_eq!(ev_tight["axes"][k]["verdict"]["pass"], k != worst);
+        // Each limited figure of the axis: value, pass and margin as evaluate gives them.
+        let recorded: Vec<(String, f64, bool, f64)> = run["figures"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|f| f["axis"] == k && !f["pass"].is_null())
+            .map(|f| {
+                (
+                    f["figure"].as_str().unwrap().to_owned(),
+                    f["value"].as_f64().unwrap(),
+                    f["pass"].as_bool().unwrap(),
+                    f["margin"].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        let judged: Vec<(String, f64, bool, f64)> = ev_tight["axes"][k]["verdict"]["figures"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| {
+                (
+                    f["figure"].as_str().unwrap().to_owned(),
+                    f["value"].as_f64().unwrap(),
+                    f["pass"].as_bool().unwrap(),
+                    f["margin"].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        assert_eq!(recorded, judged, "{g}");
+    }
+    let db_s = db.to_str().unwrap();
+    let list = run_ok(gyrotherm().args(["lot", "list", "--db", db_s]));
+    let list = String::from_utf8_lossy(&list.stdout);
+    assert!(
+        list.contains(&format!("axis {}: {} (temp_", worst + 1, gyros[worst])),
+        "{list}"
+    );
+    assert!(list.contains("2 units: 1 passed, 1 failed"), "{list}");
+    let rep = d.join("rep");
+    let out = run_ok(
+        gyrotherm()
+            .args(["lot", "report", "--db", db_s, "--out"])
+            .arg(&rep),
+    );
+    let out = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.contains("2 units (2 runs): 1 passed, 1 failed"),
+        "{out}"
+    );
+    let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(page.contains("<table id=\"axes\">"), "{page}");
+    let csv = std::fs::read_to_string(rep.join("lot.csv")).unwrap();
+    assert!(
+        csv.lines().any(|l| l.contains(",bias_stability_dph,")
+            && l.ends_with(&format!(",{},fail", gyros[worst]))),
+        "{csv}"
+    );
+
+    // A single-axis model given column lists: refused with what to do, nothing recorded.
+    let single = d.join("single.json");
+    run_ok(
+        gyrotherm()
+            .args(["train", "--method", "linear", "--gyro-col", "gyro_x_dps"])
+            .args(["--temp-col", "temp_case_c", "--out"])
+            .arg(&single)
+            .arg("--input")
+            .arg(&held),
+    );
+    let out = gyrotherm()
+        .args(["lot", "add", "--db", db_s, "--unit", "X", "--model"])
+        .arg(&single)
+        .args(["--gyro-col", GYROS, "--temp-col", "temp_case_c", "--test"])
+        .arg(&held)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("need an inertial unit's model"), "{err}");
+}
+
+/// The lines of the verdict that follows the line `header` in `text`, up to and including its
+/// `verdict:` line.
+fn verdict_after(text: &str, header: &str) -> Vec<String> {
+    let mut lines = text.lines().skip_while(|l| *l != header);
+    assert!(lines.next().is_some(), "{header:?} not in:\n{text}");
+    let mut out = Vec::new();
+    for l in lines {
+        out.push(l.to_owned());
+        if l.starts_with("verdict: ") {
+            return out;
+        }
+    }
+    panic!("no verdict line after {header:?}:\n{text}");
+}
+
+/// `report --spec` with column lists: each axis's verdicts and the unit's on stdout and on
+/// the page; the unit fit's verdict on each axis equals `evaluate --model UNIT.json --spec`
+/// of the unit `train` builds with the same lists (line for line, the same held-out log),
+/// exit 0 when every column passes, 1 when a limit between the axes fails one axis.
+#[test]
+fn report_spec_with_lists_gives_each_axis_and_the_unit_as_evaluate_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (s, t, h, model) = unit_on_all_sensors(d);
+    let loose = write_spec(
+        d,
+        "loose.toml",
+        "bias_stability_dph = { max = 1e6 }\narw_deg_rt_h = { max = 1e6 }\n",
+    );
+    let report = |spec: &Path, out: &Path| {
+        gyrotherm()
+            .args(["report", "--methods", "linear,thermal"])
+            .args(["--gyro-col", GYROS, "--temp-col", ALL_TEMPS, "--train"])
+            .arg(&s)
+            .arg("--train")
+            .arg(&t)
+            .arg("--test")
+            .arg(&h)
+            .arg("--spec")
+            .arg(spec)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap()
+    };
+    let evaluate = |spec: &Path, json_out: bool| {
+        let mut c = gyrotherm();
+        c.args(["evaluate", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&h)
+            .arg("--spec")
+            .arg(spec);
+        if json_out {
+            c.arg("--json");
+        }
+        c.output().unwrap()
+    };
+    let gyros = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];
+    let rep = d.join("rep");
+    let out = report(&loose, &rep);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let ev = String::from_utf8_lossy(&evaluate(&loose, false).stdout).into_owned();
+    let unit_fit_verdicts = |text: &str| -> Vec<Vec<String>> {
+        gyros
+            .iter()
+            .enumerate()
+            .map(|(k, g)| {
+                let from_axis: String = text
+                    .split(&format!("axis {} ({g}) against the spec:", k + 1))
+                    .nth(1)
+                    .expect("the axis's verdicts")
+                    .to_owned();
+                let header = from_axis
+                    .lines()
+                    .find(|l| l.ends_with("(unit fit):"))
+                    .expect("the unit fit's verdict")
+                    .to_owned();
+                verdict_after(&from_axis, &header)
+            })
+            .collect()
+    };
+    for (k, (r, g)) in unit_fit_verdicts(&text).iter().zip(gyros).enumerate() {
+        let e = verdict_after(&ev, &format!("axis {} ({g}) against the spec:", k + 1));
+        assert_eq!(r, &e, "{g}");
+    }
+    assert!(text.contains("unit fit: PASS on every axis"), "{text}");
+    let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(page.contains("<table class=\"unit-verdicts\">"), "{page}");
+    assert!(
+        page.contains(
+            "<tr><td>unit fit</td><td>PASS</td><td>PASS</td><td>PASS</td><td>PASS</td></tr>"
+        ),
+        "{page}"
+    );
+    for k in 1..=3 {
+        assert!(
+            page.contains(&format!("<h3>Axis {k} against the spec: PASS</h3>")),
+            "{page}"
+        );
+    }
+
+    // A limit between the unit's worst axis and the next: that axis and the unit fail, in
+    // the report as in evaluate.
+    let unit = json(&evaluate(&loose, true));
+    let (limit, worst) = limit_failing_the_worst(&stability_per_axis(&unit));
+    let tight = write_spec(
+        d,
+        "tight.toml",
+        &format!("bias_stability_dph = {{ max = {limit} }}\n"),
+    );
+    let out = evaluate(&tight, true);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        json(&out)["verdict"]["failed_axes"],
+        serde_json::json!([gyros[worst]])
+    );
+    let rep = d.join("rep_tight");
+    let out = report(&tight, &rep);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let ev = String::from_utf8_lossy(&evaluate(&tight, false).stdout).into_owned();
+    for (k, (r, g)) in unit_fit_verdicts(&text).iter().zip(gyros).enumerate() {
+        let e = verdict_after(&ev, &format!("axis {} ({g}) against the spec:", k + 1));
+        assert_eq!(r, &e, "{g}");
+    }
+    assert!(
+        text.contains(&format!("unit fit: FAIL on {}", gyros[worst])),
+        "{text}"
+    );
+    let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    let cells: String = (0..3)
+        .map(|k| {
+            if k == worst {
+                "<td>FAIL</td>"
+            } else {
+                "<td>PASS</td>"
+            }
+        })
+        .collect();
+    assert!(
+        page.contains(&format!("<tr><td>unit fit</td>{cells}<td>FAIL</td></tr>")),
+        "{page}"
+    );
+}

@@ -15,7 +15,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 
 /// Every run of the lot at `db` (an SQLite file or a postgres:// URL) as a dict of columns,
 /// the rows of `lot.csv` (`gyrotherm lot report`): numbers as float arrays (NaN where a
-/// figure has no limit), text as lists of str.
+/// figure has no limit), text as lists of str; an inertial unit's rows name the axis (`axis`,
+/// its gyro column) and the axis's verdict (`axis_verdict`), None on a single-axis run.
 #[pyfunction]
 fn read_lot<'py>(py: Python<'py>, db: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let db = db.display().to_string();
@@ -40,6 +41,8 @@ fn read_lot<'py>(py: Python<'py>, db: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let mut limit_max = Vec::with_capacity(n);
     let mut verdict = Vec::with_capacity(n);
     let mut margin = Vec::with_capacity(n);
+    let mut axis = Vec::with_capacity(n);
+    let mut axis_verdict = Vec::with_capacity(n);
     for r in &runs {
         let at = r.tested_at();
         for f in &r.figures {
@@ -62,6 +65,10 @@ fn read_lot<'py>(py: Python<'py>, db: PathBuf) -> PyResult<Bound<'py, PyDict>> {
             limit_max.push(f.limit_max.unwrap_or(f64::NAN));
             verdict.push(f.pass.map(|p| if p { "pass" } else { "fail" }));
             margin.push(f.margin.unwrap_or(f64::NAN));
+            // An inertial unit's axis (its gyro column) and the axis's verdict.
+            let a = f.axis.and_then(|k| r.axes.iter().find(|a| a.axis == k));
+            axis.push(a.map(|a| a.gyro.clone()));
+            axis_verdict.push(a.map(|a| a.verdict.as_str()));
         }
     }
     let d = PyDict::new(py);
@@ -79,5 +86,7 @@ fn read_lot<'py>(py: Python<'py>, db: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("limit_max", limit_max.into_pyarray(py))?;
     d.set_item("verdict", verdict)?;
     d.set_item("margin", margin.into_pyarray(py))?;
+    d.set_item("axis", axis)?;
+    d.set_item("axis_verdict", axis_verdict)?;
     Ok(d)
 }

@@ -56,3 +56,44 @@ def test_read_lot_errors(tmp_path):
     junk.write_bytes(b"x" * 4096)
     with pytest.raises(gt.GyrothermError, match="not an SQLite database"):
         gt.read_lot(junk)
+
+
+@pytest.fixture(scope="module")
+def unit_lot(cli, tmp_path_factory):
+    """A lot holding one inertial unit (three axes) added by the CLI from a unit model."""
+    d = tmp_path_factory.mktemp("unit_lot")
+    sim = ["simulate", "--imu", "--unit", "random", "--unit-seed", "1000", "--profile",
+           "fast-cycle"]
+    s, t, h = d / "s.csv", d / "t.csv", d / "h.csv"
+    cli(*sim, "--seed", "1", "--out", s)
+    cli(*sim, "--seed", "2", "--table-rate", "20", "--table-axis", "y", "--out", t)
+    cli(*sim, "--seed", "3", "--out", h)
+    model = d / "unit.json"
+    cli("train", "--method", "linear", "--gyro-col", "gyro_x_dps,gyro_y_dps,gyro_z_dps",
+        "--temp-col", "temp_case_c", "--input", s, "--input", t, "--out", model)
+    spec = d / "spec.toml"
+    spec.write_text("[limits]\nbias_stability_dph = { max = 1e6 }\n")
+    db = d / "lot.sqlite"
+    cli("lot", "add", "--db", db, "--unit", "IMU-1", "--model", model, "--test", h,
+        "--spec", spec)
+    return db, model, h, spec
+
+
+def test_read_lot_of_a_unit_names_each_axis(cli, unit_lot):
+    db, model, h, spec = unit_lot
+    cols = gt.read_lot(db, as_frame=False)
+    bs = [i for i, f in enumerate(cols["figure"]) if f == "bias_stability_dph"]
+    assert [cols["axis"][i] for i in bs] == ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"]
+    assert [cols["axis_verdict"][i] for i in bs] == ["pass"] * 3
+    assert {cols["run_verdict"][i] for i in bs} == {"pass"}
+    # Each axis's value is the one evaluate --model UNIT.json measures on the same log.
+    ev = gt.evaluate(h, model=model, spec=spec)
+    want = [next(f["value"] for f in a["verdict"]["figures"]
+                 if f["figure"] == "bias_stability_dph") for a in ev["axes"]]
+    assert list(cols["value"][bs]) == want
+
+
+def test_read_lot_single_axis_rows_have_no_axis(lot):
+    cols = gt.read_lot(lot, as_frame=False)
+    assert all(a is None for a in cols["axis"])
+    assert all(v is None for v in cols["axis_verdict"])

@@ -153,6 +153,29 @@ pub struct UnitVerdict {
 }
 
 impl UnitVerdict {
+    /// The one rule of a unit's verdict: it passes only when every axis passes. `axes`: each
+    /// axis's gyro column and whether it passed, in column order; `judged`: which output
+    /// (`compensated` or `raw`).
+    pub fn from_axes<'a>(
+        spec: &str,
+        spec_sha256: &str,
+        judged: &'static str,
+        axes: impl IntoIterator<Item = (&'a str, bool)>,
+    ) -> UnitVerdict {
+        let failed_axes: Vec<String> = axes
+            .into_iter()
+            .filter(|(_, pass)| !pass)
+            .map(|(g, _)| g.to_owned())
+            .collect();
+        UnitVerdict {
+            spec: spec.to_owned(),
+            spec_sha256: spec_sha256.to_owned(),
+            judged,
+            pass: failed_axes.is_empty(),
+            failed_axes,
+        }
+    }
+
     /// `PASS` or `FAIL`.
     pub fn word(&self) -> &'static str {
         if self.pass {
@@ -329,24 +352,109 @@ pub fn evaluate_imu_spec(
     }
     let tau = tau.ok_or_else(|| ImuJudgeError::Layout("no gyro column".into()))?;
     let verdict = spec.map(|sp| {
-        let failed_axes: Vec<String> = axes
-            .iter()
-            .filter(|a| a.verdict.as_ref().is_some_and(|v| !v.pass))
-            .map(|a| a.gyro.clone())
-            .collect();
-        UnitVerdict {
-            spec: sp.name.clone(),
-            spec_sha256: sp.sha256.clone(),
-            judged: if model.is_some() {
+        UnitVerdict::from_axes(
+            &sp.name,
+            &sp.sha256,
+            if model.is_some() {
                 "compensated"
             } else {
                 "raw"
             },
-            pass: failed_axes.is_empty(),
-            failed_axes,
-        }
+            axes.iter()
+                .map(|a| (a.gyro.as_str(), a.verdict.as_ref().is_none_or(|v| v.pass))),
+        )
     });
     Ok(UnitEvaluation { axes, tau, verdict })
+}
+
+/// Every figure of one axis of a unit's compensated output on each held-out log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisFigures {
+    /// The gyro column.
+    pub gyro: String,
+    /// The temperature columns the axis's model reads, the first sensor first.
+    pub temps: Vec<String>,
+    /// Per held-out log, in order: its name and the figures measured on it.
+    pub measured: Vec<(String, spec::Figures)>,
+}
+
+/// Every figure ([`spec::measure`] with `opts`) of each axis's compensated output (the flight
+/// compensator's, as `compensate` writes it) on each held-out log, each axis measured on its
+/// single-axis view of the log ([`axis_test_log`]) as `evaluate --model` measures it. The
+/// logs must be read with the model's columns ([`ImuModel::read_options`]). Axes in the
+/// model's order.
+pub fn measure_unit(
+    model: &ImuModel,
+    tests: &[(String, ImuLog)],
+    opts: &MeasureOptions,
+) -> Result<Vec<AxisFigures>, ImuJudgeError> {
+    let mut axes: Vec<AxisFigures> = model
+        .axes
+        .iter()
+        .map(|a| AxisFigures {
+            gyro: a.gyro.clone(),
+            temps: a.temps.clone(),
+            measured: Vec::with_capacity(tests.len()),
+        })
+        .collect();
+    for (name, log) in tests {
+        let comp = compensate_imu(model, log).map_err(ImuJudgeError::Unit)?;
+        for (i, a) in axes.iter_mut().enumerate() {
+            let k = log
+                .gyro
+                .iter()
+                .position(|g| g.name == a.gyro)
+                .ok_or_else(|| {
+                    ImuJudgeError::Layout(format!(
+                        "{name}: no gyro column {} (the model's axis {}); read the log with \
+                         the model's columns",
+                        a.gyro,
+                        i + 1
+                    ))
+                })?;
+            let axis_log = axis_test_log(log, k, 0);
+            let f = spec::measure(&axis_log, &comp[i].gyro_comp_dps, opts).map_err(|source| {
+                ImuJudgeError::Spec {
+                    gyro: a.gyro.clone(),
+                    output: "compensated",
+                    source: Box::new(SpecError::Measure {
+                        log: name.clone(),
+                        source,
+                    }),
+                }
+            })?;
+            a.measured.push((name.clone(), f));
+        }
+    }
+    Ok(axes)
+}
+
+/// Each axis of [`measure_unit`] judged against `spec` on all its held-out logs (as the
+/// single-axis [`spec::judge`] judges one column), and the unit's verdict
+/// ([`UnitVerdict::from_axes`]: compensated output).
+pub fn judge_unit_figures(
+    spec: &Spec,
+    axes: &[AxisFigures],
+) -> Result<(Vec<Verdict>, UnitVerdict), ImuJudgeError> {
+    let verdicts = axes
+        .iter()
+        .map(|a| {
+            spec::judge(spec, &a.measured).map_err(|source| ImuJudgeError::Spec {
+                gyro: a.gyro.clone(),
+                output: "compensated",
+                source: Box::new(source),
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let unit = UnitVerdict::from_axes(
+        &spec.name,
+        &spec.sha256,
+        "compensated",
+        axes.iter()
+            .zip(&verdicts)
+            .map(|(a, v)| (a.gyro.as_str(), v.pass)),
+    );
+    Ok((verdicts, unit))
 }
 
 /// One axis's output judged against `spec`, as `evaluate --spec` judges one column.
@@ -644,11 +752,15 @@ impl AxisVerdicts {
     }
 }
 
-/// One line per judged column across the axes: `linear: FAIL on gyro_x_dps, gyro_z_dps`,
-/// `unit fit: PASS on every axis` (the columns in the order of the tables).
-pub fn verdicts_across_axes(axes: &[AxisVerdicts]) -> Vec<String> {
+/// The name of the unit fit's column in [`unit_verdicts`] and [`verdicts_across_axes`].
+pub const UNIT_FIT_COLUMN: &str = "unit fit";
+
+/// The unit's verdict of each judged column across the axes ([`UnitVerdict::from_axes`]: a
+/// column passes for the unit only when it passes on every axis), the columns in the order
+/// of the tables, the unit's own fit ([`UNIT_FIT_COLUMN`]) last.
+pub fn unit_verdicts(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<(String, UnitVerdict)> {
     let mut names: Vec<String> = Vec::new();
-    let mut failed: Vec<Vec<&str>> = Vec::new();
+    let mut per: Vec<Vec<(&str, bool)>> = Vec::new();
     for a in axes {
         let mut cols: Vec<(String, bool)> = a
             .columns
@@ -656,30 +768,40 @@ pub fn verdicts_across_axes(axes: &[AxisVerdicts]) -> Vec<String> {
             .map(|c| (c.label.to_owned(), c.verdict.pass))
             .collect();
         if let Some((_, v)) = &a.unit_fit {
-            cols.push(("unit fit".to_owned(), v.pass));
+            cols.push((UNIT_FIT_COLUMN.to_owned(), v.pass));
         }
         for (name, pass) in cols {
             let i = match names.iter().position(|n| *n == name) {
                 Some(i) => i,
                 None => {
                     names.push(name);
-                    failed.push(Vec::new());
+                    per.push(Vec::new());
                     names.len() - 1
                 }
             };
-            if !pass {
-                failed[i].push(a.gyro.as_str());
-            }
+            per[i].push((a.gyro.as_str(), pass));
         }
     }
     names
         .into_iter()
-        .zip(failed)
-        .map(|(n, f)| {
-            if f.is_empty() {
+        .zip(per)
+        .map(|(n, axes)| {
+            let v = UnitVerdict::from_axes(&spec.name, &spec.sha256, "compensated", axes);
+            (n, v)
+        })
+        .collect()
+}
+
+/// One line per judged column across the axes ([`unit_verdicts`]): `linear: FAIL on
+/// gyro_x_dps, gyro_z_dps`, `unit fit: PASS on every axis`.
+pub fn verdicts_across_axes(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<String> {
+    unit_verdicts(spec, axes)
+        .into_iter()
+        .map(|(n, v)| {
+            if v.pass {
                 format!("{n}: PASS on every axis")
             } else {
-                format!("{n}: FAIL on {}", f.join(", "))
+                format!("{n}: FAIL on {}", v.failed_axes.join(", "))
             }
         })
         .collect()

@@ -298,12 +298,13 @@ pub fn fit_imu_full(
     } else {
         Vec::new()
     };
-    let axes: Vec<Result<ImuAxis, ImuError>> = std::thread::scope(|scope| {
+    type Checked = (ImuAxis, Result<(), ImuError>);
+    let axes: Vec<Result<Checked, ImuError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..gyro_cols.len())
             .map(|k| {
                 let (gyro_cols, temp_cols, shared) = (&gyro_cols, &temp_cols, &shared);
                 scope.spawn(move || {
-                    if multi_path {
+                    let axis = if multi_path {
                         fit_axis_multi(
                             logs,
                             shared,
@@ -327,7 +328,10 @@ pub fn fit_imu_full(
                             progress,
                             events,
                         )
-                    }
+                    }?;
+                    // The axis's part of the model's checks, here while other axes still fit.
+                    let checked = axis_checks(temp_cols, &axis);
+                    Ok((axis, checked))
                 })
             })
             .collect();
@@ -339,7 +343,11 @@ pub fn fit_imu_full(
             })
             .collect()
     });
-    let axes = axes.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let (axes, checks): (Vec<ImuAxis>, Vec<_>) = axes
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .unzip();
     let several = axes.iter().any(|a| !a.more.is_empty());
     let model = ImuModel {
         imu_format_version: if several {
@@ -351,7 +359,9 @@ pub fn fit_imu_full(
         temp_cols,
         axes,
     };
-    model.validate()?;
+    // ImuModel::validate, its per-axis part made in the axes' threads.
+    model.validate_columns()?;
+    checks.into_iter().collect::<Result<(), _>>()?;
     Ok(model)
 }
 
@@ -466,16 +476,27 @@ fn fit_axis_multi(
     };
     // The targets' per-sample part reads the axis's gyro column, not the sensor: made once per
     // run for the four sensors.
-    let samples: Vec<(bool, Result<targets::GyroSamples, targets::TargetError>)> = logs
+    // One copy of each run's columns for this axis; each sensor in turn puts its temperature
+    // column in place (the rest is the same for every sensor).
+    let mut axis_logs: Vec<(String, TestLog)> = logs
         .iter()
-        .map(|(_, l)| {
-            let a = l.axis_data(k, 0);
-            if targets::is_static(&a) {
-                (false, targets::bias_samples(&a, cfg.bias_window_s))
+        .map(|(n, l)| (n.clone(), l.axis_data(k, 0)))
+        .collect();
+    let use_sensor = |axis_logs: &mut [(String, TestLog)], j: usize| {
+        for ((_, a), (_, l)) in axis_logs.iter_mut().zip(logs) {
+            a.temp_c.clear();
+            a.temp_c.extend_from_slice(&l.temp[j].values);
+        }
+    };
+    let samples: Vec<(bool, Result<targets::GyroSamples, targets::TargetError>)> = axis_logs
+        .iter()
+        .map(|(_, a)| {
+            if targets::is_static(a) {
+                (false, targets::bias_samples(a, cfg.bias_window_s))
             } else {
                 (
                     true,
-                    targets::scale_samples(&a, cfg.settle_s, cfg.scale_window_s),
+                    targets::scale_samples(a, cfg.settle_s, cfg.scale_window_s),
                 )
             }
         })
@@ -483,10 +504,7 @@ fn fit_axis_multi(
     let mut per_sensor = Vec::with_capacity(temp_cols.len());
     for j in 0..temp_cols.len() {
         events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
-        let axis_logs: Vec<(String, TestLog)> = logs
-            .iter()
-            .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
-            .collect();
+        use_sensor(&mut axis_logs, j);
         let named: Vec<NamedLog> = axis_logs
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
@@ -528,11 +546,11 @@ fn fit_axis_multi(
                 bias.push(t);
             }
         }
-        per_sensor.push((axis_logs, id, bias, scale));
+        per_sensor.push((id, bias, scale));
     }
     let data: Vec<SensorData> = per_sensor
         .iter()
-        .map(|(_, id, bias, scale)| SensorData { id, bias, scale })
+        .map(|(id, bias, scale)| SensorData { id, bias, scale })
         .collect();
     // The several-sensor fits' ridge strengths (an experiment's override of the grid).
     let multi_thermal = match settings.multi_ridge_decades {
@@ -548,7 +566,7 @@ fn fit_axis_multi(
         first: settings.multi_first,
         select_folds: settings.multi_select_folds,
     };
-    let (order, single) = multi::select(&data, &multi_thermal, &mc);
+    let (order, single, shared) = multi::select_shared(&data, &multi_thermal, &mc);
     let scores: Vec<SensorScore> = temp_cols
         .iter()
         .zip(&single)
@@ -566,19 +584,27 @@ fn fit_axis_multi(
         });
     }
     let j0 = order[0];
-    let (axis_logs, id0, _, _) = &per_sensor[j0];
+    let (id0, bias0, scale0) = &per_sensor[j0];
+    use_sensor(&mut axis_logs, j0);
     let named: Vec<NamedLog> = axis_logs
         .iter()
         .map(|(n, l)| NamedLog { name: n, log: l })
         .collect();
     let has_bias = data.iter().all(|d| !d.bias.is_empty());
-    // Several sensors replace the bias model, and with it the one-sensor coverage map.
-    let coverage = !(order.len() > 1 && has_bias);
-    let mut outcome =
-        crate::fit::fit_model_with(&named, cfg, Some(id0.clone()), coverage, &|t, e, loss| {
-            progress(k, j0, t, e, loss)
-        })
-        .map_err(|e| fit_err(j0, e))?;
+    // Several sensors replace the bias model, and with it the one-sensor coverage map: the
+    // one-sensor bias is not fitted (unless an experiment's blend reads it), and the axis's
+    // model is checked once complete (with the unit's checks).
+    let own_bias = !(order.len() > 1 && has_bias) || settings.blend != 0.0;
+    // Its training sets are the ones made for the selection.
+    let mut outcome = crate::fit::fit_model_with(
+        &named,
+        cfg,
+        Some(id0.clone()),
+        own_bias,
+        Some((bias0, scale0)),
+        &|t, e, loss| progress(k, j0, t, e, loss),
+    )
+    .map_err(|e| fit_err(j0, e))?;
     outcome.model.features.temp_sensor = *temp_sensor;
     let mut more = Vec::new();
     let mut multi_cv_rms = None;
@@ -590,16 +616,21 @@ fn fit_axis_multi(
                 if mc.first == multi::FirstBy::Average {
                     multi::fit_multi_averaged(&data, &order, &multi_thermal, &mc, false)
                 } else {
-                    multi::fit_multi(&data, &order, &multi_thermal, &mc, false)
+                    multi::fit_multi_with(&data, &order, &multi_thermal, &mc, false, shared.as_ref())
                 }
             })
             .transpose()
             .map_err(thermal_err)?;
         // The scale factor reads the further sensors only when they help it too.
         let scale = if has_scale {
-            let one = multi::cv_rms(&data, &order[..1], &multi_thermal, &mc, true);
-            let all =
-                multi::fit_multi(&data, &order, &multi_thermal, &mc, true).map_err(thermal_err)?;
+            // The selection's statistics are the bias's when the axis has a static run.
+            let own = has_bias
+                .then(|| multi::shared(&data, order[0], &order[1..], &multi_thermal, &mc, true))
+                .flatten();
+            let sh = own.as_ref().or(shared.as_ref());
+            let one = multi::cv_rms_with(&data, &order[..1], &multi_thermal, &mc, true, sh);
+            let all = multi::fit_multi_with(&data, &order, &multi_thermal, &mc, true, sh)
+                .map_err(thermal_err)?;
             match (one, all.cv_rms) {
                 (Some(o), Some(a)) if a < o * (1.0 - settings.min_gain) => Some(all),
                 _ => None,
@@ -675,10 +706,116 @@ fn blend_with_one(mut b: multi::MultiFit, one: Option<&SubModel>, w: f64) -> mul
     b
 }
 
+/// One axis's checks in [`ImuModel::validate`]: its sensors among `temp_cols`, its model, and
+/// the flight compensator its further sensors build.
+fn axis_checks(temp_cols: &[String], a: &ImuAxis) -> Result<(), ImuError> {
+    let distinct = a
+        .temps
+        .iter()
+        .enumerate()
+        .all(|(i, t)| !a.temps[..i].contains(t));
+    if a.temps.is_empty()
+        || a.temps.len() > MAX_SENSORS
+        || !distinct
+        || !a.temps.iter().all(|t| temp_cols.contains(t))
+    {
+        return Err(ImuError::Layout(format!(
+            "axis {} must read 1 to {MAX_SENSORS} distinct temperature columns among \
+             {}",
+            a.gyro,
+            temp_cols.join(", ")
+        )));
+    }
+    if a.more.len() + 1 != a.temps.len() {
+        return Err(ImuError::Layout(format!(
+            "axis {}: `more` must hold one entry per further sensor ({} of them)",
+            a.gyro,
+            a.temps.len() - 1
+        )));
+    }
+    a.model.validate().map_err(|source| ImuError::Axis {
+        gyro: a.gyro.clone(),
+        source: Box::new(source),
+    })?;
+    if !a.more.is_empty() {
+        // The further sensors' parts must build a flight compensator.
+        axis_compensator_in(temp_cols, a)?;
+    }
+    Ok(())
+}
+
+/// `check` of each axis, on a thread per axis when there are several, in axis order.
+fn each_axis<T: Send>(axes: &[ImuAxis], check: impl Fn(&ImuAxis) -> T + Sync) -> Vec<T> {
+    if axes.len() < 2 {
+        return axes.iter().map(check).collect();
+    }
+    let check = &check;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = axes.iter().map(|a| scope.spawn(move || check(a))).collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
+}
+
+/// [`ImuModel::axis_compensator`] with the model's temperature columns `temp_cols`.
+fn axis_compensator_in(temp_cols: &[String], a: &ImuAxis) -> Result<AxisCompensator, ImuError> {
+    let index = |t: &String| {
+        temp_cols
+            .iter()
+            .position(|c| c == t)
+            .ok_or_else(|| ImuError::Layout(format!("axis {} reads unknown sensor {t}", a.gyro)))
+    };
+    let layout = |what: String| ImuError::Layout(format!("axis {}: {what}", a.gyro));
+    let first = compensator(&a.model).map_err(|source| ImuError::Compensate {
+        gyro: a.gyro.clone(),
+        source: Box::new(source),
+    })?;
+    let spec0 = *first.spec();
+    let mut axis = AxisCompensator::new(first, index(&a.temps[0])?);
+    for (t, m) in a.temps.iter().skip(1).zip(&a.more) {
+        let spec = spec0
+            .with_lags(&m.lags_s, LagOutputs::DiffFromT)
+            .map_err(|e| layout(format!("sensor {t}: {e}")))?;
+        let part = |sub: &Option<SubModel>, what: &str| match sub {
+            None => Ok(None),
+            Some(SubModel::Baseline {
+                terms,
+                coefficients,
+            }) => crate::baseline::to_core(terms, coefficients)
+                .map(Some)
+                .map_err(|e| layout(format!("sensor {t}, {what}: {e}"))),
+            Some(_) => Err(layout(format!(
+                "sensor {t}, {what}: a further sensor's part must be a baseline"
+            ))),
+        };
+        axis = axis
+            .with_sensor(
+                index(t)?,
+                spec,
+                part(&m.bias, "bias")?,
+                part(&m.scale, "scale")?,
+            )
+            .map_err(|e| layout(format!("sensor {t}: {e}")))?;
+    }
+    Ok(axis)
+}
+
 impl ImuModel {
     /// Checks the layout (one axis per gyro column, in order; each axis's sensors among the
     /// temperature columns) and every axis's model.
     pub fn validate(&self) -> Result<(), ImuError> {
+        self.validate_columns()?;
+        // The axes' checks (each runs its models over the training range) on a thread per
+        // axis; the first axis in order that fails is told, as checking in turn would.
+        each_axis(&self.axes, |a| axis_checks(&self.temp_cols, a))
+            .into_iter()
+            .collect()
+    }
+
+    /// [`ImuModel::validate`]'s checks of the file's version and gyro columns.
+    fn validate_columns(&self) -> Result<(), ImuError> {
         let several = self.axes.iter().any(|a| a.temps.len() > 1);
         let expected = if several {
             IMU_FORMAT_VERSION
@@ -699,40 +836,6 @@ impl ImuModel {
                 "the axes must list the gyro columns, in order".into(),
             ));
         }
-        for a in &self.axes {
-            let distinct = a
-                .temps
-                .iter()
-                .enumerate()
-                .all(|(i, t)| !a.temps[..i].contains(t));
-            if a.temps.is_empty()
-                || a.temps.len() > MAX_SENSORS
-                || !distinct
-                || !a.temps.iter().all(|t| self.temp_cols.contains(t))
-            {
-                return Err(ImuError::Layout(format!(
-                    "axis {} must read 1 to {MAX_SENSORS} distinct temperature columns among \
-                     {}",
-                    a.gyro,
-                    self.temp_cols.join(", ")
-                )));
-            }
-            if a.more.len() + 1 != a.temps.len() {
-                return Err(ImuError::Layout(format!(
-                    "axis {}: `more` must hold one entry per further sensor ({} of them)",
-                    a.gyro,
-                    a.temps.len() - 1
-                )));
-            }
-            a.model.validate().map_err(|source| ImuError::Axis {
-                gyro: a.gyro.clone(),
-                source: Box::new(source),
-            })?;
-            if !a.more.is_empty() {
-                // The further sensors' parts must build a flight compensator.
-                self.axis_compensator(a)?;
-            }
-        }
         Ok(())
     }
 
@@ -740,44 +843,7 @@ impl ImuModel {
     /// further sensor's pipeline and parts, reading the indices of its sensors among
     /// [`ImuModel::temp_cols`].
     pub fn axis_compensator(&self, a: &ImuAxis) -> Result<AxisCompensator, ImuError> {
-        let index = |t: &String| {
-            self.temp_cols.iter().position(|c| c == t).ok_or_else(|| {
-                ImuError::Layout(format!("axis {} reads unknown sensor {t}", a.gyro))
-            })
-        };
-        let layout = |what: String| ImuError::Layout(format!("axis {}: {what}", a.gyro));
-        let first = compensator(&a.model).map_err(|source| ImuError::Compensate {
-            gyro: a.gyro.clone(),
-            source: Box::new(source),
-        })?;
-        let spec0 = *first.spec();
-        let mut axis = AxisCompensator::new(first, index(&a.temps[0])?);
-        for (t, m) in a.temps.iter().skip(1).zip(&a.more) {
-            let spec = spec0
-                .with_lags(&m.lags_s, LagOutputs::DiffFromT)
-                .map_err(|e| layout(format!("sensor {t}: {e}")))?;
-            let part = |sub: &Option<SubModel>, what: &str| match sub {
-                None => Ok(None),
-                Some(SubModel::Baseline {
-                    terms,
-                    coefficients,
-                }) => crate::baseline::to_core(terms, coefficients)
-                    .map(Some)
-                    .map_err(|e| layout(format!("sensor {t}, {what}: {e}"))),
-                Some(_) => Err(layout(format!(
-                    "sensor {t}, {what}: a further sensor's part must be a baseline"
-                ))),
-            };
-            axis = axis
-                .with_sensor(
-                    index(t)?,
-                    spec,
-                    part(&m.bias, "bias")?,
-                    part(&m.scale, "scale")?,
-                )
-                .map_err(|e| layout(format!("sensor {t}: {e}")))?;
-        }
-        Ok(axis)
+        axis_compensator_in(&self.temp_cols, a)
     }
 
     /// The sealed JSON text (pretty; `content_sha256` of the compact content last).
@@ -790,6 +856,13 @@ impl ImuModel {
             "{body},\n  \"{CHECKSUM_KEY}\": \"{}\"\n}}\n",
             sha256_hex(compact.as_bytes())
         ))
+    }
+
+    /// The `content_sha256` of the model: SHA-256 of its compact JSON content (how the file
+    /// is formatted does not change it).
+    pub fn content_digest(&self) -> Result<String, ImuError> {
+        let compact = serde_json::to_string(self).map_err(ImuError::Json)?;
+        Ok(sha256_hex(compact.as_bytes()))
     }
 
     /// Parse and check the text (the checksum, when present, must match).

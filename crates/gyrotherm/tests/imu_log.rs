@@ -146,3 +146,82 @@ fn one_name_each_reads_a_single_axis_log_as_read_log_does() {
     let (imu_log, _) = read_imu_log(&path, &ReadOptions::default(), None).unwrap();
     assert_eq!(imu_log.axis_log(0, 0), single);
 }
+
+#[test]
+fn several_logs_read_at_once_give_each_file_s_own_result_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+    write_imu_log(&a, &imu::simulate_imu(&config(Some(2))).unwrap()).unwrap();
+    write_imu_log(&b, &imu::simulate_imu(&config(None)).unwrap()).unwrap();
+    let missing = dir.path().join("missing.csv");
+    let opts = ReadOptions {
+        gyro_col: "gyro_x_dps,gyro_y_dps,gyro_z_dps".into(),
+        temp_col: "temp_case_c,temp_x_c".into(),
+        ..ReadOptions::default()
+    };
+    let paths = [&b, &missing, &a];
+    let all = csvlog::read_imu_logs(&paths, &opts, None);
+    assert_eq!(all.len(), 3);
+    // Each result is the one-file read of the path at its place.
+    for (p, r) in paths.iter().zip(&all) {
+        match (read_imu_log(p, &opts, None), r) {
+            (Ok((one, _)), Ok((got, _))) => assert_eq!(&one, got),
+            (Err(one), Err(got)) => assert_eq!(one.to_string(), got.to_string()),
+            (one, got) => panic!("{}: {one:?} against {got:?}", p.display()),
+        }
+    }
+    assert!(all[1].is_err());
+    assert!(all[0].as_ref().unwrap().0.table.is_none());
+    assert!(all[2].as_ref().unwrap().0.table.is_some());
+}
+
+/// The further columns are parsed as strictly as the first ones: the first bad field of a
+/// column is named by column and data row (a later bad field, or a bad field in a later
+/// column, is not the one told), and an empty field between two numbers is interpolated in
+/// time (independent: the straight line between its neighbours).
+#[test]
+fn further_columns_name_their_first_bad_field_and_fill_empty_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.csv");
+    write_imu_log(&good, &imu::simulate_imu(&config(None)).unwrap()).unwrap();
+    let text = std::fs::read_to_string(&good).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let edit = |edits: &[(usize, usize, &str)]| {
+        let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+        for &(row, c, v) in edits {
+            let mut f: Vec<String> = lines[row].split(',').map(str::to_owned).collect();
+            f[c] = v.to_owned();
+            lines[row] = f.join(",");
+        }
+        let path = dir.path().join("edited.csv");
+        std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+        path
+    };
+    let opts = ReadOptions {
+        gyro_col: "gyro_x_dps,gyro_y_dps,gyro_z_dps".into(),
+        temp_col: "temp_case_c,temp_x_c,temp_y_c,temp_z_c".into(),
+        ..ReadOptions::default()
+    };
+    let (gy, ty) = (col("gyro_y_dps"), col("temp_y_c"));
+    let bad = edit(&[(40, gy, "nope"), (30, ty, "x"), (70, gy, "inf")]);
+    let e = read_imu_log(&bad, &opts, None).unwrap_err();
+    assert_eq!(e.kind, csvlog::LogErrorKind::NotANumber);
+    let msg = e.to_string();
+    assert!(
+        msg.contains("gyro_y_dps") && msg.contains("data row 40: \"nope\" is not a number"),
+        "{msg}"
+    );
+    let inf = edit(&[(70, ty, "inf")]);
+    let e = read_imu_log(&inf, &opts, None).unwrap_err();
+    assert_eq!(e.kind, csvlog::LogErrorKind::NonFinite);
+    assert!(e.to_string().contains("data row 70"), "{e}");
+    let empty = edit(&[(25, ty, "")]);
+    let (log, _) = read_imu_log(&empty, &opts, None).unwrap();
+    let (back, _) = read_imu_log(&good, &opts, None).unwrap();
+    let (t, v) = (&log.time_s, &back.temp[2].values);
+    let want = v[23] + (t[24] - t[23]) / (t[25] - t[23]) * (v[25] - v[23]);
+    assert_eq!(log.temp[2].values[24], want);
+    assert_eq!(log.temp[2].values[..24], v[..24]);
+    assert_eq!(log.temp[2].values[25..], v[25..]);
+}

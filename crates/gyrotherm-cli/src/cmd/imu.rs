@@ -22,13 +22,21 @@ pub fn is_imu_model(path: &Path) -> anyhow::Result<bool> {
 
 /// Read every log with the column lists, reporting each failure, then stop if any failed.
 pub fn read_imu_logs(paths: &[PathBuf], args: &LogArgs) -> anyhow::Result<Vec<(String, ImuLog)>> {
-    let opts = args.read_options();
+    read_imu_logs_with(paths, args, &args.read_options())
+}
+
+/// [`read_imu_logs`] with the columns of `opts` (a unit model's, [`ImuModel::read_options`]).
+pub fn read_imu_logs_with(
+    paths: &[PathBuf],
+    args: &LogArgs,
+    opts: &csvlog::ReadOptions,
+) -> anyhow::Result<Vec<(String, ImuLog)>> {
     let mut out = Vec::new();
     let mut failed = 0;
-    for p in paths {
-        match csvlog::read_imu_log(p, &opts, args.table_axis.as_deref())
-            .with_context(|| format!("cannot use log {}", p.display()))
-        {
+    // The files are read at once, each on its own thread; what each gave is told in order.
+    let read = csvlog::read_imu_logs(paths, opts, args.table_axis.as_deref());
+    for (p, r) in paths.iter().zip(read) {
+        match r.with_context(|| format!("cannot use log {}", p.display())) {
             Ok((log, report)) => {
                 if report.filled_gaps > 0 {
                     eprintln!(

@@ -225,13 +225,25 @@ fn unit_warnings(cmp: &ImuComparison) -> Vec<String> {
     out
 }
 
-fn refuse_spec(spec: &Option<std::path::PathBuf>) -> anyhow::Result<()> {
-    anyhow::ensure!(
-        spec.is_none(),
-        "`report --spec` judges single-axis columns; with --gyro-col/--temp-col lists use \
-         `compare --spec` or `evaluate --model UNIT.json --spec` (per axis and the unit), or \
-         report one axis with --gyro-col G --temp-col T"
-    );
+/// Each axis's verdicts (every column, then the unit's own fit), then the unit's verdict of
+/// each column across the axes (`compare --spec` and `report --spec` with lists).
+fn print_unit_verdicts(
+    out: &mut dyn Write,
+    spec: &gyrotherm::spec::Spec,
+    verdicts: &[imu_judge::AxisVerdicts],
+) -> std::io::Result<()> {
+    for (k, a) in verdicts.iter().enumerate() {
+        writeln!(out, "\naxis {} ({}) against the spec:", k + 1, a.gyro)?;
+        super::verdict::print_columns(out, &a.columns)?;
+        if let Some((label, v)) = &a.unit_fit {
+            writeln!(out, "\n{label} (unit fit):")?;
+            super::verdict::print(out, v)?;
+        }
+    }
+    writeln!(out, "\nspec {} across the axes:", spec.name)?;
+    for line in imu_judge::verdicts_across_axes(spec, verdicts) {
+        writeln!(out, "  {line}")?;
+    }
     Ok(())
 }
 
@@ -259,19 +271,8 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<ExitCode> {
         writeln!(out, "{}", serde_json::to_string_pretty(&j)?)?;
     } else {
         print_unit_tables(&mut out, &cmp, &cfg)?;
-        for (k, a) in verdicts.iter().flatten().enumerate() {
-            writeln!(out, "\naxis {} ({}) against the spec:", k + 1, a.gyro)?;
-            super::verdict::print_columns(&mut out, &a.columns)?;
-            if let Some((label, v)) = &a.unit_fit {
-                writeln!(out, "\n{label} (unit fit):")?;
-                super::verdict::print(&mut out, v)?;
-            }
-        }
         if let (Some(vs), Some(s)) = (&verdicts, &spec) {
-            writeln!(out, "\nspec {} across the axes:", s.name)?;
-            for line in imu_judge::verdicts_across_axes(vs) {
-                writeln!(out, "  {line}")?;
-            }
+            print_unit_verdicts(&mut out, s, vs)?;
         }
     }
     for w in unit_warnings(&cmp) {
@@ -282,9 +283,11 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<ExitCode> {
     ))
 }
 
-/// `report` with column lists: the unit page and a full page per axis.
+/// `report` with column lists: the unit page and a full page per axis; with `--spec`, every
+/// column of every axis judged as `compare --spec` judges it (on the page and on stdout),
+/// exit 1 when a column misses a limit.
 pub fn report(args: ReportArgs) -> anyhow::Result<ExitCode> {
-    refuse_spec(&args.spec)?;
+    let spec = super::verdict::load(args.spec.as_deref())?;
     let (cmp, cfg) = run_unit_comparison(
         &args.train,
         &args.test,
@@ -293,13 +296,23 @@ pub fn report(args: ReportArgs) -> anyhow::Result<ExitCode> {
         &args.fit,
         &args.log,
     )?;
-    let index = gyrotherm::report::unit::write_unit_report(&args.out, &cmp, &cfg, &[])
+    let verdicts = spec
+        .as_ref()
+        .map(|s| imu_judge::judge_unit_comparison(s, &cmp, &cfg))
+        .transpose()?;
+    let judged = spec.as_ref().zip(verdicts.as_deref());
+    let index = gyrotherm::report::unit::write_unit_report(&args.out, &cmp, &cfg, &[], judged)
         .with_context(|| format!("cannot write the report in {}", args.out.display()))?;
     let mut out = std::io::stdout().lock();
     print_unit_tables(&mut out, &cmp, &cfg)?;
+    if let Some((s, vs)) = judged {
+        print_unit_verdicts(&mut out, s, vs)?;
+    }
     writeln!(out, "report: {}", index.display())?;
     for w in unit_warnings(&cmp) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(super::verdict::exit_code(
+        verdicts.iter().flatten().all(|a| a.pass()),
+    ))
 }

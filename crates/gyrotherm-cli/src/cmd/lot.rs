@@ -22,7 +22,8 @@ pub struct LotArgs {
 
 #[derive(Debug, clap::Subcommand)]
 pub enum LotCommand {
-    /// Judge a unit's model on its held-out logs and record the run.
+    /// Judge a unit's model on its held-out logs and record the run (an inertial unit's model:
+    /// each axis and the unit).
     Add(Box<AddArgs>),
     /// List the recorded runs.
     List(ListArgs),
@@ -48,7 +49,8 @@ pub struct AddArgs {
     /// The unit's serial number.
     #[arg(long)]
     pub unit: String,
-    /// The unit's compensation model (JSON, from `gyrotherm train`).
+    /// The unit's compensation model (JSON, from `gyrotherm train`; an inertial unit's model
+    /// from `train` with column lists records a verdict per axis and the unit's).
     #[arg(long)]
     pub model: PathBuf,
     /// Held-out log to judge on (CSV); repeat for several (static and rate-table).
@@ -105,6 +107,15 @@ pub fn run(args: LotArgs) -> anyhow::Result<ExitCode> {
 
 fn add(a: AddArgs) -> anyhow::Result<ExitCode> {
     let spec = super::verdict::load(a.spec.as_deref())?;
+    if super::imu::is_imu_model(&a.model)? {
+        return add_unit(a, spec);
+    }
+    anyhow::ensure!(
+        !a.log.read_options().is_multi_column(),
+        "{}: a single-axis model; --gyro-col/--temp-col lists need an inertial unit's model \
+         (`gyrotherm train` with the same lists), whose columns lot add then reads",
+        a.model.display()
+    );
     let mut warnings = Vec::new();
     let logs = read_logs(&a.test, &a.log, &mut warnings)?;
     for w in &warnings {
@@ -150,6 +161,60 @@ fn add(a: AddArgs) -> anyhow::Result<ExitCode> {
     ))
 }
 
+/// `lot add` with an inertial unit's model: the logs read with the model's columns, each axis
+/// judged and the unit's verdict (`gyrotherm::lot::judge_imu_unit`).
+fn add_unit(a: AddArgs, spec: Option<gyrotherm::spec::Spec>) -> anyhow::Result<ExitCode> {
+    let model = gyrotherm::imu_model::ImuModel::load(&a.model)
+        .map_err(anyhow::Error::new)
+        .with_context(|| format!("cannot use model {}", a.model.display()))?;
+    let opts = model.read_options(&a.log.read_options());
+    let tests = super::imu::read_imu_logs_with(&a.test, &a.log, &opts)?;
+    let station = a.station.clone().unwrap_or_else(lot::default_station);
+    // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
+    let (mut run, verdict) = lot::judge_imu_unit(&lot::ImuUnitInputs {
+        unit: &a.unit,
+        station: &station,
+        model_path: &a.model,
+        tests: &tests,
+        spec: spec.as_ref(),
+        tau_s: a.tau_s,
+        settle_s: a.settle_s,
+    })
+    .with_context(|| format!("unit {}", a.unit))?;
+    let mut store = open_store(&a.db.db, true, a.db.busy_timeout)?;
+    run.id = store.add(&run)?;
+    let mut w = std::io::stdout().lock();
+    if a.json {
+        writeln!(w, "{}", serde_json::to_string_pretty(&run)?)?;
+    } else {
+        if let Some(v) = &verdict {
+            // As `evaluate --model UNIT.json --spec` prints it: each axis, then the unit.
+            for (k, (gyro, axis)) in v.axes.iter().enumerate() {
+                if k > 0 {
+                    writeln!(w)?;
+                }
+                writeln!(w, "axis {} ({gyro}) against the spec:", k + 1)?;
+                super::verdict::print(&mut w, axis)?;
+            }
+            writeln!(w)?;
+            writeln!(w, "{}", v.unit.line(v.axes.len()))?;
+        }
+        writeln!(
+            w,
+            "recorded run {} of unit {}: verdict {}, {} axes, {} figures on {} logs",
+            run.id,
+            run.unit,
+            run.verdict.as_str(),
+            run.axes.len(),
+            run.figures.len(),
+            run.inputs.len()
+        )?;
+    }
+    Ok(super::verdict::exit_code(
+        run.verdict != lot::RunVerdict::Fail,
+    ))
+}
+
 fn list(a: ListArgs) -> anyhow::Result<ExitCode> {
     let mut store = open_store(&a.db.db, false, a.db.busy_timeout)?;
     let runs = store.runs()?;
@@ -175,6 +240,19 @@ fn list(a: ListArgs) -> anyhow::Result<ExitCode> {
             r.model_method,
             r.figures.len()
         )?;
+        // An inertial unit: a line per axis under its run.
+        for a in &r.axes {
+            writeln!(
+                w,
+                "{:>6}  {:<16} axis {}: {} ({}), {}",
+                "",
+                "",
+                a.axis + 1,
+                a.gyro.escape_debug(),
+                a.temps.join(", ").escape_debug(),
+                a.verdict.as_str()
+            )?;
+        }
     }
     let y = lot::report::lot_yield(&runs);
     writeln!(

@@ -120,7 +120,10 @@ def read_lot(db: PathLike, *, as_frame: Optional[bool] = None):
     ``run_id``, ``unit``, ``tested_at`` (RFC 3339 UTC), ``latest`` (the unit's newest run),
     ``run_verdict``, ``station``, ``model_content_sha256``, ``log``, ``figure``, ``value``,
     ``limit_min``, ``limit_max`` (NaN when not limited), ``verdict`` (``"pass"``, ``"fail"``
-    or None) and ``margin``. A DataFrame when pandas is installed (``as_frame=None``) or
+    or None), ``margin``, and for an inertial unit's run (``lot add --model UNIT.json``)
+    ``axis`` (the axis's gyro column) and ``axis_verdict`` (the axis's verdict; the run's
+    ``run_verdict`` is the unit's, a pass only when every axis passes), both None on a
+    single-axis run. A DataFrame when pandas is installed (``as_frame=None``) or
     ``as_frame=True``, else a dict of arrays and lists. Raises ``gyrotherm.GyrothermError``
     (a missing, damaged or newer-schema lot, with the message the CLI prints).
     """

@@ -150,7 +150,13 @@ pub fn read_imu_log(
         temp_col: temp_cols[0].clone(),
         ..opts.clone()
     };
-    let (mut log, report) = super::read_log(path, &first)?;
+    let decimal_comma = opts.delimiter != b',';
+    let further: Vec<&str> = gyro_cols[1..]
+        .iter()
+        .chain(&temp_cols[1..])
+        .map(String::as_str)
+        .collect();
+    let (mut log, report, mut parsed) = super::read_log_numbers(path, &first, &further)?;
     let gyro_scale = opts.gyro_unit.dps_per_unit();
     let mut take = |name: &str, scale: f64, what: &str| -> Result<Vec<f64>, LogError> {
         let k = log
@@ -176,7 +182,10 @@ pub fn read_imu_log(
                 )
             })?;
         let col = log.extra.remove(k);
-        parse_column(path, &col, &log.time_s, scale, opts.delimiter != b',')
+        match parsed.remove(k) {
+            Some(numbers) => numbers.finish(path, &col.name, &log.time_s, scale),
+            None => parse_column(path, &col, &log.time_s, scale, decimal_comma),
+        }
     };
     let mut gyro = Vec::with_capacity(gyro_cols.len());
     gyro.push(NamedSeries {
@@ -235,6 +244,26 @@ pub fn read_imu_log(
     ))
 }
 
+/// [`read_imu_log`] of each path with the same options, one thread per file (the files are
+/// independent; a unit's training reads several, and much of a read is one thread's work):
+/// the results in the order of `paths`, each as [`read_imu_log`] gives it.
+pub fn read_imu_logs<P: AsRef<Path> + Sync>(
+    paths: &[P],
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+) -> Vec<Result<(ImuLog, ReadReport), LogError>> {
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = paths
+            .iter()
+            .map(|p| scope.spawn(move || read_imu_log(p.as_ref(), opts, table_axis)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
+}
+
 /// Parse a further column: every field a finite number (times `scale`); empty fields, which
 /// only gap filling makes, interpolated linearly in time between the real rows around them.
 fn parse_column(
@@ -244,61 +273,106 @@ fn parse_column(
     scale: f64,
     decimal_comma: bool,
 ) -> Result<Vec<f64>, LogError> {
-    let mut out = Vec::with_capacity(col.values.len());
-    let mut filled = Vec::new();
-    for (row, text) in col.values.iter().enumerate() {
+    let mut numbers = NumberColumn::default();
+    for text in &col.values {
+        numbers.push(text, decimal_comma);
+        if numbers.bad.is_some() {
+            break;
+        }
+    }
+    numbers.finish(path, &col.name, time_s, scale)
+}
+
+/// A further column's fields parsed as they are read: NaN where a field is empty, and the first
+/// field that is no number or not finite (data row index, text, what is wrong).
+#[derive(Debug, Default)]
+pub(crate) struct NumberColumn {
+    pub(crate) values: Vec<f64>,
+    bad: Option<(usize, String, Kind)>,
+}
+
+impl NumberColumn {
+    /// The next field.
+    pub(crate) fn push(&mut self, text: &str, decimal_comma: bool) {
+        let row = self.values.len();
         if text.is_empty() {
-            filled.push(row);
-            out.push(f64::NAN);
-            continue;
+            self.values.push(f64::NAN);
+            return;
         }
         let raw = text.as_bytes();
-        let v = parse_f64(raw)
-            .or_else(|| {
-                decimal_comma
-                    .then(|| parse_f64_decimal_comma(raw))
-                    .flatten()
-            })
-            .ok_or_else(|| {
-                LogError::new(
-                    Kind::NotANumber,
-                    path,
-                    None,
-                    Some(&col.name),
-                    format!("data row {}: {text:?} is not a number", row + 1),
-                )
-            })?;
-        if !v.is_finite() {
-            return Err(LogError::new(
-                Kind::NonFinite,
-                path,
-                None,
-                Some(&col.name),
-                format!("data row {}: {text:?} is not a finite number", row + 1),
-            ));
-        }
-        out.push(v * scale);
-    }
-    for row in filled {
-        let before = (0..row).rev().find(|&i| out[i].is_finite());
-        let after = (row + 1..out.len()).find(|&i| out[i].is_finite());
-        out[row] = match (before, after) {
-            (Some(a), Some(b)) => {
-                let w = (time_s[row] - time_s[a]) / (time_s[b] - time_s[a]);
-                out[a] + w * (out[b] - out[a])
+        let v = parse_f64(raw).or_else(|| {
+            decimal_comma
+                .then(|| parse_f64_decimal_comma(raw))
+                .flatten()
+        });
+        let v = match v {
+            Some(v) if v.is_finite() => v,
+            Some(_) => {
+                self.bad
+                    .get_or_insert((row, text.to_owned(), Kind::NonFinite));
+                f64::NAN
             }
-            _ => {
-                return Err(LogError::new(
-                    Kind::NotANumber,
-                    path,
-                    None,
-                    Some(&col.name),
-                    format!("data row {}: the field is empty", row + 1),
-                ))
+            None => {
+                self.bad
+                    .get_or_insert((row, text.to_owned(), Kind::NotANumber));
+                f64::NAN
             }
         };
+        self.values.push(v);
     }
-    Ok(out)
+
+    /// The column (times `scale`), its empty fields interpolated, or the error of its first
+    /// bad field (named `name` in `path`).
+    fn finish(
+        self,
+        path: &Path,
+        name: &str,
+        time_s: &[f64],
+        scale: f64,
+    ) -> Result<Vec<f64>, LogError> {
+        if let Some((row, text, kind)) = self.bad {
+            let what = match kind {
+                Kind::NonFinite => "is not a finite number",
+                _ => "is not a number",
+            };
+            return Err(LogError::new(
+                kind,
+                path,
+                None,
+                Some(name),
+                format!("data row {}: {text:?} {what}", row + 1),
+            ));
+        }
+        let mut out = self.values;
+        let mut filled = Vec::new();
+        for (row, v) in out.iter_mut().enumerate() {
+            if v.is_nan() {
+                filled.push(row);
+            } else {
+                *v *= scale;
+            }
+        }
+        for row in filled {
+            let before = (0..row).rev().find(|&i| out[i].is_finite());
+            let after = (row + 1..out.len()).find(|&i| out[i].is_finite());
+            out[row] = match (before, after) {
+                (Some(a), Some(b)) => {
+                    let w = (time_s[row] - time_s[a]) / (time_s[b] - time_s[a]);
+                    out[a] + w * (out[b] - out[a])
+                }
+                _ => {
+                    return Err(LogError::new(
+                        Kind::NotANumber,
+                        path,
+                        None,
+                        Some(name),
+                        format!("data row {}: the field is empty", row + 1),
+                    ))
+                }
+            };
+        }
+        Ok(out)
+    }
 }
 
 /// Write an inertial unit's log (`time_s`, the gyro columns, the temperature columns, the

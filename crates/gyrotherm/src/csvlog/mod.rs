@@ -27,7 +27,7 @@ mod writer;
 
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
-pub use imu::{read_imu_log, write_imu_log, ImuLog, NamedSeries};
+pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
 pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
@@ -306,6 +306,20 @@ impl ReadReport {
 /// Read and validate a whole log. The file is read once, streaming; the columns are sized
 /// from the file length and the bytes per row of the first rows.
 pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport), LogError> {
+    read_log_numbers(path, opts, &[]).map(|(log, report, _)| (log, report))
+}
+
+/// [`read_log`], the pass-through columns named in `numbers` (the first of each name) parsed
+/// as they are read ([`imu::NumberColumn`]) instead of kept as text: such a column stays in
+/// [`TestLog::extra`] by name only (no values), its numbers at the same index of the list
+/// returned. A log read with several gyro or temperature columns parses them without holding
+/// every field as a string first.
+pub(crate) fn read_log_numbers(
+    path: &Path,
+    opts: &ReadOptions,
+    numbers: &[&str],
+) -> Result<(TestLog, ReadReport, Vec<Option<imu::NumberColumn>>), LogError> {
+    let decimal_comma = opts.delimiter != b',';
     let file = File::open(path).map_err(|e| {
         LogError::new(
             LogErrorKind::Io,
@@ -320,6 +334,16 @@ pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport)
     let mut log = TestLog::default();
     let mut table: Vec<f64> = Vec::new();
     let mut extra: Vec<Vec<String>> = vec![Vec::new(); rdr.extra_count()];
+    let names: Vec<&str> = rdr.extra_names().collect();
+    let mut parsed: Vec<Option<imu::NumberColumn>> = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| {
+            let first = names.iter().position(|m| m == n) == Some(k);
+            (first && numbers.contains(n)).then(imu::NumberColumn::default)
+        })
+        .collect();
+    drop(names);
     let mut sized = false;
     while let Some(s) = rdr.next_sample()? {
         if !sized {
@@ -336,8 +360,11 @@ pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport)
             if rdr.has_table() {
                 table.reserve_exact(rows);
             }
-            for col in &mut extra {
-                col.reserve_exact(rows);
+            for (col, num) in extra.iter_mut().zip(&mut parsed) {
+                match num {
+                    Some(n) => n.values.reserve_exact(rows),
+                    None => col.reserve_exact(rows),
+                }
             }
         }
         log.time_s.push(s.time_s);
@@ -346,8 +373,12 @@ pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport)
         if let Some(t) = s.table_dps {
             table.push(t);
         }
-        for (k, col) in extra.iter_mut().enumerate() {
-            col.push(rdr.extra_text(k)?.to_owned());
+        for (k, (col, num)) in extra.iter_mut().zip(&mut parsed).enumerate() {
+            let text = rdr.extra_text(k)?;
+            match num {
+                Some(n) => n.push(text, decimal_comma),
+                None => col.push(text.to_owned()),
+            }
         }
     }
     if rdr.has_table() {
@@ -361,7 +392,7 @@ pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport)
             values,
         })
         .collect();
-    Ok((log, rdr.report().clone()))
+    Ok((log, rdr.report().clone(), parsed))
 }
 
 /// Write a log as CSV (`time_s,gyro_dps,temp_c[,table_dps],extra...`), atomically (a

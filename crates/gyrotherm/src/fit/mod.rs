@@ -302,27 +302,45 @@ pub fn fit_model_identified(
     identified: Option<thermal::Identified>,
     progress: &(dyn Fn(Target, usize, f64) + Sync),
 ) -> Result<FitOutcome, FitError> {
-    fit_model_with(logs, cfg, identified, true, progress)
+    fit_model_with(logs, cfg, identified, true, None, progress)
 }
 
-/// [`fit_model_identified`], the coverage map made only with `coverage` (a caller that
-/// replaces the bias model has no use for the one-sensor model's map).
+/// [`fit_model_identified`]; with `own_bias` false, for a caller that replaces the bias model,
+/// no bias model is fitted (unless an LSTM on it would tell the training summary), no coverage
+/// map made, and the model is left unchecked: the caller completes and checks it. `made`: the
+/// bias and scale-factor target sets of the static and the table logs, in log order, when the
+/// caller has them already (made as here, at the identification's spec).
 pub(crate) fn fit_model_with(
     logs: &[NamedLog],
     cfg: &FitConfig,
     identified: Option<thermal::Identified>,
-    coverage: bool,
+    own_bias: bool,
+    made: Option<(&[TargetSet], &[TargetSet])>,
     progress: &(dyn Fn(Target, usize, f64) + Sync),
 ) -> Result<FitOutcome, FitError> {
+    let coverage = own_bias;
+    // A residual LSTM's summary goes into the model's training record: fitted as before.
+    let fit_bias = own_bias || (cfg.thermal.residual_lstm && cfg.recipe.epochs > 0);
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
     let spec = identified
         .as_ref()
         .map_or_else(|| feature_spec(cfg), |id| id.spec);
+    let statics = logs.iter().filter(|l| targets::is_static(l.log)).count();
+    let made = made.filter(|(b, s)| b.len() == statics && s.len() == logs.len() - statics);
+    if let Some((_, scale)) = made {
+        // What making them here would refuse: a table log without a labelled step.
+        let tables = logs.iter().filter(|l| !targets::is_static(l.log));
+        if let Some((l, _)) = tables.zip(scale).find(|(_, s)| s.labelled() == 0) {
+            return Err(FitError::NoScaleSegments {
+                run: l.name.to_owned(),
+            });
+        }
+    }
     let mut bias_sets = Vec::new();
     let mut scale_sets = Vec::new();
-    for l in logs {
+    for l in logs.iter().filter(|_| made.is_none()) {
         if targets::is_static(l.log) {
             bias_sets.push(
                 targets::bias_targets(l.log, &spec, cfg.bias_window_s).map_err(|source| {
@@ -346,15 +364,17 @@ pub(crate) fn fit_model_with(
             scale_sets.push(s);
         }
     }
+    let (bias_sets, scale_sets): (&[TargetSet], &[TargetSet]) =
+        made.unwrap_or((&bias_sets, &scale_sets));
     if bias_sets.is_empty() && scale_sets.is_empty() {
         return Err(FitError::NoUsableLogs);
     }
     let (bias, scale) = std::thread::scope(|s| {
         let bias = s.spawn(|| {
-            (!bias_sets.is_empty())
+            (!bias_sets.is_empty() && fit_bias)
                 .then(|| {
                     fit_one(
-                        &bias_sets,
+                        bias_sets,
                         cfg,
                         Target::Bias,
                         identified.as_ref(),
@@ -366,7 +386,7 @@ pub(crate) fn fit_model_with(
         let scale = (!scale_sets.is_empty())
             .then(|| {
                 fit_one(
-                    &scale_sets,
+                    scale_sets,
                     cfg,
                     Target::Scale,
                     identified.as_ref(),
@@ -389,14 +409,18 @@ pub(crate) fn fit_model_with(
     let scale = scale.map_err(in_target(Target::Scale))?;
     let tables: Vec<&FeatureTable> = bias_sets
         .iter()
-        .chain(&scale_sets)
+        .chain(scale_sets)
         .map(|s| &s.table)
         .collect();
     let (temp_range_c, rate_range_c_per_s) =
         model::training_ranges(&tables).ok_or(FitError::NoFeatureSteps)?;
+    // A bias left to the caller would have told the thermal recipe's summary without an LSTM
+    // (no epochs, no loss): the training record says the same as when it is fitted here.
+    let unfitted = TrainSummary::default();
     let lstm_summary = bias
         .as_ref()
         .and_then(|b| b.1.as_ref())
+        .or((identified.is_some() && !fit_bias && !bias_sets.is_empty()).then_some(&unfitted))
         .or(scale.as_ref().and_then(|s| s.1.as_ref()));
     let all_logs: Vec<&TestLog> = logs.iter().map(|l| l.log).collect();
     let training = TrainingInfo {
@@ -430,7 +454,7 @@ pub(crate) fn fit_model_with(
     let coverage = model.bias.as_ref().filter(|_| coverage).map(|b| {
         crate::coverage::cross_validated(
             b,
-            &bias_sets,
+            bias_sets,
             &crate::coverage::CoverageSettings::default(),
         )
     });
@@ -440,7 +464,9 @@ pub(crate) fn fit_model_with(
         None => (None, Some("no bias model: no coverage map".to_owned())),
     };
     let model = ModelFile { coverage, ..model };
-    model.validate()?;
+    if own_bias {
+        model.validate()?;
+    }
     Ok(FitOutcome {
         model,
         bias_training,

@@ -29,8 +29,10 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::compensate::compensate_log;
-use crate::csvlog::TestLog;
+use crate::csvlog::{ImuLog, TestLog};
 use crate::fit::NamedLog;
+use crate::imu_judge::{ImuJudgeError, UnitVerdict};
+use crate::imu_model::ImuModel;
 use crate::metrics::EvaluationOptions;
 use crate::model::ModelFile;
 use crate::spec::{self, MeasureOptions, Spec};
@@ -51,6 +53,10 @@ pub struct Input {
 /// One measured figure of one held-out log of a run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FigureRow {
+    /// The [`AxisRecord::axis`] it was measured on, for an inertial unit's run (None for a
+    /// single-axis run, stored as axis 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis: Option<u32>,
     /// The [`Input::position`] of the log it was measured on.
     pub position: u32,
     /// The figure's key ([`spec::FIGURES`]).
@@ -94,6 +100,20 @@ impl RunVerdict {
     }
 }
 
+/// One gyro axis of an inertial unit's run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisRecord {
+    /// Its position among the unit's axes, from 0 (the model's gyro column order).
+    pub axis: u32,
+    /// The gyro column.
+    pub gyro: String,
+    /// The temperature columns the axis's model reads, the first sensor first.
+    pub temps: Vec<String>,
+    /// The axis's verdict: `pass` when each limited figure passes on every log that gives
+    /// it, `none` when judged without a spec.
+    pub verdict: RunVerdict,
+}
+
 /// One unit judged once: what a lot records.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Run {
@@ -121,6 +141,10 @@ pub struct Run {
     /// True for the newest run of its unit (set when read back).
     pub latest: bool,
     pub inputs: Vec<Input>,
+    /// An inertial unit's axes (empty for a single-axis run); the run's `verdict` is then the
+    /// unit's: `pass` only when every axis passes.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub axes: Vec<AxisRecord>,
     pub figures: Vec<FigureRow>,
 }
 
@@ -140,6 +164,40 @@ impl Run {
     /// The test date as RFC 3339 UTC.
     pub fn tested_at(&self) -> String {
         rfc3339_utc(self.tested_at_unix_ms)
+    }
+
+    /// Whether this is an inertial unit's run (with axes).
+    pub fn is_unit(&self) -> bool {
+        !self.axes.is_empty()
+    }
+
+    /// The gyro column of axis `axis` (None: a single-axis run, or no such axis).
+    pub fn gyro_of(&self, axis: Option<u32>) -> Option<&str> {
+        let k = axis?;
+        self.axes
+            .iter()
+            .find(|a| a.axis == k)
+            .map(|a| a.gyro.as_str())
+    }
+}
+
+/// The unit's verdict from its axes' verdicts: `none` when no axis was judged, else the rule
+/// of [`UnitVerdict::from_axes`] (a unit passes only when every axis passes).
+pub fn unit_verdict_of_axes(axes: &[AxisRecord]) -> RunVerdict {
+    if axes.iter().all(|a| a.verdict == RunVerdict::None) {
+        return RunVerdict::None;
+    }
+    let v = UnitVerdict::from_axes(
+        "",
+        "",
+        "compensated",
+        axes.iter()
+            .map(|a| (a.gyro.as_str(), a.verdict != RunVerdict::Fail)),
+    );
+    if v.pass {
+        RunVerdict::Pass
+    } else {
+        RunVerdict::Fail
     }
 }
 
@@ -182,6 +240,31 @@ pub enum LotError {
     Database { db: String, detail: String },
     /// A stored value the schema does not allow (edited by hand?).
     BadRow { db: String, detail: String },
+    /// An inertial unit's figures or verdict could not be computed (the message holds the
+    /// whole chain of causes).
+    Unit(ImuJudgeError),
+    /// Upgrading an older lot schema failed; its transaction was rolled back.
+    Migration {
+        db: String,
+        from: i64,
+        to: i64,
+        detail: String,
+    },
+}
+
+/// `e` and its sources, joined by `: `.
+fn write_chain(f: &mut fmt::Formatter<'_>, e: &dyn std::error::Error) -> fmt::Result {
+    let mut e: Option<&dyn std::error::Error> = Some(e);
+    let mut first = true;
+    while let Some(x) = e {
+        if !first {
+            write!(f, ": ")?;
+        }
+        write!(f, "{x}")?;
+        first = false;
+        e = x.source();
+    }
+    Ok(())
 }
 
 impl fmt::Display for LotError {
@@ -191,17 +274,7 @@ impl fmt::Display for LotError {
             LotError::Model { path, source } => write!(f, "{}: {source}", path.display()),
             LotError::Measure { log, source } => {
                 write!(f, "{log}: ")?;
-                let mut e: Option<&dyn std::error::Error> = Some(source);
-                let mut first = true;
-                while let Some(x) = e {
-                    if !first {
-                        write!(f, ": ")?;
-                    }
-                    write!(f, "{x}")?;
-                    first = false;
-                    e = x.source();
-                }
-                Ok(())
+                write_chain(f, source)
             }
             LotError::Spec(e) => write!(f, "{e}"),
             LotError::Missing { db } => write!(
@@ -236,6 +309,19 @@ impl fmt::Display for LotError {
             LotError::BadRow { db, detail } => {
                 write!(f, "{db}: {detail}; the lot was edited outside gyrotherm")
             }
+            LotError::Unit(e) => write_chain(f, e),
+            LotError::Migration {
+                db,
+                from,
+                to,
+                detail,
+            } => write!(
+                f,
+                "{db}: cannot upgrade the lot schema from version {from} to {to} ({detail}); \
+                 nothing was changed and the lot is still version {from}: a table or key the \
+                 upgrade adds may already be there (made by hand?); rename it, or upgrade with \
+                 the statements in docs/lot-schema.md, then retry"
+            ),
         }
     }
 }
@@ -368,6 +454,7 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
         for (&key, &value) in f {
             let limit = u.spec.and_then(|s| s.limit(key));
             figures.push(FigureRow {
+                axis: None,
                 position: i as u32,
                 figure: key.to_string(),
                 value,
@@ -398,9 +485,188 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
         },
         latest: false,
         inputs,
+        axes: Vec::new(),
         figures,
     };
     Ok((run, verdict))
+}
+
+/// What [`judge_imu_unit`] needs besides the logs: an inertial unit (several gyro axes).
+#[derive(Debug, Clone)]
+pub struct ImuUnitInputs<'a> {
+    pub unit: &'a str,
+    pub station: &'a str,
+    pub model_path: &'a Path,
+    /// The held-out logs, read with the model's columns ([`ImuModel::read_options`]), each
+    /// with the path it was read from.
+    pub tests: &'a [(String, ImuLog)],
+    pub spec: Option<&'a Spec>,
+    /// Bias-stability τ, s (None: the unit `compare`'s default for these logs,
+    /// [`crate::imu_judge::default_tau_s`]).
+    pub tau_s: Option<f64>,
+    /// Settle time at each table segment start, s.
+    pub settle_s: f64,
+}
+
+/// The verdict of an inertial unit's run: each axis's (in the model's order, with its gyro
+/// column) and the unit's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImuRunVerdict {
+    pub axes: Vec<(String, spec::Verdict)>,
+    pub unit: UnitVerdict,
+}
+
+/// Judge an inertial unit: compensate each held-out log with the unit's model, measure every
+/// figure of each axis ([`crate::imu_judge::measure_unit`], as `evaluate --model` measures
+/// it), judge each axis and the unit against the spec
+/// ([`crate::imu_judge::judge_unit_figures`]); the [`Run`] to record (dated now, a row per
+/// axis in [`Run::axes`], each figure with its axis) and the verdicts when a spec is given.
+pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>), LotError> {
+    let model_err = |source: Box<dyn std::error::Error + Send + Sync>| LotError::Model {
+        path: u.model_path.to_path_buf(),
+        source,
+    };
+    let text = std::fs::read_to_string(u.model_path).map_err(|source| LotError::Read {
+        path: u.model_path.to_path_buf(),
+        source,
+    })?;
+    let model_sha256 = format!("{:x}", Sha256::digest(text.as_bytes()));
+    let model = ImuModel::from_json(&text).map_err(|e| model_err(e.into()))?;
+    let content = model.content_digest().map_err(|e| model_err(e.into()))?;
+    let tau_s = u
+        .tau_s
+        .unwrap_or_else(|| crate::imu_judge::default_tau_s(u.tests).0);
+    let opts = MeasureOptions {
+        evaluation: EvaluationOptions {
+            tau_s,
+            settle_s: u.settle_s,
+            reference_scale: None,
+        },
+        noise_terms: true,
+    };
+    let mut inputs = Vec::with_capacity(u.tests.len());
+    for (i, (path, log)) in u.tests.iter().enumerate() {
+        inputs.push(Input {
+            position: i as u32,
+            path: path.clone(),
+            sha256: file_sha256(Path::new(path))?,
+            kind: if log.table.is_none() {
+                "static"
+            } else {
+                "rate_table"
+            },
+        });
+    }
+    let measured =
+        crate::imu_judge::measure_unit(&model, u.tests, &opts).map_err(LotError::Unit)?;
+    let verdict = match u.spec {
+        Some(s) => {
+            let (axes, unit) =
+                crate::imu_judge::judge_unit_figures(s, &measured).map_err(LotError::Unit)?;
+            Some(ImuRunVerdict {
+                axes: measured.iter().map(|a| a.gyro.clone()).zip(axes).collect(),
+                unit,
+            })
+        }
+        None => None,
+    };
+    let mut figures = Vec::new();
+    let mut axes = Vec::with_capacity(measured.len());
+    for (k, a) in measured.iter().enumerate() {
+        for (i, (_, f)) in a.measured.iter().enumerate() {
+            for (&key, &value) in f {
+                let limit = u.spec.and_then(|s| s.limit(key));
+                figures.push(FigureRow {
+                    axis: Some(k as u32),
+                    position: i as u32,
+                    figure: key.to_string(),
+                    value,
+                    limit_min: limit.and_then(|l| l.min),
+                    limit_max: limit.and_then(|l| l.max),
+                    pass: limit.map(|l| l.passes(value)),
+                    margin: limit.map(|l| l.margin(value)),
+                });
+            }
+        }
+        axes.push(AxisRecord {
+            axis: k as u32,
+            gyro: a.gyro.clone(),
+            temps: a.temps.clone(),
+            verdict: match &verdict {
+                Some(v) if v.axes[k].1.pass => RunVerdict::Pass,
+                Some(_) => RunVerdict::Fail,
+                None => RunVerdict::None,
+            },
+        });
+    }
+    let mut methods: Vec<&str> = Vec::new();
+    for a in &model.axes {
+        let m = a.model.method.as_str();
+        if !methods.contains(&m) {
+            methods.push(m);
+        }
+    }
+    let run = Run {
+        id: 0,
+        unit: u.unit.to_string(),
+        tested_at_unix_ms: now_unix_ms(),
+        gyrotherm_version: env!("CARGO_PKG_VERSION").to_string(),
+        station: u.station.to_string(),
+        model_path: u.model_path.display().to_string(),
+        model_sha256,
+        model_content_sha256: content,
+        model_method: methods.join(","),
+        spec_name: u.spec.map(|s| s.name.clone()),
+        spec_sha256: u.spec.map(|s| s.sha256.clone()),
+        spec_toml: u.spec.map(|s| s.text.clone()),
+        verdict: match &verdict {
+            Some(v) if v.unit.pass => RunVerdict::Pass,
+            Some(_) => RunVerdict::Fail,
+            None => RunVerdict::None,
+        },
+        latest: false,
+        inputs,
+        axes,
+        figures,
+    };
+    Ok((run, verdict))
+}
+
+/// Check a run read back against the rules of its axes and make its figures' axes what the
+/// reader expects: a single-axis run has every figure on axis 0 (read back as None); a unit's
+/// figures name one of its axes, and its verdict is its axes' ([`unit_verdict_of_axes`]).
+pub(crate) fn check_axes(r: &mut Run) -> Result<(), String> {
+    let id = r.id;
+    if r.axes.is_empty() {
+        for f in &mut r.figures {
+            if f.axis.is_some_and(|a| a != 0) {
+                return Err(format!(
+                    "run {id}: figure {} on axis {:?} of a run without axes",
+                    f.figure, f.axis
+                ));
+            }
+            f.axis = None;
+        }
+        return Ok(());
+    }
+    for f in &r.figures {
+        let k = f.axis.unwrap_or(0);
+        if !r.axes.iter().any(|a| a.axis == k) {
+            return Err(format!(
+                "run {id}: figure {} on axis {k}, which the run does not have",
+                f.figure
+            ));
+        }
+    }
+    let want = unit_verdict_of_axes(&r.axes);
+    if r.verdict != want {
+        return Err(format!(
+            "run {id}: unit verdict {} but its axes give {}",
+            r.verdict.as_str(),
+            want.as_str()
+        ));
+    }
+    Ok(())
 }
 
 /// Mark the newest run of each unit (highest id) as [`Run::latest`].
@@ -443,6 +709,7 @@ pub fn synthetic_run(unit: &str, seed: u64, tested_at_unix_ms: i64) -> Run {
             max: Some(max),
         };
         figures.push(FigureRow {
+            axis: None,
             position,
             figure: key.to_string(),
             value,
@@ -453,6 +720,7 @@ pub fn synthetic_run(unit: &str, seed: u64, tested_at_unix_ms: i64) -> Run {
         });
     }
     figures.push(FigureRow {
+        axis: None,
         position: 0,
         figure: "bias_dph".into(),
         value: rng.gen::<f64>() * 0.2 - 0.1,
@@ -498,6 +766,7 @@ pub fn synthetic_run(unit: &str, seed: u64, tested_at_unix_ms: i64) -> Run {
                 kind: "rate_table",
             },
         ],
+        axes: Vec::new(),
         figures,
     }
 }

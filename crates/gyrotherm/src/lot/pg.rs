@@ -1,13 +1,15 @@
 //! The lot in PostgreSQL: several stations on separate machines write one lot. The schema is
-//! [`PG_V1`] (the SQLite one with an identity column); each run is one transaction, and the
-//! schema is created or upgraded under an advisory lock so two stations starting at once do
-//! not both create it.
+//! [`PG_V1`] (the SQLite one with an identity column) and its upgrades ([`PG_MIGRATIONS`]);
+//! each run is one transaction, and the schema is created or upgraded under an advisory lock
+//! so two stations starting at once do not both create it.
 
 use postgres::{Client, NoTls};
 
 use super::schema::{PG_MIGRATIONS, PG_V1, RUN_COLUMNS, SCHEMA_VERSION};
 use super::time::{parse_rfc3339_utc, rfc3339_utc};
-use super::{mark_latest, FigureRow, Input, LotError, LotStore, Run, RunVerdict};
+use super::{
+    check_axes, mark_latest, AxisRecord, FigureRow, Input, LotError, LotStore, Run, RunVerdict,
+};
 
 /// The advisory-lock key that serialises schema changes (an arbitrary constant, "gyro" in
 /// ASCII).
@@ -91,8 +93,17 @@ impl PgStore {
             tx.batch_execute(PG_V1).map_err(e)?;
             1
         };
-        for step in PG_MIGRATIONS.iter().skip(from as usize - 1) {
-            tx.batch_execute(step).map_err(e)?;
+        for (i, step) in PG_MIGRATIONS.iter().enumerate().skip(from as usize - 1) {
+            // A failed step drops the transaction, which rolls every step back.
+            tx.batch_execute(step).map_err(|x| match pg_error(&db, x) {
+                LotError::Database { db, detail } => LotError::Migration {
+                    db,
+                    from,
+                    to: i as i64 + 2,
+                    detail,
+                },
+                other => other,
+            })?;
         }
         tx.execute(
             "UPDATE schema_version SET version = $1",
@@ -154,10 +165,29 @@ impl LotStore for PgStore {
             )
             .map_err(e)?;
         }
+        let axis = tx
+            .prepare(
+                "INSERT INTO run_axes (run_id, axis, gyro, temps, verdict) \
+                 VALUES ($1, $2, $3, $4, $5)",
+            )
+            .map_err(e)?;
+        for a in &run.axes {
+            tx.execute(
+                &axis,
+                &[
+                    &id,
+                    &(a.axis as i32),
+                    &a.gyro,
+                    &a.temps.join(","),
+                    &a.verdict.as_str(),
+                ],
+            )
+            .map_err(e)?;
+        }
         let fig = tx
             .prepare(
-                "INSERT INTO figures (run_id, position, figure, value, limit_min, limit_max, \
-                 verdict, margin) VALUES ($1, $2, $3, $4, $5, $6, $7, $8)",
+                "INSERT INTO figures (run_id, axis, position, figure, value, limit_min, \
+                 limit_max, verdict, margin) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9)",
             )
             .map_err(e)?;
         for f in &run.figures {
@@ -166,6 +196,7 @@ impl LotStore for PgStore {
                 &fig,
                 &[
                     &id,
+                    &(f.axis.unwrap_or(0) as i32),
                     &(f.position as i32),
                     &f.figure,
                     &f.value,
@@ -223,6 +254,7 @@ impl LotStore for PgStore {
                     .ok_or_else(|| bad(format!("run {id}: verdict {verdict:?}")))?,
                 latest: false,
                 inputs: Vec::new(),
+                axes: Vec::new(),
                 figures: Vec::new(),
             });
         }
@@ -248,17 +280,46 @@ impl LotStore for PgStore {
         }
         for r in tx
             .query(
-                "SELECT run_id, position, figure, value, limit_min, limit_max, verdict, margin \
-                 FROM figures ORDER BY run_id, position, figure",
+                "SELECT run_id, axis, gyro, temps, verdict FROM run_axes ORDER BY run_id, axis",
                 &[],
             )
             .map_err(e)?
         {
-            let Some(&i) = index.get(&r.get::<_, i64>(0)) else {
+            let id: i64 = r.get(0);
+            let Some(&i) = index.get(&id) else {
+                continue;
+            };
+            let temps: String = r.get(3);
+            let verdict: String = r.get(4);
+            runs[i].axes.push(AxisRecord {
+                axis: u32::try_from(r.get::<_, i32>(1))
+                    .map_err(|_| bad(format!("run {id}: a negative axis")))?,
+                gyro: r.get(2),
+                temps: temps.split(',').map(str::to_owned).collect(),
+                verdict: RunVerdict::parse(&verdict)
+                    .ok_or_else(|| bad(format!("run {id}: axis verdict {verdict:?}")))?,
+            });
+        }
+        // Figure keys in byte order (the order the SQLite store and the judge give), whatever
+        // the database's collation.
+        for r in tx
+            .query(
+                "SELECT run_id, position, figure, value, limit_min, limit_max, verdict, margin, \
+                 axis FROM figures ORDER BY run_id, axis, position, figure COLLATE \"C\"",
+                &[],
+            )
+            .map_err(e)?
+        {
+            let id: i64 = r.get(0);
+            let Some(&i) = index.get(&id) else {
                 continue;
             };
             let v: Option<String> = r.get(6);
             runs[i].figures.push(FigureRow {
+                axis: Some(
+                    u32::try_from(r.get::<_, i32>(8))
+                        .map_err(|_| bad(format!("run {id}: a figure on a negative axis")))?,
+                ),
                 position: r.get::<_, i32>(1) as u32,
                 figure: r.get(2),
                 value: r.get(3),
@@ -269,6 +330,9 @@ impl LotStore for PgStore {
             });
         }
         tx.commit().map_err(e)?;
+        for r in &mut runs {
+            check_axes(r).map_err(bad)?;
+        }
         mark_latest(&mut runs);
         Ok(runs)
     }

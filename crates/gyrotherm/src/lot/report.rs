@@ -1,8 +1,10 @@
 //! `lot report`: the lot's page (`DIR/index.html`) and its data (`DIR/lot.csv`).
 //!
-//! The page gives the yield (units whose newest run passed, of those judged), each figure's
-//! distribution across units and over test date with its limits drawn, and the worst units
-//! (smallest margin first). Only each unit's newest run counts; `lot.csv` holds every run,
+//! The page gives the yield (units whose newest run passed, of those judged; an inertial unit
+//! passes only when every axis passes), each figure's distribution across units (an inertial
+//! unit by its worst axis) and over test date with its limits drawn, the worst units
+//! (smallest margin first) and, when the lot holds inertial units, each unit's axes with
+//! their verdicts and worst figures. Only each unit's newest run counts; `lot.csv` holds every run,
 //! one row per figure and log, with its `latest` mark. The figures are drawn with the
 //! report's plotting helpers ([`crate::report::write_figure`]); every text from the
 //! database is escaped on the page, and CSV fields are quoted by the csv writer.
@@ -41,7 +43,8 @@ impl Yield {
     }
 }
 
-/// The yield of `runs` (newest run of each unit).
+/// The yield of `runs` (newest run of each unit; an inertial unit counts as passed only when
+/// every axis passed).
 pub fn lot_yield(runs: &[Run]) -> Yield {
     let latest = runs.iter().filter(|r| r.latest);
     let mut y = Yield {
@@ -52,7 +55,13 @@ pub fn lot_yield(runs: &[Run]) -> Yield {
     };
     for r in latest {
         y.units += 1;
-        match r.verdict {
+        // An inertial unit passes only when every axis passes.
+        let verdict = if r.is_unit() {
+            super::unit_verdict_of_axes(&r.axes)
+        } else {
+            r.verdict
+        };
+        match verdict {
             RunVerdict::Pass => y.passed += 1,
             RunVerdict::Fail => y.failed += 1,
             RunVerdict::None => y.not_judged += 1,
@@ -78,7 +87,9 @@ fn csv_text(s: &str) -> String {
     }
 }
 
-/// Every run as CSV: one row per figure and log.
+/// Every run as CSV: one row per figure and log (and axis, for an inertial unit: `axis` names
+/// its gyro column and `axis_verdict` gives the axis's verdict; both empty for a single-axis
+/// run).
 pub fn lot_csv(runs: &[Run]) -> Result<Vec<u8>, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record([
@@ -96,6 +107,8 @@ pub fn lot_csv(runs: &[Run]) -> Result<Vec<u8>, csv::Error> {
         "limit_max",
         "verdict",
         "margin",
+        "axis",
+        "axis_verdict",
     ])?;
     let num = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:e}"));
     for r in runs {
@@ -123,6 +136,11 @@ pub fn lot_csv(runs: &[Run]) -> Result<Vec<u8>, csv::Error> {
                     .map_or("", |p| if p { "pass" } else { "fail" })
                     .to_string(),
                 num(f.margin),
+                csv_text(r.gyro_of(f.axis).unwrap_or("")),
+                f.axis
+                    .and_then(|k| r.axes.iter().find(|a| a.axis == k))
+                    .map_or("", |a| a.verdict.as_str())
+                    .to_string(),
             ])?;
         }
     }
@@ -195,7 +213,10 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
             let (fig, val, mar) =
                 worst.map_or((String::new(), String::new(), String::new()), |f| {
                     (
-                        f.figure.clone(),
+                        match r.gyro_of(f.axis) {
+                            Some(g) => format!("{} ({g})", f.figure),
+                            None => f.figure.clone(),
+                        },
                         format!("{:.4e}", f.value),
                         format!("{:+.3e}", f.margin.unwrap_or(f64::NAN)),
                     )
@@ -210,6 +231,48 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
                 val,
                 mar
             );
+        }
+        h.push_str("</tbody>\n</table>\n");
+    }
+
+    // Inertial units: each axis's verdict and its worst figure (single-axis lots have none).
+    let units: Vec<&&Run> = latest.iter().filter(|r| r.is_unit()).collect();
+    if !units.is_empty() {
+        h.push_str(
+            "<h2>Axes of each inertial unit</h2>\n<p>A unit passes only when every axis \
+             passes.</p>\n<table id=\"axes\">\n<thead><tr><th>unit</th><th>unit verdict</th>\
+             <th>axis</th><th>sensors</th><th>axis verdict</th><th>worst figure</th>\
+             <th>value</th><th>margin</th></tr></thead>\n<tbody>\n",
+        );
+        for r in units {
+            for a in &r.axes {
+                let worst = r
+                    .figures
+                    .iter()
+                    .filter(|f| f.axis == Some(a.axis) && f.margin.is_some())
+                    .min_by(|x, y| x.margin.unwrap_or(0.0).total_cmp(&y.margin.unwrap_or(0.0)));
+                let (fig, val, mar) =
+                    worst.map_or((String::new(), String::new(), String::new()), |f| {
+                        (
+                            f.figure.clone(),
+                            format!("{:.4e}", f.value),
+                            format!("{:+.3e}", f.margin.unwrap_or(f64::NAN)),
+                        )
+                    });
+                let _ = writeln!(
+                    h,
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
+                     <td>{}</td><td>{}</td></tr>",
+                    escape(&r.unit),
+                    r.verdict.as_str(),
+                    escape(&a.gyro),
+                    escape(&a.temps.join(", ")),
+                    a.verdict.as_str(),
+                    escape(&fig),
+                    val,
+                    mar
+                );
+            }
         }
         h.push_str("</tbody>\n</table>\n");
     }

@@ -2,12 +2,17 @@
 //! keeps them in step) so a lab can create the tables in its own database.
 //!
 //! A store holds one row in `schema_version`. Opening a store with an older version runs the
-//! steps after it ([`SQLITE_MIGRATIONS`], [`PG_MIGRATIONS`], index i upgrades version i to
-//! i + 1) in the same transaction as the check; a newer version is refused and nothing is
-//! written.
+//! steps after it ([`SQLITE_MIGRATIONS`], [`PG_MIGRATIONS`], index i upgrades version i + 1
+//! to i + 2) in the same transaction as the check; a newer version is refused and nothing is
+//! written. A new store is made the same way (version 1, then every step), so the steps run
+//! on every new lot, not only on the old ones.
+//!
+//! Version 2 holds inertial units: a unit's run has a row per axis in `run_axes` (its gyro
+//! column, the temperature columns its model reads, its verdict) and its figures carry the
+//! axis (`figures.axis`, 0 for a single-axis run, which has no `run_axes` row).
 
 /// The schema version this gyrotherm writes and reads.
-pub const SCHEMA_VERSION: i64 = 1;
+pub const SCHEMA_VERSION: i64 = 2;
 
 /// Version 1 in SQLite.
 pub const SQLITE_V1: &str = "\
@@ -97,12 +102,59 @@ CREATE VIEW latest_runs AS
 INSERT INTO schema_version (version) VALUES (1);
 ";
 
-/// Upgrades of an SQLite lot: index i takes version i + 1 to i + 2 (none yet: version 1 is
-/// the first).
-pub const SQLITE_MIGRATIONS: &[&str] = &[];
+/// Version 1 to 2 in SQLite: the axes of a unit's run, and the axis of each figure.
+/// SQLite cannot change a primary key in place, so `figures` is copied into a new table with
+/// the axis in its key (every existing figure on axis 0) and renamed.
+pub const SQLITE_V1_TO_V2: &str = "\
+CREATE TABLE run_axes (
+    run_id  INTEGER NOT NULL REFERENCES runs (id),
+    axis    INTEGER NOT NULL,
+    gyro    TEXT NOT NULL,
+    temps   TEXT NOT NULL,
+    verdict TEXT NOT NULL CHECK (verdict IN ('pass', 'fail', 'none')),
+    PRIMARY KEY (run_id, axis)
+);
+CREATE TABLE figures_v2 (
+    run_id    INTEGER NOT NULL REFERENCES runs (id),
+    axis      INTEGER NOT NULL DEFAULT 0,
+    position  INTEGER NOT NULL,
+    figure    TEXT NOT NULL,
+    value     DOUBLE PRECISION NOT NULL,
+    limit_min DOUBLE PRECISION,
+    limit_max DOUBLE PRECISION,
+    verdict   TEXT CHECK (verdict IN ('pass', 'fail')),
+    margin    DOUBLE PRECISION,
+    PRIMARY KEY (run_id, axis, position, figure),
+    FOREIGN KEY (run_id, position) REFERENCES run_inputs (run_id, position)
+);
+INSERT INTO figures_v2 (run_id, axis, position, figure, value, limit_min, limit_max, verdict, margin)
+    SELECT run_id, 0, position, figure, value, limit_min, limit_max, verdict, margin FROM figures;
+DROP TABLE figures;
+ALTER TABLE figures_v2 RENAME TO figures;
+UPDATE schema_version SET version = 2;
+";
+
+/// Version 1 to 2 in PostgreSQL: as [`SQLITE_V1_TO_V2`]; PostgreSQL changes the key in place.
+pub const PG_V1_TO_V2: &str = "\
+CREATE TABLE run_axes (
+    run_id  BIGINT NOT NULL REFERENCES runs (id),
+    axis    INTEGER NOT NULL,
+    gyro    TEXT NOT NULL,
+    temps   TEXT NOT NULL,
+    verdict TEXT NOT NULL CHECK (verdict IN ('pass', 'fail', 'none')),
+    PRIMARY KEY (run_id, axis)
+);
+ALTER TABLE figures ADD COLUMN axis INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE figures DROP CONSTRAINT figures_pkey;
+ALTER TABLE figures ADD PRIMARY KEY (run_id, axis, position, figure);
+UPDATE schema_version SET version = 2;
+";
+
+/// Upgrades of an SQLite lot: index i takes version i + 1 to i + 2.
+pub const SQLITE_MIGRATIONS: &[&str] = &[SQLITE_V1_TO_V2];
 
 /// Upgrades of a PostgreSQL lot, as [`SQLITE_MIGRATIONS`].
-pub const PG_MIGRATIONS: &[&str] = &[];
+pub const PG_MIGRATIONS: &[&str] = &[PG_V1_TO_V2];
 
 /// The columns every reader selects, in this order (both stores).
 pub(crate) const RUN_COLUMNS: &str = "id, unit, tested_at, gyrotherm_version, station, \
@@ -117,5 +169,13 @@ mod tests {
         let doc = include_str!("../../../../docs/lot-schema.md");
         assert!(doc.contains(super::SQLITE_V1.trim_end()), "SQLite schema");
         assert!(doc.contains(super::PG_V1.trim_end()), "PostgreSQL schema");
+        assert!(
+            doc.contains(super::SQLITE_V1_TO_V2.trim_end()),
+            "SQLite upgrade to version 2"
+        );
+        assert!(
+            doc.contains(super::PG_V1_TO_V2.trim_end()),
+            "PostgreSQL upgrade to version 2"
+        );
     }
 }

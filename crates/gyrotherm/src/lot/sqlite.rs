@@ -12,7 +12,9 @@ use rusqlite::{params, Connection, ErrorCode, OpenFlags, TransactionBehavior};
 
 use super::schema::{RUN_COLUMNS, SCHEMA_VERSION, SQLITE_MIGRATIONS, SQLITE_V1};
 use super::time::{parse_rfc3339_utc, rfc3339_utc};
-use super::{mark_latest, FigureRow, Input, LotError, LotStore, Run, RunVerdict};
+use super::{
+    check_axes, mark_latest, AxisRecord, FigureRow, Input, LotError, LotStore, Run, RunVerdict,
+};
 
 /// A lot in an SQLite file.
 pub struct SqliteStore {
@@ -141,9 +143,18 @@ impl SqliteStore {
             }
             Some(v) => v,
         };
-        for step in SQLITE_MIGRATIONS.iter().skip(from as usize - 1) {
+        for (i, step) in SQLITE_MIGRATIONS.iter().enumerate().skip(from as usize - 1) {
+            // A failed step drops the transaction, which rolls every step back.
             tx.execute_batch(step)
-                .map_err(|e| db_error(&db, e, self.busy_timeout_ms))?;
+                .map_err(|e| match db_error(&db, e, self.busy_timeout_ms) {
+                    LotError::Database { db, detail } => LotError::Migration {
+                        db,
+                        from,
+                        to: i as i64 + 2,
+                        detail,
+                    },
+                    other => other,
+                })?;
         }
         tx.execute(
             "UPDATE schema_version SET version = ?1",
@@ -218,15 +229,32 @@ impl LotStore for SqliteStore {
                 ins.execute(params![id, i.position, i.path, i.sha256, i.kind])
                     .map_err(e)?;
             }
+            let mut axis = tx
+                .prepare_cached(
+                    "INSERT INTO run_axes (run_id, axis, gyro, temps, verdict) \
+                     VALUES (?1, ?2, ?3, ?4, ?5)",
+                )
+                .map_err(e)?;
+            for a in &run.axes {
+                axis.execute(params![
+                    id,
+                    a.axis,
+                    a.gyro,
+                    a.temps.join(","),
+                    a.verdict.as_str()
+                ])
+                .map_err(e)?;
+            }
             let mut fig = tx
                 .prepare_cached(
-                    "INSERT INTO figures (run_id, position, figure, value, limit_min, \
-                     limit_max, verdict, margin) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
+                    "INSERT INTO figures (run_id, axis, position, figure, value, limit_min, \
+                     limit_max, verdict, margin) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
                 )
                 .map_err(e)?;
             for f in &run.figures {
                 fig.execute(params![
                     id,
+                    f.axis.unwrap_or(0),
                     f.position,
                     f.figure,
                     f.value,
@@ -281,6 +309,7 @@ impl LotStore for SqliteStore {
                         .ok_or_else(|| bad(format!("run {id}: verdict {verdict:?}")))?,
                     latest: false,
                     inputs: Vec::new(),
+                    axes: Vec::new(),
                     figures: Vec::new(),
                 });
             }
@@ -311,8 +340,30 @@ impl LotStore for SqliteStore {
         {
             let mut q = tx
                 .prepare(
+                    "SELECT run_id, axis, gyro, temps, verdict FROM run_axes \
+                     ORDER BY run_id, axis",
+                )
+                .map_err(e)?;
+            let mut rows = q.query([]).map_err(e)?;
+            while let Some(r) = rows.next().map_err(e)? {
+                let id: i64 = r.get(0).map_err(e)?;
+                let Some(&i) = index.get(&id) else { continue };
+                let temps: String = r.get(3).map_err(e)?;
+                let verdict: String = r.get(4).map_err(e)?;
+                runs[i].axes.push(AxisRecord {
+                    axis: r.get(1).map_err(e)?,
+                    gyro: r.get(2).map_err(e)?,
+                    temps: temps.split(',').map(str::to_owned).collect(),
+                    verdict: RunVerdict::parse(&verdict)
+                        .ok_or_else(|| bad(format!("run {id}: axis verdict {verdict:?}")))?,
+                });
+            }
+        }
+        {
+            let mut q = tx
+                .prepare(
                     "SELECT run_id, position, figure, value, limit_min, limit_max, verdict, \
-                     margin FROM figures ORDER BY run_id, position, figure",
+                     margin, axis FROM figures ORDER BY run_id, axis, position, figure",
                 )
                 .map_err(e)?;
             let mut rows = q.query([]).map_err(e)?;
@@ -321,6 +372,7 @@ impl LotStore for SqliteStore {
                 let Some(&i) = index.get(&id) else { continue };
                 let v: Option<String> = r.get(6).map_err(e)?;
                 runs[i].figures.push(FigureRow {
+                    axis: Some(r.get(8).map_err(e)?),
                     position: r.get(1).map_err(e)?,
                     figure: r.get(2).map_err(e)?,
                     value: r.get(3).map_err(e)?,
@@ -332,6 +384,9 @@ impl LotStore for SqliteStore {
             }
         }
         tx.commit().map_err(e)?;
+        for r in &mut runs {
+            check_axes(r).map_err(bad)?;
+        }
         mark_latest(&mut runs);
         Ok(runs)
     }

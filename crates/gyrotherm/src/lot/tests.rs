@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use super::time::rfc3339_utc;
 use super::*;
 
 fn bytes(p: &Path) -> Vec<u8> {
@@ -161,7 +162,7 @@ fn newer_schema_and_foreign_database_are_refused_unchanged() {
             e,
             LotError::NewerSchema {
                 found: 99,
-                supported: 1,
+                supported: 2,
                 ..
             }
         ),
@@ -391,4 +392,410 @@ fn postgres_store_same_promises() {
     let url = pg.create_db("lot_c");
     let e = open_store(&url, false, 0).err().unwrap();
     assert!(matches!(e, LotError::NotALot { .. }), "{e:?}");
+}
+
+/// A three-axis unit's run with made-up figures (each axis: the figures of
+/// [`synthetic_run`]), every limited figure set to half its limit (so it passes) except the
+/// bias stability of `fail_axis`, set to twice its limit. The verdicts are set by hand from
+/// those values: an axis fails only when one of its figures is above its limit, and the unit
+/// only when an axis fails.
+fn synthetic_unit(unit: &str, seed: u64, at: i64, fail_axis: Option<u32>) -> Run {
+    let mut run = synthetic_run(unit, seed, at);
+    let base = std::mem::take(&mut run.figures);
+    let gyros = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];
+    for (k, g) in gyros.iter().enumerate() {
+        let k = k as u32;
+        let fails = fail_axis == Some(k);
+        for f in &base {
+            let mut f = f.clone();
+            f.axis = Some(k);
+            if let Some(max) = f.limit_max {
+                let bad = fails && f.figure == "bias_stability_dph";
+                f.value = if bad { 2.0 * max } else { 0.5 * max };
+                f.pass = Some(!bad);
+                f.margin = Some(max - f.value);
+            } else {
+                f.value += k as f64;
+            }
+            run.figures.push(f);
+        }
+        run.axes.push(AxisRecord {
+            axis: k,
+            gyro: g.to_string(),
+            temps: vec!["temp_case_c".into(), format!("temp_{}_c", &g[5..6])],
+            verdict: if fails {
+                RunVerdict::Fail
+            } else {
+                RunVerdict::Pass
+            },
+        });
+    }
+    run.verdict = if fail_axis.is_some() {
+        RunVerdict::Fail
+    } else {
+        RunVerdict::Pass
+    };
+    run.model_method = "thermal".into();
+    run
+}
+
+/// Add two units (one failing on axis y) beside a single-axis run and check the round trip,
+/// the yield and what the report shows; the store must be empty.
+pub(crate) fn exercise_unit_store(s: &mut dyn LotStore) {
+    let single = synthetic_run("S-1", 7, 1_700_000_000_000);
+    let good = synthetic_unit("IMU-1", 8, 1_700_000_100_000, None);
+    let bad = synthetic_unit("IMU-2", 9, 1_700_000_200_000, Some(1));
+    for r in [&single, &good, &bad] {
+        s.add(r).unwrap();
+    }
+    let runs = s.runs().unwrap();
+    assert_eq!(runs.len(), 3);
+    for (got, want) in runs.iter().zip([&single, &good, &bad]) {
+        let mut g = got.clone();
+        g.id = 0;
+        g.latest = false;
+        assert_eq!(&g, want, "{}", want.unit);
+    }
+    // A row per axis per figure: 3 axes × 4 figures.
+    assert_eq!(runs[1].figures.len(), 12);
+    assert!(runs[0].axes.is_empty() && runs[0].figures.iter().all(|f| f.axis.is_none()));
+    // The single-axis run is judged as before; the units by every axis.
+    let single_pass = usize::from(single.verdict == RunVerdict::Pass);
+    let y = report::lot_yield(&runs);
+    assert_eq!(
+        (y.units, y.passed, y.failed),
+        (3, 1 + single_pass, 2 - single_pass)
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let page = report::write_lot_report(dir.path(), "units", &runs).unwrap();
+    let html = std::fs::read_to_string(page).unwrap();
+    assert!(html.contains("<table id=\"axes\">"), "{html}");
+    assert!(
+        html.contains(
+            "<tr><td>IMU-2</td><td>fail</td><td>gyro_y_dps</td><td>temp_case_c, temp_y_c</td>\
+             <td>fail</td><td>bias_stability_dph</td>"
+        ),
+        "{html}"
+    );
+    // The worst units table names the axis of a unit's worst figure.
+    assert!(
+        html.contains("<td>bias_stability_dph (gyro_y_dps)</td>"),
+        "{html}"
+    );
+    let csv = String::from_utf8(report::lot_csv(&runs).unwrap()).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 4 + 12 + 12);
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with(",margin,axis,axis_verdict"));
+    assert!(
+        csv.lines().any(|l| l.starts_with("3,IMU-2,")
+            && l.contains(",bias_stability_dph,")
+            && l.ends_with(",gyro_y_dps,fail")),
+        "{csv}"
+    );
+    // Single-axis rows leave the axis columns empty.
+    assert!(csv.lines().nth(1).unwrap().ends_with(",,"), "{csv}");
+}
+
+#[test]
+fn sqlite_store_holds_inertial_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("lot.sqlite");
+    let mut s = SqliteStore::open(&db, true, 5000).unwrap();
+    exercise_unit_store(&mut s);
+    // A unit's verdict that its axes do not give (edited by hand) is refused on reading.
+    drop(s);
+    let c = rusqlite::Connection::open(&db).unwrap();
+    c.execute("UPDATE runs SET verdict = 'pass' WHERE unit = 'IMU-2'", [])
+        .unwrap();
+    drop(c);
+    let e = SqliteStore::open(&db, false, 5000)
+        .unwrap()
+        .runs()
+        .unwrap_err();
+    assert!(matches!(e, LotError::BadRow { .. }), "{e:?}");
+    assert!(e.to_string().contains("its axes give fail"), "{e}");
+}
+
+/// Write `run` as gyrotherm 1 wrote it into a version 1 lot (the statements of the version 1
+/// `add`, kept here as they were: the test's fixture of the old code path).
+const V1_INSERT_RUN: &str = "INSERT INTO runs (unit, tested_at, gyrotherm_version, station, \
+model_path, model_sha256, model_content_sha256, model_method, spec_name, spec_sha256, \
+spec_toml, verdict) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)";
+const V1_INSERT_INPUT: &str =
+    "INSERT INTO run_inputs (run_id, position, path, sha256, kind) VALUES (?1, ?2, ?3, ?4, ?5)";
+const V1_INSERT_FIGURE: &str = "INSERT INTO figures (run_id, position, figure, value, \
+limit_min, limit_max, verdict, margin) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)";
+
+/// A version 1 SQLite lot at `db` holding `runs`, made as gyrotherm 1 made it: WAL mode, the
+/// version 1 script, each run in its own transaction.
+fn write_v1_sqlite(db: &Path, runs: &[Run]) {
+    let mut c = rusqlite::Connection::open(db).unwrap();
+    c.query_row("PRAGMA journal_mode = WAL", [], |_| Ok(()))
+        .unwrap();
+    c.execute_batch(&format!("BEGIN; {} COMMIT;", schema::SQLITE_V1))
+        .unwrap();
+    for r in runs {
+        let tx = c.transaction().unwrap();
+        tx.execute(
+            V1_INSERT_RUN,
+            rusqlite::params![
+                r.unit,
+                rfc3339_utc(r.tested_at_unix_ms),
+                r.gyrotherm_version,
+                r.station,
+                r.model_path,
+                r.model_sha256,
+                r.model_content_sha256,
+                r.model_method,
+                r.spec_name,
+                r.spec_sha256,
+                r.spec_toml,
+                r.verdict.as_str()
+            ],
+        )
+        .unwrap();
+        let id = tx.last_insert_rowid();
+        for i in &r.inputs {
+            tx.execute(
+                V1_INSERT_INPUT,
+                rusqlite::params![id, i.position, i.path, i.sha256, i.kind],
+            )
+            .unwrap();
+        }
+        for f in &r.figures {
+            tx.execute(
+                V1_INSERT_FIGURE,
+                rusqlite::params![
+                    id,
+                    f.position,
+                    f.figure,
+                    f.value,
+                    f.limit_min,
+                    f.limit_max,
+                    f.pass.map(|p| if p { "pass" } else { "fail" }),
+                    f.margin
+                ],
+            )
+            .unwrap();
+        }
+        tx.commit().unwrap();
+    }
+}
+
+#[test]
+fn sqlite_version_1_lot_is_upgraded_and_keeps_every_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("v1.sqlite");
+    let old = [
+        synthetic_run("A-001", 1, 1_700_000_000_000),
+        synthetic_run("B-002", 2, 1_700_000_100_000),
+    ];
+    write_v1_sqlite(&db, &old);
+    // The fixture is a version 1 lot: its version row, and figures without an axis.
+    {
+        let c = rusqlite::Connection::open(&db).unwrap();
+        let v: i64 = c
+            .query_row("SELECT version FROM schema_version", [], |r| r.get(0))
+            .unwrap();
+        let cols: Vec<String> = c
+            .prepare("SELECT name FROM pragma_table_info('figures')")
+            .unwrap()
+            .query_map([], |r| r.get(0))
+            .unwrap()
+            .map(Result::unwrap)
+            .collect();
+        assert_eq!(v, 1);
+        assert!(!cols.iter().any(|c| c == "axis"), "{cols:?}");
+    }
+    // A reader (lot list, lot report) opens it: upgraded in place.
+    let mut s = SqliteStore::open(&db, false, 5000).unwrap();
+    assert_eq!(s.schema_version().unwrap(), 2);
+    let runs = s.runs().unwrap();
+    assert_eq!(runs.len(), 2);
+    for (got, want) in runs.iter().zip(&old) {
+        let mut g = got.clone();
+        g.id = 0;
+        g.latest = false;
+        assert_eq!(&g, want);
+    }
+    // The upgraded lot takes a unit beside the old runs.
+    s.add(&synthetic_unit("IMU-1", 3, 1_700_000_200_000, Some(2)))
+        .unwrap();
+    let runs = s.runs().unwrap();
+    assert_eq!(runs.len(), 3);
+    assert_eq!(runs[2].axes.len(), 3);
+    assert_eq!(runs[2].verdict, RunVerdict::Fail);
+    // Its figures went in with their axis.
+    let c = rusqlite::Connection::open(&db).unwrap();
+    let axes: Vec<i64> = c
+        .prepare("SELECT DISTINCT axis FROM figures ORDER BY axis")
+        .unwrap()
+        .query_map([], |r| r.get(0))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    assert_eq!(axes, [0, 1, 2]);
+}
+
+#[test]
+fn failed_upgrade_changes_nothing_and_says_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("v1.sqlite");
+    write_v1_sqlite(&db, &[synthetic_run("A-001", 1, 0)]);
+    // A table the upgrade would create, made by hand: the upgrade stops at it.
+    {
+        let c = rusqlite::Connection::open(&db).unwrap();
+        c.execute_batch("CREATE TABLE run_axes (note TEXT);")
+            .unwrap();
+    }
+    let e = SqliteStore::open(&db, true, 5000).err().unwrap();
+    assert!(
+        matches!(e, LotError::Migration { from: 1, to: 2, .. }),
+        "{e:?}"
+    );
+    let m = e.to_string();
+    assert!(
+        m.contains("nothing was changed") && m.contains("docs/lot-schema.md"),
+        "{m}"
+    );
+    // Still version 1, its figures table as it was (no axis column), the run in it.
+    let c = rusqlite::Connection::open(&db).unwrap();
+    let v: i64 = c
+        .query_row("SELECT version FROM schema_version", [], |r| r.get(0))
+        .unwrap();
+    let has_axis: i64 = c
+        .query_row(
+            "SELECT count(*) FROM pragma_table_info('figures') WHERE name = 'axis'",
+            [],
+            |r| r.get(0),
+        )
+        .unwrap();
+    let n: i64 = c
+        .query_row("SELECT count(*) FROM figures", [], |r| r.get(0))
+        .unwrap();
+    assert_eq!((v, has_axis, n), (1, 0, 4));
+}
+
+/// [`write_v1_sqlite`] in PostgreSQL (the same version 1 statements with `$n` parameters).
+fn write_v1_pg(url: &str, runs: &[Run]) {
+    let mut c = postgres::Client::connect(url, postgres::NoTls).unwrap();
+    let mut tx = c.transaction().unwrap();
+    tx.batch_execute(schema::PG_V1).unwrap();
+    tx.commit().unwrap();
+    let pg = |q: &str| {
+        let mut out = q.to_string();
+        for n in (1..=12).rev() {
+            out = out.replace(&format!("?{n}"), &format!("${n}"));
+        }
+        out
+    };
+    for r in runs {
+        let mut tx = c.transaction().unwrap();
+        let id: i64 = tx
+            .query_one(
+                &format!("{} RETURNING id", pg(V1_INSERT_RUN)),
+                &[
+                    &r.unit,
+                    &rfc3339_utc(r.tested_at_unix_ms),
+                    &r.gyrotherm_version,
+                    &r.station,
+                    &r.model_path,
+                    &r.model_sha256,
+                    &r.model_content_sha256,
+                    &r.model_method,
+                    &r.spec_name,
+                    &r.spec_sha256,
+                    &r.spec_toml,
+                    &r.verdict.as_str(),
+                ],
+            )
+            .unwrap()
+            .get(0);
+        for i in &r.inputs {
+            tx.execute(
+                &pg(V1_INSERT_INPUT),
+                &[&id, &(i.position as i32), &i.path, &i.sha256, &i.kind],
+            )
+            .unwrap();
+        }
+        for f in &r.figures {
+            let v = f.pass.map(|p| if p { "pass" } else { "fail" });
+            tx.execute(
+                &pg(V1_INSERT_FIGURE),
+                &[
+                    &id,
+                    &(f.position as i32),
+                    &f.figure,
+                    &f.value,
+                    &f.limit_min,
+                    &f.limit_max,
+                    &v,
+                    &f.margin,
+                ],
+            )
+            .unwrap();
+        }
+        tx.commit().unwrap();
+    }
+}
+
+#[test]
+fn postgres_store_holds_units_and_upgrades_version_1() {
+    let Some(pg) = PgServer::start() else { return };
+    let url = pg.create_db("lot_units");
+    let mut s = open_store(&url, true, 0).unwrap();
+    exercise_unit_store(s.as_mut());
+    drop(s);
+
+    // A version 1 lot made by the old statements: upgraded on opening, every run kept.
+    let url = pg.create_db("lot_v1");
+    let old = [
+        synthetic_run("A-001", 1, 1_700_000_000_000),
+        synthetic_run("B-002", 2, 1_700_000_100_000),
+    ];
+    write_v1_pg(&url, &old);
+    let mut s = open_store(&url, false, 0).unwrap();
+    assert_eq!(s.schema_version().unwrap(), 2);
+    let runs = s.runs().unwrap();
+    for (got, want) in runs.iter().zip(&old) {
+        let mut g = got.clone();
+        g.id = 0;
+        g.latest = false;
+        assert_eq!(&g, want);
+    }
+    s.add(&synthetic_unit("IMU-1", 3, 1_700_000_200_000, None))
+        .unwrap();
+    let runs = s.runs().unwrap();
+    assert_eq!((runs.len(), runs[2].axes.len()), (3, 3));
+    assert_eq!(report::lot_yield(&runs).units, 3);
+    drop(s);
+
+    // A failed upgrade is rolled back whole: still version 1, figures without an axis.
+    let url = pg.create_db("lot_v1_blocked");
+    write_v1_pg(&url, &old[..1]);
+    let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
+    c.batch_execute("CREATE TABLE run_axes (note TEXT)")
+        .unwrap();
+    let e = open_store(&url, true, 0).err().unwrap();
+    assert!(
+        matches!(e, LotError::Migration { from: 1, to: 2, .. }),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("nothing was changed"), "{e}");
+    let v: i32 = c
+        .query_one("SELECT version FROM schema_version", &[])
+        .unwrap()
+        .get(0);
+    let has_axis: i64 = c
+        .query_one(
+            "SELECT count(*) FROM information_schema.columns \
+             WHERE table_name = 'figures' AND column_name = 'axis'",
+            &[],
+        )
+        .unwrap()
+        .get(0);
+    assert_eq!((v, has_axis), (1, 0));
 }

@@ -2,16 +2,18 @@
 //! with the table across axes (axis × figure) and a section per axis (its comparison table,
 //! its compensation and bias figures, a link to its full page), and each axis's full
 //! single-axis report in `DIR/axisN/` (N = 1, 2, … in gyro column order: folder names never
-//! come from the log's column names).
+//! come from the log's column names). Judged against a spec sheet (`report --spec`), the page
+//! also gives the unit's verdict of each column and each axis's verdicts.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::html::{escape, push_table, CSS};
+use super::html::{escape, push_table, Table, CSS};
 use super::{grouped_warnings, results_table, write_full_report_with, ReportError};
 use crate::atomic_file::write_bytes_atomically;
 use crate::compare::CompareConfig;
-use crate::imu_judge::ImuComparison;
+use crate::imu_judge::{unit_verdicts, AxisVerdicts, ImuComparison, UNIT_FIT_COLUMN};
+use crate::spec::{Spec, Verdict};
 
 /// The figures of each axis's page that the unit page shows in the axis's section, with
 /// their captions.
@@ -27,20 +29,90 @@ pub const UNIT_PAGE_FIGURES: [(&str, &str); 2] = [
 ];
 
 /// The across-axes table names the log, the figure and the axis in its first three columns.
-const UNIT_CSS: &str = "table.across-axes td:nth-child(-n+3){text-align:left}";
+const UNIT_CSS: &str = "table.across-axes td:nth-child(-n+3){text-align:left}\
+table.axis-verdicts td:nth-child(-n+3){text-align:left}";
 
 /// The folder of axis `k` (0-based) inside the report folder.
 pub fn axis_folder(k: usize) -> String {
     format!("axis{}", k + 1)
 }
 
+/// The unit's verdict of each judged column ([`unit_verdicts`]): a row per column, a cell per
+/// axis and the unit's cell (`PASS` only when every axis passes).
+pub fn unit_verdict_table(spec: &Spec, verdicts: &[AxisVerdicts]) -> Table {
+    let mut headers = vec!["column".to_owned()];
+    headers.extend(verdicts.iter().map(|a| a.gyro.clone()));
+    headers.push("unit".to_owned());
+    let rows = unit_verdicts(spec, verdicts)
+        .into_iter()
+        .map(|(name, unit)| {
+            let mut row = vec![name];
+            for a in verdicts {
+                let failed = unit.failed_axes.contains(&a.gyro);
+                row.push(if failed { "FAIL" } else { "PASS" }.to_owned());
+            }
+            row.push(unit.word().to_owned());
+            row
+        })
+        .collect();
+    Table { headers, rows }
+}
+
+/// One axis's verdicts: a row per judged column, figure and held-out log.
+pub fn axis_verdict_table(a: &AxisVerdicts) -> Table {
+    let headers = [
+        "column",
+        "figure",
+        "held-out log",
+        "value",
+        "unit",
+        "limit",
+        "verdict",
+        "margin",
+    ]
+    .map(str::to_owned)
+    .to_vec();
+    let mut rows = Vec::new();
+    let mut push = |label: &str, v: &Verdict| {
+        for f in &v.figures {
+            let limit = match (f.min, f.max) {
+                (Some(a), Some(b)) => format!("{a} ..= {b}"),
+                (Some(a), None) => format!(">= {a}"),
+                (None, Some(b)) => format!("<= {b}"),
+                (None, None) => String::new(),
+            };
+            rows.push(vec![
+                label.to_owned(),
+                f.figure.to_owned(),
+                f.log.clone(),
+                format!("{:.4e}", f.value),
+                f.unit.to_owned(),
+                limit,
+                if f.pass { "pass" } else { "FAIL" }.to_owned(),
+                format!("{:+.3e}", f.margin),
+            ]);
+        }
+    };
+    for c in &a.columns {
+        push(c.label, &c.verdict);
+    }
+    if let Some((label, v)) = &a.unit_fit {
+        push(&format!("{UNIT_FIT_COLUMN}: {label}"), v);
+    }
+    Table { headers, rows }
+}
+
 /// Write every axis's full report, then `dir/index.html`; returns the unit page's path.
-/// `extra_warnings` (e.g. gaps filled on reading) are listed after the axes' findings.
+/// `extra_warnings` (e.g. gaps filled on reading) are listed after the axes' findings. With
+/// `judged` (a spec sheet and [`crate::imu_judge::judge_unit_comparison`]'s verdicts), the
+/// page shows the unit's verdict of each column across the axes and, in each axis's section,
+/// the axis's verdicts.
 pub fn write_unit_report(
     dir: &Path,
     cmp: &ImuComparison,
     cfg: &CompareConfig,
     extra_warnings: &[String],
+    judged: Option<(&Spec, &[AxisVerdicts])>,
 ) -> Result<PathBuf, ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
         path: dir.to_path_buf(),
@@ -74,6 +146,18 @@ pub fn write_unit_report(
     );
     h.push_str("<h2>Across axes</h2>\n");
     push_table(&mut h, &cmp.across_axes(cfg), "across-axes");
+    if let Some((spec, verdicts)) = judged {
+        let pass = verdicts.iter().all(AxisVerdicts::pass);
+        let _ = writeln!(
+            h,
+            "<h2>Against the spec {}: {}</h2>\n<p>Each column's compensated output on every \
+             held-out log, axis by axis; a column passes for the unit only when it passes on \
+             every axis. Each axis's section lists its figures.</p>",
+            escape(&spec.name),
+            if pass { "PASS" } else { "FAIL" }
+        );
+        push_table(&mut h, &unit_verdict_table(spec, verdicts), "unit-verdicts");
+    }
     h.push_str("<h2>Warnings</h2>\n");
     if warnings.is_empty() {
         h.push_str("<p>None.</p>\n");
@@ -100,6 +184,15 @@ pub fn write_unit_report(
             escape(&unit_fit)
         );
         push_table(&mut h, &results_table(&a.table(cfg)), "comparison");
+        if let Some(v) = judged.and_then(|(_, vs)| vs.get(k)) {
+            let _ = writeln!(
+                h,
+                "<h3>Axis {} against the spec: {}</h3>",
+                k + 1,
+                if v.pass() { "PASS" } else { "FAIL" }
+            );
+            push_table(&mut h, &axis_verdict_table(v), "axis-verdicts");
+        }
         for (stem, caption) in UNIT_PAGE_FIGURES {
             // An axis without the run a figure needs has no such file (its page says why).
             if !dir.join(&folder).join(format!("{stem}.png")).is_file() {

@@ -790,6 +790,83 @@ mod tests {
         assert!(shrunk[0].abs() < 0.1 && shrunk[1].abs() < 0.1, "{shrunk:?}");
     }
 
+    /// The statistics of some columns taken from a wider design's ([`Stats::columns`]) are
+    /// those of a design of these columns alone, to the bit: per segment (centred on the run's
+    /// means) and per run, and so the cross-validated scores and the fit from them
+    /// (independent: the narrower design built and scored on its own).
+    #[test]
+    fn column_subsets_of_statistics_equal_the_narrow_design_s_own() {
+        let (nc, keep) = (6, [0usize, 1, 3, 5]);
+        let mut wide = Design {
+            x: Vec::new(),
+            y: Vec::new(),
+            step: Vec::new(),
+            n_steps: Vec::new(),
+        };
+        let mut narrow = Design {
+            x: Vec::new(),
+            y: Vec::new(),
+            step: Vec::new(),
+            n_steps: Vec::new(),
+        };
+        for r in 0..2 {
+            let (mut xw, mut xn, mut y, mut step) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for k in 0..400 {
+                if k % 7 == 3 {
+                    continue;
+                }
+                let row: Vec<f64> = (0..nc)
+                    .map(|c| ((k * (c + 2) + 31 * r) as f64 * 0.013).sin() * (c + 1) as f64 + 10.0)
+                    .collect();
+                y.push(0.3 * row[0] - 0.7 * row[3] + (k as f64 * 0.29).cos());
+                xn.extend(keep.iter().map(|&c| row[c]));
+                xw.extend(row);
+                step.push(k);
+            }
+            for d in [&mut wide, &mut narrow] {
+                d.y.push(y.clone());
+                d.step.push(step.clone());
+                d.n_steps.push(400);
+            }
+            wide.x.push(xw);
+            narrow.x.push(xn);
+        }
+        let (folds, gap, lambdas) = (5, 12, [1e-6, 1e-3, 1e-1]);
+        let layouts: Vec<Layout> = (0..2)
+            .map(|r| layout(&wide.step[r], wide.n_steps[r], folds, gap))
+            .collect();
+        let seg_w = segment_stats(&wide, nc, &layouts);
+        let seg_n = segment_stats(&narrow, keep.len(), &layouts);
+        let bits = |s: &Stats| {
+            let mut v = vec![s.n.to_bits(), s.sy.to_bits(), s.syy.to_bits()];
+            for x in s.sx.iter().chain(&s.sxx).chain(&s.sxy) {
+                v.push(x.to_bits());
+            }
+            v
+        };
+        let sub: Vec<Vec<Stats>> = seg_w
+            .iter()
+            .map(|run| run.iter().map(|s| s.columns(&keep)).collect())
+            .collect();
+        for (a, b) in sub.iter().flatten().zip(seg_n.iter().flatten()) {
+            assert_eq!(bits(a), bits(b));
+        }
+        let runs: Vec<(&[Stats], &Layout)> = sub.iter().map(Vec::as_slice).zip(&layouts).collect();
+        let scores = segment_scores(&runs, keep.len(), folds, &lambdas);
+        let own = cv_scores(&narrow, keep.len(), folds, gap, &lambdas);
+        assert_eq!(
+            scores.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            own.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        );
+        for (a, b) in run_stats(&wide, nc)
+            .iter()
+            .zip(&run_stats(&narrow, keep.len()))
+        {
+            assert_eq!(bits(&a.columns(&keep)), bits(b));
+        }
+    }
+
     /// Every basis stays within the flight crate's 16 terms, and starts with the constant.
     #[test]
     fn bases_fit_the_flight_crate() {

@@ -171,16 +171,19 @@ fn combined(parts: &[(&[TargetSet], &Terms)]) -> (Design, usize) {
         return (d, 0);
     };
     for (r, s) in first.iter().enumerate() {
-        let mut x = Vec::new();
-        let mut y = Vec::new();
-        let mut step = Vec::new();
         let n_rows = parts
             .iter()
             .map(|(sets, _)| sets[r].table.n_rows())
             .min()
             .unwrap_or(0);
+        let used = |k: usize| s.mask[k] && s.target[k].is_finite();
+        // Sized ahead: a design grown row by row copies itself over and over.
+        let rows = (0..n_rows).filter(|&k| used(k)).count();
+        let mut x = Vec::with_capacity(rows * nc);
+        let mut y = Vec::with_capacity(rows);
+        let mut step = Vec::with_capacity(rows);
         for k in 0..n_rows {
-            if s.mask[k] && s.target[k].is_finite() {
+            if used(k) {
                 for (i, (sets, terms)) in parts.iter().enumerate() {
                     terms.extend_design_row(sets[r].table.row(k), usize::from(i == 0), &mut x);
                 }
@@ -256,6 +259,157 @@ pub fn cv_rms<'a>(
     s.is_finite().then_some(s)
 }
 
+/// One target's design over a first sensor's terms and further sensors' columns, in a fixed
+/// order, with its per-segment statistics: the cross-validation (and fit) of the first sensor
+/// with any further sensors taken in that order comes from these, to the bit, instead of from
+/// a design of its own. Every trial of [`select`] and the fits after it read the same rows
+/// and the same values in each column; only which columns differs, and each entry of the
+/// statistics is a sum over rows of its own columns alone.
+pub struct Shared {
+    first: usize,
+    scale: bool,
+    /// The further sensors, in column order.
+    rest: Vec<usize>,
+    /// First column of each part (the first sensor's terms without the constant, then each
+    /// further sensor's), and the end.
+    starts: Vec<usize>,
+    design: Design,
+    folds: usize,
+    layouts: Vec<Layout>,
+    segs: Vec<Vec<Stats>>,
+    runs: std::cell::OnceCell<Vec<Stats>>,
+}
+
+/// [`Shared`] statistics of one target for the sensor `first` followed by `rest`; None where
+/// a trial's design could differ in its rows (the sensors' feature tables not all of the
+/// same length in every run), the first sensor has no training set or the selection's folds
+/// are set apart from the fit's ([`MultiConfig::select_folds`], an experiment): the callers
+/// then build each design on its own.
+pub fn shared<'a>(
+    sensors: &[SensorData<'a>],
+    first: usize,
+    rest: &[usize],
+    cfg: &ThermalConfig,
+    multi: &MultiConfig,
+    scale: bool,
+) -> Option<Shared> {
+    let sets = |s: &SensorData<'a>| target_sets(s, scale);
+    let f = &sensors[first];
+    let first_sets = sets(f);
+    if first_sets.is_empty() || multi.select_folds > 0 {
+        return None;
+    }
+    let same_rows = rest.iter().all(|&j| {
+        let other = sets(&sensors[j]);
+        other.len() == first_sets.len()
+            && other
+                .iter()
+                .zip(first_sets)
+                .all(|(o, s)| o.table.n_rows() == s.table.n_rows())
+    });
+    if !same_rows {
+        return None;
+    }
+    let t0 = first_terms(first_sets, cfg, f.id, scale);
+    // Each further sensor's terms depend on that sensor alone, never on its place in the
+    // order: a trial's columns are a subset of this design's.
+    let extra: Vec<Terms> = rest
+        .iter()
+        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
+        .collect();
+    let mut order = vec![first];
+    order.extend_from_slice(rest);
+    let extra = same_terms(sensors, &order, cfg, multi, scale, extra);
+    let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(first_sets, &t0)];
+    for (&j, t) in rest.iter().zip(&extra) {
+        parts.push((sets(&sensors[j]), t));
+    }
+    let (design, nc) = combined(&parts);
+    let mut starts = vec![0, t0.len() - 1];
+    for t in &extra {
+        starts.push(starts[starts.len() - 1] + t.len());
+    }
+    debug_assert_eq!(starts.last(), Some(&nc));
+    let folds = folds_for(&design, f.id);
+    let gap = f.id.gap_steps;
+    let layouts: Vec<Layout> = if folds == 0 {
+        Vec::new()
+    } else {
+        (0..design.x.len())
+            .map(|r| layout(&design.step[r], design.n_steps[r], folds, gap))
+            .collect()
+    };
+    let segs = if folds == 0 {
+        Vec::new()
+    } else {
+        segment_stats(&design, nc, &layouts)
+    };
+    Some(Shared {
+        first,
+        scale,
+        rest: rest.to_vec(),
+        starts,
+        design,
+        folds,
+        layouts,
+        segs,
+        runs: std::cell::OnceCell::new(),
+    })
+}
+
+impl Shared {
+    /// The columns of `order` (the first sensor, then further sensors in this design's
+    /// order), or None when `order` is not such a trial of this design.
+    fn columns(&self, order: &[usize], scale: bool) -> Option<Vec<usize>> {
+        if scale != self.scale || order.first() != Some(&self.first) {
+            return None;
+        }
+        let mut cols: Vec<usize> = (self.starts[0]..self.starts[1]).collect();
+        let mut from = 0;
+        for &j in &order[1..] {
+            let at = from + self.rest[from..].iter().position(|&r| r == j)?;
+            cols.extend(self.starts[at + 1]..self.starts[at + 2]);
+            from = at + 1;
+        }
+        Some(cols)
+    }
+
+    /// The cross-validated scores over `lambdas` of the columns `cols` (None without folds).
+    fn scores(&self, cols: &[usize], lambdas: &[f64]) -> Option<Vec<f64>> {
+        if self.folds == 0 {
+            return None;
+        }
+        let segs: Vec<Vec<Stats>> = self
+            .segs
+            .iter()
+            .map(|run| run.iter().map(|s| s.columns(cols)).collect())
+            .collect();
+        let runs: Vec<(&[Stats], &Layout)> =
+            segs.iter().map(Vec::as_slice).zip(&self.layouts).collect();
+        Some(segment_scores(&runs, cols.len(), self.folds, lambdas))
+    }
+}
+
+/// [`cv_rms`], from `shared` when `order` is one of its trials.
+pub fn cv_rms_with<'a>(
+    sensors: &[SensorData<'a>],
+    order: &[usize],
+    cfg: &ThermalConfig,
+    multi: &MultiConfig,
+    scale: bool,
+    shared: Option<&Shared>,
+) -> Option<f64> {
+    let Some((sh, cols)) = shared.and_then(|sh| Some((sh, sh.columns(order, scale)?))) else {
+        return cv_rms(sensors, order, cfg, multi, scale);
+    };
+    let (s, _) = choose_ridge(
+        sh.scores(&cols, &cfg.ridge_grid)?,
+        &cfg.ridge_grid,
+        cfg.ridge_tolerance,
+    );
+    s.is_finite().then_some(s)
+}
+
 /// The sensors an axis keeps, first sensor first (see the module doc), and each one-sensor
 /// score.
 pub fn select(
@@ -263,6 +417,18 @@ pub fn select(
     cfg: &ThermalConfig,
     multi: &MultiConfig,
 ) -> (Vec<usize>, Vec<Option<f64>>) {
+    let (order, single, _) = select_shared(sensors, cfg, multi);
+    (order, single)
+}
+
+/// [`select`], its trials' cross-validation from one [`Shared`] design over the best sensor
+/// and every other in ranked order, which it also returns (for [`fit_multi_with`] and
+/// [`cv_rms_with`]; None where there was nothing to try or it could not be made).
+pub fn select_shared(
+    sensors: &[SensorData],
+    cfg: &ThermalConfig,
+    multi: &MultiConfig,
+) -> (Vec<usize>, Vec<Option<f64>>, Option<Shared>) {
     let scale = sensors.iter().all(|s| s.bias.is_empty());
     let single: Vec<Option<f64>> = (0..sensors.len())
         .map(|j| cv_rms(sensors, &[j], cfg, multi, scale))
@@ -293,7 +459,12 @@ pub fn select(
     }
     let mut order = vec![ranked[0]];
     let Some(mut best) = single[ranked[0]] else {
-        return (order, single);
+        return (order, single, None);
+    };
+    let sh = if ranked.len() > 1 {
+        shared(sensors, ranked[0], &ranked[1..], cfg, multi, scale)
+    } else {
+        None
     };
     for &j in &ranked[1..] {
         if order.len() >= gyrotherm_core::multi::MAX_SENSORS {
@@ -301,14 +472,14 @@ pub fn select(
         }
         let mut trial = order.clone();
         trial.push(j);
-        if let Some(s) = cv_rms(sensors, &trial, cfg, multi, scale) {
+        if let Some(s) = cv_rms_with(sensors, &trial, cfg, multi, scale, sh.as_ref()) {
             if s < best * (1.0 - multi.min_gain) {
                 best = s;
                 order = trial;
             }
         }
     }
-    (order, single)
+    (order, single, sh)
 }
 
 /// A fitted target on several sensors: the first sensor's model (constant first, its
@@ -329,6 +500,18 @@ pub fn fit_multi<'a>(
     multi: &MultiConfig,
     scale: bool,
 ) -> Result<MultiFit, ThermalError> {
+    fit_multi_with(sensors, order, cfg, multi, scale, None)
+}
+
+/// [`fit_multi`], from `shared` when `order` is one of its trials.
+pub fn fit_multi_with<'a>(
+    sensors: &[SensorData<'a>],
+    order: &[usize],
+    cfg: &ThermalConfig,
+    multi: &MultiConfig,
+    scale: bool,
+    shared: Option<&Shared>,
+) -> Result<MultiFit, ThermalError> {
     let first = &sensors[order[0]];
     let sets = |s: &SensorData<'a>| target_sets(s, scale);
     let t0 = first_terms(sets(first), cfg, first.id, scale);
@@ -341,7 +524,15 @@ pub fn fit_multi<'a>(
     for (&j, t) in order[1..].iter().zip(&extra) {
         parts.push((sets(&sensors[j]), t));
     }
-    let (d, nc) = combined(&parts);
+    let from_shared = shared.and_then(|sh| Some((sh, sh.columns(order, scale)?)));
+    let own;
+    let (d, nc) = match &from_shared {
+        Some((sh, cols)) => (&sh.design, cols.len()),
+        None => {
+            own = combined(&parts);
+            (&own.0, own.1)
+        }
+    };
     let labelled: usize = d.y.iter().map(Vec::len).sum();
     let needed = nc + 1 + d.y.len();
     if labelled < needed {
@@ -350,13 +541,21 @@ pub fn fit_multi<'a>(
             needed,
         });
     }
-    let folds = folds_for(&d, first.id);
     let RidgeFit {
         cv,
         lambda,
         beta,
         constant,
-    } = ridge_fit(&d, nc, folds, first.id.gap_steps, cfg)?;
+    } = match &from_shared {
+        Some((sh, cols)) => {
+            let runs = sh
+                .runs
+                .get_or_init(|| run_stats(&sh.design, sh.starts[sh.starts.len() - 1]));
+            let stats: Vec<Stats> = runs.iter().map(|s| s.columns(cols)).collect();
+            ridge_fit_from(sh.scores(cols, &cfg.ridge_grid), &stats, nc, cfg)?
+        }
+        None => ridge_fit(d, nc, folds_for(d, first.id), first.id.gap_steps, cfg)?,
+    };
     let n0 = t0.len() - 1;
     let mut coefficients = vec![constant];
     coefficients.extend_from_slice(&beta[..n0]);

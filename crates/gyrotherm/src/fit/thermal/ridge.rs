@@ -54,6 +54,27 @@ impl Stats {
             syy: self.syy - o.syy,
         }
     }
+    /// The statistics of the columns `cols` (increasing indices): each entry is the sum it
+    /// would be over those columns alone, to the bit (every entry is summed on its own, in
+    /// row order); the lower triangle of Σxxᵀ left zero as [`Stats::add`] leaves it.
+    pub(super) fn columns(&self, cols: &[usize]) -> Stats {
+        let nc = self.sx.len();
+        let m = cols.len();
+        let mut sxx = vec![0.0; m * m];
+        for (a, &i) in cols.iter().enumerate() {
+            for (b, &j) in cols.iter().enumerate().skip(a) {
+                sxx[a * m + b] = self.sxx[i * nc + j];
+            }
+        }
+        Stats {
+            n: self.n,
+            sx: cols.iter().map(|&i| self.sx[i]).collect(),
+            sy: self.sy,
+            sxx,
+            sxy: cols.iter().map(|&i| self.sxy[i]).collect(),
+            syy: self.syy,
+        }
+    }
     /// Add the statistics of a disjoint set of rows.
     pub(super) fn merge(&mut self, o: &Stats) {
         let add = |a: &mut [f64], b: &[f64]| a.iter_mut().zip(b).for_each(|(p, q)| *p += q);
@@ -449,27 +470,32 @@ pub(super) fn ridge_fit(
     gap_steps: usize,
     cfg: &ThermalConfig,
 ) -> Result<RidgeFit, ThermalError> {
-    let (cv, lambda) = if folds == 0 {
-        (None, cfg.fallback_ridge)
-    } else {
-        let (s, l) = best_ridge(
-            d,
-            nc,
-            folds,
-            gap_steps,
-            &cfg.ridge_grid,
-            cfg.ridge_tolerance,
-        );
-        (
-            s.is_finite().then_some(s),
-            if s.is_finite() { l } else { cfg.fallback_ridge },
-        )
+    let scores = (folds > 0).then(|| cv_scores(d, nc, folds, gap_steps, &cfg.ridge_grid));
+    ridge_fit_from(scores, &run_stats(d, nc), nc, cfg)
+}
+
+/// [`ridge_fit`] from a design's cross-validated scores over `cfg.ridge_grid` ([`cv_scores`];
+/// None without folds) and its runs' statistics ([`run_stats`]).
+pub(super) fn ridge_fit_from(
+    scores: Option<Vec<f64>>,
+    stats: &[Stats],
+    nc: usize,
+    cfg: &ThermalConfig,
+) -> Result<RidgeFit, ThermalError> {
+    let (cv, lambda) = match scores {
+        None => (None, cfg.fallback_ridge),
+        Some(scores) => {
+            let (s, l) = choose_ridge(scores, &cfg.ridge_grid, cfg.ridge_tolerance);
+            (
+                s.is_finite().then_some(s),
+                if s.is_finite() { l } else { cfg.fallback_ridge },
+            )
+        }
     };
-    let stats = run_stats(d, nc);
-    let (g, b, _) = centred_normal(&stats, nc);
+    let (g, b, _) = centred_normal(stats, nc);
     let beta = ridge_solve(&g, &b, nc, lambda).ok_or(ThermalError::Singular)?;
     let (mut c0, mut n) = (0.0, 0.0);
-    for s in &stats {
+    for s in stats {
         if s.n >= 1.0 {
             c0 += s.sy - s.sx.iter().zip(&beta).map(|(p, q)| p * q).sum::<f64>();
             n += s.n;

@@ -12,10 +12,44 @@
 //! statistics, equal to the one from the design's rows up to rounding.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use super::ridge::{layout, segment_scores, Layout, Stats};
 use super::*;
 use gyrotherm_core::features::MAX_LAGS;
+
+/// The search's maps' hasher: their keys are a few integers made here (τ's bits, exponents),
+/// never outside input, so a multiply-and-rotate hash (rustc's `FxHash`) serves, at a fraction
+/// of the default hasher's cost, which a profile put at 2–3 % of a unit's training. Only
+/// lookups use the maps, never their order.
+#[derive(Default, Clone, Copy)]
+struct KeyHasher(u64);
+
+impl KeyHasher {
+    fn add(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+impl Hasher for KeyHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        bytes.iter().for_each(|&b| self.add(u64::from(b)));
+    }
+    fn write_u8(&mut self, v: u8) {
+        self.add(u64::from(v));
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.add(v);
+    }
+    fn write_usize(&mut self, v: usize) {
+        self.add(v as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+type KeyMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
 
 /// A design column: `T^t · Π D(τ)^p` over `(τ bits, p)`, sorted, unused entries `(0, 0)`
 /// last.
@@ -76,12 +110,12 @@ struct Run {
     /// Per segment: labelled steps, Σy, Σy².
     seg: Vec<(f64, f64, f64)>,
     /// `D(τ)` at the labelled steps, by τ's bits.
-    lag: HashMap<u64, Vec<f64>>,
-    cols: HashMap<Col, ColSums>,
+    lag: KeyMap<u64, Vec<f64>>,
+    cols: KeyMap<Col, ColSums>,
     /// Buffers of the centred columns, kept from one candidate to the next.
     pool: Vec<Vec<f64>>,
     /// Per-segment Σx_i·x_j of centred columns, by the pair (in order).
-    cross: HashMap<(Col, Col), Vec<f64>>,
+    cross: KeyMap<(Col, Col), Vec<f64>>,
 }
 
 /// The spec of the search's temperature steps: the published spec without lags.
@@ -168,10 +202,10 @@ impl<'a> Scorer<'a> {
                 y,
                 layout,
                 seg,
-                lag: HashMap::new(),
-                cols: HashMap::new(),
+                lag: KeyMap::default(),
+                cols: KeyMap::default(),
                 pool: Vec::new(),
-                cross: HashMap::new(),
+                cross: KeyMap::default(),
             });
         }
         Ok(Some(Scorer {
@@ -219,32 +253,53 @@ impl<'a> Scorer<'a> {
 /// same arithmetic (`gyrotherm_core::features`), without its other features. Eight lags go
 /// through the run together: each is a chain of dependent steps, and eight chains keep the
 /// processor busy where one waits on each step.
+#[cfg(test)]
 fn lag_differences(t: &[f64], gaps: &[u64], p: f64, taus: &[f64]) -> Vec<Vec<f64>> {
-    let mut out: Vec<Vec<f64>> = taus.iter().map(|_| vec![0.0; t.len()]).collect();
+    let every: Vec<usize> = (0..t.len()).collect();
+    lag_differences_at(t, gaps, p, taus, &every)
+}
+
+/// [`lag_differences`] kept only at the steps `keep` (increasing): the lags still run through
+/// every step, but a search that reads a few steps stores only those.
+fn lag_differences_at(
+    t: &[f64],
+    gaps: &[u64],
+    p: f64,
+    taus: &[f64],
+    keep: &[usize],
+) -> Vec<Vec<f64>> {
+    let mut out: Vec<Vec<f64>> = taus.iter().map(|_| vec![0.0; keep.len()]).collect();
     for (tau, dst) in taus.chunks(8).zip(out.chunks_mut(8)) {
         match tau.len() {
-            1 => lag_lanes::<1>(t, gaps, p, tau, dst),
-            2 => lag_lanes::<2>(t, gaps, p, tau, dst),
-            3 | 4 => lag_lanes::<4>(t, gaps, p, tau, dst),
-            _ => lag_lanes::<8>(t, gaps, p, tau, dst),
+            1 => lag_lanes::<1>(t, gaps, p, tau, keep, dst),
+            2 => lag_lanes::<2>(t, gaps, p, tau, keep, dst),
+            3 | 4 => lag_lanes::<4>(t, gaps, p, tau, keep, dst),
+            _ => lag_lanes::<8>(t, gaps, p, tau, keep, dst),
         }
     }
     out
 }
 
-/// [`lag_differences`] of up to `W` lags (`dst` one output per lag), in `W` lanes; unused
+/// [`lag_differences_at`] of up to `W` lags (`dst` one output per lag), in `W` lanes; unused
 /// lanes run a τ of 1 s and are dropped.
-fn lag_lanes<const W: usize>(t: &[f64], gaps: &[u64], p: f64, tau: &[f64], dst: &mut [Vec<f64>]) {
+fn lag_lanes<const W: usize>(
+    t: &[f64],
+    gaps: &[u64],
+    p: f64,
+    tau: &[f64],
+    keep: &[usize],
+    dst: &mut [Vec<f64>],
+) {
     let mut lane = [1.0; W];
     lane[..tau.len()].copy_from_slice(tau);
     let g1 = lane.map(|tau| -libm::expm1(-p / tau));
     let mut c = [t.first().copied().unwrap_or(0.0); W];
-    let mut d = vec![[0.0; W]; t.len()];
-    for ((&v, &n), dk) in t.iter().zip(gaps).zip(&mut d) {
+    let mut d = vec![[0.0; W]; keep.len()];
+    let mut next = 0;
+    for (k, (&v, &n)) in t.iter().zip(gaps).enumerate() {
         if n == 1 {
             for i in 0..W {
                 c[i] += g1[i] * (v - c[i]);
-                dk[i] = v - c[i];
             }
         } else {
             for i in 0..W {
@@ -253,8 +308,13 @@ fn lag_lanes<const W: usize>(t: &[f64], gaps: &[u64], p: f64, tau: &[f64], dst: 
                     _ => -libm::expm1(-(n as f64) * p / lane[i]),
                 };
                 c[i] += gain * (v - c[i]);
-                dk[i] = v - c[i];
             }
+        }
+        if keep.get(next) == Some(&k) {
+            for i in 0..W {
+                d[next][i] = v - c[i];
+            }
+            next += 1;
         }
     }
     for (i, o) in dst.iter_mut().enumerate() {
@@ -274,11 +334,13 @@ impl Run {
             }
         }
         let p = FeatureSpec::THERMAL_STATE.step_period_s;
-        for (tau, all) in new
-            .iter()
-            .zip(lag_differences(&self.t_all, &self.gaps, p, &new))
-        {
-            let d = self.steps.iter().map(|&k| all[k]).collect();
+        for (tau, d) in new.iter().zip(lag_differences_at(
+            &self.t_all,
+            &self.gaps,
+            p,
+            &new,
+            &self.steps,
+        )) {
             self.lag.insert(tau.to_bits(), d);
         }
         Ok(())
@@ -288,7 +350,7 @@ impl Run {
     fn prepare(&mut self, lags: &[f64], cols: &[Col]) -> Result<(), ThermalError> {
         self.make_lags(lags)?;
         // Centred values of the columns some missing sum needs, for this candidate only.
-        let mut values: HashMap<Col, Vec<f64>> = HashMap::new();
+        let mut values: KeyMap<Col, Vec<f64>> = KeyMap::default();
         let mut missing = Vec::new();
         for (i, &a) in cols.iter().enumerate() {
             for &b in &cols[i..] {
