@@ -3,11 +3,10 @@
 //! axis reads.
 //!
 //! By default ([`ImuSensors::All`]) every axis may read every listed sensor: with the
-//! `thermal` method each sensor's lags are identified on its own, the sensor with which the
-//! model on every sensor has the lowest cross-validated RMS comes first, and the others join
-//! unless they double the cross-validated RMS ([`crate::fit::thermal::multi`]); the axis's
-//! model is then the first sensor's model plus each further sensor's part (its `T, T², T³`
-//! and lag differences, [`SensorModel`]), run by the flight
+//! `thermal` method each sensor's lags are identified on its own, the sensor whose one-sensor
+//! fit has the lowest cross-validated RMS comes first, and the others join while they lower
+//! the cross-validated RMS ([`crate::fit::thermal::multi`]); the axis's model is then the first
+//! sensor's model plus each further sensor's linear part ([`SensorModel`]), run by the flight
 //! [`AxisCompensator`]. With [`ImuSensors::ChooseOne`] (and for methods without
 //! cross-validation, which keep the first sensor) each axis reads one sensor, an ordinary
 //! single-sensor [`ModelFile`]. The axes fit on their own threads. A fault in one sensor
@@ -616,7 +615,14 @@ fn fit_axis_multi(
                 if mc.first == multi::FirstBy::Average {
                     multi::fit_multi_averaged(&data, &order, &multi_thermal, &mc, false)
                 } else {
-                    multi::fit_multi_with(&data, &order, &multi_thermal, &mc, false, shared.as_ref())
+                    multi::fit_multi_with(
+                        &data,
+                        &order,
+                        &multi_thermal,
+                        &mc,
+                        false,
+                        shared.as_ref(),
+                    )
                 }
             })
             .transpose()

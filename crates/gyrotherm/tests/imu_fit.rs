@@ -120,27 +120,47 @@ fn every_sensor_when_cross_validation_keeps_it() {
     assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
     assert_eq!(a.more.len(), 1);
     assert_eq!(model.imu_format_version, IMU_FORMAT_VERSION);
-    // The further sensor's bias part: T, T², T³ and each of its lag differences, over the
+    // The further sensor's bias part: T and each of its lag differences, linearly, over the
     // features (T, dT, D1, …), no constant (the default further terms, written out here).
-    let lags = a.more[0].lags_s.len();
-    let n = 2 + lags;
-    let power = |i: usize, q: u8| {
+    let power = |n: usize, i: usize, q: u8| {
         let mut p = vec![0u8; n];
         p[i] = q;
         p
     };
-    let mut want = vec![power(0, 1), power(0, 2), power(0, 3)];
-    want.extend((0..lags).map(|j| power(2 + j, 1)));
-    match a.more[0].bias.as_ref() {
-        Some(gyrotherm::model::SubModel::Baseline {
-            terms,
-            coefficients,
-        }) => {
-            assert_eq!(terms.powers, want);
-            assert_eq!(coefficients.len(), want.len());
+    let further_terms = |a: &gyrotherm::imu_model::ImuAxis, cubic: bool| {
+        let lags = a.more[0].lags_s.len();
+        let n = 2 + lags;
+        let mut want = vec![power(n, 0, 1)];
+        if cubic {
+            want.extend([power(n, 0, 2), power(n, 0, 3)]);
         }
-        other => panic!("further bias part: {other:?}"),
-    }
+        want.extend((0..lags).map(|j| power(n, 2 + j, 1)));
+        match a.more[0].bias.as_ref() {
+            Some(gyrotherm::model::SubModel::Baseline {
+                terms,
+                coefficients,
+            }) => {
+                assert_eq!(terms.powers, want);
+                assert_eq!(coefficients.len(), want.len());
+            }
+            other => panic!("further bias part: {other:?}"),
+        }
+    };
+    further_terms(a, false);
+    // The experiment's cubic further terms: T, T², T³ and each lag difference.
+    let cubic = fit_imu_with(
+        &training(),
+        &thermal(),
+        &ImuFitSettings {
+            multi_extra: gyrotherm::fit::thermal::multi::ExtraTerms::Cubic,
+            ..all
+        },
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap();
+    assert_eq!(cubic.axes[0].temps.len(), 2, "{:?}", cubic.axes[0].scores);
+    further_terms(&cubic.axes[0], true);
     let text = model.to_json().unwrap();
     assert_eq!(ImuModel::from_json(&text).unwrap(), model);
     // A further sensor that is not a column of the unit is refused.

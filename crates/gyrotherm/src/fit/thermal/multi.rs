@@ -2,22 +2,15 @@
 //!
 //! Each sensor's lags are identified on its own ([`identify`], as for a one-sensor fit). The
 //! axis model is the first sensor's terms ([`basis`], with its constant) plus, for each
-//! further sensor, its temperature, its square and cube and its lag differences, linearly
-//! (`T_s, T_s², T_s³, D_s1, …`, [`ExtraTerms::Cubic`]): a difference between sensors (a
-//! gradient) is a linear combination of these columns, and the temperature polynomial is
-//! not tied to the sensor that comes first. One ridge fit over all columns, strength chosen
-//! by the same blocked cross-validation.
+//! further sensor, its temperature and its lag differences, linearly (`T_s, D_s1, …`): a
+//! difference between sensors (a gradient) is a linear combination of these columns. One
+//! ridge fit over all columns, strength chosen by the same blocked cross-validation.
 //!
-//! Which sensor comes first ([`FirstBy::Combined`]): each sensor in turn, the others after
-//! it ranked by their one-sensor cross-validated RMS; the order whose model on every sensor
-//! has the lowest cross-validated RMS is kept. Each other sensor, in that order, joins when
-//! the cross-validated RMS of the bias (of the scale factor when the axis has no static run)
-//! drops below `(1 − min_gain)` times the best so far (at first the first sensor's
-//! one-sensor score; [`MultiConfig::min_gain`]). The scale-factor model reads the further
-//! sensors only when its own cross-validated RMS passes the same test. On the design family
-//! the first sensor chosen by its one-sensor score was often the case sensor, and the worst
-//! held-out cases (airborne climbs) came from that: the cubic on the case temperature, the
-//! coil's polynomial and memory carried by lags (docs/experiments/imu-worst-model.md).
+//! Which sensors stay: the sensor whose one-sensor fit has the lowest cross-validated RMS
+//! comes first; each other sensor, best first, joins when the cross-validated RMS of the
+//! bias (of the scale factor when the axis has no static run) drops below
+//! `(1 − min_gain)` times the best so far ([`MultiConfig::min_gain`]). The scale-factor model
+//! reads the further sensors only when its own cross-validated RMS passes the same test.
 //!
 //! The default `min_gain` is −1: a sensor joins unless it doubles the cross-validated RMS.
 //! On the design family the blocked cross-validation within the chamber runs scored further
@@ -25,6 +18,11 @@
 //! 1.26 × the noise floor, worst 7.85 → 5.91; docs/experiments/imu.md): the chamber runs do
 //! not move the gradients independently enough for the folds to see what they carry, so the
 //! test is kept as a guard against a sensor that ruins the fit, not as a filter.
+//!
+//! Experiments ([`MultiConfig`]): other terms of the further sensors ([`ExtraTerms`]), the
+//! first sensor chosen by the score of the model on every sensor ([`FirstBy::Combined`]) or
+//! the bias model averaged over each sensor first ([`FirstBy::Average`]), separate folds for
+//! the selection; docs/experiments/imu-worst-model.md has what each gave.
 
 use super::*;
 use crate::targets::TargetSet;
