@@ -127,7 +127,7 @@ fn add(a: AddArgs) -> anyhow::Result<ExitCode> {
         .collect();
     let station = a.station.clone().unwrap_or_else(lot::default_station);
     // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
-    let (mut run, verdict) = judge_unit(&UnitInputs {
+    let (run, verdict) = judge_unit(&UnitInputs {
         unit: &a.unit,
         station: &station,
         model_path: &a.model,
@@ -137,28 +137,10 @@ fn add(a: AddArgs) -> anyhow::Result<ExitCode> {
         settle_s: a.settle_s,
     })
     .with_context(|| format!("unit {}", a.unit))?;
-    let mut store = open_store(&a.db.db, true, a.db.busy_timeout)?;
-    run.id = store.add(&run)?;
-    let mut w = std::io::stdout().lock();
-    if a.json {
-        writeln!(w, "{}", serde_json::to_string_pretty(&run)?)?;
-    } else {
-        if let Some(v) = &verdict {
-            super::verdict::print(&mut w, v)?;
-        }
-        writeln!(
-            w,
-            "recorded run {} of unit {}: verdict {}, {} figures on {} logs",
-            run.id,
-            run.unit,
-            run.verdict.as_str(),
-            run.figures.len(),
-            run.inputs.len()
-        )?;
-    }
-    Ok(super::verdict::exit_code(
-        run.verdict != lot::RunVerdict::Fail,
-    ))
+    record(&a, run, |w| match &verdict {
+        Some(v) => super::verdict::print(w, v),
+        None => Ok(()),
+    })
 }
 
 /// `lot add` with an inertial unit's model: the logs read with the model's columns, each axis
@@ -171,7 +153,7 @@ fn add_unit(a: AddArgs, spec: Option<gyrotherm::spec::Spec>) -> anyhow::Result<E
     let tests = super::imu::read_imu_logs_with(&a.test, &a.log, &opts)?;
     let station = a.station.clone().unwrap_or_else(lot::default_station);
     // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
-    let (mut run, verdict) = lot::judge_imu_unit(&lot::ImuUnitInputs {
+    let (run, verdict) = lot::judge_imu_unit(&lot::ImuUnitInputs {
         unit: &a.unit,
         station: &station,
         model_path: &a.model,
@@ -181,31 +163,48 @@ fn add_unit(a: AddArgs, spec: Option<gyrotherm::spec::Spec>) -> anyhow::Result<E
         settle_s: a.settle_s,
     })
     .with_context(|| format!("unit {}", a.unit))?;
+    record(&a, run, |w| {
+        let Some(v) = &verdict else {
+            return Ok(());
+        };
+        // As `evaluate --model UNIT.json --spec` prints it: each axis, then the unit.
+        for (k, (gyro, axis)) in v.axes.iter().enumerate() {
+            if k > 0 {
+                writeln!(w)?;
+            }
+            writeln!(w, "axis {} ({gyro}) against the spec:", k + 1)?;
+            super::verdict::print(w, axis)?;
+        }
+        writeln!(w)?;
+        writeln!(w, "{}", v.unit.line(v.axes.len()))
+    })
+}
+
+/// The judged run into the lot (judged first: a unit that cannot be judged leaves the lot as
+/// it was), then what was recorded: the run as JSON, or the verdict (`print_verdict`) and a
+/// line naming the run; exit status 1 on a failed run.
+fn record(
+    a: &AddArgs,
+    mut run: lot::Run,
+    print_verdict: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> anyhow::Result<ExitCode> {
     let mut store = open_store(&a.db.db, true, a.db.busy_timeout)?;
     run.id = store.add(&run)?;
     let mut w = std::io::stdout().lock();
     if a.json {
         writeln!(w, "{}", serde_json::to_string_pretty(&run)?)?;
     } else {
-        if let Some(v) = &verdict {
-            // As `evaluate --model UNIT.json --spec` prints it: each axis, then the unit.
-            for (k, (gyro, axis)) in v.axes.iter().enumerate() {
-                if k > 0 {
-                    writeln!(w)?;
-                }
-                writeln!(w, "axis {} ({gyro}) against the spec:", k + 1)?;
-                super::verdict::print(&mut w, axis)?;
-            }
-            writeln!(w)?;
-            writeln!(w, "{}", v.unit.line(v.axes.len()))?;
-        }
+        print_verdict(&mut w)?;
+        let axes = match run.axes.len() {
+            0 => String::new(),
+            n => format!("{n} axes, "),
+        };
         writeln!(
             w,
-            "recorded run {} of unit {}: verdict {}, {} axes, {} figures on {} logs",
+            "recorded run {} of unit {}: verdict {}, {axes}{} figures on {} logs",
             run.id,
             run.unit,
             run.verdict.as_str(),
-            run.axes.len(),
             run.figures.len(),
             run.inputs.len()
         )?;
