@@ -21,10 +21,10 @@
 //! pipeline and baseline code of the same port (the port of a model on that sensor's features
 //! whose B and K are its parts), suffixed `_a<i>s<j>`, with a state of only what the core's
 //! further sensor holds (that pipeline and its latest accepted reading, not a whole
-//! single-axis state), and the port's hooks (`@MORE_*@`) call
-//! the `more_*` functions, a port of the core's further-sensor handling: plausibility against
-//! each sensor's own last good reading, the pipelines pushed together, the parts added in
-//! order, every pipeline restarted on a new time base. So each axis computes exactly what the
+//! single-axis state), and the port's hooks (`@MORE_*@`) call the `more_*` functions, a port
+//! of the core's further-sensor handling: plausibility against each sensor's own last good
+//! reading, the pipelines pushed together, the parts added in order, every pipeline restarted
+//! on a new time base. So each axis computes exactly what the
 //! core's [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last
 //! bit.
 //!
