@@ -19,10 +19,12 @@
 //! `gt_step` with `gyro[i]` and the temperature of the first sensor it reads. An axis that
 //! reads further sensors ([`gyrotherm_core::multi`]) gets, per further sensor, the feature
 //! pipeline and baseline code of the same port (the port of a model on that sensor's features
-//! whose B and K are its parts), suffixed `_a<i>s<j>`, and the port's hooks (`@MORE_*@`) call
-//! the `more_*` functions, a port of the core's further-sensor handling: plausibility against
-//! each sensor's own last good reading, the pipelines pushed together, the parts added in
-//! order, every pipeline restarted on a new time base. So each axis computes exactly what the
+//! whose B and K are its parts), suffixed `_a<i>s<j>`, with a state of only what the core's
+//! further sensor holds (that pipeline and its latest accepted reading, not a whole
+//! single-axis state), and the port's hooks (`@MORE_*@`) call the `more_*` functions, a port
+//! of the core's further-sensor handling: plausibility against each sensor's own last good
+//! reading, the pipelines pushed together, the parts added in order, every pipeline restarted
+//! on a new time base. So each axis computes exactly what the
 //! core's [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last
 //! bit.
 //!
@@ -346,6 +348,26 @@ fn file_scope_names(source: &str) -> Vec<String> {
     names
 }
 
+/// A further sensor's state, as the core's further sensor holds it (`FeaturePipeline` and
+/// the latest accepted reading): the fields of the single-axis `struct gt_state` that the
+/// pipeline functions of [`sensor_pieces`] and the `more_*` functions use, and no others (no
+/// time axis, fault handling, LSTM or coverage state: those are the axis's). File-scope names
+/// as in the single-axis header, suffixed like the sensor's code.
+const SENSOR_STATE: &str = "struct gt_state {
+    uint64_t hist_k[GT_HISTORY_STEPS]; /* feature steps kept (step index, temperature) */
+    double hist_t[GT_HISTORY_STEPS];
+    double lag_c[GT_LAG_SLOTS];        /* first-order thermal lags, deg C */
+    double t0_s;                       /* first accepted sample's time */
+    double pipe_last_s;                /* last accepted sample's time */
+    uint64_t last_step;
+    double good_time_s;                /* latest accepted reading and its time */
+    double good_temp_c;
+    uint32_t hist_head;
+    uint32_t hist_len;
+    uint8_t started, has_good;
+};
+";
+
 /// The pieces of a further sensor's single-axis port that the axis uses: the constants of
 /// its feature pipeline, its baseline type and data (the parts of B and K), the pipeline
 /// (`hist_back`, `emit`, `pipe_push`) and `base_eval`. The rest of that port (its compensator,
@@ -398,10 +420,15 @@ fn sensor_pieces(src: &str, parts: bool) -> String {
             }
         }
     }
-    out.push_str(between(
-        "/* The i-th newest stored step",
-        "/* Compensator::rebase",
-    ));
+    // The coverage verdict is the first sensor's: a further sensor's pipeline keeps no T and
+    // dT for it (its state has no such fields, so a template change that moved these lines
+    // fails to compile rather than writing elsewhere).
+    out.push_str(
+        &between("/* The i-th newest stored step", "/* Compensator::rebase").replace(
+            "    s->cov_temp_c = t;\n    s->cov_rate_c_per_s = rate;\n",
+            "",
+        ),
+    );
     if parts {
         out.push_str(between(
             "/* BaselineModel::eval. */",
@@ -573,7 +600,7 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
         let mut sensor_src = String::new();
         for (k, se) in ax.sensors.iter().enumerate() {
             let ss = format!("{suffix}s{}", k + 1);
-            let (sh, ssrc) = c::generate(&se.model, "a further sensor");
+            let (_, ssrc) = c::generate(&se.model, "a further sensor");
             let names = file_scope_names(&ssrc);
             let _ = writeln!(
                 h,
@@ -585,10 +612,8 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
                 "#define GT_LAG_SLOTS{ss} {}",
                 se.model.spec.lags().len().max(1)
             );
-            let from = sh.find("struct gt_state {").unwrap_or(0);
-            let to = sh[from..].find("\n};\n").map_or(sh.len(), |k| from + k + 4);
             let _ = writeln!(h, "typedef struct gt_state{ss} gt_state{ss};");
-            h.push_str(&rename(&sh[from..to], &names, &ss));
+            h.push_str(&rename(SENSOR_STATE, &names, &ss));
             h.push('\n');
             let _ = write!(
                 sensor_src,
