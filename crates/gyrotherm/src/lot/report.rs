@@ -20,7 +20,7 @@ use crate::report::{
 };
 use crate::spec::FIGURES;
 
-use super::{Run, RunVerdict};
+use super::{FigureRow, Run, RunVerdict};
 
 /// How many units the "worst units" table lists.
 pub const WORST_UNITS: usize = 10;
@@ -55,13 +55,8 @@ pub fn lot_yield(runs: &[Run]) -> Yield {
     };
     for r in latest {
         y.units += 1;
-        // An inertial unit passes only when every axis passes.
-        let verdict = if r.is_unit() {
-            super::unit_verdict_of_axes(&r.axes)
-        } else {
-            r.verdict
-        };
-        match verdict {
+        // A unit's verdict is its axes' (made so when judged, checked when read back).
+        match r.verdict {
             RunVerdict::Pass => y.passed += 1,
             RunVerdict::Fail => y.failed += 1,
             RunVerdict::None => y.not_judged += 1,
@@ -76,6 +71,24 @@ fn min_margin(r: &Run) -> Option<f64> {
         .iter()
         .filter_map(|f| f.margin)
         .min_by(f64::total_cmp)
+}
+
+/// The cells of the figure with the smallest margin among `figures` (name, value, margin;
+/// empty when none has a margin), its name as `name` gives it.
+fn worst_cells<'a>(
+    figures: impl Iterator<Item = &'a FigureRow>,
+    name: impl Fn(&FigureRow) -> String,
+) -> (String, String, String) {
+    figures
+        .filter(|f| f.margin.is_some())
+        .min_by(|a, b| a.margin.unwrap_or(0.0).total_cmp(&b.margin.unwrap_or(0.0)))
+        .map_or((String::new(), String::new(), String::new()), |f| {
+            (
+                name(f),
+                format!("{:.4e}", f.value),
+                format!("{:+.3e}", f.margin.unwrap_or(f64::NAN)),
+            )
+        })
 }
 
 /// A CSV text field that a spreadsheet would run as a formula gets a leading `'`.
@@ -205,22 +218,10 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
              <th>worst figure</th><th>value</th><th>margin</th></tr></thead>\n<tbody>\n",
         );
         for (r, _) in ranked.iter().take(WORST_UNITS) {
-            let worst = r
-                .figures
-                .iter()
-                .filter(|f| f.margin.is_some())
-                .min_by(|a, b| a.margin.unwrap_or(0.0).total_cmp(&b.margin.unwrap_or(0.0)));
-            let (fig, val, mar) =
-                worst.map_or((String::new(), String::new(), String::new()), |f| {
-                    (
-                        match r.gyro_of(f.axis) {
-                            Some(g) => format!("{} ({g})", f.figure),
-                            None => f.figure.clone(),
-                        },
-                        format!("{:.4e}", f.value),
-                        format!("{:+.3e}", f.margin.unwrap_or(f64::NAN)),
-                    )
-                });
+            let (fig, val, mar) = worst_cells(r.figures.iter(), |f| match r.gyro_of(f.axis) {
+                Some(g) => format!("{} ({g})", f.figure),
+                None => f.figure.clone(),
+            });
             let _ = writeln!(
                 h,
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
@@ -246,19 +247,8 @@ pub fn write_lot_report(dir: &Path, title: &str, runs: &[Run]) -> Result<PathBuf
         );
         for r in units {
             for a in &r.axes {
-                let worst = r
-                    .figures
-                    .iter()
-                    .filter(|f| f.axis == Some(a.axis) && f.margin.is_some())
-                    .min_by(|x, y| x.margin.unwrap_or(0.0).total_cmp(&y.margin.unwrap_or(0.0)));
-                let (fig, val, mar) =
-                    worst.map_or((String::new(), String::new(), String::new()), |f| {
-                        (
-                            f.figure.clone(),
-                            format!("{:.4e}", f.value),
-                            format!("{:+.3e}", f.margin.unwrap_or(f64::NAN)),
-                        )
-                    });
+                let on_axis = r.figures.iter().filter(|f| f.axis == Some(a.axis));
+                let (fig, val, mar) = worst_cells(on_axis, |f| f.figure.clone());
                 let _ = writeln!(
                     h,
                     "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
