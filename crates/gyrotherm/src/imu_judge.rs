@@ -308,9 +308,10 @@ pub fn evaluate_imu_spec(
         };
         let (raw, t) = judge(&g.values, "raw", g.name.clone())?;
         tau.get_or_insert(t);
-        let (compensated, temps) = match (&comp, model) {
+        // The axis's compensated output and sensors (compensate_imu returns the model's axes
+        // in order; this column's is found by name), or none without a model.
+        let comp_axis = match (&comp, model) {
             (Some(c), Some(m)) => {
-                // compensate_imu returns the model's axes in order; find this column's.
                 let i = m
                     .axes
                     .iter()
@@ -318,23 +319,22 @@ pub fn evaluate_imu_spec(
                     .ok_or_else(|| {
                         ImuJudgeError::Layout(format!("the model has no axis {}", g.name))
                     })?;
-                let (e, _) = judge(
-                    &c[i].gyro_comp_dps,
-                    "compensated",
-                    format!("{}_comp", g.name),
-                )?;
-                (Some(e), m.axes[i].temps.clone())
+                Some((c[i].gyro_comp_dps.as_slice(), &m.axes[i].temps))
             }
-            _ => (None, Vec::new()),
+            _ => None,
+        };
+        let (compensated, temps) = match comp_axis {
+            Some((values, temps)) => {
+                let (e, _) = judge(values, "compensated", format!("{}_comp", g.name))?;
+                (Some(e), temps.clone())
+            }
+            None => (None, Vec::new()),
         };
         let verdict = match spec {
             Some(sp) => {
-                let (values, output) = match (&comp, model) {
-                    (Some(c), Some(m)) => {
-                        let i = m.axes.iter().position(|a| a.gyro == g.name).unwrap_or(k);
-                        (c[i].gyro_comp_dps.as_slice(), "compensated")
-                    }
-                    _ => (g.values.as_slice(), "raw"),
+                let (values, output) = match comp_axis {
+                    Some((values, _)) => (values, "compensated"),
+                    None => (g.values.as_slice(), "raw"),
                 };
                 Some(judge_axis(
                     sp, &axis_log, values, settings, tau0_s, log_name, &g.name, output,
