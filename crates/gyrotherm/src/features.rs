@@ -164,14 +164,17 @@ pub fn extract_series(
     let mut pipe = FeaturePipeline::new(*spec)?;
     let nf = spec.n_features();
     let (names, units) = feature_names(spec);
+    // Sized ahead: a step is a sample, at most one per step period, so the table never
+    // grows by copying (on a long log that copying is most of the extraction's cost).
+    let steps = step_bound(time_s, spec.step_period_s);
     let mut table = FeatureTable {
         spec: *spec,
         n_features: nf,
         names,
         units,
-        step_time_s: Vec::new(),
-        sample_index: Vec::new(),
-        rows: Vec::new(),
+        step_time_s: Vec::with_capacity(steps),
+        sample_index: Vec::with_capacity(steps),
+        rows: Vec::with_capacity(steps.saturating_mul(nf)),
     };
     for (i, (&t, &c)) in time_s.iter().zip(temp_c).enumerate() {
         match pipe.push(t, c) {
@@ -193,7 +196,56 @@ pub fn extract_series(
     Ok(table)
 }
 
+/// At most how many steps the pipeline makes of samples at `time_s`: one per sample, and no
+/// more than one per period `p` over the time they span (every sample when that span is not
+/// a finite number of periods, which the pipeline refuses anyway).
+fn step_bound(time_s: &[f64], p: f64) -> usize {
+    let n = time_s.len();
+    match (time_s.first(), time_s.last()) {
+        (Some(&a), Some(&b)) => {
+            let periods = (b - a) / p;
+            if periods.is_finite() && periods >= 0.0 && periods < n as f64 {
+                // Two more: the first sample's step and the last's rounding.
+                (periods as usize).saturating_add(2).min(n)
+            } else {
+                n
+            }
+        }
+        _ => 0,
+    }
+}
+
 /// Run the core pipeline over a whole log.
 pub fn extract(log: &TestLog, spec: &FeatureSpec) -> Result<FeatureTable, FeatureError> {
     extract_series(&log.time_s, &log.temp_c, spec)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table is sized ahead from `step_bound`: it must never be below the steps the core
+    /// pipeline makes (counted by the pipeline itself), or the table grows by copying.
+    #[test]
+    fn step_bound_covers_every_step_the_pipeline_makes() {
+        let spec = FeatureSpec::THERMAL_STATE;
+        let cases: Vec<Vec<f64>> = vec![
+            (0..500).map(f64::from).collect(), // 1 Hz: a step per sample
+            (0..5000).map(|i| f64::from(i) * 0.1).collect(), // 10 Hz: one in ten
+            (0..300).map(|i| f64::from(i) * 2.0).collect(), // 0.5 Hz: gaps between steps
+            (0..800).map(|i| f64::from(i) * 0.37 + 1e6).collect(), // off the grid, late start
+            (0..600)
+                .map(|i| f64::from(i) + if i > 300 { 900.0 } else { 0.0 })
+                .collect(), // a 15-minute gap
+            vec![42.0],
+        ];
+        for t in cases {
+            let temp: Vec<f64> = t.iter().map(|x| 20.0 + (x * 1e-3).sin()).collect();
+            let table = extract_series(&t, &temp, &spec).expect("a valid series");
+            let bound = step_bound(&t, spec.step_period_s);
+            assert!(table.n_rows() >= 1 && table.n_rows() <= bound);
+            assert!(bound <= t.len());
+        }
+        assert_eq!(step_bound(&[], 1.0), 0);
+    }
 }

@@ -294,7 +294,6 @@ fn lag_lanes<const W: usize>(
     lane[..tau.len()].copy_from_slice(tau);
     let g1 = lane.map(|tau| -libm::expm1(-p / tau));
     let mut c = [t.first().copied().unwrap_or(0.0); W];
-    let mut d = vec![[0.0; W]; keep.len()];
     let mut next = 0;
     for (k, (&v, &n)) in t.iter().zip(gaps).enumerate() {
         if n == 1 {
@@ -311,14 +310,11 @@ fn lag_lanes<const W: usize>(
             }
         }
         if keep.get(next) == Some(&k) {
-            for i in 0..W {
-                d[next][i] = v - c[i];
+            for (o, ci) in dst.iter_mut().zip(c) {
+                o[next] = v - ci;
             }
             next += 1;
         }
-    }
-    for (i, o) in dst.iter_mut().enumerate() {
-        o.iter_mut().zip(&d).for_each(|(x, dk)| *x = dk[i]);
     }
 }
 
