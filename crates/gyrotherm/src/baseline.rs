@@ -206,6 +206,25 @@ impl Terms {
         }));
     }
 
+    /// The terms as each one's non-zero powers, for building many design rows
+    /// ([`SparseTerms::extend_design_row`]).
+    pub fn sparse(&self) -> SparseTerms {
+        let mut sparse = SparseTerms {
+            ends: Vec::with_capacity(self.powers.len()),
+            factors: Vec::new(),
+        };
+        for p in &self.powers {
+            sparse.factors.extend(
+                p.iter()
+                    .enumerate()
+                    .filter(|(_, &q)| q != 0)
+                    .map(|(f, &q)| (f, q)),
+            );
+            sparse.ends.push(sparse.factors.len());
+        }
+        sparse
+    }
+
     /// The monomial values of term `j..` at feature vector `x` (ground evaluation, `powi`).
     pub fn design_row(&self, x: &[f64]) -> Vec<f64> {
         self.powers
@@ -217,6 +236,35 @@ impl Terms {
                     .product()
             })
             .collect()
+    }
+}
+
+/// [`Terms`] kept as each term's non-zero powers in feature order ([`Terms::sparse`]): a
+/// design row is then a few products per term instead of a pass over every feature.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SparseTerms {
+    /// End of each term's factors in `factors`.
+    ends: Vec<usize>,
+    /// (feature, power) of every non-zero power, term after term.
+    factors: Vec<(usize, u8)>,
+}
+
+impl SparseTerms {
+    /// [`Terms::extend_design_row`], to the bit: the same factors multiplied in the same
+    /// order (a power 0 is the exact factor 1, left out of both).
+    pub fn extend_design_row(&self, x: &[f64], from: usize, out: &mut Vec<f64>) {
+        let mut start = if from == 0 { 0 } else { self.ends[from - 1] };
+        out.extend(self.ends[from..].iter().map(|&end| {
+            let mut acc = 1.0;
+            // A feature past the row's end is skipped, as `zip` does there.
+            for &(f, q) in &self.factors[start..end] {
+                if let Some(&v) = x.get(f) {
+                    acc *= if q == 1 { v } else { v.powi(i32::from(q)) };
+                }
+            }
+            start = end;
+            acc
+        }));
     }
 }
 

@@ -242,7 +242,7 @@ fn core_evaluation_equals_ground_evaluation() {
     assert!(f.rms_residual < 1e-4, "rms {}", f.rms_residual);
 }
 
-/// `extend_design_row` appends `design_row`'s values to the bit (the reference: `design_row`
+/// `extend_design_row` (and its sparse form) appends `design_row`'s values to the bit (the reference: `design_row`
 /// itself, `powi` on every factor), at powers 0 to 4 and at zero, negative and tiny values.
 #[test]
 fn extend_design_row_is_design_row_to_the_bit() {
@@ -260,6 +260,11 @@ fn extend_design_row_is_design_row_to_the_bit() {
             t.extend_design_row(&x, from, &mut out);
             let got: Vec<u64> = out[1..].iter().map(|v| v.to_bits()).collect();
             assert_eq!(got, want[from..], "{x:?}");
+            // The sparse form the fits build their designs with: the same bits.
+            let mut out = vec![9.0];
+            t.sparse().extend_design_row(&x, from, &mut out);
+            let got: Vec<u64> = out[1..].iter().map(|v| v.to_bits()).collect();
+            assert_eq!(got, want[from..], "sparse, {x:?}");
         }
     }
 }

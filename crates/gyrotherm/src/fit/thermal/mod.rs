@@ -347,15 +347,19 @@ fn design(runs: &[RunData], lags: &[f64], terms: &Terms) -> Result<Design, Therm
         step: Vec::new(),
         n_steps: Vec::new(),
     };
+    let sparse = terms.sparse();
     for r in runs {
         let table = extract_series(&r.log.time_s, &r.log.temp_c, &spec)
             .map_err(|e| ThermalError::Features(e.to_string()))?;
-        let mut x = Vec::new();
-        let mut y = Vec::new();
-        let mut step = Vec::new();
-        for k in 0..table.n_rows().min(r.mask.len()) {
+        let n = table.n_rows().min(r.mask.len());
+        // Sized ahead: a design grown row by row copies itself over and over.
+        let rows = r.mask[..n].iter().filter(|&&m| m).count();
+        let mut x = Vec::with_capacity(rows * nc);
+        let mut y = Vec::with_capacity(rows);
+        let mut step = Vec::with_capacity(rows);
+        for k in 0..n {
             if r.mask[k] {
-                terms.extend_design_row(table.row(k), 1, &mut x);
+                sparse.extend_design_row(table.row(k), 1, &mut x);
                 debug_assert_eq!(x.len() % nc.max(1), 0);
                 y.push(r.target[k]);
                 step.push(k);
@@ -702,13 +706,17 @@ pub fn fit_target(
         step: Vec::new(),
         n_steps: Vec::new(),
     };
+    let sparse = terms.sparse();
     for s in sets {
-        let mut x = Vec::new();
-        let mut y = Vec::new();
-        let mut step = Vec::new();
+        let used = |k: usize| s.mask[k] && s.target[k].is_finite();
+        // Sized ahead: a design grown row by row copies itself over and over.
+        let rows = (0..s.table.n_rows()).filter(|&k| used(k)).count();
+        let mut x = Vec::with_capacity(rows * nc);
+        let mut y = Vec::with_capacity(rows);
+        let mut step = Vec::with_capacity(rows);
         for k in 0..s.table.n_rows() {
-            if s.mask[k] && s.target[k].is_finite() {
-                terms.extend_design_row(s.table.row(k), 1, &mut x);
+            if used(k) {
+                sparse.extend_design_row(s.table.row(k), 1, &mut x);
                 y.push(s.target[k]);
                 step.push(k);
             }

@@ -168,6 +168,7 @@ fn combined(parts: &[(&[TargetSet], &Terms)]) -> (Design, usize) {
     let Some((first, _)) = parts.first() else {
         return (d, 0);
     };
+    let sparse: Vec<_> = parts.iter().map(|(_, t)| t.sparse()).collect();
     for (r, s) in first.iter().enumerate() {
         let n_rows = parts
             .iter()
@@ -182,7 +183,7 @@ fn combined(parts: &[(&[TargetSet], &Terms)]) -> (Design, usize) {
         let mut step = Vec::with_capacity(rows);
         for k in 0..n_rows {
             if used(k) {
-                for (i, (sets, terms)) in parts.iter().enumerate() {
+                for (i, ((sets, _), terms)) in parts.iter().zip(&sparse).enumerate() {
                     terms.extend_design_row(sets[r].table.row(k), usize::from(i == 0), &mut x);
                 }
                 y.push(s.target[k]);
