@@ -776,6 +776,36 @@ pub fn fit_target(
 mod tests {
     use super::*;
 
+    /// `Stats::of_rows` is `Stats::add` of each row in turn, to the bit (the reference: the
+    /// row-at-a-time update), for column counts around its block of eight and with zero,
+    /// negative-zero and wide-ranging values.
+    #[test]
+    fn stats_of_rows_is_add_row_by_row_to_the_bit() {
+        for nc in [0, 1, 3, 7, 8, 9, 16, 17, 30] {
+            for n in [0, 1, 5, 257] {
+                let x: Vec<f64> = (0..n * nc)
+                    .map(|k| match k % 11 {
+                        0 => 0.0,
+                        1 => -0.0,
+                        _ => (k as f64 * 0.731).sin() * 10f64.powi((k % 7) as i32 - 3),
+                    })
+                    .collect();
+                let y: Vec<f64> = (0..n).map(|k| (k as f64 * 1.3).cos() * 1e-5).collect();
+                let mut want = Stats::new(nc);
+                for k in 0..n {
+                    want.add(&x[k * nc..(k + 1) * nc], y[k], 1.0);
+                }
+                let got = Stats::of_rows(&x, &y, nc);
+                let bits = |s: &Stats| {
+                    let mut v = vec![s.n.to_bits(), s.sy.to_bits(), s.syy.to_bits()];
+                    v.extend(s.sx.iter().chain(&s.sxx).chain(&s.sxy).map(|f| f.to_bits()));
+                    v
+                };
+                assert_eq!(bits(&got), bits(&want), "{nc} columns, {n} rows");
+            }
+        }
+    }
+
     /// Ridge with λ = 0 is ordinary least squares: on y = 2 + 3·x1 − x2 exactly, the centred
     /// normal equations give the coefficients back (independent: the generating formula).
     #[test]

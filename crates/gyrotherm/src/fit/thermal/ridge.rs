@@ -42,6 +42,62 @@ impl Stats {
                 .for_each(|(r, xj)| *r += xi * xj);
         }
     }
+    /// The statistics of the rows `x` (`nc` columns each, row after row) with targets `y`:
+    /// [`Stats::add`] of each row in turn (sign 1), to the bit. Every entry is still its own
+    /// sum in row order; the rows are taken eight entries of Σxxᵀ at a time, which keeps
+    /// those sums in registers instead of reading and writing them at every row.
+    pub(super) fn of_rows(x: &[f64], y: &[f64], nc: usize) -> Stats {
+        let mut s = Stats::new(nc);
+        if nc == 0 {
+            s.n = y.len() as f64;
+            for &v in y {
+                s.sy += v;
+                s.syy += v * v;
+            }
+            return s;
+        }
+        let rows = || x.chunks_exact(nc).zip(y);
+        for _ in rows() {
+            s.n += 1.0;
+        }
+        for (_, &v) in rows() {
+            s.sy += v;
+            s.syy += v * v;
+        }
+        for i in 0..nc {
+            let (mut sx, mut sxy) = (0.0, 0.0);
+            for (r, &v) in rows() {
+                sx += r[i];
+                sxy += r[i] * v;
+            }
+            s.sx[i] = sx;
+            s.sxy[i] = sxy;
+            let mut j = i;
+            while j + 8 <= nc {
+                let mut acc = [0.0; 8];
+                for (r, _) in rows() {
+                    let (xi, xj) = (r[i], &r[j..j + 8]);
+                    for (a, v) in acc.iter_mut().zip(xj) {
+                        *a += xi * v;
+                    }
+                }
+                s.sxx[i * nc + j..i * nc + j + 8].copy_from_slice(&acc);
+                j += 8;
+            }
+            let rest = nc - j;
+            if rest > 0 {
+                let mut acc = [0.0; 8];
+                for (r, _) in rows() {
+                    let (xi, xj) = (r[i], &r[j..nc]);
+                    for (a, v) in acc.iter_mut().zip(xj) {
+                        *a += xi * v;
+                    }
+                }
+                s.sxx[i * nc + j..(i + 1) * nc].copy_from_slice(&acc[..rest]);
+            }
+        }
+        s
+    }
     #[cfg(test)]
     pub(super) fn minus(&self, o: &Stats) -> Stats {
         let sub = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p - q).collect();
@@ -181,7 +237,8 @@ pub(super) fn layout(steps: &[usize], n_steps: usize, folds: usize, gap: usize) 
 /// Per-segment statistics of each run of a design, its columns and target centred on the
 /// run's means (so that the residual sums taken from them lose no digits to the offsets).
 pub(super) fn segment_stats(d: &Design, nc: usize, layouts: &[Layout]) -> Vec<Vec<Stats>> {
-    let mut xc = vec![0.0; nc];
+    let mut xc = Vec::new();
+    let mut yc = Vec::new();
     (0..d.x.len())
         .map(|r| {
             let (x, y) = (&d.x[r], &d.y[r]);
@@ -196,15 +253,13 @@ pub(super) fn segment_stats(d: &Design, nc: usize, layouts: &[Layout]) -> Vec<Ve
                 .rows
                 .iter()
                 .map(|&(a, b)| {
-                    let mut s = Stats::new(nc);
-                    for k in a..b {
-                        let row = &x[k * nc..(k + 1) * nc];
-                        xc.iter_mut()
-                            .zip(row.iter().zip(&mx))
-                            .for_each(|(c, (v, m))| *c = v - m);
-                        s.add(&xc, y[k] - my, 1.0);
+                    xc.clear();
+                    for row in x[a * nc..b * nc].chunks_exact(nc.max(1)) {
+                        xc.extend(row.iter().zip(&mx).map(|(v, m)| v - m));
                     }
-                    s
+                    yc.clear();
+                    yc.extend(y[a..b].iter().map(|v| v - my));
+                    Stats::of_rows(&xc, &yc, nc)
                 })
                 .collect()
         })
