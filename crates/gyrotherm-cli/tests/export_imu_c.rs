@@ -25,6 +25,15 @@ const UNITS: usize = 120;
 const BATCH: usize = 60;
 /// Lines per stream.
 const LINES: usize = 600;
+/// Lines of the long streams (units 13, 53 and 93): past 65,536 feature steps, so that a step
+/// index or time kept in too narrow a type in the C state shows as a difference.
+const LONG_LINES: usize = 70_000;
+
+/// Whether unit `u` streams [`LONG_LINES`] lines: its faults stop after [`LINES`] and the
+/// clock runs on at 1 Hz, each step one more than the last.
+fn long_stream(u: usize) -> bool {
+    u % 40 == 13
+}
 
 fn have_gcc() -> bool {
     Command::new("gcc")
@@ -102,15 +111,17 @@ fn unit_model(u: usize) -> (serde_json::Value, usize, usize) {
 }
 
 /// Unit `u`'s stream: rows of (t, gyro per axis, temperature per sensor). About one line in
-/// eight has a fault of any kind; sensor `u % temps` is NaN for lines 100 to 159 and reads
-/// -127 °C (a DS18B20 bus error) at lines 300 to 304.
+/// eight of the first [`LINES`] has a fault of any kind; sensor `u % temps` is NaN for lines
+/// 100 to 159 and reads -127 °C (a DS18B20 bus error) at lines 300 to 304. A long stream
+/// ([`long_stream`]) goes on without faults to [`LONG_LINES`].
 fn unit_stream(u: usize, axes: usize, temps: usize) -> Vec<Vec<f64>> {
     let mut rng = Lcg(0xfa17 + u as u64);
     let bad_sensor = u % temps;
     let (mut offset, mut out) = (0.0f64, Vec::new());
-    for i in 0..LINES {
+    let lines = if long_stream(u) { LONG_LINES } else { LINES };
+    for i in 0..lines {
         let x = i as f64;
-        let fault = rng.next() + 0.5 < 0.13;
+        let fault = rng.next() + 0.5 < 0.13 && i < LINES;
         let kind = ((rng.next() + 0.5) * 24.0) as usize;
         let axis = ((rng.next() + 0.5) * axes as f64) as usize % axes;
         let sensor = ((rng.next() + 0.5) * temps as f64) as usize % temps;
@@ -250,6 +261,7 @@ fn generated_unit_c_equals_the_unit_stream() {
     let d = dir.path();
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
     let (mut lines, mut axis_lines, mut differ, mut statuses) = (0usize, 0, 0, [0usize; 4]);
+    let mut long_lines = 0usize;
     let mut verdicts = [0usize; 5];
     // Axis-lines by the number of sensors the axis reads (1 to 4).
     let mut by_sensors = [0usize; 5];
@@ -353,6 +365,14 @@ fn generated_unit_c_equals_the_unit_stream() {
         let out = std::fs::read(bdir.join("out.bin")).unwrap();
         let mut at = 0usize;
         for ((u, m, _, axes, _), s) in units.iter().zip(&streams) {
+            if long_stream(*u) {
+                // Past 65,536 one-second steps after the last fault (none of the last lines
+                // is faulted, so no new time base restarts the count there).
+                let tail = &s[LINES..];
+                assert!(tail.windows(2).all(|w| w[1][0] - w[0][0] == 1.0));
+                assert!(tail.len() > 65_536, "unit {u}");
+                long_lines += s.len();
+            }
             let want = stream_in_process(m, s);
             assert_eq!(want.len(), s.len(), "unit {u}: one line out per line in");
             // The coverage verdicts: the core unit stepped here, each axis's map on its
@@ -427,7 +447,8 @@ fn generated_unit_c_equals_the_unit_stream() {
         assert_eq!(at, out.len(), "driver output length");
     }
     println!(
-        "unit differential: {UNITS} units, {lines} lines ({axis_lines} axis-lines) compared, \
+        "unit differential: {UNITS} units, {lines} lines ({axis_lines} axis-lines; \
+         {long_lines} lines in the long streams) compared, \
          {differ} lines differ (axis-lines ok {}, held {}, degraded {}, invalid {}; coverage \
          inside {}, edge {}, outside {}, no verdict {}, no map {}; axis-lines on an axis reading \
          1, 2, 3, 4 sensors: {:?}); {:.1} s",
@@ -450,6 +471,8 @@ fn generated_unit_c_equals_the_unit_stream() {
     // Every status occurred often, so each path was compared.
     assert!(statuses.iter().all(|v| *v > 1000), "statuses {statuses:?}");
     assert!(verdicts.iter().all(|v| *v > 500), "verdicts {verdicts:?}");
+    // The three long streams were compared.
+    assert_eq!(long_lines, 3 * LONG_LINES);
     // Axes reading each number of sensors were compared.
     assert!(
         by_sensors[1..].iter().all(|v| *v > 2000),
