@@ -348,25 +348,66 @@ fn file_scope_names(source: &str) -> Vec<String> {
     names
 }
 
-/// A further sensor's state, as the core's further sensor holds it (`FeaturePipeline` and
-/// the latest accepted reading): the fields of the single-axis `struct gt_state` that the
+/// The fields of the single-axis `struct gt_state` that a further sensor keeps, as the core's
+/// further sensor holds them (`FeaturePipeline` and the latest accepted reading): those the
 /// pipeline functions of [`sensor_pieces`] and the `more_*` functions use, and no others (no
-/// time axis, fault handling, LSTM or coverage state: those are the axis's). File-scope names
-/// as in the single-axis header, suffixed like the sensor's code.
-const SENSOR_STATE: &str = "struct gt_state {
-    uint64_t hist_k[GT_HISTORY_STEPS]; /* feature steps kept (step index, temperature) */
-    double hist_t[GT_HISTORY_STEPS];
-    double lag_c[GT_LAG_SLOTS];        /* first-order thermal lags, deg C */
-    double t0_s;                       /* first accepted sample's time */
-    double pipe_last_s;                /* last accepted sample's time */
-    uint64_t last_step;
-    double good_time_s;                /* latest accepted reading and its time */
-    double good_temp_c;
-    uint32_t hist_head;
-    uint32_t hist_len;
-    uint8_t started, has_good;
-};
-";
+/// time axis, fault handling, LSTM or coverage state: those are the axis's).
+const SENSOR_FIELDS: [&str; 12] = [
+    "hist_k",
+    "hist_t",
+    "lag_c",
+    "t0_s",
+    "pipe_last_s",
+    "last_step",
+    "good_time_s",
+    "good_temp_c",
+    "hist_head",
+    "hist_len",
+    "started",
+    "has_good",
+];
+
+/// A further sensor's state: the single-axis header's `struct gt_state` (`header`, as
+/// [`c::generate`] writes it) declaring only the [`SENSOR_FIELDS`], each with the type and
+/// size that port gives it (one definition: the template's). File-scope names as in the
+/// single-axis header, to be suffixed like the sensor's code.
+fn sensor_state(header: &str) -> String {
+    let body = header
+        .find("struct gt_state {")
+        .map(|a| &header[a + "struct gt_state {".len()..])
+        .and_then(|rest| rest.find("};").map(|b| &rest[..b]))
+        .unwrap_or("");
+    // The declarations without their comments.
+    let mut code = String::new();
+    let mut rest = body;
+    while let Some(a) = rest.find("/*") {
+        code.push_str(&rest[..a]);
+        rest = rest[a..].find("*/").map_or("", |b| &rest[a + b + 2..]);
+    }
+    code.push_str(rest);
+    // Each field's type and declarator ("hist_k[GT_HISTORY_STEPS]"), by name.
+    let mut fields: Vec<(String, String, String)> = Vec::new();
+    for decl in code.split(';') {
+        let decl = decl.split_whitespace().collect::<Vec<_>>().join(" ");
+        let Some((ty, declarators)) = decl.split_once(' ') else {
+            continue;
+        };
+        for d in declarators.split(',').map(str::trim) {
+            let name = d.split('[').next().unwrap_or("").trim();
+            fields.push((name.to_owned(), ty.to_owned(), d.to_owned()));
+        }
+    }
+    // In the order of SENSOR_FIELDS (the state's layout); a field the template lost is left
+    // out, and the pipeline code that uses it does not compile.
+    let mut out = String::from("struct gt_state {\n");
+    for f in SENSOR_FIELDS {
+        if let Some((_, ty, d)) = fields.iter().find(|(n, _, _)| n == f) {
+            out.push_str(&format!("    {ty} {d};\n"));
+        }
+    }
+    out.push_str("};\n");
+    out
+}
 
 /// The pieces of a further sensor's single-axis port that the axis uses: the constants of
 /// its feature pipeline, its baseline type and data (the parts of B and K), the pipeline
@@ -600,7 +641,7 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
         let mut sensor_src = String::new();
         for (k, se) in ax.sensors.iter().enumerate() {
             let ss = format!("{suffix}s{}", k + 1);
-            let (_, ssrc) = c::generate(&se.model, "a further sensor");
+            let (sh, ssrc) = c::generate(&se.model, "a further sensor");
             let names = file_scope_names(&ssrc);
             let _ = writeln!(
                 h,
@@ -613,7 +654,7 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
                 se.model.spec.lags().len().max(1)
             );
             let _ = writeln!(h, "typedef struct gt_state{ss} gt_state{ss};");
-            h.push_str(&rename(SENSOR_STATE, &names, &ss));
+            h.push_str(&rename(&sensor_state(&sh), &names, &ss));
             h.push('\n');
             let _ = write!(
                 sensor_src,
@@ -848,6 +889,41 @@ mod tests {
             rename(text, &names, "_a1"),
             "/* emit */ emit_a1(s, 1e0, 2.5e-3f, STEP_P_a1); x_emit = emit_x + e0_a1;"
         );
+    }
+
+    /// A further sensor's state is the single-axis template's `struct gt_state` cut to
+    /// [`SENSOR_FIELDS`]: every field once, with the template's own declaration (the
+    /// reference: the template text, read here line by line).
+    #[test]
+    fn a_further_sensors_state_is_the_templates_fields() {
+        let template = include_str!("templates/gyrotherm_model.h.in");
+        let header = template.replace("@MORE_STATE@", "");
+        let got = sensor_state(&header);
+        let decls: Vec<&str> = got.lines().filter(|l| l.ends_with(';')).collect();
+        for f in SENSOR_FIELDS {
+            let with = |d: &&&str| d.split([' ', ',', ';', '[']).any(|w| w == f);
+            assert_eq!(decls.iter().filter(with).count(), 1, "{f} in {got}");
+        }
+        assert!(got.starts_with("struct gt_state {\n") && got.ends_with("};\n"));
+        // The types, as the template declares them.
+        for (field, ty) in [
+            ("last_step", "uint64_t"),
+            ("hist_k", "uint64_t"),
+            ("started", "uint8_t"),
+        ] {
+            let line = template
+                .lines()
+                .find(|l| l.split([' ', ',', ';', '[']).any(|w| w == field))
+                .unwrap();
+            assert!(line.trim_start().starts_with(ty), "{line}");
+            assert!(decls
+                .iter()
+                .any(|d| d.trim_start().starts_with(ty) && d.contains(field)));
+        }
+        // Nothing of the axis's own state (time base, LSTM, coverage) is declared.
+        for f in ["base_s", "lstm_h", "cov_temp_c", "has_held", "unplaced"] {
+            assert!(!got.contains(f), "{f} in {got}");
+        }
     }
 
     #[test]
