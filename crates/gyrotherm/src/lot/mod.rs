@@ -366,16 +366,19 @@ pub fn open_store(
     }
 }
 
-/// What [`judge_unit`] needs besides the logs.
+/// What [`judge_unit`] needs besides the logs; for an inertial unit (several gyro axes,
+/// [`judge_imu_unit`]) the same with its logs ([`ImuUnitInputs`]).
 #[derive(Debug, Clone)]
-pub struct UnitInputs<'a> {
+pub struct UnitInputs<'a, L = (PathBuf, TestLog)> {
     pub unit: &'a str,
     pub station: &'a str,
     pub model_path: &'a Path,
-    /// The held-out logs, already read, with the paths they were read from.
-    pub tests: &'a [(PathBuf, TestLog)],
+    /// The held-out logs, already read, with the paths they were read from (an inertial
+    /// unit's read with the model's columns, [`ImuModel::read_options`]).
+    pub tests: &'a [L],
     pub spec: Option<&'a Spec>,
-    /// Bias-stability τ, s (None: `compare`'s default for these logs).
+    /// Bias-stability τ, s (None: `compare`'s default for these logs; for an inertial unit
+    /// [`crate::imu_judge::default_tau_s`]).
     pub tau_s: Option<f64>,
     /// Settle time at each table segment start, s.
     pub settle_s: f64,
@@ -491,22 +494,8 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
     Ok((run, verdict))
 }
 
-/// What [`judge_imu_unit`] needs besides the logs: an inertial unit (several gyro axes).
-#[derive(Debug, Clone)]
-pub struct ImuUnitInputs<'a> {
-    pub unit: &'a str,
-    pub station: &'a str,
-    pub model_path: &'a Path,
-    /// The held-out logs, read with the model's columns ([`ImuModel::read_options`]), each
-    /// with the path it was read from.
-    pub tests: &'a [(String, ImuLog)],
-    pub spec: Option<&'a Spec>,
-    /// Bias-stability τ, s (None: the unit `compare`'s default for these logs,
-    /// [`crate::imu_judge::default_tau_s`]).
-    pub tau_s: Option<f64>,
-    /// Settle time at each table segment start, s.
-    pub settle_s: f64,
-}
+/// What [`judge_imu_unit`] needs besides the logs: an inertial unit's [`UnitInputs`].
+pub type ImuUnitInputs<'a> = UnitInputs<'a, (String, ImuLog)>;
 
 /// The verdict of an inertial unit's run: each axis's (in the model's order, with its gyro
 /// column) and the unit's.
