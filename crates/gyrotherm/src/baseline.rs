@@ -259,7 +259,15 @@ impl SparseTerms {
             // A feature past the row's end is skipped, as `zip` does there.
             for &(f, q) in &self.factors[start..end] {
                 if let Some(&v) = x.get(f) {
-                    acc *= if q == 1 { v } else { v.powi(i32::from(q)) };
+                    // Low powers as `powi` computes them (squaring, then a product), without
+                    // the call.
+                    acc *= match q {
+                        1 => v,
+                        2 => v * v,
+                        3 => v * (v * v),
+                        4 => (v * v) * (v * v),
+                        _ => v.powi(i32::from(q)),
+                    };
                 }
             }
             start = end;

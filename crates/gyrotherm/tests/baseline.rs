@@ -249,11 +249,25 @@ fn extend_design_row_is_design_row_to_the_bit() {
     let terms = gyrotherm::fit::thermal::basis(gyrotherm::fit::thermal::Basis::Full, 3);
     let mut t = terms.clone();
     t.powers.push(vec![4, 0, 1, 0, 2]);
-    for x in [
+    // Three chosen rows, then a sweep of values over many magnitudes and both signs (the
+    // sparse form squares and multiplies low powers itself instead of calling `powi`).
+    let mut rows = vec![
         [21.3125, 1e-3, -0.4, 2.75, -7.0],
         [-38.0625, -0.06, 0.0, -1e-300, 3.5],
         [0.0, 0.0, 1e-5, -0.0, 1.0 / 3.0],
-    ] {
+    ];
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut draw = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        mantissa * 10f64.powi(((state >> 3) % 40) as i32 - 20)
+    };
+    for _ in 0..2000 {
+        rows.push([draw(), draw(), draw(), draw(), draw()]);
+    }
+    for x in rows {
         let want: Vec<u64> = t.design_row(&x).iter().map(|v| v.to_bits()).collect();
         for from in [0, 1] {
             let mut out = vec![9.0];
