@@ -22,7 +22,8 @@
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin imu_family -- [--family
 //! design|confirm] [--units 30] [--first 0] [--settings case,chosen,all] [--threads 2]
-//! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned] [--hold none,lags,...]`; `--train planned` adds a
+//! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned|soak] [--hold none,lags,...]`;
+//! `--train soak` adds a static run with 6-hour soaks (docs/experiments/imu-soak.md); `--train planned` adds a
 //! static run on the chamber profile `gyrotherm plan` proposes from the unit's own airborne
 //! run (case sensor, a seed other than the held-out one's) to the training runs; `bench/imu_family.sh` runs it as recorded in `docs/experiments/imu.md`.
 //! Settings are chosen on the design family only; the confirmation family is run once.
@@ -119,6 +120,35 @@ fn sim(
     )
 }
 
+/// `seed-shock` with its soaks lengthened from 9,000 s to `hours` (`--soak-hours`, default
+/// 6: 21,600 s, one and a half of the family's longest stress time constant; the run is then
+/// 53,200 s), at the same 3 °C/min. Training data that holds each temperature long enough for
+/// the coil's memory to settle, so that the slow lag is pinned by the data rather than traded
+/// against the temperature polynomial (docs/experiments/imu-worst-case.md).
+fn soak_profile(hours: f64) -> Profile {
+    let soak = hours * 3600.0;
+    let rows = [
+        (3000.0, 22.0),
+        (1240.0, -40.0),
+        (soak, -40.0),
+        (2000.0, 60.0),
+        (soak, 60.0),
+        (760.0, 22.0),
+        (3000.0, 22.0),
+    ];
+    Profile {
+        name: "soak-6h".to_owned(),
+        start_c: 22.0,
+        segments: rows
+            .iter()
+            .map(|&(duration_s, target_c)| gyrotherm::sim::Segment {
+                duration_s,
+                target_c,
+            })
+            .collect(),
+    }
+}
+
 fn sim_profile(
     unit: &ImuUnit,
     profile: Profile,
@@ -185,6 +215,9 @@ struct Job<'a> {
     min_gain: f64,
     /// Add a static run on the chamber profile `gyrotherm plan` proposes for the unit.
     planned: bool,
+    /// Add a static run with soaks of `soak_h` hours at -40 and +60 °C ([`soak_profile`]).
+    soak: bool,
+    soak_h: f64,
     /// Input holds to apply each model with (see the module doc).
     holds: &'a [String],
     /// A hold other than `none` was asked for: apply every hold through the replica.
@@ -601,6 +634,12 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             sim_profile(&unit, plan.profile(), s0 + 41, None)?,
         ));
     }
+    if job.soak {
+        train.push((
+            "soak-static".to_owned(),
+            sim_profile(&unit, soak_profile(job.soak_h), s0 + 43, None)?,
+        ));
+    }
     let train_static_truth = job.dump.as_ref().map(|_| train[0].1.clone());
     for (_, l) in &mut train {
         l.extra.clear();
@@ -828,10 +867,11 @@ fn run() -> Result<(), String> {
     let min_gain: f64 = get("--min-gain").map_or(Ok(ImuFitSettings::default().min_gain), |v| {
         v.parse().map_err(|e| format!("--min-gain: {e}"))
     })?;
-    let planned = match get("--train").as_deref() {
-        None | Some("seed-shock") => false,
-        Some("planned") => true,
-        Some(v) => return Err(format!("--train {v:?}: use seed-shock or planned")),
+    let (planned, soak) = match get("--train").as_deref() {
+        None | Some("seed-shock") => (false, false),
+        Some("planned") => (true, false),
+        Some("soak") => (false, true),
+        Some(v) => return Err(format!("--train {v:?}: use seed-shock, planned or soak")),
     };
     let holds: Vec<String> = get("--hold")
         .unwrap_or_else(|| "none".into())
@@ -845,6 +885,10 @@ fn run() -> Result<(), String> {
         settings: &settings,
         min_gain,
         planned,
+        soak,
+        soak_h: get("--soak-hours").map_or(Ok(6.0), |v| {
+            v.parse().map_err(|e| format!("--soak-hours: {e}"))
+        })?,
         holds: &holds,
         replica: holds.iter().any(|h| h != "none"),
         dump: get("--dump"),
@@ -1002,7 +1046,13 @@ fn run() -> Result<(), String> {
     println!(
         "{family} family ({} units × 3 axes), trained on seed-shock static + one table run per axis{}",
         seeds.len(),
-        if planned { " + a static run on the planned profile" } else { "" }
+        if planned {
+            " + a static run on the planned profile"
+        } else if soak {
+            " + a static run with long soaks at -40 and +60 °C (--soak-hours)"
+        } else {
+            ""
+        }
     );
     // The hold column only when a hold was asked for (the recorded tables keep their form).
     let hold_head = if job.replica { " hold |" } else { "" };
