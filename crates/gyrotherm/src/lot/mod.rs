@@ -194,11 +194,7 @@ pub fn unit_verdict_of_axes(axes: &[AxisRecord]) -> RunVerdict {
         axes.iter()
             .map(|a| (a.gyro.as_str(), a.verdict != RunVerdict::Fail)),
     );
-    if v.pass {
-        RunVerdict::Pass
-    } else {
-        RunVerdict::Fail
-    }
+    RunVerdict::of(Some(v.pass))
 }
 
 /// Why a lot could not be read or written, or a unit judged.
@@ -396,17 +392,9 @@ pub fn file_sha256(path: &Path) -> Result<String, LotError> {
 /// Judge one unit: compensate each held-out log with its model, measure every figure, judge
 /// against the spec; the [`Run`] to record (dated now), and the spec's verdict when given.
 pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotError> {
-    let model_err = |source: Box<dyn std::error::Error + Send + Sync>| LotError::Model {
-        path: u.model_path.to_path_buf(),
-        source,
-    };
-    let text = std::fs::read_to_string(u.model_path).map_err(|source| LotError::Read {
-        path: u.model_path.to_path_buf(),
-        source,
-    })?;
-    let model_sha256 = format!("{:x}", Sha256::digest(text.as_bytes()));
-    let (model, _) = ModelFile::from_json_sealed(&text).map_err(|e| model_err(e.into()))?;
-    let content = model.content_digest().map_err(|e| model_err(e.into()))?;
+    let (text, model_sha256) = u.model_text()?;
+    let (model, _) = ModelFile::from_json_sealed(&text).map_err(|e| u.model_err(e.into()))?;
+    let content = model.content_digest().map_err(|e| u.model_err(e.into()))?;
     let named: Vec<NamedLog> = u
         .tests
         .iter()
@@ -415,17 +403,7 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
             log: l,
         })
         .collect();
-    let tau_s = u
-        .tau_s
-        .unwrap_or_else(|| crate::compare::default_tau_s(&named).0);
-    let opts = MeasureOptions {
-        evaluation: EvaluationOptions {
-            tau_s,
-            settle_s: u.settle_s,
-            reference_scale: None,
-        },
-        noise_terms: true,
-    };
+    let opts = u.measure_options(|| crate::compare::default_tau_s(&named).0);
     let mut inputs = Vec::new();
     let mut measured = Vec::new();
     for (i, (path, log)) in u.tests.iter().enumerate() {
@@ -440,7 +418,7 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
                 "rate_table"
             },
         });
-        let comp = compensate_log(&model, log).map_err(|e| model_err(e.into()))?;
+        let comp = compensate_log(&model, log).map_err(|e| u.model_err(e.into()))?;
         let f =
             spec::measure(log, &comp.gyro_comp_dps, &opts).map_err(|source| LotError::Measure {
                 log: name.clone(),
@@ -455,47 +433,115 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
     let mut figures = Vec::new();
     for (i, (_, f)) in measured.iter().enumerate() {
         for (&key, &value) in f {
-            let limit = u.spec.and_then(|s| s.limit(key));
-            figures.push(FigureRow {
-                axis: None,
-                position: i as u32,
-                figure: key.to_string(),
-                value,
-                limit_min: limit.and_then(|l| l.min),
-                limit_max: limit.and_then(|l| l.max),
-                pass: limit.map(|l| l.passes(value)),
-                margin: limit.map(|l| l.margin(value)),
-            });
+            figures.push(u.figure_row(None, i, key, value));
         }
     }
-    let run = Run {
-        id: 0,
-        unit: u.unit.to_string(),
-        tested_at_unix_ms: now_unix_ms(),
-        gyrotherm_version: env!("CARGO_PKG_VERSION").to_string(),
-        station: u.station.to_string(),
-        model_path: u.model_path.display().to_string(),
+    let run = u.run(
         model_sha256,
-        model_content_sha256: content,
-        model_method: model.method.as_str().to_string(),
-        spec_name: u.spec.map(|s| s.name.clone()),
-        spec_sha256: u.spec.map(|s| s.sha256.clone()),
-        spec_toml: u.spec.map(|s| s.text.clone()),
-        verdict: match &verdict {
-            Some(v) if v.pass => RunVerdict::Pass,
-            Some(_) => RunVerdict::Fail,
-            None => RunVerdict::None,
-        },
-        latest: false,
+        content,
+        model.method.as_str().to_string(),
+        RunVerdict::of(verdict.as_ref().map(|v| v.pass)),
         inputs,
-        axes: Vec::new(),
+        Vec::new(),
         figures,
-    };
+    );
     Ok((run, verdict))
 }
 
 /// What [`judge_imu_unit`] needs besides the logs: an inertial unit's [`UnitInputs`].
 pub type ImuUnitInputs<'a> = UnitInputs<'a, (String, ImuLog)>;
+
+impl<L> UnitInputs<'_, L> {
+    /// A model error in [`UnitInputs::model_path`].
+    fn model_err(&self, source: Box<dyn std::error::Error + Send + Sync>) -> LotError {
+        LotError::Model {
+            path: self.model_path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// The model file's text and the SHA-256 of its bytes.
+    fn model_text(&self) -> Result<(String, String), LotError> {
+        let text = std::fs::read_to_string(self.model_path).map_err(|source| LotError::Read {
+            path: self.model_path.to_path_buf(),
+            source,
+        })?;
+        let sha = format!("{:x}", Sha256::digest(text.as_bytes()));
+        Ok((text, sha))
+    }
+
+    /// How each figure is measured: τ (`tau_s` when given, else the default for the logs)
+    /// and the settle time.
+    fn measure_options(&self, default_tau_s: impl FnOnce() -> f64) -> MeasureOptions {
+        MeasureOptions {
+            evaluation: EvaluationOptions {
+                tau_s: self.tau_s.unwrap_or_else(default_tau_s),
+                settle_s: self.settle_s,
+                reference_scale: None,
+            },
+            noise_terms: true,
+        }
+    }
+
+    /// A figure's row, with the spec's limit for it and its verdict when a spec is given.
+    fn figure_row(&self, axis: Option<u32>, position: usize, key: &str, value: f64) -> FigureRow {
+        let limit = self.spec.and_then(|s| s.limit(key));
+        FigureRow {
+            axis,
+            position: position as u32,
+            figure: key.to_string(),
+            value,
+            limit_min: limit.and_then(|l| l.min),
+            limit_max: limit.and_then(|l| l.max),
+            pass: limit.map(|l| l.passes(value)),
+            margin: limit.map(|l| l.margin(value)),
+        }
+    }
+
+    /// The [`Run`] of this unit, dated now, with what the judging found.
+    #[allow(clippy::too_many_arguments)]
+    fn run(
+        &self,
+        model_sha256: String,
+        model_content_sha256: String,
+        model_method: String,
+        verdict: RunVerdict,
+        inputs: Vec<Input>,
+        axes: Vec<AxisRecord>,
+        figures: Vec<FigureRow>,
+    ) -> Run {
+        Run {
+            id: 0,
+            unit: self.unit.to_string(),
+            tested_at_unix_ms: now_unix_ms(),
+            gyrotherm_version: env!("CARGO_PKG_VERSION").to_string(),
+            station: self.station.to_string(),
+            model_path: self.model_path.display().to_string(),
+            model_sha256,
+            model_content_sha256,
+            model_method,
+            spec_name: self.spec.map(|s| s.name.clone()),
+            spec_sha256: self.spec.map(|s| s.sha256.clone()),
+            spec_toml: self.spec.map(|s| s.text.clone()),
+            verdict,
+            latest: false,
+            inputs,
+            axes,
+            figures,
+        }
+    }
+}
+
+impl RunVerdict {
+    /// Pass or fail as judged, none without a spec.
+    fn of(pass: Option<bool>) -> RunVerdict {
+        match pass {
+            Some(true) => RunVerdict::Pass,
+            Some(false) => RunVerdict::Fail,
+            None => RunVerdict::None,
+        }
+    }
+}
 
 /// The verdict of an inertial unit's run: each axis's (in the model's order, with its gyro
 /// column) and the unit's.
@@ -511,28 +557,10 @@ pub struct ImuRunVerdict {
 /// ([`crate::imu_judge::judge_unit_figures`]); the [`Run`] to record (dated now, a row per
 /// axis in [`Run::axes`], each figure with its axis) and the verdicts when a spec is given.
 pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>), LotError> {
-    let model_err = |source: Box<dyn std::error::Error + Send + Sync>| LotError::Model {
-        path: u.model_path.to_path_buf(),
-        source,
-    };
-    let text = std::fs::read_to_string(u.model_path).map_err(|source| LotError::Read {
-        path: u.model_path.to_path_buf(),
-        source,
-    })?;
-    let model_sha256 = format!("{:x}", Sha256::digest(text.as_bytes()));
-    let model = ImuModel::from_json(&text).map_err(|e| model_err(e.into()))?;
-    let content = model.content_digest().map_err(|e| model_err(e.into()))?;
-    let tau_s = u
-        .tau_s
-        .unwrap_or_else(|| crate::imu_judge::default_tau_s(u.tests).0);
-    let opts = MeasureOptions {
-        evaluation: EvaluationOptions {
-            tau_s,
-            settle_s: u.settle_s,
-            reference_scale: None,
-        },
-        noise_terms: true,
-    };
+    let (text, model_sha256) = u.model_text()?;
+    let model = ImuModel::from_json(&text).map_err(|e| u.model_err(e.into()))?;
+    let content = model.content_digest().map_err(|e| u.model_err(e.into()))?;
+    let opts = u.measure_options(|| crate::imu_judge::default_tau_s(u.tests).0);
     let mut inputs = Vec::with_capacity(u.tests.len());
     for (i, (path, log)) in u.tests.iter().enumerate() {
         inputs.push(Input {
@@ -564,28 +592,14 @@ pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>),
     for (k, a) in measured.iter().enumerate() {
         for (i, (_, f)) in a.measured.iter().enumerate() {
             for (&key, &value) in f {
-                let limit = u.spec.and_then(|s| s.limit(key));
-                figures.push(FigureRow {
-                    axis: Some(k as u32),
-                    position: i as u32,
-                    figure: key.to_string(),
-                    value,
-                    limit_min: limit.and_then(|l| l.min),
-                    limit_max: limit.and_then(|l| l.max),
-                    pass: limit.map(|l| l.passes(value)),
-                    margin: limit.map(|l| l.margin(value)),
-                });
+                figures.push(u.figure_row(Some(k as u32), i, key, value));
             }
         }
         axes.push(AxisRecord {
             axis: k as u32,
             gyro: a.gyro.clone(),
             temps: a.temps.clone(),
-            verdict: match &verdict {
-                Some(v) if v.axes[k].1.pass => RunVerdict::Pass,
-                Some(_) => RunVerdict::Fail,
-                None => RunVerdict::None,
-            },
+            verdict: RunVerdict::of(verdict.as_ref().map(|v| v.axes[k].1.pass)),
         });
     }
     let mut methods: Vec<&str> = Vec::new();
@@ -595,29 +609,15 @@ pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>),
             methods.push(m);
         }
     }
-    let run = Run {
-        id: 0,
-        unit: u.unit.to_string(),
-        tested_at_unix_ms: now_unix_ms(),
-        gyrotherm_version: env!("CARGO_PKG_VERSION").to_string(),
-        station: u.station.to_string(),
-        model_path: u.model_path.display().to_string(),
+    let run = u.run(
         model_sha256,
-        model_content_sha256: content,
-        model_method: methods.join(","),
-        spec_name: u.spec.map(|s| s.name.clone()),
-        spec_sha256: u.spec.map(|s| s.sha256.clone()),
-        spec_toml: u.spec.map(|s| s.text.clone()),
-        verdict: match &verdict {
-            Some(v) if v.unit.pass => RunVerdict::Pass,
-            Some(_) => RunVerdict::Fail,
-            None => RunVerdict::None,
-        },
-        latest: false,
+        content,
+        methods.join(","),
+        RunVerdict::of(verdict.as_ref().map(|v| v.unit.pass)),
         inputs,
         axes,
         figures,
-    };
+    );
     Ok((run, verdict))
 }
 
