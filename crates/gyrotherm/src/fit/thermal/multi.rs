@@ -128,27 +128,51 @@ pub fn first_terms(sets: &[TargetSet], cfg: &ThermalConfig, id: &Identified, sca
     basis(kind, lags)
 }
 
-/// With [`ExtraTerms::Same`], each further sensor's first-sensor terms less the constant;
-/// otherwise `extra` as it is.
-fn same_terms(
+/// The terms of one target on the sensors `order`: the first sensor's (its constant first)
+/// and each further sensor's ([`extra_terms`], or with [`ExtraTerms::Same`] the further
+/// sensor's own first-sensor terms without the constant). A further sensor's terms depend
+/// on that sensor alone, never on its place in the order.
+fn order_terms(
     sensors: &[SensorData],
     order: &[usize],
     cfg: &ThermalConfig,
     multi: &MultiConfig,
     scale: bool,
-    extra: Vec<Terms>,
-) -> Vec<Terms> {
-    if multi.extra != ExtraTerms::Same {
-        return extra;
-    }
-    order[1..]
+) -> (Terms, Vec<Terms>) {
+    let first = &sensors[order[0]];
+    let t0 = first_terms(target_sets(first, scale), cfg, first.id, scale);
+    let extra = order[1..]
         .iter()
         .map(|&j| {
             let s = &sensors[j];
-            let mut t = first_terms(target_sets(s, scale), cfg, s.id, scale);
-            t.powers.remove(0);
-            t
+            if multi.extra == ExtraTerms::Same {
+                let mut t = first_terms(target_sets(s, scale), cfg, s.id, scale);
+                t.powers.remove(0);
+                t
+            } else {
+                extra_terms(s.id.report.lags_s.len(), multi.extra)
+            }
         })
+        .collect();
+    (t0, extra)
+}
+
+/// The parts of the design of one target on the sensors `order` with their terms
+/// ([`order_terms`]), for [`combined`].
+fn order_parts<'s, 't>(
+    sensors: &[SensorData<'s>],
+    order: &[usize],
+    scale: bool,
+    t0: &'t Terms,
+    extra: &'t [Terms],
+) -> Vec<(&'s [TargetSet], &'t Terms)> {
+    std::iter::once((target_sets(&sensors[order[0]], scale), t0))
+        .chain(
+            order[1..]
+                .iter()
+                .zip(extra)
+                .map(|(&j, t)| (target_sets(&sensors[j], scale), t)),
+        )
         .collect()
 }
 
@@ -225,18 +249,9 @@ pub fn cv_rms<'a>(
     scale: bool,
 ) -> Option<f64> {
     let first = &sensors[order[0]];
-    let sets = |s: &SensorData<'a>| target_sets(s, scale);
-    let t0 = first_terms(sets(first), cfg, first.id, scale);
-    let extra: Vec<Terms> = order[1..]
-        .iter()
-        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
-        .collect();
-    let extra = same_terms(sensors, order, cfg, multi, scale, extra);
-    let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
-    for (&j, t) in order[1..].iter().zip(&extra) {
-        parts.push((sets(&sensors[j]), t));
-    }
-    if sets(first).is_empty() {
+    let (t0, extra) = order_terms(sensors, order, cfg, multi, scale);
+    let parts = order_parts(sensors, order, scale, &t0, &extra);
+    if target_sets(first, scale).is_empty() {
         return None;
     }
     let (d, nc) = combined(&parts);
@@ -309,20 +324,12 @@ pub fn shared<'a>(
     if !same_rows {
         return None;
     }
-    let t0 = first_terms(first_sets, cfg, f.id, scale);
-    // Each further sensor's terms depend on that sensor alone, never on its place in the
-    // order: a trial's columns are a subset of this design's.
-    let extra: Vec<Terms> = rest
-        .iter()
-        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
-        .collect();
     let mut order = vec![first];
     order.extend_from_slice(rest);
-    let extra = same_terms(sensors, &order, cfg, multi, scale, extra);
-    let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(first_sets, &t0)];
-    for (&j, t) in rest.iter().zip(&extra) {
-        parts.push((sets(&sensors[j]), t));
-    }
+    // Each further sensor's terms depend on that sensor alone, never on its place in the
+    // order: a trial's columns are a subset of this design's.
+    let (t0, extra) = order_terms(sensors, &order, cfg, multi, scale);
+    let parts = order_parts(sensors, &order, scale, &t0, &extra);
     let (design, nc) = combined(&parts);
     let mut starts = vec![0, t0.len() - 1];
     for t in &extra {
@@ -512,17 +519,8 @@ pub fn fit_multi_with<'a>(
     shared: Option<&Shared>,
 ) -> Result<MultiFit, ThermalError> {
     let first = &sensors[order[0]];
-    let sets = |s: &SensorData<'a>| target_sets(s, scale);
-    let t0 = first_terms(sets(first), cfg, first.id, scale);
-    let extra: Vec<Terms> = order[1..]
-        .iter()
-        .map(|&j| extra_terms(sensors[j].id.report.lags_s.len(), multi.extra))
-        .collect();
-    let extra = same_terms(sensors, order, cfg, multi, scale, extra);
-    let mut parts: Vec<(&[TargetSet], &Terms)> = vec![(sets(first), &t0)];
-    for (&j, t) in order[1..].iter().zip(&extra) {
-        parts.push((sets(&sensors[j]), t));
-    }
+    let (t0, extra) = order_terms(sensors, order, cfg, multi, scale);
+    let parts = order_parts(sensors, order, scale, &t0, &extra);
     let from_shared = shared.and_then(|sh| Some((sh, sh.columns(order, scale)?)));
     let own;
     let (d, nc) = match &from_shared {
