@@ -127,20 +127,30 @@ fn add(a: AddArgs) -> anyhow::Result<ExitCode> {
         .collect();
     let station = a.station.clone().unwrap_or_else(lot::default_station);
     // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
-    let (run, verdict) = judge_unit(&UnitInputs {
-        unit: &a.unit,
-        station: &station,
-        model_path: &a.model,
-        tests: &tests,
-        spec: spec.as_ref(),
-        tau_s: a.tau_s,
-        settle_s: a.settle_s,
-    })
-    .with_context(|| format!("unit {}", a.unit))?;
+    let (run, verdict) = judge_unit(&inputs(&a, &station, spec.as_ref(), &tests))
+        .with_context(|| format!("unit {}", a.unit))?;
     record(&a, run, |w| match &verdict {
         Some(v) => super::verdict::print(w, v),
         None => Ok(()),
     })
+}
+
+/// What `lot add` judges a unit on besides its logs `tests`, from its arguments.
+fn inputs<'a, L>(
+    a: &'a AddArgs,
+    station: &'a str,
+    spec: Option<&'a gyrotherm::spec::Spec>,
+    tests: &'a [L],
+) -> UnitInputs<'a, L> {
+    UnitInputs {
+        unit: &a.unit,
+        station,
+        model_path: &a.model,
+        tests,
+        spec,
+        tau_s: a.tau_s,
+        settle_s: a.settle_s,
+    }
 }
 
 /// `lot add` with an inertial unit's model: the logs read with the model's columns, each axis
@@ -153,16 +163,8 @@ fn add_unit(a: AddArgs, spec: Option<gyrotherm::spec::Spec>) -> anyhow::Result<E
     let tests = super::imu::read_imu_logs_with(&a.test, &a.log, &opts)?;
     let station = a.station.clone().unwrap_or_else(lot::default_station);
     // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
-    let (run, verdict) = lot::judge_imu_unit(&lot::ImuUnitInputs {
-        unit: &a.unit,
-        station: &station,
-        model_path: &a.model,
-        tests: &tests,
-        spec: spec.as_ref(),
-        tau_s: a.tau_s,
-        settle_s: a.settle_s,
-    })
-    .with_context(|| format!("unit {}", a.unit))?;
+    let (run, verdict) = lot::judge_imu_unit(&inputs(&a, &station, spec.as_ref(), &tests))
+        .with_context(|| format!("unit {}", a.unit))?;
     record(&a, run, |w| {
         let Some(v) = &verdict else {
             return Ok(());

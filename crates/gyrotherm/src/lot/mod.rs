@@ -248,6 +248,22 @@ pub enum LotError {
     },
 }
 
+impl LotError {
+    /// A database error met at upgrade step `step` (0: version 1 → 2) from version `from`,
+    /// as the failed upgrade it is; any other error as it was.
+    pub(crate) fn in_migration(self, from: i64, step: usize) -> LotError {
+        match self {
+            LotError::Database { db, detail } => LotError::Migration {
+                db,
+                from,
+                to: step as i64 + 2,
+                detail,
+            },
+            other => other,
+        }
+    }
+}
+
 /// `e` and its sources, joined by `: `.
 fn write_chain(f: &mut fmt::Formatter<'_>, e: &dyn std::error::Error) -> fmt::Result {
     let mut e: Option<&dyn std::error::Error> = Some(e);

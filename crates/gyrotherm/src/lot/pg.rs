@@ -95,15 +95,8 @@ impl PgStore {
         };
         for (i, step) in PG_MIGRATIONS.iter().enumerate().skip(from as usize - 1) {
             // A failed step drops the transaction, which rolls every step back.
-            tx.batch_execute(step).map_err(|x| match pg_error(&db, x) {
-                LotError::Database { db, detail } => LotError::Migration {
-                    db,
-                    from,
-                    to: i as i64 + 2,
-                    detail,
-                },
-                other => other,
-            })?;
+            tx.batch_execute(step)
+                .map_err(|x| pg_error(&db, x).in_migration(from, i))?;
         }
         tx.execute(
             "UPDATE schema_version SET version = $1",

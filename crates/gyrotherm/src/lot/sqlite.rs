@@ -146,15 +146,7 @@ impl SqliteStore {
         for (i, step) in SQLITE_MIGRATIONS.iter().enumerate().skip(from as usize - 1) {
             // A failed step drops the transaction, which rolls every step back.
             tx.execute_batch(step)
-                .map_err(|e| match db_error(&db, e, self.busy_timeout_ms) {
-                    LotError::Database { db, detail } => LotError::Migration {
-                        db,
-                        from,
-                        to: i as i64 + 2,
-                        detail,
-                    },
-                    other => other,
-                })?;
+                .map_err(|e| db_error(&db, e, self.busy_timeout_ms).in_migration(from, i))?;
         }
         tx.execute(
             "UPDATE schema_version SET version = ?1",
