@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 mod cli;
-use cli::{gyrotherm, run_ok, simulate_args};
+use cli::{assert_exit, gyrotherm, run_ok, simulate_args};
 
 const GYROS: &str = "gyro_x_dps,gyro_y_dps,gyro_z_dps";
 const UNIT: [&str; 7] = [
@@ -469,12 +469,7 @@ fn evaluate_spec_judges_every_axis_and_the_unit_fails_when_one_axis_misses() {
             .unwrap()
     };
     let out = unit_run(&loose);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 0);
     let unit = json(&out);
     assert_eq!(unit["verdict"]["pass"], true);
     assert_eq!(unit["verdict"]["judged"], "compensated");
@@ -518,12 +513,7 @@ fn evaluate_spec_judges_every_axis_and_the_unit_fails_when_one_axis_misses() {
         ),
     );
     let out = unit_run(&tight);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 1);
     let unit = json(&out);
     assert_eq!(unit["verdict"]["pass"], false);
     assert_eq!(
@@ -635,12 +625,7 @@ fn compare_spec_judges_every_column_of_every_axis() {
             .unwrap()
     };
     let out = compare(&loose);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 0);
     let cmp = json(&out);
     let evaluated = json(&run_ok(
         gyrotherm()
@@ -684,12 +669,7 @@ fn compare_spec_judges_every_column_of_every_axis() {
         &format!("bias_stability_dph = {{ max = {} }}\n", (lo + hi) / 2.0),
     );
     let out = compare(&tight);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 1);
     let text = run_text_compare(&s, &t, &h, temps, &tight);
     assert!(text.contains("across the axes:"), "{text}");
     assert!(text.contains(": FAIL on "), "{text}");
@@ -793,12 +773,7 @@ fn lot_add_records_each_axis_and_the_unit_as_evaluate_judges_them() {
         c.output().unwrap()
     };
     let out = add("IMU-1", &loose, false);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 0);
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(text.matches("against the spec:").count(), 3, "{text}");
     assert!(
@@ -806,12 +781,7 @@ fn lot_add_records_each_axis_and_the_unit_as_evaluate_judges_them() {
         "{text}"
     );
     let out = add("IMU-2", &tight, true);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 1);
     let run = json(&out);
     assert_eq!(run["verdict"], "fail");
     let gyros = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];
@@ -968,12 +938,7 @@ fn report_spec_with_lists_gives_each_axis_and_the_unit_as_evaluate_does() {
     let gyros = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];
     let rep = d.join("rep");
     let out = report(&loose, &rep);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 0);
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     let ev = String::from_utf8_lossy(&evaluate(&loose, false).stdout).into_owned();
     let unit_fit_verdicts = |text: &str| -> Vec<Vec<String>> {
@@ -1032,12 +997,7 @@ fn report_spec_with_lists_gives_each_axis_and_the_unit_as_evaluate_does() {
     );
     let rep = d.join("rep_tight");
     let out = report(&tight, &rep);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_exit(&out, 1);
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     let ev = String::from_utf8_lossy(&evaluate(&tight, false).stdout).into_owned();
     for (k, (r, g)) in unit_fit_verdicts(&text).iter().zip(gyros).enumerate() {

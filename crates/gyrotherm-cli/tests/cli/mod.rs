@@ -32,6 +32,16 @@ pub fn run_ok(cmd: &mut Command) -> Output {
     out
 }
 
+/// Fails the test with the command's stderr unless `out` exited with `code`.
+pub fn assert_exit(out: &Output, code: i32) {
+    assert_eq!(
+        out.status.code(),
+        Some(code),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// `gyrotherm simulate ARGS --out DIR/NAME`; returns the path written.
 pub fn simulate_args(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
     let path = dir.join(name);
