@@ -803,27 +803,13 @@ fn lot_add_records_each_axis_and_the_unit_as_evaluate_judges_them() {
             .unwrap()
             .iter()
             .filter(|f| f["axis"] == k && !f["pass"].is_null())
-            .map(|f| {
-                (
-                    f["figure"].as_str().unwrap().to_owned(),
-                    f["value"].as_f64().unwrap(),
-                    f["pass"].as_bool().unwrap(),
-                    f["margin"].as_f64().unwrap(),
-                )
-            })
+            .map(figure_fields)
             .collect();
         let judged: Vec<(String, f64, bool, f64)> = ev_tight["axes"][k]["verdict"]["figures"]
             .as_array()
             .unwrap()
             .iter()
-            .map(|f| {
-                (
-                    f["figure"].as_str().unwrap().to_owned(),
-                    f["value"].as_f64().unwrap(),
-                    f["pass"].as_bool().unwrap(),
-                    f["margin"].as_f64().unwrap(),
-                )
-            })
+            .map(figure_fields)
             .collect();
         assert_eq!(recorded, judged, "{g}");
     }
@@ -1022,4 +1008,15 @@ fn report_spec_with_lists_gives_each_axis_and_the_unit_as_evaluate_does() {
         page.contains(&format!("<tr><td>unit fit</td>{cells}<td>FAIL</td></tr>")),
         "{page}"
     );
+}
+
+/// A judged figure's name, value, pass and margin, as the JSON of `lot add` and `evaluate`
+/// give them.
+fn figure_fields(f: &serde_json::Value) -> (String, f64, bool, f64) {
+    (
+        f["figure"].as_str().unwrap().to_owned(),
+        f["value"].as_f64().unwrap(),
+        f["pass"].as_bool().unwrap(),
+        f["margin"].as_f64().unwrap(),
+    )
 }
