@@ -479,20 +479,22 @@ fn compare_unit(
         .map_err(|e| {
             FitError::new_err(format!("comparison failed: {}", gyrotherm::error_chain(&e)))
         })?;
-        let mut j = serde_json::to_value(cmp.summary(&cfg))
+        let verdicts = spec
+            .as_ref()
+            .map(|s| {
+                gyrotherm::imu_judge::judge_unit_comparison(s, &cmp, &cfg).map_err(|e| {
+                    MetricsError::new_err(format!(
+                        "spec {}: {}",
+                        s.name,
+                        gyrotherm::error_chain(&e)
+                    ))
+                })
+            })
+            .transpose()?;
+        let j = cmp
+            .summary_json(&cfg, verdicts.as_deref())
+            .and_then(|j| serde_json::to_string(&j))
             .map_err(|e| FitError::new_err(e.to_string()))?;
-        if let Some(s) = &spec {
-            let v = gyrotherm::imu_judge::judge_unit_comparison(s, &cmp, &cfg).map_err(|e| {
-                MetricsError::new_err(format!("spec {}: {}", s.name, gyrotherm::error_chain(&e)))
-            })?;
-            if let Some(o) = j.as_object_mut() {
-                o.insert(
-                    "verdicts".into(),
-                    serde_json::to_value(v).map_err(|e| FitError::new_err(e.to_string()))?,
-                );
-            }
-        }
-        let j = serde_json::to_string(&j).map_err(|e| FitError::new_err(e.to_string()))?;
         Ok((j, notes))
     })
 }

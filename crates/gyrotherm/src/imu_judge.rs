@@ -893,6 +893,21 @@ pub struct AcrossAxes {
 }
 
 impl ImuComparison {
+    /// `gyrotherm compare --json` of the unit (and Python's `compare`): the
+    /// [`summary`](Self::summary), with `verdicts` (each axis's, [`judge_unit_comparison`])
+    /// when it was judged against a spec.
+    pub fn summary_json(
+        &self,
+        cfg: &CompareConfig,
+        verdicts: Option<&[AxisVerdicts]>,
+    ) -> Result<serde_json::Value, serde_json::Error> {
+        let mut j = serde_json::to_value(self.summary(cfg))?;
+        if let (Some(v), Some(o)) = (verdicts, j.as_object_mut()) {
+            o.insert("verdicts".into(), serde_json::to_value(v)?);
+        }
+        Ok(j)
+    }
+
     /// The JSON form.
     pub fn summary(&self, cfg: &CompareConfig) -> ImuComparisonSummary {
         let t = self.across_axes(cfg);

@@ -264,10 +264,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<ExitCode> {
         .transpose()?;
     let mut out = std::io::stdout().lock();
     if args.json {
-        let mut j = serde_json::to_value(cmp.summary(&cfg))?;
-        if let (Some(v), Some(o)) = (&verdicts, j.as_object_mut()) {
-            o.insert("verdicts".into(), serde_json::to_value(v)?);
-        }
+        let j = cmp.summary_json(&cfg, verdicts.as_deref())?;
         writeln!(out, "{}", serde_json::to_string_pretty(&j)?)?;
     } else {
         print_unit_tables(&mut out, &cmp, &cfg)?;
