@@ -75,20 +75,14 @@ pub fn axis_verdict_table(a: &AxisVerdicts) -> Table {
     let mut rows = Vec::new();
     let mut push = |label: &str, v: &Verdict| {
         for f in &v.figures {
-            let limit = match (f.min, f.max) {
-                (Some(a), Some(b)) => format!("{a} ..= {b}"),
-                (Some(a), None) => format!(">= {a}"),
-                (None, Some(b)) => format!("<= {b}"),
-                (None, None) => String::new(),
-            };
             rows.push(vec![
                 label.to_owned(),
                 f.figure.to_owned(),
                 f.log.clone(),
                 format!("{:.4e}", f.value),
                 f.unit.to_owned(),
-                limit,
-                if f.pass { "pass" } else { "FAIL" }.to_owned(),
+                f.limit_text(),
+                f.word().to_owned(),
                 format!("{:+.3e}", f.margin),
             ]);
         }

@@ -21,6 +21,27 @@ pub struct FigureVerdict {
     pub margin: f64,
 }
 
+impl FigureVerdict {
+    /// The limit as text: `min ..= max`, `>= min`, `<= max`, or empty.
+    pub fn limit_text(&self) -> String {
+        match (self.min, self.max) {
+            (Some(a), Some(b)) => format!("{a} ..= {b}"),
+            (Some(a), None) => format!(">= {a}"),
+            (None, Some(b)) => format!("<= {b}"),
+            (None, None) => String::new(),
+        }
+    }
+
+    /// `pass` or `FAIL`.
+    pub fn word(&self) -> &'static str {
+        if self.pass {
+            "pass"
+        } else {
+            "FAIL"
+        }
+    }
+}
+
 /// The verdict of one run (one output column over its logs).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Verdict {
@@ -47,19 +68,13 @@ impl Verdict {
     pub fn lines(&self) -> Vec<String> {
         let mut out = Vec::with_capacity(self.figures.len() + 1);
         for f in &self.figures {
-            let limit = match (f.min, f.max) {
-                (Some(a), Some(b)) => format!("{a} ..= {b}"),
-                (Some(a), None) => format!(">= {a}"),
-                (None, Some(b)) => format!("<= {b}"),
-                (None, None) => String::new(),
-            };
             out.push(format!(
                 "{:<22} {:>14} {:<7} limit {:<18} {} margin {:+.4e}  ({})",
                 f.figure,
                 fmt_value(f.value),
                 f.unit,
-                limit,
-                if f.pass { "pass" } else { "FAIL" },
+                f.limit_text(),
+                f.word(),
                 f.margin,
                 f.log
             ));
