@@ -276,7 +276,7 @@ pub fn cv_rms<'a>(
 /// One target's design over a first sensor's terms and further sensors' columns, in a fixed
 /// order, with its per-segment statistics: the cross-validation (and fit) of the first sensor
 /// with any further sensors taken in that order comes from these, to the bit, instead of from
-/// a design of its own. Every trial of [`select`] and the fits after it read the same rows
+/// a design of its own. Every trial of [`select_shared`] and the fits after it read the same rows
 /// and the same values in each column; only which columns differs, and each entry of the
 /// statistics is a sum over rows of its own columns alone.
 pub struct Shared {
@@ -417,17 +417,7 @@ pub fn cv_rms_with<'a>(
 }
 
 /// The sensors an axis keeps, first sensor first (see the module doc), and each one-sensor
-/// score.
-pub fn select(
-    sensors: &[SensorData],
-    cfg: &ThermalConfig,
-    multi: &MultiConfig,
-) -> (Vec<usize>, Vec<Option<f64>>) {
-    let (order, single, _) = select_shared(sensors, cfg, multi);
-    (order, single)
-}
-
-/// [`select`], its trials' cross-validation from one [`Shared`] design over the best sensor
+/// score; the trials' cross-validation comes from one [`Shared`] design over the best sensor
 /// and every other in ranked order, which it also returns (for [`fit_multi_with`] and
 /// [`cv_rms_with`]; None where there was nothing to try or it could not be made).
 pub fn select_shared(
