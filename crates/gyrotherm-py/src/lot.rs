@@ -66,7 +66,7 @@ fn read_lot<'py>(py: Python<'py>, db: PathBuf) -> PyResult<Bound<'py, PyDict>> {
             verdict.push(f.pass.map(|p| if p { "pass" } else { "fail" }));
             margin.push(f.margin.unwrap_or(f64::NAN));
             // An inertial unit's axis (its gyro column) and the axis's verdict.
-            let a = f.axis.and_then(|k| r.axes.iter().find(|a| a.axis == k));
+            let a = r.axis_of(f.axis);
             axis.push(a.map(|a| a.gyro.clone()));
             axis_verdict.push(a.map(|a| a.verdict.as_str()));
         }

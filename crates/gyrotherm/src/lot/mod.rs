@@ -171,13 +171,15 @@ impl Run {
         !self.axes.is_empty()
     }
 
+    /// The record of axis `axis` (None: a single-axis run, or no such axis).
+    pub fn axis_of(&self, axis: Option<u32>) -> Option<&AxisRecord> {
+        let k = axis?;
+        self.axes.iter().find(|a| a.axis == k)
+    }
+
     /// The gyro column of axis `axis` (None: a single-axis run, or no such axis).
     pub fn gyro_of(&self, axis: Option<u32>) -> Option<&str> {
-        let k = axis?;
-        self.axes
-            .iter()
-            .find(|a| a.axis == k)
-            .map(|a| a.gyro.as_str())
+        self.axis_of(axis).map(|a| a.gyro.as_str())
     }
 }
 

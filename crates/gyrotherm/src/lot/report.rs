@@ -150,8 +150,7 @@ pub fn lot_csv(runs: &[Run]) -> Result<Vec<u8>, csv::Error> {
                     .to_string(),
                 num(f.margin),
                 csv_text(r.gyro_of(f.axis).unwrap_or("")),
-                f.axis
-                    .and_then(|k| r.axes.iter().find(|a| a.axis == k))
+                r.axis_of(f.axis)
                     .map_or("", |a| a.verdict.as_str())
                     .to_string(),
             ])?;
