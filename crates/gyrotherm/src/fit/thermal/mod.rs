@@ -776,6 +776,13 @@ pub fn fit_target(
 mod tests {
     use super::*;
 
+    /// Every entry of `s`, as bits (for comparisons to the bit).
+    fn bits(s: &Stats) -> Vec<u64> {
+        let mut v = vec![s.n.to_bits(), s.sy.to_bits(), s.syy.to_bits()];
+        v.extend(s.sx.iter().chain(&s.sxx).chain(&s.sxy).map(|f| f.to_bits()));
+        v
+    }
+
     /// `Stats::of_rows` is `Stats::add` of each row in turn, to the bit (the reference: the
     /// row-at-a-time update), for column counts around its block of eight and with zero,
     /// negative-zero and wide-ranging values.
@@ -796,11 +803,6 @@ mod tests {
                     want.add(&x[k * nc..(k + 1) * nc], y[k], 1.0);
                 }
                 let got = Stats::of_rows(&x, &y, nc);
-                let bits = |s: &Stats| {
-                    let mut v = vec![s.n.to_bits(), s.sy.to_bits(), s.syy.to_bits()];
-                    v.extend(s.sx.iter().chain(&s.sxx).chain(&s.sxy).map(|f| f.to_bits()));
-                    v
-                };
                 assert_eq!(bits(&got), bits(&want), "{nc} columns, {n} rows");
             }
         }
@@ -876,13 +878,6 @@ mod tests {
             .collect();
         let seg_w = segment_stats(&wide, nc, &layouts);
         let seg_n = segment_stats(&narrow, keep.len(), &layouts);
-        let bits = |s: &Stats| {
-            let mut v = vec![s.n.to_bits(), s.sy.to_bits(), s.syy.to_bits()];
-            for x in s.sx.iter().chain(&s.sxx).chain(&s.sxy) {
-                v.push(x.to_bits());
-            }
-            v
-        };
         let sub: Vec<Vec<Stats>> = seg_w
             .iter()
             .map(|run| run.iter().map(|s| s.columns(&keep)).collect())
