@@ -392,9 +392,8 @@ fn generated_unit_c_equals_the_unit_stream() {
             // features (C: 0 inside, 1 edge, 2 outside, 3 no verdict yet, 4 no map).
             let mut unit = gyrotherm::compensate_imu_lines::flight_unit(m).unwrap();
             // An axis on its fallback: the fallback's map on the fallback's features.
-            let map_of = |f: &gyrotherm::model::ModelFile| {
-                f.coverage.as_ref().map(|c| c.to_core().unwrap())
-            };
+            let map_of =
+                |f: &gyrotherm::model::ModelFile| f.coverage.as_ref().map(|c| c.to_core().unwrap());
             let maps: Vec<_> = m
                 .axes
                 .iter()

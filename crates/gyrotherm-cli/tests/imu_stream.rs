@@ -509,13 +509,7 @@ fn a_further_sensor_dead_for_good_leaves_its_axes_on_their_fallbacks() {
     }
     let model = d.join("unit.json");
     let mut train = gyrotherm();
-    train.args([
-        "train",
-        "--gyro-col",
-        &GYROS.join(","),
-        "--temp-col",
-        TEMPS,
-    ]);
+    train.args(["train", "--gyro-col", &GYROS.join(","), "--temp-col", TEMPS]);
     for i in &inputs {
         train.arg("--input").arg(i);
     }
@@ -604,7 +598,10 @@ fn a_further_sensor_dead_for_good_leaves_its_axes_on_their_fallbacks() {
     );
     let lost = text.lines().count() - 1 - 5_060;
     // Without fallbacks: degraded from 60 s after the loss to the end (the defect).
-    assert!(count(&old_counts, "degraded") >= lost - 61, "{old_counts:?}");
+    assert!(
+        count(&old_counts, "degraded") >= lost - 61,
+        "{old_counts:?}"
+    );
     // With them: on the fallback instead, never degraded after the first minute.
     assert!(count(&fb_counts, "fallback") >= lost - 61, "{fb_counts:?}");
     assert_eq!(
@@ -615,5 +612,8 @@ fn a_further_sensor_dead_for_good_leaves_its_axes_on_their_fallbacks() {
     assert_eq!(count(&clean_counts, "fallback"), 0);
     // The error stays near the fault-free one (and well below the frozen model's).
     assert!(with_fallback < 1.5 * clean, "{with_fallback} vs {clean}");
-    assert!(without > 2.0 * with_fallback, "{without} vs {with_fallback}");
+    assert!(
+        without > 2.0 * with_fallback,
+        "{without} vs {with_fallback}"
+    );
 }

@@ -387,9 +387,7 @@ impl Status {
 
     /// The status from its name (`as_str`).
     pub fn parse(s: &str) -> Option<Status> {
-        Status::ALL
-            .into_iter()
-            .find(|v| v.as_str() == s)
+        Status::ALL.into_iter().find(|v| v.as_str() == s)
     }
 }
 

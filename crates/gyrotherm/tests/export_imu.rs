@@ -169,8 +169,7 @@ fn generated_unit_module_equals_the_stream_to_the_last_bit() {
     let model = ImuModel::load(&example_dir().join("model.json")).unwrap();
     // The example's file predates fallbacks: it has none.
     assert!(gyrotherm_model::FALLBACKS.iter().all(Option::is_none));
-    let (lines, differ, not_ok, _) =
-        module_vs_stream(&model, &gyrotherm_model::FALLBACKS, false);
+    let (lines, differ, not_ok, _) = module_vs_stream(&model, &gyrotherm_model::FALLBACKS, false);
     println!(
         "rust unit module vs stream: {lines} lines, {differ} differ; not ok per axis {not_ok:?}"
     );

@@ -719,7 +719,11 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
             let fs = format!("{suffix}f");
             let (fh, fsrc) = c::generate(fm, fabout);
             let _ = writeln!(h, "#define GT_N_FEATURES{fs} {}", fm.spec.n_features());
-            let _ = writeln!(h, "#define GT_LAG_SLOTS{fs} {}", fm.spec.lags().len().max(1));
+            let _ = writeln!(
+                h,
+                "#define GT_LAG_SLOTS{fs} {}",
+                fm.spec.lags().len().max(1)
+            );
             let from = fh.find("struct gt_state {").unwrap_or(0);
             let to = fh[from..].find("\n};\n").map_or(fh.len(), |k| from + k + 4);
             let names = file_scope_names(&fsrc);
@@ -808,7 +812,10 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
                 "        if (s->fb{i}) {{\n            return gt_coverage_of_a{i}f(&s->a{i}f, sigma_dph);\n        }}"
             );
         }
-        let _ = writeln!(src, "        return gt_coverage_of_a{i}(&s->a{i}, sigma_dph);");
+        let _ = writeln!(
+            src,
+            "        return gt_coverage_of_a{i}(&s->a{i}, sigma_dph);"
+        );
     }
     src.push_str(
         "    default:\n        if (sigma_dph != 0) {\n            *sigma_dph = NAN;\n        }\n        \
@@ -843,8 +850,7 @@ const UNIT_HEADER_DOC: &str =
  * when compiled with -ffp-contract=off on IEEE 754 hardware with FLT_EVAL_METHOD == 0. */
 ";
 
-const UNIT_HEADER_API: &str =
-    "typedef enum {
+const UNIT_HEADER_API: &str = "typedef enum {
     GT_OK = 0,
     GT_HELD = 1,
     GT_DEGRADED = 2,
