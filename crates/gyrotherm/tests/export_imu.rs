@@ -119,7 +119,7 @@ fn module_vs_stream(
     }
     let mut out = Vec::new();
     compensate_imu_lines(
-        &model,
+        model,
         text.as_bytes(),
         "generated".as_ref(),
         &gyrotherm::ReadOptions::default(),
