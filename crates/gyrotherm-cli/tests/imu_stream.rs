@@ -4,7 +4,11 @@
 //!   axis that reads that sensor;
 //! - with time-stamp faults (which batch refuses), every axis's four columns equal, to the
 //!   last character, those of the single-axis `compensate --stream` run with that axis's own
-//!   model on its gyro and sensor columns: an independent path through the same flight core.
+//!   model on its gyro and sensor columns: an independent path through the same flight core;
+//! - a further sensor that dies for good (the default fit, every axis on several sensors)
+//!   leaves each axis reading it compensating on its fallback (status `fallback`), with the
+//!   x-axis bias stability near the fault-free figure, where a model without fallbacks (as
+//!   written before them) stays degraded.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -442,4 +446,174 @@ fn line_handling_is_the_single_axis_streams() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("column temp_y_c"), "{err}");
+}
+
+/// Bias stability (τ = 100 s, GJB 2426A / IEEE 952 as `gyrotherm::metrics` computes it) of
+/// column `col` of a compensated 1 Hz log, °/h, and the count of each status in `status_col`.
+fn column_figures(text: &str, col: &str, status_col: &str) -> (f64, Vec<(String, usize)>) {
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let (c, s) = (
+        head.iter().position(|h| *h == col).unwrap(),
+        head.iter().position(|h| *h == status_col).unwrap(),
+    );
+    let (mut rate, mut counts) = (Vec::new(), Vec::<(String, usize)>::new());
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        rate.push(f[c].parse::<f64>().unwrap());
+        match counts.iter_mut().find(|(k, _)| k == f[s]) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((f[s].to_owned(), 1)),
+        }
+    }
+    let bs = gyrotherm::metrics::bias_stability_dph(&rate, 1.0, 100.0)
+        .unwrap()
+        .bias_stability_dph;
+    (bs, counts)
+}
+
+fn count(counts: &[(String, usize)], status: &str) -> usize {
+    counts.iter().find(|(k, _)| k == status).map_or(0, |c| c.1)
+}
+
+/// A further sensor dies for good: the default fit (every axis may read every sensor) of a
+/// design-family unit, trained as the design family is (`seed-shock` static and one table run
+/// per axis), judged on an `airborne` run of the unit whose sensor `S` (a further sensor of
+/// axis x) reads nothing from line 5,061 on (5,060 s: cruise). With the model file as
+/// `train` writes it, each axis that reads `S` runs on its fallback from 60 s after the loss
+/// on, and the x-axis bias stability stays near the fault-free one; the same file without its
+/// fallbacks (a file written before them) keeps those axes degraded, B and K frozen.
+#[test]
+fn a_further_sensor_dead_for_good_leaves_its_axes_on_their_fallbacks() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let unit = ["--imu", "--unit", "random", "--unit-seed", "1000"];
+    let shock = ["--profile", "seed-shock"];
+    let mut inputs = vec![simulate_args(
+        d,
+        "static.csv",
+        &[&unit[..], &shock[..], &["--seed", "1"]].concat(),
+    )];
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        let seed = (2 + k).to_string();
+        inputs.push(simulate_args(
+            d,
+            &format!("table_{axis}.csv"),
+            &[
+                &unit[..],
+                &shock[..],
+                &["--seed", &seed, "--table-rate", "20", "--table-axis", axis],
+            ]
+            .concat(),
+        ));
+    }
+    let model = d.join("unit.json");
+    let mut train = gyrotherm();
+    train.args(["train", "--gyro-col", &GYROS.join(","), "--temp-col", TEMPS]);
+    for i in &inputs {
+        train.arg("--input").arg(i);
+    }
+    run_ok(train.arg("--out").arg(&model));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let axes = v["axes"].as_array().unwrap();
+    // Every axis with further sensors carries the one-sensor fit of its first sensor.
+    for a in axes {
+        let several = a["temps"].as_array().unwrap().len() > 1;
+        assert_eq!(a.get("fallback").is_some(), several, "{}", a["gyro"]);
+    }
+    let further_x: Vec<String> = axes[0]["temps"].as_array().unwrap()[1..]
+        .iter()
+        .map(|t| t.as_str().unwrap().to_owned())
+        .collect();
+    assert!(!further_x.is_empty(), "axis x reads one sensor");
+    // The further sensor of x that the most axes read.
+    let readers = |t: &str| {
+        axes.iter()
+            .filter(|a| a["temps"].as_array().unwrap().iter().any(|s| s == t))
+            .count()
+    };
+    let dead = further_x.iter().max_by_key(|t| readers(t)).unwrap().clone();
+    // The file without fallbacks, unsealed: what `train` wrote before them.
+    let mut old = v.clone();
+    old.as_object_mut().unwrap().remove("content_sha256");
+    for a in old["axes"].as_array_mut().unwrap() {
+        a.as_object_mut().unwrap().remove("fallback");
+    }
+    let old_model = d.join("old.json");
+    std::fs::write(&old_model, serde_json::to_string_pretty(&old).unwrap()).unwrap();
+
+    let flight = simulate_args(
+        d,
+        "airborne.csv",
+        &[&unit[..], &["--profile", "airborne", "--seed", "31"]].concat(),
+    );
+    let text = std::fs::read_to_string(&flight).unwrap();
+    let col = text
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == dead)
+        .unwrap();
+    let faulty = d.join("airborne_dead.csv");
+    std::fs::write(
+        &faulty,
+        edited(&text, |i, f| {
+            if i > 5_060 {
+                f[col].clear();
+            }
+        }),
+    )
+    .unwrap();
+    let compensate = |m: &Path, input: &Path, name: &str| {
+        let out = d.join(name);
+        run_ok(
+            gyrotherm()
+                .args(["compensate", "--model"])
+                .arg(m)
+                .arg("--input")
+                .arg(input)
+                .arg("--out")
+                .arg(&out),
+        );
+        column_figures(
+            &std::fs::read_to_string(out).unwrap(),
+            "gyro_x_dps_comp",
+            "gyro_x_dps_status",
+        )
+    };
+    let (clean, clean_counts) = compensate(&model, &flight, "clean.csv");
+    let (with_fallback, fb_counts) = compensate(&model, &faulty, "fallback.csv");
+    let (without, old_counts) = compensate(&old_model, &faulty, "old.csv");
+    let (raw, _) = column_figures(&text, "gyro_x_dps", "gyro_x_dps");
+    println!(
+        "airborne, unit 1000, sensor {dead} (read by {} axes) dead from line 5,061 of {}: \
+         x-axis bias stability (τ = 100 s) fault-free {clean:.4} °/h, with fallback \
+         {with_fallback:.4} °/h, without (older file) {without:.4} °/h, raw {raw:.4} °/h; \
+         x statuses fault-free {clean_counts:?}, with fallback {fb_counts:?}, without \
+         {old_counts:?}",
+        readers(&dead),
+        text.lines().count() - 1
+    );
+    let lost = text.lines().count() - 1 - 5_060;
+    // Without fallbacks: degraded from 60 s after the loss to the end (the defect).
+    assert!(
+        count(&old_counts, "degraded") >= lost - 61,
+        "{old_counts:?}"
+    );
+    // With them: on the fallback instead, never degraded after the first minute.
+    assert!(count(&fb_counts, "fallback") >= lost - 61, "{fb_counts:?}");
+    assert_eq!(
+        count(&fb_counts, "degraded"),
+        count(&clean_counts, "degraded"),
+        "{fb_counts:?}"
+    );
+    assert_eq!(count(&clean_counts, "fallback"), 0);
+    // The error stays near the fault-free one (and well below the frozen model's).
+    assert!(with_fallback < 1.5 * clean, "{with_fallback} vs {clean}");
+    assert!(
+        without > 2.0 * with_fallback,
+        "{without} vs {with_fallback}"
+    );
 }

@@ -28,6 +28,10 @@
 //!   (Ĝ − B) / K is beyond f64; there is no rate
 //!   ([`Corrected::rate`] is `None`, `rate_dps` is 0). The temperature and time are still
 //!   judged and used.
+//! - [`Status::Fallback`]: only from an axis that reads further sensors and carries a
+//!   fallback model ([`crate::multi::AxisCompensator::with_fallback`]): a further sensor is
+//!   given up on (the axis on all its sensors is degraded while its first sensor alone is
+//!   believed), and B and K are current from the fallback model on the first sensor alone.
 //!
 //! A temperature sample is rejected when it is not finite; when it lies outside
 //! [`TempLimits::min_c`]..=[`TempLimits::max_c`]; when it implies a rate of change no chamber or
@@ -354,9 +358,22 @@ pub enum Status {
     Degraded = 2,
     /// The gyro sample is not finite (or its corrected rate would overflow): no rate.
     Invalid = 3,
+    /// Temperature accepted; B and K current from the axis's fallback model on its first
+    /// sensor alone, because a further sensor it reads is given up on
+    /// ([`crate::multi::AxisCompensator::with_fallback`]).
+    Fallback = 4,
 }
 
 impl Status {
+    /// Every status, in the order of their codes (`status as usize`).
+    pub const ALL: [Status; 5] = [
+        Status::Ok,
+        Status::Held,
+        Status::Degraded,
+        Status::Invalid,
+        Status::Fallback,
+    ];
+
     /// Lower-case name, as in the `status` column of `gyrotherm compensate`.
     pub const fn as_str(self) -> &'static str {
         match self {
@@ -364,14 +381,13 @@ impl Status {
             Status::Held => "held",
             Status::Degraded => "degraded",
             Status::Invalid => "invalid",
+            Status::Fallback => "fallback",
         }
     }
 
     /// The status from its name (`as_str`).
     pub fn parse(s: &str) -> Option<Status> {
-        [Status::Ok, Status::Held, Status::Degraded, Status::Invalid]
-            .into_iter()
-            .find(|v| v.as_str() == s)
+        Status::ALL.into_iter().find(|v| v.as_str() == s)
     }
 }
 

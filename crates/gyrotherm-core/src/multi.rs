@@ -19,11 +19,23 @@
 //! the axis holds, as with a rejected temperature. A reading the axis does not read changes
 //! nothing. A missing index (`temps` shorter than the axis expects) is a fault of that sensor.
 //!
+//! Fallback: an axis may also carry a fallback model on its first sensor alone
+//! ([`AxisCompensator::with_fallback`]), a [`Compensator`] stepped alongside on every sample
+//! (so its lags, rate window and LSTM states are warm when it is needed). When the axis on
+//! all its sensors is [`Status::Degraded`] (a further sensor not believed for longer than
+//! [`TempLimits::degraded_after_s`], the same clock that makes any axis degraded) while the
+//! fallback alone is not, the axis gives the fallback's output, with status
+//! [`Status::Fallback`] where the fallback's is ok (its held or invalid status otherwise). It
+//! goes back to all its sensors as soon as they give a sample that is not degraded again.
+//! Which one is used is decided on samples where neither output is invalid (an invalid
+//! sample keeps the latest choice: an invalid status hides whether the temperatures were
+//! believed).
+//!
 //! No allocation, fixed sizes, no panics on any input.
 
 use crate::baseline::BaselineModel;
 use crate::compensator::{
-    plausible_reading, Compensator, Corrected, ModelError, MoreSensors, TempLimits,
+    plausible_reading, Compensator, Corrected, ModelError, MoreSensors, Status, TempLimits,
 };
 use crate::features::{FeaturePipeline, FeatureSpec};
 
@@ -110,6 +122,10 @@ pub struct AxisCompensator {
     /// index among `temps`.
     first: Compensator,
     more: MoreParts,
+    /// The fallback on the first sensor alone (see the module doc), stepped alongside.
+    fallback: Option<Compensator>,
+    /// Whether the latest sample that decided it ran on the fallback.
+    on_fallback: bool,
 }
 
 impl From<Compensator> for AxisCompensator {
@@ -130,6 +146,8 @@ impl AxisCompensator {
             more: MoreParts {
                 parts: core::array::from_fn(|_| None),
             },
+            fallback: None,
+            on_fallback: false,
         }
     }
 
@@ -172,6 +190,26 @@ impl AxisCompensator {
             last_good: None,
         });
         Ok(self)
+    }
+
+    /// The same axis with a fallback: `fallback`, a compensator whose models read the first
+    /// sensor's features alone, run on the first sensor (whatever its own channel) alongside
+    /// the axis and used while the axis on all its sensors is degraded and the fallback is
+    /// not (see the module doc). A later call replaces an earlier fallback.
+    pub fn with_fallback(mut self, fallback: Compensator) -> Self {
+        self.fallback = Some(fallback.with_channel(self.first.channel()));
+        self.on_fallback = false;
+        self
+    }
+
+    /// The fallback compensator, if the axis has one.
+    pub fn fallback(&self) -> Option<&Compensator> {
+        self.fallback.as_ref()
+    }
+
+    /// Whether the latest sample's output came from the fallback (false without one).
+    pub fn on_fallback(&self) -> bool {
+        self.on_fallback
     }
 
     /// The indices into `temps` this axis reads, first sensor first.
@@ -218,13 +256,35 @@ impl AxisCompensator {
     /// ([`Compensator::step_unit`]).
     pub fn step(&mut self, time_s: f64, gyro_dps: f64, temps: &[f64]) -> Corrected {
         let t0 = reading(temps, self.first.channel());
-        self.first
-            .step_with(time_s, gyro_dps, t0, &mut self.more, temps)
+        let all = self
+            .first
+            .step_with(time_s, gyro_dps, t0, &mut self.more, temps);
+        let Some(fallback) = &mut self.fallback else {
+            return all;
+        };
+        let alone = fallback.step(time_s, gyro_dps, t0);
+        if all.status != Status::Invalid && alone.status != Status::Invalid {
+            self.on_fallback = all.status == Status::Degraded && alone.status != Status::Degraded;
+        }
+        if !self.on_fallback {
+            return all;
+        }
+        Corrected {
+            status: match alone.status {
+                Status::Ok => Status::Fallback,
+                other => other,
+            },
+            ..alone
+        }
     }
 
-    /// Start over (as [`Compensator::reset`], for every sensor).
+    /// Start over (as [`Compensator::reset`], for every sensor and the fallback).
     pub fn reset(&mut self) {
         self.first.reset();
         self.more.rebase();
+        if let Some(f) = &mut self.fallback {
+            f.reset();
+        }
+        self.on_fallback = false;
     }
 }

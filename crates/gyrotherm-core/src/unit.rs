@@ -163,10 +163,27 @@ impl<const N: usize> Unit<N> {
         sensors: &[&[StaticSensor]],
         n_temps: usize,
     ) -> Result<Self, UnitError> {
-        if models.len() != channels.len() || sensors.len() > models.len() {
+        Self::from_static_fallbacks(models, channels, sensors, &[], n_temps)
+    }
+
+    /// [`Unit::from_static_sensors`] with fallbacks: axis `i` also carries `fallbacks[i]`
+    /// (when `Some`), the model on its first sensor alone that it runs on while a further
+    /// sensor is given up on ([`AxisCompensator::with_fallback`]; an axis beyond `fallbacks`
+    /// has none).
+    pub fn from_static_fallbacks(
+        models: &[StaticModel],
+        channels: &[u8],
+        sensors: &[&[StaticSensor]],
+        fallbacks: &[Option<StaticModel>],
+        n_temps: usize,
+    ) -> Result<Self, UnitError> {
+        if models.len() != channels.len()
+            || sensors.len() > models.len()
+            || fallbacks.len() > models.len()
+        {
             return Err(UnitError::Layout {
                 axes: models.len(),
-                channels: channels.len().max(sensors.len()),
+                channels: channels.len().max(sensors.len()).max(fallbacks.len()),
             });
         }
         let mut unit = Unit::new(n_temps);
@@ -183,6 +200,11 @@ impl<const N: usize> Unit<N> {
                         a.with_sensor(usize::from(s.channel), s.spec, bias, part(&s.scale)?)
                     })
                     .map_err(|source| UnitError::Model { axis, source })?;
+            }
+            if let Some(f) = fallbacks.get(axis).and_then(Option::as_ref) {
+                let f = Compensator::from_static(f)
+                    .map_err(|source| UnitError::Model { axis, source })?;
+                a = a.with_fallback(f);
             }
             unit.push_axis(a)?;
         }
@@ -332,6 +354,61 @@ mod tests {
         }
         // The fault reaches the axes that read sensor 0 only.
         assert_eq!((held0, held1), (30, 0));
+    }
+
+    /// A further sensor dies for good: the axis holds for `degraded_after_s` (60 s), then
+    /// gives its fallback's output (a compensator on the first sensor alone, stepped beside
+    /// it here) with status fallback, its held status while the first sensor glitches, and its
+    /// own output again once the further sensor is back. Without a fallback it stays degraded.
+    #[test]
+    fn a_further_sensor_dead_for_good_runs_the_axis_on_its_fallback() {
+        let fallback = || {
+            Compensator::new(
+                FeatureSpec::PUBLISHED,
+                TargetModel::constant(2e-3),
+                TargetModel::constant(1.01),
+            )
+            .unwrap()
+        };
+        let mut with = multi_axis(1, &[3]).with_fallback(fallback());
+        let mut without = multi_axis(1, &[3]);
+        let mut alone = fallback().with_channel(1);
+        let mut counts = [0usize; 5];
+        for i in 0..600 {
+            let x = f64::from(i);
+            // Sensor 3 is lost from 100 s to 400 s; sensor 1 glitches at 250 s.
+            let s3 = if (100..400).contains(&i) {
+                f64::NAN
+            } else {
+                25.0
+            };
+            let s1 = if i == 250 { f64::NAN } else { 21.0 + 0.01 * x };
+            let temps = [20.0, s1, 22.0, s3];
+            let got = with.step(x, 0.01, &temps);
+            let old = without.step(x, 0.01, &temps);
+            let fb = alone.step(x, 0.01, s1);
+            counts[got.status as usize] += 1;
+            match i {
+                // Sensor 3 lost: held for 60 s, then the fallback (held at the glitch).
+                100..=159 => assert_eq!((got, old.status), (old, Status::Held), "{i}"),
+                160..=399 => {
+                    assert_eq!(old.status, Status::Degraded, "{i}");
+                    let want = if i == 250 {
+                        Status::Held
+                    } else {
+                        Status::Fallback
+                    };
+                    assert_eq!(got, Corrected { status: want, ..fb }, "{i}");
+                    assert!(with.on_fallback());
+                }
+                // Back on all sensors as soon as sensor 3 is believed again.
+                _ => assert_eq!(got, old, "{i}"),
+            }
+        }
+        assert_eq!(counts[Status::Fallback as usize], 239);
+        // Reset starts over on all sensors.
+        with.reset();
+        assert!(!with.on_fallback());
     }
 
     #[test]

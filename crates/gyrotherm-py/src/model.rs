@@ -350,7 +350,7 @@ pub fn coverage_names() -> Vec<(u8, &'static str)> {
 /// Status code → name, as in the `status` column of the CLI's streaming output.
 pub fn status_names() -> Vec<(u8, &'static str)> {
     use gyrotherm_core::compensator::Status;
-    [Status::Ok, Status::Held, Status::Degraded, Status::Invalid]
+    Status::ALL
         .into_iter()
         .map(|s| (s as u8, s.as_str()))
         .collect()

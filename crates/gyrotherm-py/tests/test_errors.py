@@ -156,7 +156,7 @@ def test_compensate_gives_bad_samples_a_status(logs):
     names = [gt.STATUS_NAMES[int(s)] for s in out.status]
     assert names[5] == "invalid" and out.rate_dps[5] == 0.0
     assert names[:5] == ["ok"] * 5 and names[6:] == ["ok"] * 94
-    assert set(gt.STATUS_NAMES.values()) == {"ok", "held", "degraded", "invalid"}
+    assert set(gt.STATUS_NAMES.values()) == {"ok", "held", "degraded", "invalid", "fallback"}
     with pytest.raises(TypeError):
         gt.Model("not a model")
 

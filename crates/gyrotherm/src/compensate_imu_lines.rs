@@ -18,7 +18,9 @@
 //! or implausible holds only the axes that read it, and a gyro field
 //! that is not a number (or NaN, infinite) makes only its own axis `invalid` (in
 //! [`Mode::Strict`] a gyro field that is not a number stops the run, as a malformed line). A
-//! bad time stamp reaches every axis alike. The columns are looked up by the model's names;
+//! bad time stamp reaches every axis alike. An axis whose further sensor is given up on runs
+//! on its fallback model, if the model file has one, with status `fallback`
+//! ([`gyrotherm_core::multi`]). The columns are looked up by the model's names;
 //! the log must hold every one (the error names the first missing). Coverage columns and
 //! extrapolation warnings are the single-axis stream's only.
 
@@ -79,21 +81,28 @@ pub struct ImuLinesSummary {
     pub rows: u64,
     /// Malformed lines written as invalid on every axis ([`Mode::Stream`] only).
     pub malformed: u64,
-    /// Per axis, in the model's order: lines ok, held, degraded, invalid.
-    pub per_axis: Vec<[u64; 4]>,
+    /// Per axis, in the model's order: lines ok, held, degraded, invalid, fallback (the
+    /// codes of [`Status`]).
+    pub per_axis: Vec<[u64; 5]>,
 }
 
 impl ImuLinesSummary {
-    /// `N lines (m malformed); gyro_x: ok a, held b, degraded c, invalid d; ...`.
+    /// `N lines (m malformed); gyro_x: ok a, held b, degraded c, invalid d; ...`, with
+    /// `, fallback e` for an axis that ran on its fallback.
     pub fn describe(&self, model: &ImuModel) -> String {
         let mut s = format!("{} lines", self.rows);
         if self.malformed > 0 {
             s.push_str(&format!(" ({} malformed)", self.malformed));
         }
-        for (g, [ok, held, degraded, invalid]) in model.gyro_cols.iter().zip(&self.per_axis) {
+        for (g, [ok, held, degraded, invalid, fallback]) in
+            model.gyro_cols.iter().zip(&self.per_axis)
+        {
             s.push_str(&format!(
                 "; {g}: ok {ok}, held {held}, degraded {degraded}, invalid {invalid}"
             ));
+            if *fallback > 0 {
+                s.push_str(&format!(", fallback {fallback}"));
+            }
         }
         s
     }
@@ -168,7 +177,7 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
     )?;
     writer.set_flush_each_row(flush_each_row);
     let mut summary = ImuLinesSummary {
-        per_axis: vec![[0; 4]; n_axes],
+        per_axis: vec![[0; 5]; n_axes],
         ..ImuLinesSummary::default()
     };
     let mut fields = Fields::default();

@@ -84,6 +84,9 @@ impl LinesSummary {
             Status::Held => self.held += 1,
             Status::Degraded => self.degraded += 1,
             Status::Invalid => self.invalid += 1,
+            // Only an axis with further sensors and a fallback gives it, never one model on
+            // one sensor: counted as ok would hide it, so it is counted with held.
+            Status::Fallback => self.held += 1,
         }
     }
 

@@ -10,7 +10,9 @@
 //! [`AxisCompensator`]. With [`ImuSensors::ChooseOne`] (and for methods without
 //! cross-validation, which keep the first sensor) each axis reads one sensor, an ordinary
 //! single-sensor [`ModelFile`]. The axes fit on their own threads. A fault in one sensor
-//! reaches only the axes that read it.
+//! reaches only the axes that read it. An axis with further sensors also keeps its first
+//! sensor's one-sensor model as its `fallback` ([`ImuAxis::fallback`]), which it runs on
+//! (status `fallback`) while a further sensor is given up on.
 //!
 //! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
 //! format is unchanged): 1 when every axis reads one sensor (as older builds wrote), 2 when
@@ -86,6 +88,12 @@ pub struct ImuAxis {
     /// Cross-validated RMS of the bias on all the sensors read (with several).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub multi_cv_rms: Option<f64>,
+    /// With further sensors: the one-sensor model on the first sensor alone (its `thermal`
+    /// fit), which the axis runs on while a further sensor is given up on (status
+    /// `fallback`, [`gyrotherm_core::multi`]). Files written before it have none: such an
+    /// axis stays held and then degraded while a further sensor is lost.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<ModelFile>,
 }
 
 /// An inertial unit's model.
@@ -436,6 +444,7 @@ fn fit_axis(
         model: outcome.model,
         more: Vec::new(),
         multi_cv_rms: None,
+        fallback: None,
     })
 }
 
@@ -590,16 +599,14 @@ fn fit_axis_multi(
         .map(|(n, l)| NamedLog { name: n, log: l })
         .collect();
     let has_bias = data.iter().all(|d| !d.bias.is_empty());
-    // Several sensors replace the bias model, and with it the one-sensor coverage map: the
-    // one-sensor bias is not fitted (unless an experiment's blend reads it), and the axis's
-    // model is checked once complete (with the unit's checks).
-    let own_bias = !(order.len() > 1 && has_bias) || settings.blend != 0.0;
+    // The first sensor's whole one-sensor fit, bias included: with further sensors it is the
+    // axis's fallback (kept below before several sensors replace its bias and coverage map).
     // Its training sets are the ones made for the selection.
     let mut outcome = crate::fit::fit_model_with(
         &named,
         cfg,
         Some(id0.clone()),
-        own_bias,
+        true,
         Some((bias0, scale0)),
         &|t, e, loss| progress(k, j0, t, e, loss),
     )
@@ -607,6 +614,7 @@ fn fit_axis_multi(
     outcome.model.features.temp_sensor = *temp_sensor;
     let mut more = Vec::new();
     let mut multi_cv_rms = None;
+    let fallback = (order.len() > 1).then(|| outcome.model.clone());
     if order.len() > 1 {
         let thermal_err = |e: crate::fit::thermal::ThermalError| fit_err(j0, FitError::from(e));
         let has_scale = data.iter().all(|d| !d.scale.is_empty());
@@ -673,6 +681,7 @@ fn fit_axis_multi(
         model: outcome.model,
         more,
         multi_cv_rms,
+        fallback,
     })
 }
 
@@ -743,6 +752,19 @@ fn axis_checks(temp_cols: &[String], a: &ImuAxis) -> Result<(), ImuError> {
         gyro: a.gyro.clone(),
         source: Box::new(source),
     })?;
+    if let Some(f) = &a.fallback {
+        if a.more.is_empty() {
+            return Err(ImuError::Layout(format!(
+                "axis {}: a `fallback` model is only for an axis that reads further sensors \
+                 (remove it: this axis's model already reads its one sensor alone)",
+                a.gyro
+            )));
+        }
+        f.validate().map_err(|source| ImuError::Axis {
+            gyro: a.gyro.clone(),
+            source: Box::new(source),
+        })?;
+    }
     if !a.more.is_empty() {
         // The further sensors' parts must build a flight compensator.
         axis_compensator_in(temp_cols, a)?;
@@ -804,6 +826,13 @@ fn axis_compensator_in(temp_cols: &[String], a: &ImuAxis) -> Result<AxisCompensa
                 part(&m.scale, "scale")?,
             )
             .map_err(|e| layout(format!("sensor {t}: {e}")))?;
+    }
+    if let Some(f) = &a.fallback {
+        let f = compensator(f).map_err(|source| ImuError::Compensate {
+            gyro: a.gyro.clone(),
+            source: Box::new(source),
+        })?;
+        axis = axis.with_fallback(f);
     }
     Ok(axis)
 }

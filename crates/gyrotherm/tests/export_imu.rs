@@ -41,9 +41,14 @@ fn imu_flight_example_module_is_current() {
     }
 }
 
-#[test]
-fn generated_unit_module_equals_the_stream_to_the_last_bit() {
-    let model = ImuModel::load(&example_dir().join("model.json")).unwrap();
+/// The module's unit (with `fallbacks`) against the stream of `model` on the faulted run,
+/// `dead` also losing the second sensor for good from line 20,000 on: lines compared, lines
+/// that differ, per axis the lines not ok and the lines on the fallback.
+fn module_vs_stream(
+    model: &ImuModel,
+    fallbacks: &[Option<gyrotherm_core::static_model::StaticModel>],
+    dead: bool,
+) -> (usize, usize, Vec<usize>, Vec<usize>) {
     let cfg = ImuConfig {
         run: SimConfig {
             seed: 7,
@@ -87,6 +92,7 @@ fn generated_unit_module_equals_the_stream_to_the_last_bit() {
         row.extend(temp.iter().map(|c| c[i]));
         match i {
             8_000..8_200 => row[1 + n_axes + 1] = f64::NAN,
+            20_000.. if dead => row[1 + n_axes + 1] = f64::NAN,
             9_000..9_020 => row[1 + n_axes + 1] = -127.0,
             10_001 => row[1] = 1.797e308,
             10_003 => row[2] = -1.797e308,
@@ -113,7 +119,7 @@ fn generated_unit_module_equals_the_stream_to_the_last_bit() {
     }
     let mut out = Vec::new();
     compensate_imu_lines(
-        &model,
+        model,
         text.as_bytes(),
         "generated".as_ref(),
         &gyrotherm::ReadOptions::default(),
@@ -123,15 +129,17 @@ fn generated_unit_module_equals_the_stream_to_the_last_bit() {
     )
     .unwrap();
     let out = String::from_utf8(out).unwrap();
-    let mut unit: Unit<{ gyrotherm_model::AXES }> = Unit::from_static_sensors(
+    let mut unit: Unit<{ gyrotherm_model::AXES }> = Unit::from_static_fallbacks(
         &gyrotherm_model::MODELS,
         &gyrotherm_model::CHANNELS,
         &gyrotherm_model::SENSORS,
+        fallbacks,
         gyrotherm_model::TEMPS,
     )
     .unwrap();
     let width = 1 + n_axes + model.temp_cols.len();
-    let (mut lines, mut differ, mut not_ok) = (0, 0, [0usize; 3]);
+    let (mut lines, mut differ) = (0, 0);
+    let (mut not_ok, mut on_fallback) = (vec![0usize; n_axes], vec![0usize; n_axes]);
     for (r, l) in rows.iter().zip(out.lines().skip(1)) {
         let f: Vec<&str> = l.split(',').collect();
         let got = unit.step(r[0], &r[1..1 + n_axes], &r[1 + n_axes..]);
@@ -148,13 +156,23 @@ fn generated_unit_module_equals_the_stream_to_the_last_bit() {
                     None => f[a + 2].is_empty(),
                 };
             not_ok[k] += usize::from(c.status != gyrotherm_core::Status::Ok);
+            on_fallback[k] += usize::from(c.status == gyrotherm_core::Status::Fallback);
         }
         differ += usize::from(!same);
     }
+    assert_eq!(lines, rows.len());
+    (lines, differ, not_ok, on_fallback)
+}
+
+#[test]
+fn generated_unit_module_equals_the_stream_to_the_last_bit() {
+    let model = ImuModel::load(&example_dir().join("model.json")).unwrap();
+    // The example's file predates fallbacks: it has none.
+    assert!(gyrotherm_model::FALLBACKS.iter().all(Option::is_none));
+    let (lines, differ, not_ok, _) = module_vs_stream(&model, &gyrotherm_model::FALLBACKS, false);
     println!(
         "rust unit module vs stream: {lines} lines, {differ} differ; not ok per axis {not_ok:?}"
     );
-    assert_eq!(lines, rows.len());
     assert_eq!(differ, 0);
     // The module's axes read further sensors (so their code was compared), and every axis
     // that reads the failing sensor (temps[1]) is held through its 200 s of NaN.
@@ -163,5 +181,34 @@ fn generated_unit_module_equals_the_stream_to_the_last_bit() {
         let reads_1 = gyrotherm_model::CHANNELS[k] == 1
             || gyrotherm_model::SENSORS[k].iter().any(|s| s.channel == 1);
         assert!(!reads_1 || *n >= 200, "axis {k}: {not_ok:?}");
+    }
+}
+
+/// With fallbacks (each axis's first-sensor model standing in for its fallback, as static data
+/// like the module's) and the second sensor lost for good: the core unit built from the
+/// static data equals the stream of the model file with the same fallbacks, line for line,
+/// and every axis that reads that sensor as a further one runs on its fallback.
+#[test]
+fn static_fallbacks_equal_the_stream_when_a_further_sensor_dies() {
+    let mut model = ImuModel::load(&example_dir().join("model.json")).unwrap();
+    for a in &mut model.axes {
+        a.fallback = Some(a.model.clone());
+    }
+    model.validate().unwrap();
+    let fallbacks: Vec<Option<gyrotherm_core::static_model::StaticModel>> = model
+        .axes
+        .iter()
+        .map(|a| Some(gyrotherm::export::static_model(&a.model).unwrap()))
+        .collect();
+    let (lines, differ, _, on_fallback) = module_vs_stream(&model, &fallbacks, true);
+    println!("rust unit with fallbacks vs stream: {lines} lines, {differ} differ; on fallback per axis {on_fallback:?}");
+    assert_eq!(differ, 0);
+    for (k, n) in on_fallback.iter().enumerate() {
+        let further_1 = gyrotherm_model::SENSORS[k].iter().any(|s| s.channel == 1);
+        if further_1 {
+            assert!(*n > 5_000, "axis {k}: {on_fallback:?}");
+        } else {
+            assert_eq!(*n, 0, "axis {k}");
+        }
     }
 }

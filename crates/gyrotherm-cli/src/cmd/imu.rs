@@ -171,8 +171,13 @@ pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .zip(&summary.per_axis)
         .map(|(g, n)| {
+            let fallback = if n[4] > 0 {
+                format!(", {} fallback", n[4])
+            } else {
+                String::new()
+            };
             format!(
-                "{g}: {} ok, {} held, {} degraded, {} invalid",
+                "{g}: {} ok, {} held, {} degraded, {} invalid{fallback}",
                 n[0], n[1], n[2], n[3]
             )
         })

@@ -61,7 +61,7 @@ fn main() {
     let cover = gyrotherm_model::MODEL.coverage_map().and_then(Result::ok);
     let mut outside = 0u32;
     let mut sensors = MockSensors { k: 0 };
-    let mut counts = [0u32; 4];
+    let mut counts = [0u32; 5];
     let mut last_rate = 0.0;
     // The loop: one call per sample; no allocation, no panic, a rate for every finite gyro.
     while let Some(s) = sensors.next() {
@@ -69,7 +69,8 @@ fn main() {
         counts[out.status as usize] += 1;
         match out.status {
             // Current compensation: use the rate.
-            Status::Ok => last_rate = out.rate_dps,
+            // (Fallback comes only from an axis that reads further sensors: a unit's.)
+            Status::Ok | Status::Fallback => last_rate = out.rate_dps,
             // Temperature sensor fault: the rate is still compensated with the last good
             // bias and scale factor; flag it in telemetry.
             Status::Held | Status::Degraded => last_rate = out.rate_dps,

@@ -23,11 +23,12 @@
 //!   temps[1] is the model's 2nd temperature column.
 //!   temps[2] is the model's 3rd temperature column.
 //!   temps[3] is the model's 4th temperature column.
-//! Use: `let mut unit = gyrotherm_core::unit::Unit::<AXES>::from_static_sensors(&MODELS, &CHANNELS, &SENSORS, TEMPS)?;`
+//! Use: `let mut unit = gyrotherm_core::unit::Unit::<AXES>::from_static_fallbacks(&MODELS, &CHANNELS, &SENSORS, &FALLBACKS, TEMPS)?;`
 //! then `unit.step(time_s, &gyro, &temps)` per sample: entry i is axis i's corrected
 //! sample (axis i runs MODELS[i] on temps[CHANNELS[i]], and SENSORS[i] on the further
-//! sensors it reads; with no further sensor `Unit::from_static(&MODELS, &CHANNELS, TEMPS)`
-//! is the same).
+//! sensors it reads, with FALLBACKS[i] on temps[CHANNELS[i]] alone while a further
+//! sensor is given up on; with no fallback `Unit::from_static_sensors(&MODELS, &CHANNELS, &SENSORS, TEMPS)`
+//! is the same, with no further sensor `Unit::from_static(&MODELS, &CHANNELS, TEMPS)`).
 //! Do not edit: re-export instead.
 
 use gyrotherm_core::compensator::TempLimits;
@@ -399,3 +400,12 @@ StaticSensor {
 
 /// Each axis's further sensors (none: the axis reads CHANNELS[i] alone).
 pub static SENSORS: [&[StaticSensor]; AXES] = [&SENSORS_A0, &SENSORS_A1, &SENSORS_A2];
+
+/// Each axis's fallback on its first sensor alone (None: the axis has none).
+#[rustfmt::skip]
+#[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]
+pub static FALLBACKS: [Option<StaticModel>; AXES] = [
+None,
+None,
+None,
+];

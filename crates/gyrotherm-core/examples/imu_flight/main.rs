@@ -15,17 +15,18 @@ mod gyrotherm_model;
 
 use gyrotherm_core::unit::Unit;
 use gyrotherm_core::Status;
-use gyrotherm_model::{AXES, CHANNELS, MODELS, SENSORS, TEMPS};
+use gyrotherm_model::{AXES, CHANNELS, FALLBACKS, MODELS, SENSORS, TEMPS};
 
 fn main() {
     // Start-up: the only fallible step, done once.
-    let Ok(mut unit) = Unit::<AXES>::from_static_sensors(&MODELS, &CHANNELS, &SENSORS, TEMPS)
+    let Ok(mut unit) =
+        Unit::<AXES>::from_static_fallbacks(&MODELS, &CHANNELS, &SENSORS, &FALLBACKS, TEMPS)
     else {
         std::process::exit(2);
     };
     // Mock sensors: the unit at rest in a bay cooling from +40 °C to −20 °C; one temperature
     // sensor (temps[1]) fails for two minutes (NaN), and the clock glitches once.
-    let mut counts = [[0u32; 4]; AXES];
+    let mut counts = [[0u32; 5]; AXES];
     for k in 0..3_600u32 {
         let t = f64::from(k);
         let bay = 40.0 - 60.0 * (1.0 - libm::exp(-t / 900.0));
@@ -46,13 +47,15 @@ fn main() {
     }
     for (i, c) in counts.iter().enumerate() {
         println!(
-            "axis {i} (reads temps[{}] and {} further): ok {}, held {}, degraded {}, invalid {}",
+            "axis {i} (reads temps[{}] and {} further): ok {}, held {}, degraded {}, invalid {}, \
+             fallback {}",
             CHANNELS[i],
             SENSORS[i].len(),
             c[Status::Ok as usize],
             c[Status::Held as usize],
             c[Status::Degraded as usize],
-            c[Status::Invalid as usize]
+            c[Status::Invalid as usize],
+            c[Status::Fallback as usize]
         );
     }
 }

@@ -18,7 +18,8 @@ Progress = Union[bool, Callable[[str, int, float], Any], None]
 
 #: Per-sample status codes of :meth:`Model.compensate` (the flight compensator's): ok, held
 #: (temperature rejected, B and K held), degraded (no good temperature for too long),
-#: invalid (gyro sample not finite: no rate).
+#: invalid (gyro sample not finite: no rate), fallback (a unit's axis whose further sensor is
+#: given up on, compensating on its fallback model on its first sensor alone).
 STATUS_NAMES: Dict[int, str] = dict(_g.STATUS_NAMES)
 
 

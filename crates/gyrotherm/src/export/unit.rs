@@ -26,12 +26,15 @@
 //! reading, the pipelines pushed together, the parts added in order, every pipeline restarted
 //! on a new time base. So each axis computes exactly what the
 //! core's [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last
-//! bit.
+//! bit. An axis with a fallback model ([`crate::imu_model::ImuAxis::fallback`]) also gets the
+//! single-axis port of that model, suffixed `_a<i>f`, stepped on its first sensor alongside,
+//! and the unit function makes the core's choice between the two outputs
+//! ([`gyrotherm_core::multi`]: status `GT_FALLBACK`).
 //!
 //! **Rust.** `gyrotherm_model.rs` holds `AXES`, `TEMPS`, `CHANNELS` (the first sensor each
-//! axis reads), `MODELS` (one [`StaticModel`] per axis) and `SENSORS` (each axis's further
-//! sensors), for
-//! [`Unit::from_static_sensors`](gyrotherm_core::unit::Unit::from_static_sensors).
+//! axis reads), `MODELS` (one [`StaticModel`] per axis), `SENSORS` (each axis's further
+//! sensors) and `FALLBACKS` (each axis's fallback model, if any), for
+//! [`Unit::from_static_fallbacks`](gyrotherm_core::unit::Unit::from_static_fallbacks).
 //!
 //! **Column names.** Generated source holds only generator text and numbers: the column
 //! names, which come from the model file, are never written into it (a name could close a
@@ -156,11 +159,16 @@ pub fn generate_imu(
                 }
             })
             .collect();
+        let fallback = match &a.fallback {
+            Some(f) => Some((static_model(f).map_err(err)?, describe(f).map_err(err)?)),
+            None => None,
+        };
         axes.push(AxisExport {
             channel: core.first().channel(),
             about: describe(&a.model).map_err(err)?,
             model: first,
             sensors,
+            fallback,
         });
     }
     let layout = Layout {
@@ -176,12 +184,14 @@ pub fn generate_imu(
     })
 }
 
-/// One axis to export: its first sensor's model and channel, its further sensors.
+/// One axis to export: its first sensor's model and channel, its further sensors, and its
+/// fallback model on the first sensor alone (with its description).
 struct AxisExport {
     model: StaticModel,
     about: String,
     channel: usize,
     sensors: Vec<SensorExport>,
+    fallback: Option<(StaticModel, String)>,
 }
 
 impl AxisExport {
@@ -242,6 +252,12 @@ impl Layout<'_> {
                         (false, true) => "K",
                         (false, false) => "neither B nor K",
                     }
+                ));
+            }
+            if let Some((_, about)) = &a.fallback {
+                out.push(format!(
+                    "  fallback on {temp}[{}] alone, while a further sensor is given up on: {about};",
+                    a.channel
                 ));
             }
         }
@@ -698,6 +714,43 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
         src.push_str(&rename(&body, &names, &suffix));
         src.push_str(&sensor_src);
         src.push_str(&more_fns);
+        if let Some((fm, fabout)) = &ax.fallback {
+            // The fallback: the single-axis port of its model, as an axis's, suffixed _a<i>f.
+            let fs = format!("{suffix}f");
+            let (fh, fsrc) = c::generate(fm, fabout);
+            let _ = writeln!(h, "#define GT_N_FEATURES{fs} {}", fm.spec.n_features());
+            let _ = writeln!(
+                h,
+                "#define GT_LAG_SLOTS{fs} {}",
+                fm.spec.lags().len().max(1)
+            );
+            let from = fh.find("struct gt_state {").unwrap_or(0);
+            let to = fh[from..].find("\n};\n").map_or(fh.len(), |k| from + k + 4);
+            let names = file_scope_names(&fsrc);
+            let _ = writeln!(h, "typedef struct gt_state{fs} gt_state{fs};");
+            h.push_str(&rename(&fh[from..to], &names, &fs));
+            h.push('\n');
+            let _ = writeln!(
+                states,
+                "    gt_state{fs} a{i}f; /* axis {i}'s fallback */\n    \
+                 uint8_t fb{i};        /* axis {i} runs on its fallback */"
+            );
+            // The shared helpers are axis 0's.
+            let body_at = fsrc.find("#include <string.h>\n").map_or(0, |k| k + 20);
+            let mut body = fsrc[body_at..].to_owned();
+            if let (Some(a), Some(b)) = (body.find(SHARED_FROM), body.find(SHARED_TO)) {
+                body.replace_range(a..b, "");
+            }
+            let _ = write!(
+                src,
+                "\n/* ---- axis {i}'s fallback, on its first sensor alone: {fabout} ---- */\n\
+                 static void gt_init{fs}(gt_state{fs} *s);\n\
+                 static gt_status gt_step{fs}(gt_state{fs} *s, double time_s, double gyro_dps,\n    \
+                 double temp_c, double *rate_dps, double *bias_dps, double *scale);\n\
+                 static gt_coverage gt_coverage_of{fs}(const gt_state{fs} *s, double *sigma_dph);\n"
+            );
+            src.push_str(&rename(&body, &names, &fs));
+        }
     }
     h.push_str(
         "typedef struct gt_state gt_state;\n\n\
@@ -709,8 +762,11 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
     h.push_str(UNIT_HEADER_API);
     // The unit's functions.
     src.push_str("\n/* ---- the unit ---- */\nvoid gt_init(gt_state *s)\n{\n");
-    for i in 0..n {
+    for (i, ax) in axes.iter().enumerate() {
         let _ = writeln!(src, "    gt_init_a{i}(&s->a{i});");
+        if ax.fallback.is_some() {
+            let _ = writeln!(src, "    gt_init_a{i}f(&s->a{i}f);\n    s->fb{i} = 0u;");
+        }
     }
     src.push_str(
         "}\n\nvoid gt_step_imu_bk(gt_state *s, double t, const double gyro[GT_AXES],\n    \
@@ -726,6 +782,19 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
             "    status[{i}] = gt_step_a{i}(&s->a{i}, t, gyro[{i}], temp[{}], &rate[{i}], &bias[{i}], &scale[{i}]);",
             ax.channel
         );
+        if ax.fallback.is_some() {
+            // gyrotherm_core::multi::AxisCompensator::step's choice, on the two outputs.
+            let _ = writeln!(
+                src,
+                "    {{\n        double rf, bf, kf;\n        \
+                 gt_status sf = gt_step_a{i}f(&s->a{i}f, t, gyro[{i}], temp[{}], &rf, &bf, &kf);\n        \
+                 if (status[{i}] != GT_INVALID && sf != GT_INVALID) {{\n            \
+                 s->fb{i} = (uint8_t)(status[{i}] == GT_DEGRADED && sf != GT_DEGRADED);\n        }}\n        \
+                 if (s->fb{i}) {{\n            status[{i}] = sf == GT_OK ? GT_FALLBACK : sf;\n            \
+                 rate[{i}] = rf;\n            bias[{i}] = bf;\n            scale[{i}] = kf;\n        }}\n    }}",
+                ax.channel
+            );
+        }
     }
     src.push_str(
         "}\n\nvoid gt_step_imu(gt_state *s, double t, const double gyro[GT_AXES],\n    \
@@ -735,10 +804,17 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
          gt_coverage gt_coverage_of_axis(const gt_state *s, int axis, double *sigma_dph)\n{\n    \
          switch (axis) {\n",
     );
-    for i in 0..n {
+    for (i, ax) in axes.iter().enumerate() {
+        let _ = writeln!(src, "    case {i}:");
+        if ax.fallback.is_some() {
+            let _ = writeln!(
+                src,
+                "        if (s->fb{i}) {{\n            return gt_coverage_of_a{i}f(&s->a{i}f, sigma_dph);\n        }}"
+            );
+        }
         let _ = writeln!(
             src,
-            "    case {i}:\n        return gt_coverage_of_a{i}(&s->a{i}, sigma_dph);"
+            "        return gt_coverage_of_a{i}(&s->a{i}, sigma_dph);"
         );
     }
     src.push_str(
@@ -763,14 +839,24 @@ const UNIT_HEADER_DOC: &str =
  * and K after the first sensor's, in order; it uses a sample only when every sensor it reads
  * is believed, each against its own latest good reading (gyrotherm-core's multi module). So a
  * fault in one temperature sensor holds only the axes that read it, a bad time stamp reaches
- * every axis alike, and a non-finite gyro sample makes only its own axis GT_INVALID. gt_coverage_of_axis(s, i, &sigma_dph) is gt_coverage_of
- * for axis i (GT_NO_VERDICT and NaN for an axis out of range).
+ * every axis alike, and a non-finite gyro sample makes only its own axis GT_INVALID. An axis
+ * with a fallback (listed above) also runs the single-axis compensator of its fallback model on
+ * its first sensor, from the start; while the axis on all its sensors is GT_DEGRADED and the
+ * fallback is not, it gives the fallback's output, with status GT_FALLBACK where the
+ * fallback's is GT_OK (its GT_HELD otherwise), decided on samples where neither is GT_INVALID.
+ * gt_coverage_of_axis(s, i, &sigma_dph) is gt_coverage_of for axis i (its fallback's while
+ * it runs on it; GT_NO_VERDICT and NaN for an axis out of range).
  * The numbers equal gyrotherm-core's (and `gyrotherm compensate --stream`'s) to the last bit
  * when compiled with -ffp-contract=off on IEEE 754 hardware with FLT_EVAL_METHOD == 0. */
 ";
 
-const UNIT_HEADER_API: &str =
-    "typedef enum { GT_OK = 0, GT_HELD = 1, GT_DEGRADED = 2, GT_INVALID = 3 } gt_status;
+const UNIT_HEADER_API: &str = "typedef enum {
+    GT_OK = 0,
+    GT_HELD = 1,
+    GT_DEGRADED = 2,
+    GT_INVALID = 3,
+    GT_FALLBACK = 4
+} gt_status;
 typedef enum {
     GT_INSIDE = 0,
     GT_EDGE = 1,
@@ -805,12 +891,14 @@ fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
         let _ = writeln!(out, "//! {line}");
     }
     out.push_str(
-        "//! Use: `let mut unit = gyrotherm_core::unit::Unit::<AXES>::from_static_sensors(&MODELS, \
-         &CHANNELS, &SENSORS, TEMPS)?;`\n\
+        "//! Use: `let mut unit = gyrotherm_core::unit::Unit::<AXES>::from_static_fallbacks(&MODELS, \
+         &CHANNELS, &SENSORS, &FALLBACKS, TEMPS)?;`\n\
          //! then `unit.step(time_s, &gyro, &temps)` per sample: entry i is axis i's corrected\n\
          //! sample (axis i runs MODELS[i] on temps[CHANNELS[i]], and SENSORS[i] on the further\n\
-         //! sensors it reads; with no further sensor `Unit::from_static(&MODELS, &CHANNELS, TEMPS)`\n\
-         //! is the same).\n\
+         //! sensors it reads, with FALLBACKS[i] on temps[CHANNELS[i]] alone while a further\n\
+         //! sensor is given up on; with no fallback `Unit::from_static_sensors(&MODELS, \
+         &CHANNELS, &SENSORS, TEMPS)`\n\
+         //! is the same, with no further sensor `Unit::from_static(&MODELS, &CHANNELS, TEMPS)`).\n\
          //! Do not edit: re-export instead.\n\n\
          use gyrotherm_core::compensator::TempLimits;\n\
          #[allow(unused_imports)]\n\
@@ -874,6 +962,23 @@ fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     );
+    out.push_str(
+        "\n/// Each axis's fallback on its first sensor alone (None: the axis has none).\n\
+         #[rustfmt::skip]\n\
+         #[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n\
+         pub static FALLBACKS: [Option<StaticModel>; AXES] = [\n",
+    );
+    for a in axes {
+        match &a.fallback {
+            Some((m, _)) => {
+                out.push_str("Some(");
+                out.push_str(&rust::model_expr(m));
+                out.push_str("),\n");
+            }
+            None => out.push_str("None,\n"),
+        }
+    }
+    out.push_str("];\n");
     out
 }
 
