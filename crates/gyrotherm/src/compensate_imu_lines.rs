@@ -60,9 +60,11 @@ pub fn output_columns(model: &ImuModel) -> Vec<String> {
 /// The flight unit of `model`: axis `i` runs axis `i`'s model on its sensors' indices among
 /// the model's temperature columns (the first sensor's compensator and any further sensors'
 /// parts, [`imu_axis_compensators`]), the same axes as batch [`crate::imu_model::compensate_imu`].
-pub fn flight_unit(model: &ImuModel) -> Result<StreamUnit, ImuError> {
+pub fn flight_unit(model: &ImuModel) -> Result<Box<StreamUnit>, ImuError> {
     let comps = imu_axis_compensators(model)?;
-    let mut unit = StreamUnit::new(model.temp_cols.len());
+    // Boxed: a unit of 16 axes, each with its fallback, is some 370 KB, more than a
+    // thread's stack holds in the copies a return by value can make.
+    let mut unit = Box::new(StreamUnit::new(model.temp_cols.len()));
     for (c, a) in comps.into_iter().zip(&model.axes) {
         unit.push_axis(c).map_err(|e| {
             ImuError::Layout(format!(
