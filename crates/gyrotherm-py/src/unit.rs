@@ -107,6 +107,8 @@ fn is_unit_model_file(path: PathBuf) -> bool {
 #[pyclass(module = "gyrotherm._gyrotherm", name = "RawUnitModel", frozen)]
 pub struct RawUnitModel {
     file: ImuModel,
+    /// What to tell the user about the file as loaded (no content checksum).
+    load_warnings: Vec<String>,
 }
 
 fn model_err(e: impl std::error::Error + 'static) -> PyErr {
@@ -122,16 +124,31 @@ type AxisColumns<'py> = (
 
 #[pymethods]
 impl RawUnitModel {
+    /// Read and check a unit model file (`load_warnings` says when it has no content
+    /// checksum).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<RawUnitModel> {
-        let file = py.detach(|| ImuModel::load(&path)).map_err(model_err)?;
-        Ok(RawUnitModel { file })
+        let (file, seal) = py
+            .detach(|| ImuModel::load_sealed(&path))
+            .map_err(model_err)?;
+        Ok(RawUnitModel {
+            file,
+            load_warnings: seal.warning(&path).into_iter().collect(),
+        })
     }
 
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<RawUnitModel> {
         let file = ImuModel::from_json(text).map_err(py_err::<ModelError>)?;
-        Ok(RawUnitModel { file })
+        Ok(RawUnitModel {
+            file,
+            load_warnings: Vec::new(),
+        })
+    }
+
+    #[getter]
+    fn load_warnings(&self) -> Vec<String> {
+        self.load_warnings.clone()
     }
 
     /// Write the file atomically (the bytes `gyrotherm train` writes).
@@ -355,7 +372,13 @@ fn fit_unit(
     if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
         return Err(e);
     }
-    Ok((RawUnitModel { file }, deprecation))
+    Ok((
+        RawUnitModel {
+            file,
+            load_warnings: Vec::new(),
+        },
+        deprecation,
+    ))
 }
 
 /// The figures of each axis of a unit log, as `gyrotherm evaluate --json` prints them with

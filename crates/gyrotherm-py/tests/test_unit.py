@@ -3,6 +3,8 @@ lists, ``UnitModel`` (load, save, compensate per axis), against the CLI on the s
 same model file bytes, the same compensated numbers to the last bit."""
 
 import csv
+import json
+import warnings
 
 import numpy as np
 import pytest
@@ -178,3 +180,23 @@ def test_unit_progress_callback_error_is_raised(unit_logs):
     with pytest.raises(KeyError, match="stop"):
         gt.fit(static=unit_logs["static"], method="linear", gyro_col=GYROS, temp_col=TEMPS,
                progress=boom)
+
+
+def test_unsealed_unit_model_file_loads_with_a_warning_naming_it(unit_logs, tmp_path):
+    good = gt.fit(
+        static=unit_logs["static"], table=unit_logs["table"], method="linear",
+        gyro_col=GYROS, temp_col=TEMPS,
+    )
+    doc = json.loads(good.to_json())
+    del doc["content_sha256"]
+    path = tmp_path / "unsealed.json"
+    path.write_text(json.dumps(doc))
+    # As a single-axis file without its checksum (test_errors.py).
+    with pytest.warns(gt.GyrothermWarning, match="unsealed.json: no content_sha256"):
+        loaded = gt.UnitModel.load(path)
+    assert loaded.to_json() == good.to_json()
+    sealed = tmp_path / "sealed.json"
+    good.save(sealed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", gt.GyrothermWarning)
+        gt.UnitModel.load(sealed)

@@ -21,7 +21,8 @@
 //! bad time stamp reaches every axis alike. An axis whose further sensor is given up on runs
 //! on its fallback model, if the model file has one, with status `fallback`
 //! ([`gyrotherm_core::multi`]). The columns are looked up by the model's names;
-//! the log must hold every one (the error names the first missing). Coverage columns and
+//! the log must hold every gyro column and every temperature column an axis reads (the error
+//! names the first missing); a column no axis reads is not looked for. Coverage columns and
 //! extrapolation warnings are the single-axis stream's only.
 
 use std::io::{BufRead, Write};
@@ -125,7 +126,8 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
 ) -> Result<ImuLinesSummary, LinesError> {
     let mut unit = flight_unit(model).map_err(LinesError::Unit)?;
     let n_axes = model.gyro_cols.len();
-    let (Some(gyro0), Some(temp0)) = (model.gyro_cols.first(), model.temp_cols.first()) else {
+    let read = model.temps_read();
+    let (Some(gyro0), Some(temp0)) = (model.gyro_cols.first(), read.first()) else {
         return Err(LinesError::Unit(ImuError::Layout(
             "the model lists no gyro or no temperature column".into(),
         )));
@@ -134,7 +136,7 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
     // other columns are looked up below.
     let first = ReadOptions {
         gyro_col: gyro0.clone(),
-        temp_col: temp0.clone(),
+        temp_col: (*temp0).to_owned(),
         ..opts.clone()
     };
     let (headers, mut line_no) = read_header(&mut input, source, &first)?;
@@ -160,10 +162,15 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
         .iter()
         .map(|g| find(g, "gyro"))
         .collect::<Result<Vec<_>, _>>()?;
+    // A column no axis reads is not looked for: its channel stays NaN, which no axis sees.
     let ci = model
         .temp_cols
         .iter()
-        .map(|t| find(t, "temperature"))
+        .map(|t| {
+            read.contains(&t.as_str())
+                .then(|| find(t, "temperature"))
+                .transpose()
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let gyro_scale = opts.gyro_unit.dps_per_unit();
     let delimiter = opts.delimiter;
@@ -252,8 +259,10 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
                 };
             }
             // A temperature that is not a number is a sensor fault: NaN, held.
-            for (c, &k) in temps.iter_mut().zip(&ci) {
-                *c = parse_number(fields.get(line, k), decimal_comma).unwrap_or(f64::NAN);
+            for (c, k) in temps.iter_mut().zip(&ci) {
+                *c = k
+                    .and_then(|k| parse_number(fields.get(line, k), decimal_comma))
+                    .unwrap_or(f64::NAN);
             }
             Ok(time_s)
         })();

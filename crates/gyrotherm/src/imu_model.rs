@@ -16,7 +16,13 @@
 //!
 //! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
 //! format is unchanged): 1 when every axis reads one sensor (as older builds wrote), 2 when
-//! an axis reads several; sealed with `content_sha256` like a single-axis file.
+//! an axis reads several; sealed with `content_sha256` like a single-axis file. It is read
+//! with a single-axis file's checks ([`crate::model`]): a key named twice is refused, a file
+//! without its seal is read with a warning for the caller to tell ([`Seal::warning`]), every
+//! axis's model is checked as a single-axis model, each further sensor's parts as least-squares
+//! sub-models (plausible coefficients, one per term), and B and K of the whole axis, further
+//! sensors included, must stay plausible over the training range. A unit has 1 to
+//! [`MAX_STREAM_AXES`] axes, each on a gyro column of its own.
 
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -26,10 +32,15 @@ use gyrotherm_core::features::LagOutputs;
 use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 
 use crate::compensate::compensator;
+use crate::compensate_imu_lines::MAX_STREAM_AXES;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
-use crate::model::{sha256_hex, ModelFile, ModelFileError, SubModel, TempSensorDef, CHECKSUM_KEY};
+use crate::json_keys::DuplicateKey;
+use crate::model::{
+    content_digest_of, parse_sealed, ModelFile, ModelFileError, Seal, SealedTextError, SubModel,
+    SubModelError, Target, TempSensorDef, CHECKSUM_KEY,
+};
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
@@ -127,8 +138,19 @@ pub enum ImuError {
     },
     /// The file's structure is inconsistent (the message says what).
     Layout(String),
+    /// Further sensor `temp` of axis `gyro`: its part of the bias or scale factor is not
+    /// valid.
+    FurtherSensor {
+        gyro: String,
+        temp: String,
+        part: Target,
+        source: Box<SubModelError>,
+    },
     /// The text is not an inertial-unit model (JSON error, or a field).
     Json(serde_json::Error),
+    /// An object names a key twice: which value counts would depend on the reader, and the
+    /// content hash covers only one.
+    DuplicateKey(DuplicateKey),
     /// `content_sha256` does not match the content.
     Checksum { found: String, computed: String },
     /// The log lacks a column the model needs.
@@ -153,7 +175,11 @@ impl std::fmt::Display for ImuError {
             }
             ImuError::Axis { gyro, .. } => write!(f, "the model of axis {gyro}"),
             ImuError::Layout(m) => write!(f, "{m}"),
+            ImuError::FurtherSensor {
+                gyro, temp, part, ..
+            } => write!(f, "axis {gyro}: further sensor {temp}, {}", part.as_str()),
             ImuError::Json(_) => write!(f, "not an inertial-unit model file"),
+            ImuError::DuplicateKey(d) => d.fmt(f),
             ImuError::Checksum { found, computed } => write!(
                 f,
                 "{CHECKSUM_KEY} {found} does not match the content ({computed}): the file was \
@@ -175,6 +201,7 @@ impl std::error::Error for ImuError {
         match self {
             ImuError::Fit { source, .. } => Some(source.as_ref()),
             ImuError::Axis { source, .. } => Some(source.as_ref()),
+            ImuError::FurtherSensor { source, .. } => Some(source.as_ref()),
             ImuError::Json(e) => Some(e),
             ImuError::Compensate { source, .. } => Some(source.as_ref()),
             ImuError::Io { source, .. } => Some(source),
@@ -272,6 +299,8 @@ pub fn fit_imu_full(
         .ok_or_else(|| ImuError::Layout("no training logs".into()))?;
     let gyro_cols: Vec<String> = first.gyro.iter().map(|s| s.name.clone()).collect();
     let temp_cols: Vec<String> = first.temp.iter().map(|s| s.name.clone()).collect();
+    // Before any fit: a model that could not be compensated is not worth the hours.
+    check_axis_count(gyro_cols.len())?;
     for (name, l) in logs {
         let g: Vec<&String> = l.gyro.iter().map(|s| &s.name).collect();
         let t: Vec<&String> = l.temp.iter().map(|s| &s.name).collect();
@@ -766,10 +795,42 @@ fn axis_checks(temp_cols: &[String], a: &ImuAxis) -> Result<(), ImuError> {
         })?;
     }
     if !a.more.is_empty() {
-        // The further sensors' parts must build a flight compensator.
-        axis_compensator_in(temp_cols, a)?;
+        // The further sensors' parts must build a flight compensator, and with the first
+        // sensor's model keep B and K plausible over the training range, as a single-axis
+        // model must.
+        let comp = axis_compensator_in(temp_cols, a)?;
+        let further: Vec<_> = comp.further().map(|(_, s, b, k)| (s, b, k)).collect();
+        a.model
+            .check_outputs_with_further(comp.first().spec(), &further)
+            .map_err(|source| ImuError::Axis {
+                gyro: a.gyro.clone(),
+                source: Box::new(source),
+            })?;
     }
     Ok(())
+}
+
+/// Refuse more gyro axes than a unit model may have: the capacity of the flight unit that
+/// compensates it ([`MAX_STREAM_AXES`]).
+fn check_axis_count(n: usize) -> Result<(), ImuError> {
+    if n > MAX_STREAM_AXES {
+        return Err(ImuError::Layout(format!(
+            "{n} gyro columns: a unit model has at most {MAX_STREAM_AXES} axes (what \
+             `compensate` runs); split the unit into models of at most {MAX_STREAM_AXES} gyro \
+             columns"
+        )));
+    }
+    Ok(())
+}
+
+/// The first name listed twice in `names`, with both positions (1-based).
+fn repeated(names: &[String]) -> Option<(&str, usize, usize)> {
+    names.iter().enumerate().find_map(|(i, n)| {
+        names[..i]
+            .iter()
+            .position(|m| m == n)
+            .map(|j| (n.as_str(), j + 1, i + 1))
+    })
 }
 
 /// `check` of each axis, on a thread per axis when there are several, in axis order.
@@ -806,24 +867,38 @@ fn axis_compensator_in(temp_cols: &[String], a: &ImuAxis) -> Result<AxisCompensa
         let spec = spec0
             .with_lags(&m.lags_s, LagOutputs::DiffFromT)
             .map_err(|e| layout(format!("sensor {t}: {e}")))?;
-        let part = |sub: &Option<SubModel>, what: &str| match sub {
+        let part = |sub: &Option<SubModel>, what: Target| match sub {
             None => Ok(None),
-            Some(SubModel::Baseline {
-                terms,
-                coefficients,
-            }) => crate::baseline::to_core(terms, coefficients)
-                .map(Some)
-                .map_err(|e| layout(format!("sensor {t}, {what}: {e}"))),
+            Some(
+                sub @ SubModel::Baseline {
+                    terms,
+                    coefficients,
+                },
+            ) => {
+                // A single-axis file's checks of a least-squares part: its terms, one
+                // coefficient per term, each finite and plausible.
+                sub.validate(spec.n_features())
+                    .map_err(|source| ImuError::FurtherSensor {
+                        gyro: a.gyro.clone(),
+                        temp: t.clone(),
+                        part: what,
+                        source: Box::new(source),
+                    })?;
+                crate::baseline::to_core(terms, coefficients)
+                    .map(Some)
+                    .map_err(|e| layout(format!("sensor {t}, {}: {e}", what.as_str())))
+            }
             Some(_) => Err(layout(format!(
-                "sensor {t}, {what}: a further sensor's part must be a baseline"
+                "sensor {t}, {}: a further sensor's part must be a baseline",
+                what.as_str()
             ))),
         };
         axis = axis
             .with_sensor(
                 index(t)?,
                 spec,
-                part(&m.bias, "bias")?,
-                part(&m.scale, "scale")?,
+                part(&m.bias, Target::Bias)?,
+                part(&m.scale, Target::Scale)?,
             )
             .map_err(|e| layout(format!("sensor {t}: {e}")))?;
     }
@@ -851,6 +926,28 @@ impl ImuModel {
 
     /// [`ImuModel::validate`]'s checks of the file's version and gyro columns.
     fn validate_columns(&self) -> Result<(), ImuError> {
+        // What is wrong with the axes is said before the version: the version expected
+        // follows from them.
+        if self.axes.is_empty() || self.gyro_cols.is_empty() {
+            return Err(ImuError::Layout(
+                "the model has no gyro axes (`axes` and `gyro_cols` must list at least one); \
+                 re-train"
+                    .into(),
+            ));
+        }
+        check_axis_count(self.axes.len().max(self.gyro_cols.len()))?;
+        if let Some((g, i, j)) = repeated(&self.gyro_cols) {
+            return Err(ImuError::Layout(format!(
+                "gyro column {g:?} is listed twice in `gyro_cols` (axes {i} and {j}): each axis \
+                 reads a gyro column of its own; re-train, or check a hand edit"
+            )));
+        }
+        if let Some((t, i, j)) = repeated(&self.temp_cols) {
+            return Err(ImuError::Layout(format!(
+                "temperature column {t:?} is listed twice in `temp_cols` (entries {i} and {j}); \
+                 re-train, or check a hand edit"
+            )));
+        }
         let several = self.axes.iter().any(|a| a.temps.len() > 1);
         let expected = if several {
             IMU_FORMAT_VERSION
@@ -884,38 +981,59 @@ impl ImuModel {
     /// The sealed JSON text (pretty; `content_sha256` of the compact content last).
     pub fn to_json(&self) -> Result<String, ImuError> {
         self.validate()?;
-        let compact = serde_json::to_string(self).map_err(ImuError::Json)?;
         let text = serde_json::to_string_pretty(self).map_err(ImuError::Json)?;
         let body = text.strip_suffix("\n}").unwrap_or(&text);
         Ok(format!(
             "{body},\n  \"{CHECKSUM_KEY}\": \"{}\"\n}}\n",
-            sha256_hex(compact.as_bytes())
+            self.content_digest()?
         ))
     }
 
     /// The `content_sha256` of the model: SHA-256 of its compact JSON content (how the file
     /// is formatted does not change it).
     pub fn content_digest(&self) -> Result<String, ImuError> {
-        let compact = serde_json::to_string(self).map_err(ImuError::Json)?;
-        Ok(sha256_hex(compact.as_bytes()))
+        content_digest_of(self).map_err(ImuError::Json)
     }
 
     /// Parse and check the text (the checksum, when present, must match).
     pub fn from_json(text: &str) -> Result<ImuModel, ImuError> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let mut v: serde_json::Value = serde_json::from_str(text).map_err(ImuError::Json)?;
-        let sealed = v.as_object_mut().and_then(|o| o.remove(CHECKSUM_KEY));
-        let m: ImuModel = serde_json::from_value(v).map_err(ImuError::Json)?;
-        if let Some(found) = sealed {
-            let compact = serde_json::to_string(&m).map_err(ImuError::Json)?;
-            let computed = sha256_hex(compact.as_bytes());
-            let found = found.as_str().map_or(found.to_string(), str::to_owned);
-            if !found.eq_ignore_ascii_case(&computed) {
-                return Err(ImuError::Checksum { found, computed });
-            }
-        }
+        Self::from_json_sealed(text).map(|(m, _)| m)
+    }
+
+    /// [`from_json`](Self::from_json), also saying whether the text was sealed (a caller
+    /// warns on [`Seal::Absent`], see [`Seal::warning`]). Read as a single-axis file is: a
+    /// key named twice in any object is refused.
+    pub fn from_json_sealed(text: &str) -> Result<(ImuModel, Seal), ImuError> {
+        let (m, sealed) = Self::parse(text, true)?;
+        Ok((m, if sealed { Seal::Verified } else { Seal::Absent }))
+    }
+
+    /// The model and whether the text held a checksum (checked only when `verify`).
+    fn parse(text: &str, verify: bool) -> Result<(ImuModel, bool), ImuError> {
+        let (m, sealed): (ImuModel, bool) =
+            parse_sealed(text, verify, |_| Ok::<(), std::convert::Infallible>(())).map_err(
+                |e| match e {
+                    SealedTextError::DuplicateKey(d) => ImuError::DuplicateKey(d),
+                    SealedTextError::NotJson(e) | SealedTextError::Fields(e) => ImuError::Json(e),
+                    SealedTextError::Refused(never) => match never {},
+                    SealedTextError::Checksum { found, computed } => {
+                        ImuError::Checksum { found, computed }
+                    }
+                },
+            )?;
         m.validate()?;
-        Ok(m)
+        Ok((m, sealed))
+    }
+
+    /// Re-seal a unit model file after a deliberate hand edit, as [`ModelFile::seal`]: read
+    /// it without checking its `content_sha256`, check everything else, and write it back
+    /// with a new one. Returns the model and its new digest.
+    pub fn seal(path: &Path) -> Result<(ImuModel, String), ImuError> {
+        let text = read_text(path)?;
+        let (m, _) = Self::parse(&text, false)?;
+        m.save(path)?;
+        let digest = m.content_digest()?;
+        Ok((m, digest))
     }
 
     /// Write atomically.
@@ -931,20 +1049,33 @@ impl ImuModel {
 
     /// Read and check a file.
     pub fn load(path: &Path) -> Result<ImuModel, ImuError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ImuError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::from_json(&text)
+        Self::load_sealed(path).map(|(m, _)| m)
     }
 
-    /// Read options naming the model's columns (the rest of `base` kept).
+    /// [`load`](Self::load), also saying whether the file was sealed (a caller warns on
+    /// [`Seal::Absent`]; see [`Seal::warning`]).
+    pub fn load_sealed(path: &Path) -> Result<(ImuModel, Seal), ImuError> {
+        Self::from_json_sealed(&read_text(path)?)
+    }
+
+    /// Read options naming the model's columns (the rest of `base` kept): its gyro columns
+    /// and the temperature columns its axes read ([`ImuModel::temps_read`]).
     pub fn read_options(&self, base: &ReadOptions) -> ReadOptions {
         ReadOptions {
             gyro_col: self.gyro_cols.join(","),
-            temp_col: self.temp_cols.join(","),
+            temp_col: self.temps_read().join(","),
             ..base.clone()
         }
+    }
+
+    /// The temperature columns some axis reads, in the order of [`ImuModel::temp_cols`]: the
+    /// ones a log must hold (a column no axis reads changes no output).
+    pub fn temps_read(&self) -> Vec<&str> {
+        self.temp_cols
+            .iter()
+            .filter(|t| self.axes.iter().any(|a| a.temps.contains(t)))
+            .map(String::as_str)
+            .collect()
     }
 
     /// Index of each axis's first (or only) sensor in the temperature columns.
@@ -959,6 +1090,14 @@ impl ImuModel {
             })
             .collect()
     }
+}
+
+/// The text of the file `path`.
+fn read_text(path: &Path) -> Result<String, ImuError> {
+    std::fs::read_to_string(path).map_err(|source| ImuError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The compensated series of one axis.
@@ -1004,7 +1143,8 @@ pub fn imu_axis_compensators(model: &ImuModel) -> Result<Vec<AxisCompensator>, I
 
 /// Compensate an inertial unit's log: each axis's flight compensator fed, sample by sample,
 /// with its gyro column and the model's temperature columns. The log must hold the model's
-/// columns (the error names the first one missing).
+/// gyro columns and the temperature columns its axes read (the error names the first one
+/// missing); a column no axis reads is not looked for.
 pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensated>, ImuError> {
     let find = |list: &[crate::csvlog::NamedSeries], name: &str, role| {
         list.iter()
@@ -1015,10 +1155,16 @@ pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensa
             })
     };
     let mut comps = imu_axis_compensators(model)?;
-    let temps: Vec<&[f64]> = model
+    let read = model.temps_read();
+    let temps: Vec<Option<&[f64]>> = model
         .temp_cols
         .iter()
-        .map(|t| find(&log.temp, t, "temperature").map(|i| log.temp[i].values.as_slice()))
+        .map(|t| {
+            if !read.contains(&t.as_str()) {
+                return Ok(None);
+            }
+            find(&log.temp, t, "temperature").map(|i| Some(log.temp[i].values.as_slice()))
+        })
         .collect::<Result<_, _>>()?;
     let n = log.len();
     let mut out = Vec::with_capacity(model.axes.len());
@@ -1033,7 +1179,7 @@ pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensa
         };
         for i in 0..n {
             for (v, t) in row.iter_mut().zip(&temps) {
-                *v = t[i];
+                *v = t.map_or(f64::NAN, |t| t[i]);
             }
             let c = comp.step(log.time_s[i], g[i], &row);
             r.bias_dps.push(c.bias_dps);

@@ -28,9 +28,12 @@ pub struct ExportArgs {
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
     if super::imu::is_imu_model(&args.model)? {
-        let model = ImuModel::load(&args.model)
+        let (model, seal) = ImuModel::load_sealed(&args.model)
             .map_err(anyhow::Error::new)
             .with_context(|| format!("cannot use model {}", args.model.display()))?;
+        if let Some(w) = seal.warning(&args.model) {
+            eprintln!("gyrotherm: warning: {w}");
+        }
         let files = export_imu(&model, args.lang, &args.out)?;
         for f in files {
             eprintln!("gyrotherm: wrote {}", f.display());

@@ -133,9 +133,12 @@ pub fn train(args: TrainArgs) -> anyhow::Result<ExitCode> {
 /// `compensate` with an inertial-unit model: for each gyro column G the output adds
 /// `G_bias`, `G_scale`, `G_comp` and `G_status`.
 pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
-    let model = ImuModel::load(&args.model)
+    let (model, seal) = ImuModel::load_sealed(&args.model)
         .map_err(anyhow::Error::new)
         .with_context(|| format!("cannot use model {}", args.model.display()))?;
+    if let Some(w) = seal.warning(&args.model) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
     if args.stream {
         anyhow::ensure!(
             args.log.fill_gaps_max_s.is_none(),

@@ -1,11 +1,13 @@
 //! `gyrotherm model`: look after model files. `seal FILE` re-seals a model after a deliberate
 //! hand edit: every check but the content checksum is applied, then the file is written back
-//! with a new `content_sha256`.
+//! with a new `content_sha256`. Both actions take a single-axis model or an inertial unit's.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use gyrotherm::model::ModelFile;
+use anyhow::Context as _;
+use gyrotherm::imu_model::ImuModel;
+use gyrotherm::model::{ModelFile, Seal};
 
 #[derive(Debug, clap::Args)]
 pub struct ModelArgs {
@@ -29,6 +31,12 @@ pub enum ModelAction {
 }
 
 pub fn run(args: ModelArgs) -> anyhow::Result<ExitCode> {
+    let file = match &args.action {
+        ModelAction::Seal { file } | ModelAction::Check { file } => file,
+    };
+    if super::imu::is_imu_model(file)? {
+        return run_unit(args.action);
+    }
     match args.action {
         ModelAction::Seal { file } => {
             let (_, digest) = ModelFile::seal(&file)?;
@@ -42,13 +50,49 @@ pub fn run(args: ModelArgs) -> anyhow::Result<ExitCode> {
             if let Some(w) = seal.warning(&file) {
                 eprintln!("gyrotherm: warning: {w}");
             }
-            let state = match seal {
-                gyrotherm::model::Seal::Verified => "ok, sealed",
-                gyrotherm::model::Seal::Absent => "ok but not sealed",
-            };
             println!(
-                "{}: {state}, content_sha256 {}",
+                "{}: {}, content_sha256 {}",
                 file.display(),
+                state(seal),
+                m.content_digest()?
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn state(seal: Seal) -> &'static str {
+    match seal {
+        Seal::Verified => "ok, sealed",
+        Seal::Absent => "ok but not sealed",
+    }
+}
+
+/// [`run`] with an inertial unit's model file: the same checks as `compensate` applies.
+fn run_unit(action: ModelAction) -> anyhow::Result<ExitCode> {
+    let context = |file: &PathBuf| format!("cannot use model {}", file.display());
+    match action {
+        ModelAction::Seal { file } => {
+            let (_, digest) = ImuModel::seal(&file)
+                .map_err(anyhow::Error::new)
+                .with_context(|| context(&file))?;
+            eprintln!(
+                "gyrotherm: sealed {} (content_sha256 {digest})",
+                file.display()
+            );
+        }
+        ModelAction::Check { file } => {
+            let (m, seal) = ImuModel::load_sealed(&file)
+                .map_err(anyhow::Error::new)
+                .with_context(|| context(&file))?;
+            if let Some(w) = seal.warning(&file) {
+                eprintln!("gyrotherm: warning: {w}");
+            }
+            println!(
+                "{}: {} (inertial unit, {} axes), content_sha256 {}",
+                file.display(),
+                state(seal),
+                m.axes.len(),
                 m.content_digest()?
             );
         }

@@ -184,8 +184,11 @@ class UnitModel:
 
     @classmethod
     def load(cls, path: PathLike) -> "UnitModel":
-        """Read and check a unit model file (raises ``gyrotherm.ModelError``)."""
-        return cls(_g.RawUnitModel.load(os.fspath(path)))
+        """Read and check a unit model file (raises ``gyrotherm.ModelError``; warns with
+        ``gyrotherm.GyrothermWarning`` when it has no content checksum)."""
+        raw = _g.RawUnitModel.load(os.fspath(path))
+        _warn(raw.load_warnings)
+        return cls(raw)
 
     @classmethod
     def from_json(cls, text: str) -> "UnitModel":

@@ -181,6 +181,14 @@ pub(super) fn check_norm(name: &str, z: &ZScore, channels: usize) -> Result<(), 
     Ok(())
 }
 
+/// A further sensor of an axis in the training-range check
+/// ([`ModelFile::check_outputs_with_further`]): its features and its parts of B and K.
+pub(crate) type FurtherPart<'a> = (
+    &'a FeatureSpec,
+    Option<&'a BaselineModel>,
+    Option<&'a BaselineModel>,
+);
+
 /// A sub-model that cannot be evaluated: the tensor or field at fault.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -300,12 +308,29 @@ impl ModelFile {
         &self,
         spec: &FeatureSpec,
     ) -> Result<(), ModelFileError> {
+        self.check_outputs_with_further(spec, &[])
+    }
+
+    /// [`check_outputs_in_training_range`](Self::check_outputs_in_training_range) of the
+    /// model with further sensors' parts added to B and K (an axis of an inertial unit that
+    /// reads several sensors, as its flight compensator adds them): each further sensor runs
+    /// its own features over the same temperatures as the first, the one training range the
+    /// file keeps.
+    pub(crate) fn check_outputs_with_further(
+        &self,
+        spec: &FeatureSpec,
+        further: &[FurtherPart<'_>],
+    ) -> Result<(), ModelFileError> {
         use gyrotherm_core::features::FeaturePipeline;
         let t = &self.training;
         let (t_lo, t_hi) = (t.temp_range_c.min, t.temp_range_c.max);
         let (r_lo, r_hi) = (t.rate_range_c_per_s.min, t.rate_range_c_per_s.max);
         let dt = spec.step_period_s;
-        let slowest = spec.lags().iter().fold(spec.rate_lag_s, |a, &b| a.max(b));
+        let slowest = further
+            .iter()
+            .flat_map(|(s, _, _)| s.lags())
+            .chain(spec.lags())
+            .fold(spec.rate_lag_s, |a, &b| a.max(b));
         let hold = ((3.0 * slowest / dt).ceil() as usize + 2).min(MAX_PROBE_STEPS);
         let ramp = |from: f64, to: f64, rate: f64| -> Vec<f64> {
             let n = ((to - from) / (rate * dt)).ceil();
@@ -326,6 +351,13 @@ impl ModelFile {
         if r_lo < 0.0 {
             probes.push(ramp(t_hi, t_lo, r_lo));
         }
+        let field = |target: Target| {
+            if further.is_empty() {
+                target.as_str().to_owned()
+            } else {
+                format!("{} with the further sensors' parts", target.as_str())
+            }
+        };
         let build = |target: Target, sub: Option<&SubModel>, absent: f64| {
             target_model(sub, absent)
                 .map_err(|e| ModelFileError::invalid(target.as_str(), e.to_string()))
@@ -335,10 +367,31 @@ impl ModelFile {
         for temps in probes {
             let (mut bias, mut scale) = (bias0.clone(), scale0.clone());
             let mut pipeline = FeaturePipeline::new(*spec).map_err(ModelFileError::Features)?;
+            let mut more = further
+                .iter()
+                .map(|(s, _, _)| FeaturePipeline::new(**s).map_err(ModelFileError::Features))
+                .collect::<Result<Vec<_>, _>>()?;
             for (k, &temp) in temps.iter().enumerate() {
-                let Ok(Some(step)) = pipeline.push(k as f64 * dt, temp) else {
+                let time_s = k as f64 * dt;
+                let mut more_ok = true;
+                for p in &mut more {
+                    more_ok = p.push(time_s, temp).is_ok() && more_ok;
+                }
+                let Ok(Some(step)) = pipeline.push(time_s, temp) else {
                     continue;
                 };
+                // The further sensors' parts, as the flight compensator adds them.
+                let (mut b_more, mut k_more) = (0.0, 0.0);
+                for (p, (_, b, k)) in more.iter().zip(further) {
+                    let f = p.current().filter(|_| more_ok);
+                    let eval = |m: Option<&BaselineModel>| match (m, f) {
+                        (None, _) => 0.0,
+                        (Some(m), Some(f)) => m.eval_features(f).unwrap_or(f64::NAN),
+                        (Some(_), None) => f64::NAN,
+                    };
+                    b_more += eval(*b);
+                    k_more += eval(*k);
+                }
                 let rate = (0..spec.n_features())
                     .find(|&i| spec.kind(i) == Some(FeatureKind::Rate))
                     .and_then(|i| step.features.as_slice().get(i).copied())
@@ -346,21 +399,21 @@ impl ModelFile {
                 let at = || {
                     format!("at T = {temp:.3} °C, dT = {rate:.3e} °C/s, inside the training range ({t_lo} to {t_hi} °C, {r_lo:.3e} to {r_hi:.3e} °C/s)")
                 };
-                let b = bias.eval(&step.features).unwrap_or(f64::NAN);
+                let b = bias.eval(&step.features).unwrap_or(f64::NAN) + b_more;
                 if !(b.is_finite() && b.abs() <= MAX_PLAUSIBLE_BIAS_DPS) {
                     return Err(ModelFileError::invalid(
-                        "bias",
+                        &field(Target::Bias),
                         format!(
                             "predicts B = {b:e} °/s {}: not a gyro bias (|B| ≤ {MAX_PLAUSIBLE_BIAS_DPS} °/s); re-train, or check a hand edit",
                             at()
                         ),
                     ));
                 }
-                let k_sf = scale.eval(&step.features).unwrap_or(f64::NAN);
+                let k_sf = scale.eval(&step.features).unwrap_or(f64::NAN) + k_more;
                 let (k_lo, k_hi) = PLAUSIBLE_SCALE;
                 if !(k_sf >= k_lo && k_sf <= k_hi) {
                     return Err(ModelFileError::invalid(
-                        "scale",
+                        &field(Target::Scale),
                         format!(
                             "predicts K = {k_sf:e} {}: a scale factor must stay within {k_lo} to {k_hi} (nominal 1); re-train, or check a hand edit",
                             at()

@@ -507,3 +507,4 @@ mod seal;
 pub use checks::SubModelError;
 pub use flight::{padded_core_lstm, target_model, CompensateError};
 use seal::supported_list;
+pub(crate) use seal::{content_digest_of, parse_sealed, SealedTextError};

@@ -6,8 +6,7 @@ impl ModelFile {
     /// SHA-256 of the model's content (its compact JSON, fields in declaration order):
     /// layout and key order of the file do not change it, any value does.
     pub fn content_digest(&self) -> Result<String, ModelFileError> {
-        let compact = serde_json::to_string(self).map_err(ModelFileError::Fields)?;
-        Ok(sha256_hex(compact.as_bytes()))
+        content_digest_of(self).map_err(ModelFileError::Fields)
     }
 
     /// The JSON text (pretty, shortest round-trip floats), after [`validate`](Self::validate),
@@ -36,44 +35,28 @@ impl ModelFile {
 
     /// The model and whether the text held a checksum (checked only when `verify`).
     pub(super) fn parse(text: &str, verify: bool) -> Result<(ModelFile, bool), ModelFileError> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        // Before anything reads a value: a repeated key would give the checksum one value
-        // and another reader the other.
-        check_unique_keys(text).map_err(|e| match e {
-            KeyCheckError::Duplicate(d) => ModelFileError::DuplicateKey(d),
-            KeyCheckError::NotJson(e) => ModelFileError::NotJson(e),
-        })?;
         // Version first, so that a newer file gets "unsupported version", not a field error.
-        let mut v: serde_json::Value =
-            serde_json::from_str(text).map_err(ModelFileError::NotJson)?;
-        match v.get("format_version") {
-            None => return Err(ModelFileError::MissingVersion),
+        let version = |v: &serde_json::Value| match v.get("format_version") {
+            None => Err(ModelFileError::MissingVersion),
             Some(fv) => match fv.as_u64() {
-                Some(n) if SUPPORTED_VERSIONS.contains(&(n as u32)) && n <= u32::MAX as u64 => {}
-                _ => {
-                    return Err(ModelFileError::UnsupportedVersion {
-                        found: fv.to_string(),
-                    })
+                Some(n) if SUPPORTED_VERSIONS.contains(&(n as u32)) && n <= u32::MAX as u64 => {
+                    Ok(())
                 }
+                _ => Err(ModelFileError::UnsupportedVersion {
+                    found: fv.to_string(),
+                }),
             },
-        }
-        let sealed = v.as_object_mut().and_then(|o| o.remove(CHECKSUM_KEY));
-        let has_seal = sealed.is_some();
-        let m: ModelFile = match &sealed {
-            // Parsed from the text where possible: its errors give line and column.
-            None => serde_json::from_str(text).map_err(ModelFileError::Fields)?,
-            Some(_) => serde_json::from_value(v).map_err(ModelFileError::Fields)?,
         };
-        if let (Some(found), true) = (sealed, verify) {
-            let computed = m.content_digest()?;
-            let found = match found {
-                serde_json::Value::String(s) => s,
-                other => other.to_string(),
-            };
-            if !found.eq_ignore_ascii_case(&computed) {
-                return Err(ModelFileError::Checksum { found, computed });
-            }
-        }
+        let (m, has_seal): (ModelFile, bool) =
+            parse_sealed(text, verify, version).map_err(|e| match e {
+                SealedTextError::DuplicateKey(d) => ModelFileError::DuplicateKey(d),
+                SealedTextError::NotJson(e) => ModelFileError::NotJson(e),
+                SealedTextError::Refused(e) => e,
+                SealedTextError::Fields(e) => ModelFileError::Fields(e),
+                SealedTextError::Checksum { found, computed } => {
+                    ModelFileError::Checksum { found, computed }
+                }
+            })?;
         m.validate()?;
         Ok((m, has_seal))
     }
@@ -142,6 +125,71 @@ impl Seal {
             )),
         }
     }
+}
+
+/// Why [`parse_sealed`] refused a text (each model kind maps it onto its own error).
+#[derive(Debug)]
+pub(crate) enum SealedTextError<E> {
+    /// An object names a key twice.
+    DuplicateKey(DuplicateKey),
+    /// The text is not JSON.
+    NotJson(serde_json::Error),
+    /// The caller's look at the raw value (its version) refused it.
+    Refused(E),
+    /// A field is missing, unknown or of the wrong type.
+    Fields(serde_json::Error),
+    /// The checksum does not match the content.
+    Checksum { found: String, computed: String },
+}
+
+/// SHA-256 of `content`'s compact JSON (fields in declaration order): what
+/// [`CHECKSUM_KEY`] seals, for every kind of model file.
+pub(crate) fn content_digest_of<T: Serialize>(content: &T) -> Result<String, serde_json::Error> {
+    let compact = serde_json::to_string(content)?;
+    Ok(sha256_hex(compact.as_bytes()))
+}
+
+/// Read a model text sealed with [`CHECKSUM_KEY`], of any model kind `T`: a leading
+/// byte-order mark skipped; a key named twice in any object refused before anything reads a
+/// value (a repeated key would give the checksum one value and another reader the other);
+/// `look` sees the JSON value before its fields are read (a version check); the seal taken
+/// out and, when `verify`, compared with [`content_digest_of`] the content read. Returns the
+/// content and whether the text held a seal (a file without one, written before files were
+/// sealed or by hand, is read on its other checks; the caller tells the user, see
+/// [`Seal::warning`]). The content's own checks are the caller's.
+pub(crate) fn parse_sealed<T, E>(
+    text: &str,
+    verify: bool,
+    look: impl FnOnce(&serde_json::Value) -> Result<(), E>,
+) -> Result<(T, bool), SealedTextError<E>>
+where
+    T: Serialize + serde::de::DeserializeOwned,
+{
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    check_unique_keys(text).map_err(|e| match e {
+        KeyCheckError::Duplicate(d) => SealedTextError::DuplicateKey(d),
+        KeyCheckError::NotJson(e) => SealedTextError::NotJson(e),
+    })?;
+    let mut v: serde_json::Value = serde_json::from_str(text).map_err(SealedTextError::NotJson)?;
+    look(&v).map_err(SealedTextError::Refused)?;
+    let sealed = v.as_object_mut().and_then(|o| o.remove(CHECKSUM_KEY));
+    let has_seal = sealed.is_some();
+    let m: T = match &sealed {
+        // Parsed from the text where possible: its errors give line and column.
+        None => serde_json::from_str(text).map_err(SealedTextError::Fields)?,
+        Some(_) => serde_json::from_value(v).map_err(SealedTextError::Fields)?,
+    };
+    if let (Some(found), true) = (sealed, verify) {
+        let computed = content_digest_of(&m).map_err(SealedTextError::Fields)?;
+        let found = match found {
+            serde_json::Value::String(s) => s,
+            other => other.to_string(),
+        };
+        if !found.eq_ignore_ascii_case(&computed) {
+            return Err(SealedTextError::Checksum { found, computed });
+        }
+    }
+    Ok((m, has_seal))
 }
 
 pub(super) fn supported_list() -> String {
