@@ -902,10 +902,12 @@ impl ImuModel {
 
     /// Read and check a file.
     pub fn load(path: &Path) -> Result<ImuModel, ImuError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ImuError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            crate::input_file::read_capped_to_string(path, crate::input_file::InputKind::Model)
+                .map_err(|source| ImuError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
         Self::from_json(&text)
     }
 

@@ -2,6 +2,7 @@
 //! hand edit: every check but the content checksum is applied, then the file is written back
 //! with a new `content_sha256`.
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -46,11 +47,13 @@ pub fn run(args: ModelArgs) -> anyhow::Result<ExitCode> {
                 gyrotherm::model::Seal::Verified => "ok, sealed",
                 gyrotherm::model::Seal::Absent => "ok but not sealed",
             };
-            println!(
+            // Errors returned, not `println!`: a closed pipe ends the command quietly.
+            writeln!(
+                std::io::stdout(),
                 "{}: {state}, content_sha256 {}",
                 file.display(),
                 m.content_digest()?
-            );
+            )?;
         }
     }
     Ok(ExitCode::SUCCESS)
