@@ -100,7 +100,8 @@ fn imu_judge_period(log: &ImuLog) -> f64 {
 /// Whether the file holds an inertial unit's model.
 #[pyfunction]
 fn is_unit_model_file(path: PathBuf) -> bool {
-    std::fs::read_to_string(path).is_ok_and(|t| imu_model::is_imu_model_text(&t))
+    gyrotherm::input_file::read_capped_to_string(&path, gyrotherm::input_file::InputKind::Model)
+        .is_ok_and(|t| imu_model::is_imu_model_text(&t))
 }
 
 /// A unit model file in memory.

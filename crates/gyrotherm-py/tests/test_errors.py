@@ -85,8 +85,10 @@ def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
         gt.fit(static=logs["static"], recipe="fancy")
     with pytest.raises(gt.FitError, match="method: unknown value \"spline\""):
         gt.fit(static=logs["static"], method="spline")
-    with pytest.raises(gt.FitError, match="epochs must be at least 1"):
+    with pytest.raises(gt.FitError, match="epochs must be a whole number from 1 to 1000000, not 0"):
         gt.fit(static=logs["static"], epochs=0)
+    with pytest.raises(gt.FitError, match="epochs must be a whole number from 1 to 1000000, not 100000000000"):
+        gt.fit(static=logs["static"], epochs=100_000_000_000)
     with pytest.raises(gt.FitError, match="given as a static log but its table_dps column has non-zero rates"):
         gt.fit(static=logs["table"], method="linear")
     with pytest.raises(gt.FitError, match="given as a rate-table log"):

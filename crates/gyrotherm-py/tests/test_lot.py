@@ -97,3 +97,16 @@ def test_read_lot_single_axis_rows_have_no_axis(lot):
     cols = gt.read_lot(lot, as_frame=False)
     assert all(a is None for a in cols["axis"])
     assert all(v is None for v in cols["axis_verdict"])
+
+
+@pytest.mark.parametrize("url", [
+    "postgres://gyro:s3cret@127.0.0.1:1/lot",
+    "postgres://gyro@127.0.0.1:1/lot?password=s3cret",
+    "postgresql://127.0.0.1:1/lot?user=gyro&password=s3cret&connect_timeout=2",
+])
+def test_read_lot_masks_every_form_of_password(url):
+    # Port 1 on the loopback refuses the connection: the error names the lot, password masked.
+    with pytest.raises(gt.GyrothermError) as e:
+        gt.read_lot(url)
+    msg = str(e.value)
+    assert "s3cret" not in msg and "***" in msg, msg

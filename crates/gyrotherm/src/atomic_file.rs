@@ -270,6 +270,62 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomically(path, |w| w.write_all(bytes))
 }
 
+/// An output path that names one of the same command's inputs: writing it would replace
+/// the input (a raw log overwritten by a model, a model by its own output).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OutputIsInput {
+    /// The output as given.
+    pub output: PathBuf,
+    /// The input it names, as given.
+    pub input: PathBuf,
+}
+
+impl std::fmt::Display for OutputIsInput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} is also an input of this command ({}); nothing was written: give the output \
+             another path",
+            self.output.display(),
+            self.input.display()
+        )
+    }
+}
+
+impl std::error::Error for OutputIsInput {}
+
+/// Refuse outputs that would replace one of `inputs`, before anything is read or written.
+/// Paths are compared canonical (links, `..` and relative paths resolved), so `./a.csv` and
+/// `dir/../a.csv` are one file. Only outputs written by replacing a file are checked
+/// ([`Destination::Replace`]): standard output, FIFOs and devices replace nothing (`--input
+/// /dev/stdin --out -` on a terminal names one device twice, and is fine). An output that does
+/// not exist yet is no input; an input that cannot be resolved (missing) is left to its
+/// reader to report.
+pub fn refuse_outputs_over_inputs(
+    outputs: &[&Path],
+    inputs: &[&Path],
+) -> Result<(), OutputIsInput> {
+    let inputs: Vec<(PathBuf, &Path)> = inputs
+        .iter()
+        .filter_map(|p| Some((std::fs::canonicalize(p).ok()?, *p)))
+        .collect();
+    for out in outputs {
+        if !matches!(destination(out), Ok(Destination::Replace(_))) {
+            continue;
+        }
+        let Ok(canonical) = std::fs::canonicalize(out) else {
+            continue;
+        };
+        if let Some((_, input)) = inputs.iter().find(|(c, _)| *c == canonical) {
+            return Err(OutputIsInput {
+                output: out.to_path_buf(),
+                input: input.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Temporary files now being written by this process.
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
@@ -551,6 +607,29 @@ mod tests {
         write_bytes_atomically(Path::new("/dev/null"), b"discarded").unwrap();
         let ft = std::fs::metadata("/dev/null").unwrap().file_type();
         assert!(ft.is_char_device());
+    }
+
+    #[test]
+    fn an_output_that_is_an_input_is_refused_by_its_canonical_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let log = dir.path().join("static.csv");
+        std::fs::write(&log, b"raw").unwrap();
+        std::fs::create_dir(dir.path().join("sub")).unwrap();
+        let other = dir.path().join("sub/../static.csv");
+        let err = refuse_outputs_over_inputs(&[&other], &[Path::new("x.csv"), &log]).unwrap_err();
+        assert_eq!(
+            (err.output.as_path(), err.input.as_path()),
+            (other.as_path(), log.as_path())
+        );
+        assert!(err.to_string().contains("is also an input"), "{err}");
+        assert_eq!(std::fs::read(&log).unwrap(), b"raw");
+        // A new file, another file, a device: no input replaced.
+        let new = dir.path().join("model.json");
+        refuse_outputs_over_inputs(&[&new], &[&log]).unwrap();
+        std::fs::write(&new, b"{}").unwrap();
+        refuse_outputs_over_inputs(&[&new], &[&log]).unwrap();
+        #[cfg(unix)]
+        refuse_outputs_over_inputs(&[Path::new("/dev/null")], &[Path::new("/dev/null")]).unwrap();
     }
 
     #[test]

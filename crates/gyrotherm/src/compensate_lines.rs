@@ -35,10 +35,10 @@ use gyrotherm_core::compensator::{Corrected, Status};
 use crate::csvlog::{LogError, LogErrorKind, LogReader, LogWriter, ReadOptions};
 use crate::model::ModelFile;
 
-/// Longest line read, bytes (line break included). A longer line is malformed: in
-/// [`Mode::Stream`] it gives one `invalid` output line and its bytes are skipped without being
-/// kept, so one endless line cannot take the memory of a flight computer.
-pub const MAX_LINE_BYTES: usize = 64 * 1024;
+/// Longest line read, bytes (line break included): the log reader's cap. A longer line is
+/// malformed: in [`Mode::Stream`] it gives one `invalid` output line and its bytes are skipped
+/// without being kept, so one endless line cannot take the memory of a flight computer.
+pub use crate::csvlog::MAX_LINE_BYTES;
 
 /// Columns appended to every row, in order.
 pub const OUTPUT_COLUMNS: [&str; 6] = [

@@ -1094,10 +1094,12 @@ impl ImuModel {
 
 /// The text of the file `path`.
 fn read_text(path: &Path) -> Result<String, ImuError> {
-    std::fs::read_to_string(path).map_err(|source| ImuError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::input_file::read_capped_to_string(path, crate::input_file::InputKind::Model).map_err(
+        |source| ImuError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+    )
 }
 
 /// The compensated series of one axis.

@@ -60,6 +60,7 @@ pub mod features;
 pub mod fit;
 pub mod imu_judge;
 pub mod imu_model;
+pub mod input_file;
 pub mod json_keys;
 pub mod lot;
 pub mod metrics;

@@ -145,6 +145,7 @@ fn plot(
 }
 
 pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
+    super::common::refuse_outputs_over_inputs(args.plot.as_deref(), [args.input.as_path()])?;
     let settings = args.settings();
     settings.validate()?;
     let kind = settings.kind;

@@ -156,6 +156,19 @@ pub fn read_logs(
     Ok(out)
 }
 
+/// Refuse, before any work, an output path that names one of the command's inputs
+/// (`gyrotherm::atomic_file::refuse_outputs_over_inputs`): `train --out static.csv` would
+/// replace the raw log with the model.
+pub fn refuse_outputs_over_inputs<'a>(
+    outputs: impl IntoIterator<Item = &'a Path>,
+    inputs: impl IntoIterator<Item = &'a Path>,
+) -> anyhow::Result<()> {
+    let outputs: Vec<&Path> = outputs.into_iter().collect();
+    let inputs: Vec<&Path> = inputs.into_iter().collect();
+    gyrotherm::atomic_file::refuse_outputs_over_inputs(&outputs, &inputs)?;
+    Ok(())
+}
+
 /// The library's view of read logs: name and data.
 pub fn named(logs: &[(String, TestLog)]) -> Vec<NamedLog<'_>> {
     logs.iter()

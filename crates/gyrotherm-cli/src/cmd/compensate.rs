@@ -39,6 +39,12 @@ pub struct CompensateArgs {
 }
 
 pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
+    super::common::refuse_outputs_over_inputs(
+        args.out.as_deref(),
+        [Some(args.model.as_path()), args.input.as_deref()]
+            .into_iter()
+            .flatten(),
+    )?;
     if super::imu::is_imu_model(&args.model)? {
         return super::imu::compensate(args);
     }

@@ -17,7 +17,10 @@ use super::train::TrainArgs;
 /// Whether `path` holds an inertial-unit model (an unreadable file is left to the
 /// single-axis path, which names the problem).
 pub fn is_imu_model(path: &Path) -> anyhow::Result<bool> {
-    Ok(std::fs::read_to_string(path).is_ok_and(|t| imu_model::is_imu_model_text(&t)))
+    Ok(
+        gyrotherm::input_file::read_capped_to_string(path, gyrotherm::input_file::InputKind::Model)
+            .is_ok_and(|t| imu_model::is_imu_model_text(&t)),
+    )
 }
 
 /// Read every log with the column lists, reporting each failure, then stop if any failed.

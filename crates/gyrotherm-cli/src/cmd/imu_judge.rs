@@ -240,7 +240,7 @@ fn print_unit_verdicts(
             super::verdict::print(out, v)?;
         }
     }
-    writeln!(out, "\nspec {} across the axes:", spec.name)?;
+    writeln!(out, "\nspec {} across the axes:", spec.name.escape_debug())?;
     for line in imu_judge::verdicts_across_axes(spec, verdicts) {
         writeln!(out, "  {line}")?;
     }

@@ -2,6 +2,7 @@
 //! hand edit: every check but the content checksum is applied, then the file is written back
 //! with a new `content_sha256`. Both actions take a single-axis model or an inertial unit's.
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -50,12 +51,14 @@ pub fn run(args: ModelArgs) -> anyhow::Result<ExitCode> {
             if let Some(w) = seal.warning(&file) {
                 eprintln!("gyrotherm: warning: {w}");
             }
-            println!(
+            // Errors returned, not `println!`: a closed pipe ends the command quietly.
+            writeln!(
+                std::io::stdout(),
                 "{}: {}, content_sha256 {}",
                 file.display(),
                 state(seal),
                 m.content_digest()?
-            );
+            )?;
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -88,13 +91,14 @@ fn run_unit(action: ModelAction) -> anyhow::Result<ExitCode> {
             if let Some(w) = seal.warning(&file) {
                 eprintln!("gyrotherm: warning: {w}");
             }
-            println!(
+            writeln!(
+                std::io::stdout(),
                 "{}: {} (inertial unit, {} axes), content_sha256 {}",
                 file.display(),
                 state(seal),
                 m.axes.len(),
                 m.content_digest()?
-            );
+            )?;
         }
     }
     Ok(ExitCode::SUCCESS)

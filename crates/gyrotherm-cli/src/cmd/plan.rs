@@ -1,6 +1,7 @@
 //! `gyrotherm plan`: what the training logs cover of a flight's envelope and a chamber
 //! profile that covers it (`gyrotherm::plan`; this file only translates).
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -44,6 +45,16 @@ pub struct PlanArgs {
 }
 
 pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
+    super::common::refuse_outputs_over_inputs(
+        args.out.as_deref(),
+        args.flight
+            .as_deref()
+            .into_iter()
+            .chain(args.input.iter().map(PathBuf::as_path)),
+    )?;
+    // Written with errors returned, not `println!`: a closed pipe (`| head -1`) ends the
+    // command quietly instead of a panic.
+    let mut w = std::io::stdout().lock();
     let s = PlanSettings {
         temp_min_c: args.temp_min_c,
         temp_max_c: args.temp_max_c,
@@ -58,7 +69,8 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
         .map(|p| read_log_reporting(p, &args.log))
         .transpose()?;
     let env = resolve_envelope(flight.as_ref(), &s)?;
-    println!(
+    writeln!(
+        w,
         "envelope: {:.1} to {:.1} °C, |dT| up to {:.2} °C/min{}",
         env.temp_min_c,
         env.temp_max_c,
@@ -68,18 +80,20 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
         } else {
             ""
         }
-    );
-    println!(
+    )?;
+    writeln!(
+        w,
         "chamber: {} to {} °C, ramps up to {} °C/min",
         s.chamber_min_c, s.chamber_max_c, s.chamber_max_rate_c_per_min
-    );
+    )?;
     if !args.input.is_empty() {
         let mut warnings = Vec::new();
         let train = read_logs(&args.input, &args.log, &mut warnings)?;
         match training_coverage(&named(&train), flight.as_ref(), &env)? {
-            Err(why) => println!("training coverage: none: {why}"),
+            Err(why) => writeln!(w, "training coverage: none: {why}")?,
             Ok(c) => {
-                println!(
+                writeln!(
+                    w,
                     "training covers {} of {} (T, dT) cells: {:.1} to {:.1} °C, {:.2} to {:.2} \
                      °C/min",
                     c.covered_cells,
@@ -88,19 +102,21 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
                     c.temp_span_c.1,
                     c.rate_span_c_per_min.0,
                     c.rate_span_c_per_min.1
-                );
+                )?;
                 if let Some([inside, edge, outside]) = c.flight_shares {
-                    println!(
+                    writeln!(
+                        w,
                         "flight: {:.1} % of samples inside, {:.1} % at the edge, {:.1} % outside",
                         100.0 * inside,
                         100.0 * edge,
                         100.0 * outside
-                    );
+                    )?;
                 }
-                println!(
+                writeln!(
+                    w,
                     "envelope (temperature × ±rate): {:.1} % outside",
                     100.0 * c.envelope_outside
-                );
+                )?;
             }
         }
     }
@@ -108,7 +124,8 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
     for n in &plan.notes {
         eprintln!("gyrotherm: warning: {n}");
     }
-    println!(
+    writeln!(
+        w,
         "proposed profile: {:.1} to {:.1} °C; ramps at {}; {:.0} s ({:.1} h)",
         plan.temp_lo_c,
         plan.temp_hi_c,
@@ -119,18 +136,20 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
             .join(", "),
         plan.duration_s(),
         plan.duration_s() / 3600.0
-    );
-    println!(
+    )?;
+    writeln!(
+        w,
         "{:>4}  {:<5} {:>8} {:>8} {:>10} {:>10}",
         "#", "step", "from °C", "to °C", "°C/min", "s"
-    );
+    )?;
     for (i, seg) in plan.segments.iter().enumerate() {
         let step = match seg.step {
             Step::Hold => "hold",
             Step::Ramp => "ramp",
             Step::Soak => "soak",
         };
-        println!(
+        writeln!(
+            w,
             "{:>4}  {:<5} {:>8.1} {:>8.1} {:>10.2} {:>10.0}",
             i + 1,
             step,
@@ -138,12 +157,12 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
             seg.to_c,
             seg.rate_c_per_min,
             seg.duration_s
-        );
+        )?;
     }
     if let Some(out) = &args.out {
         gyrotherm::atomic_file::write_bytes_atomically(out, plan.profile_text().as_bytes())
             .with_context(|| format!("cannot write {}", out.display()))?;
-        println!("wrote {}", out.display());
+        writeln!(w, "wrote {}", out.display())?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -1,5 +1,6 @@
 //! `gyrotherm simulate`: write a simulated thermal-chamber test log (see `gyrotherm::sim`).
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -98,13 +99,28 @@ pub struct SimulateArgs {
 }
 
 pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
+    // Errors returned, not `println!`: a closed pipe ends the command quietly.
+    let mut w = std::io::stdout().lock();
     if args.list_profiles {
         for (name, what) in BUILTIN_PROFILES {
-            println!("{name:<12} {what}");
+            writeln!(w, "{name:<12} {what}")?;
         }
         return Ok(ExitCode::SUCCESS);
     }
     let random = args.unit.as_deref() == Some(std::path::Path::new("random"));
+    // The log, and the unit's parameters beside it (`--unit random`, `--imu`).
+    let sidecar_of = args.out.as_ref().map(|o| {
+        let mut p = o.clone().into_os_string();
+        p.push(".unit.json");
+        PathBuf::from(p)
+    });
+    super::common::refuse_outputs_over_inputs(
+        args.out.iter().chain(&sidecar_of).map(PathBuf::as_path),
+        args.profile_file
+            .iter()
+            .chain(args.unit.iter().filter(|_| !random))
+            .map(PathBuf::as_path),
+    )?;
     let unit = match (&args.unit, args.unit_seed) {
         (Some(_), Some(seed)) if random => sim::random_unit(seed),
         (Some(_), None) if random => {
@@ -117,13 +133,16 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         (None, None) => FogUnit::default(),
     };
     if args.print_unit {
-        println!("{}", serde_json::to_string_pretty(&unit)?);
+        writeln!(w, "{}", serde_json::to_string_pretty(&unit)?)?;
         return Ok(ExitCode::SUCCESS);
     }
     let profile = match &args.profile_file {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read profile file {}", path.display()))?;
+            let text = gyrotherm::input_file::read_capped_to_string(
+                path,
+                gyrotherm::input_file::InputKind::Profile,
+            )
+            .with_context(|| format!("cannot read profile file {}", path.display()))?;
             Profile::parse(&text, &path.display().to_string())?
         }
         None => Profile::builtin(&args.profile)?,

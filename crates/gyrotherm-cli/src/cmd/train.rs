@@ -125,6 +125,10 @@ pub struct TrainArgs {
 }
 
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
+    super::common::refuse_outputs_over_inputs(
+        [args.out.as_path()],
+        args.input.iter().map(PathBuf::as_path),
+    )?;
     if args.log.read_options().is_multi_column() {
         return super::imu::train(args);
     }

@@ -85,6 +85,38 @@ impl LogError {
     }
 }
 
+impl LogError {
+    /// A line of `path` longer than [`MAX_LINE_BYTES`](super::MAX_LINE_BYTES) at `line`.
+    pub(crate) fn line_too_long(path: impl Into<PathBuf>, line: u64) -> Self {
+        LogError::new(
+            LogErrorKind::LineTooLong,
+            path,
+            Some(line),
+            None,
+            format!(
+                "line longer than {} bytes; a log line holds a few numbers: check that this \
+                 is a log with one record per line",
+                super::MAX_LINE_BYTES
+            ),
+        )
+    }
+}
+
+/// Most characters of a field quoted in a message: enough to recognise it, while a message
+/// about a huge field stays one line.
+pub(crate) const QUOTED_FIELD_CHARS: usize = 40;
+
+/// A field as a message quotes it: in double quotes with escapes (no control character reaches
+/// the terminal), cut to its first [`QUOTED_FIELD_CHARS`] characters and its length in bytes
+/// when longer.
+pub(crate) fn quoted_field(raw: &[u8]) -> String {
+    let text = String::from_utf8_lossy(raw);
+    match text.char_indices().nth(QUOTED_FIELD_CHARS) {
+        None => format!("{text:?}"),
+        Some((at, _)) => format!("{:?}… ({} bytes)", &text[..at], raw.len()),
+    }
+}
+
 impl std::fmt::Display for LogError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}", self.path.display())?;

@@ -340,7 +340,11 @@ impl NumberColumn {
                 path,
                 None,
                 Some(name),
-                format!("data row {}: {text:?} {what}", row + 1),
+                format!(
+                    "data row {}: {} {what}",
+                    row + 1,
+                    super::error::quoted_field(text.as_bytes())
+                ),
             ));
         }
         let mut out = self.values;

@@ -37,6 +37,11 @@ pub use writer::{format_f64, LogWriter};
 use std::fs::File;
 use std::path::Path;
 
+/// Longest line of a log, bytes (line break included), for every reader (the batch reader,
+/// the compensator's stream): a log line holds a few numbers, and one endless line (a file
+/// without line breaks, `/dev/zero`) must not take unbounded memory.
+pub const MAX_LINE_BYTES: usize = 64 * 1024;
+
 /// Standard column names.
 pub const TIME_COL: &str = "time_s";
 /// Gyro output, °/s.

@@ -232,6 +232,9 @@ pub enum LotError {
         found: i64,
         supported: i64,
     },
+    /// A schema version below 1, which no gyrotherm writes (edited by hand?): nothing can
+    /// tell which upgrades the tables still need.
+    InvalidSchema { db: String, found: i64 },
     /// Another writer held the database for longer than the busy timeout.
     Locked { db: String, waited_ms: u64 },
     /// Any other database error.
@@ -314,6 +317,13 @@ impl fmt::Display for LotError {
                 "{db}: lot schema version {found} is newer than this gyrotherm reads \
                  ({supported}); nothing was changed: use a newer gyrotherm"
             ),
+            LotError::InvalidSchema { db, found } => write!(
+                f,
+                "{db}: lot schema version {found} is not one gyrotherm writes (versions start \
+                 at 1); nothing was changed: the schema_version table was edited outside \
+                 gyrotherm; restore the lot from a backup, or set the version its tables match \
+                 (docs/lot-schema.md)"
+            ),
             LotError::Locked { db, waited_ms } => write!(
                 f,
                 "{db}: locked by another writer for more than {waited_ms} ms; nothing was \
@@ -359,6 +369,129 @@ pub trait LotStore {
     fn runs(&mut self) -> Result<Vec<Run>, LotError>;
     /// The schema version the store holds.
     fn schema_version(&mut self) -> Result<i64, LotError>;
+}
+
+/// `db` (a lot's `--db`: a URL, a `key=value` connection string or a file path) as a message
+/// may show it: every password replaced by `***`. Masked: the URL's `user:PASSWORD@` (the
+/// credentials end at the first `@`, as the PostgreSQL URL parser reads them, or at the last
+/// one before the query when there are several, so that no part of a password with an `@`
+/// shows), URL query parameters and `key=value` settings whose key ends in `password`
+/// (`password`, `sslpassword`; any case, percent-encoded or not), quoted values whole.
+/// The command line and Python show a lot's name only through this.
+pub fn redact_db(db: &str) -> String {
+    let Some((scheme, rest)) = db.split_once("://") else {
+        return redact_conninfo(db);
+    };
+    let before_query = rest.split('?').next().unwrap_or(rest);
+    let at = before_query.rfind('@').or_else(|| rest.find('@'));
+    let (auth, tail) = match at {
+        Some(k) => (Some(&rest[..k]), &rest[k + 1..]),
+        None => (None, rest),
+    };
+    let mut out = format!("{scheme}://");
+    if let Some(auth) = auth {
+        match auth.split_once(':') {
+            Some((user, _)) => out.push_str(&format!("{user}:***@")),
+            None => out.push_str(&format!("{auth}@")),
+        }
+    }
+    match tail.split_once('?') {
+        Some((path, query)) => {
+            out.push_str(path);
+            out.push('?');
+            let params: Vec<String> = query
+                .split('&')
+                .map(|p| match p.split_once('=') {
+                    Some((k, _)) if is_password_key(&percent_decode(k)) => format!("{k}=***"),
+                    _ => p.to_owned(),
+                })
+                .collect();
+            out.push_str(&params.join("&"));
+        }
+        None => out.push_str(tail),
+    }
+    out
+}
+
+/// A connection setting that holds a secret.
+fn is_password_key(key: &str) -> bool {
+    key.trim().to_ascii_lowercase().ends_with("password")
+}
+
+/// `%XX` escapes decoded (others kept as they are).
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// A `key=value` connection string (libpq's form: values bare up to white space, or in
+/// single quotes with `\'` escapes) with the values of password keys masked; any other text
+/// (a file path) as it is, unless it holds such a setting.
+fn redact_conninfo(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(eq) = rest.find('=') {
+        let (head, after) = rest.split_at(eq);
+        // The key: the word just before `=` (white space allowed around it).
+        let key = head.trim_end();
+        let key_start = key.rfind(|c: char| c.is_whitespace()).map_or(0, |k| k + 1);
+        let is_secret = is_password_key(&key[key_start..]);
+        out.push_str(head);
+        out.push('=');
+        let after = &after[1..];
+        let value_start = after.len() - after.trim_start().len();
+        out.push_str(&after[..value_start]);
+        let value = &after[value_start..];
+        let value_len = if let Some(quoted) = value.strip_prefix('\'') {
+            let mut escaped = false;
+            let end = quoted
+                .char_indices()
+                .find(|&(_, c)| {
+                    let close = c == '\'' && !escaped;
+                    escaped = c == '\\' && !escaped;
+                    close
+                })
+                .map_or(quoted.len(), |(k, _)| k + 1);
+            1 + end
+        } else {
+            value.find(char::is_whitespace).unwrap_or(value.len())
+        };
+        if is_secret {
+            out.push_str("***");
+        } else {
+            out.push_str(&value[..value_len]);
+        }
+        rest = &value[value_len..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// A stored schema version below 1 is refused before anything is written: upgrades run from
+/// the version found, and below 1 there is none to run from (the tables would be stamped
+/// current without them, and the lot unusable for good).
+pub(crate) fn check_known(db: &str, version: i64) -> Result<(), LotError> {
+    if version < 1 {
+        return Err(LotError::InvalidSchema {
+            db: db.to_string(),
+            found: version,
+        });
+    }
+    Ok(())
 }
 
 /// Open the lot at `db`: a `postgres://` or `postgresql://` URL, else an SQLite file path.
@@ -480,7 +613,11 @@ impl<L> UnitInputs<'_, L> {
 
     /// The model file's text and the SHA-256 of its bytes.
     fn model_text(&self) -> Result<(String, String), LotError> {
-        let text = std::fs::read_to_string(self.model_path).map_err(|source| LotError::Read {
+        let text = crate::input_file::read_capped_to_string(
+            self.model_path,
+            crate::input_file::InputKind::Model,
+        )
+        .map_err(|source| LotError::Read {
             path: self.model_path.to_path_buf(),
             source,
         })?;

@@ -8,7 +8,8 @@ use postgres::{Client, NoTls};
 use super::schema::{PG_MIGRATIONS, PG_V1, RUN_COLUMNS, SCHEMA_VERSION};
 use super::time::{parse_rfc3339_utc, rfc3339_utc};
 use super::{
-    check_axes, mark_latest, AxisRecord, FigureRow, Input, LotError, LotStore, Run, RunVerdict,
+    check_axes, check_known, mark_latest, AxisRecord, FigureRow, Input, LotError, LotStore, Run,
+    RunVerdict,
 };
 
 /// The advisory-lock key that serialises schema changes (an arbitrary constant, "gyro" in
@@ -22,22 +23,11 @@ pub struct PgStore {
     db: String,
 }
 
-/// `url` with any password replaced by `***` (messages must not print secrets).
-fn redact(url: &str) -> String {
-    if let Some((scheme, rest)) = url.split_once("://") {
-        if let Some((auth, host)) = rest.split_once('@') {
-            if let Some((user, _)) = auth.split_once(':') {
-                return format!("{scheme}://{user}:***@{host}");
-            }
-        }
-    }
-    url.to_string()
-}
-
 impl PgStore {
     /// Connect to `url` and, with `create`, make the schema if missing.
     pub fn open(url: &str, create: bool) -> Result<Self, LotError> {
-        let db = redact(url);
+        // Messages must not print secrets.
+        let db = super::redact_db(url);
         let client = Client::connect(url, NoTls).map_err(|e| LotError::Database {
             db: db.clone(),
             detail: format!("cannot connect: {e}"),
@@ -67,6 +57,7 @@ impl PgStore {
                 .map_err(e)?
                 .get(0);
             let v = i64::from(v.ok_or(LotError::NotALot { db: db.clone() })?);
+            check_known(&db, v)?;
             if v > SCHEMA_VERSION {
                 return Err(LotError::NewerSchema {
                     db,
@@ -93,6 +84,7 @@ impl PgStore {
             tx.batch_execute(PG_V1).map_err(e)?;
             1
         };
+        // `from` is at least 1 here (checked above).
         for (i, step) in PG_MIGRATIONS.iter().enumerate().skip(from as usize - 1) {
             // A failed step drops the transaction, which rolls every step back.
             tx.batch_execute(step)

@@ -13,7 +13,8 @@ use rusqlite::{params, Connection, ErrorCode, OpenFlags, TransactionBehavior};
 use super::schema::{RUN_COLUMNS, SCHEMA_VERSION, SQLITE_MIGRATIONS, SQLITE_V1};
 use super::time::{parse_rfc3339_utc, rfc3339_utc};
 use super::{
-    check_axes, mark_latest, AxisRecord, FigureRow, Input, LotError, LotStore, Run, RunVerdict,
+    check_axes, check_known, mark_latest, AxisRecord, FigureRow, Input, LotError, LotStore, Run,
+    RunVerdict,
 };
 
 /// A lot in an SQLite file.
@@ -26,7 +27,7 @@ pub struct SqliteStore {
 impl SqliteStore {
     /// Open (and with `create`, make) the lot at `path`.
     pub fn open(path: &Path, create: bool, busy_timeout_ms: u64) -> Result<Self, LotError> {
-        let db = path.display().to_string();
+        let db = super::redact_db(&path.display().to_string());
         if !create && !path.exists() {
             return Err(LotError::Missing { db });
         }
@@ -46,8 +47,9 @@ impl SqliteStore {
         Ok(store)
     }
 
+    /// The lot's name in messages (a password in a mistyped URL masked).
     fn db(&self) -> String {
-        self.path.display().to_string()
+        super::redact_db(&self.path.display().to_string())
     }
 
     fn err(&self, e: rusqlite::Error) -> LotError {
@@ -82,6 +84,7 @@ impl SqliteStore {
     }
 
     fn check_not_newer(&self, v: i64) -> Result<(), LotError> {
+        check_known(&self.db(), v)?;
         if v > SCHEMA_VERSION {
             return Err(LotError::NewerSchema {
                 db: self.db(),
@@ -107,12 +110,12 @@ impl SqliteStore {
                     .map_err(|e| self.err(e))?;
             }
         }
+        let db = self.db();
         let tx = self
             .conn
             .transaction_with_behavior(TransactionBehavior::Immediate)
-            .map_err(|e| db_error(&self.path.display().to_string(), e, self.busy_timeout_ms))?;
+            .map_err(|e| db_error(&db, e, self.busy_timeout_ms))?;
         // Another station may have created or upgraded it while this one waited.
-        let db = self.path.display().to_string();
         let now: Option<i64> = {
             let n: i64 = tx
                 .query_row(
@@ -141,8 +144,12 @@ impl SqliteStore {
                     supported: SCHEMA_VERSION,
                 })
             }
-            Some(v) => v,
+            Some(v) => {
+                check_known(&db, v)?;
+                v
+            }
         };
+        // `from` is at least 1 here (checked above).
         for (i, step) in SQLITE_MIGRATIONS.iter().enumerate().skip(from as usize - 1) {
             // A failed step drops the transaction, which rolls every step back.
             tx.execute_batch(step)

@@ -799,3 +799,122 @@ fn postgres_store_holds_units_and_upgrades_version_1() {
         .get(0);
     assert_eq!((v, has_axis), (1, 0));
 }
+
+/// A stored schema version below 1 (no gyrotherm writes one) is refused by readers and
+/// writers alike, and the lot is left as it was: before, `from as usize - 1` wrapped, the
+/// upgrade steps were skipped and the version set to the current one, and every later open
+/// failed with "no such table: run_axes".
+#[test]
+fn sqlite_schema_version_below_1_is_refused_unchanged() {
+    for bad in [0i64, -1, i64::MIN] {
+        let dir = tempfile::tempdir().unwrap();
+        let db = dir.path().join("v1.sqlite");
+        write_v1_sqlite(&db, &[synthetic_run("A-001", 1, 0)]);
+        {
+            let c = rusqlite::Connection::open(&db).unwrap();
+            c.execute("UPDATE schema_version SET version = ?1", [bad])
+                .unwrap();
+        }
+        for create in [false, true] {
+            let e = SqliteStore::open(&db, create, 5000).err().unwrap();
+            assert!(
+                matches!(e, LotError::InvalidSchema { found, .. } if found == bad),
+                "{e:?}"
+            );
+            let m = e.to_string();
+            assert!(
+                m.contains(&format!(
+                    "lot schema version {bad} is not one gyrotherm writes"
+                )) && m.contains("nothing was changed"),
+                "{m}"
+            );
+        }
+        let c = rusqlite::Connection::open(&db).unwrap();
+        let v: i64 = c
+            .query_row("SELECT version FROM schema_version", [], |r| r.get(0))
+            .unwrap();
+        let tables: i64 = c
+            .query_row(
+                "SELECT count(*) FROM sqlite_master WHERE name = 'run_axes'",
+                [],
+                |r| r.get(0),
+            )
+            .unwrap();
+        assert_eq!((v, tables), (bad, 0));
+    }
+}
+
+/// The same in PostgreSQL.
+#[test]
+fn postgres_schema_version_below_1_is_refused_unchanged() {
+    let Some(pg) = PgServer::start() else { return };
+    let url = pg.create_db("lot_v0");
+    write_v1_pg(&url, &[synthetic_run("A-001", 1, 0)]);
+    let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
+    c.batch_execute("UPDATE schema_version SET version = 0")
+        .unwrap();
+    for create in [false, true] {
+        let e = open_store(&url, create, 0).err().unwrap();
+        assert!(
+            matches!(e, LotError::InvalidSchema { found: 0, .. }),
+            "{e:?}"
+        );
+    }
+    let v: i32 = c
+        .query_one("SELECT version FROM schema_version", &[])
+        .unwrap()
+        .get(0);
+    let axes: bool = c
+        .query_one("SELECT to_regclass('run_axes') IS NOT NULL", &[])
+        .unwrap()
+        .get(0);
+    assert_eq!((v, axes), (0, false));
+}
+
+/// Every way a PostgreSQL password can be written is masked in a lot's name as messages show
+/// it (the forms of the PostgreSQL manual, "Connection Strings": URL credentials, URL query
+/// parameters, `key=value` settings, quoted or not); nothing else changes.
+#[test]
+fn every_form_of_a_password_is_masked() {
+    for (db, want) in [
+        (
+            "postgres://gyro:s3cret@db.lab:5432/lot",
+            "postgres://gyro:***@db.lab:5432/lot",
+        ),
+        (
+            "postgresql://gyro@db.lab/lot?password=s3cret",
+            "postgresql://gyro@db.lab/lot?password=***",
+        ),
+        (
+            "postgres://db.lab/lot?user=gyro&password=s3cret&sslmode=disable",
+            "postgres://db.lab/lot?user=gyro&password=***&sslmode=disable",
+        ),
+        (
+            "postgres://db.lab/lot?PassWord=s3cret&sslpassword=k3y",
+            "postgres://db.lab/lot?PassWord=***&sslpassword=***",
+        ),
+        (
+            "postgres://db.lab/lot?pass%77ord=s3cret",
+            "postgres://db.lab/lot?pass%77ord=***",
+        ),
+        (
+            "postgres://gyro:s3@cret@db.lab/lot",
+            "postgres://gyro:***@db.lab/lot",
+        ),
+        (
+            "host=db.lab user=gyro password=s3cret dbname=lot",
+            "host=db.lab user=gyro password=*** dbname=lot",
+        ),
+        (
+            "host=db.lab password = 's3 c\\'ret' dbname=lot",
+            "host=db.lab password = *** dbname=lot",
+        ),
+        ("postgres://gyro@db.lab/lot", "postgres://gyro@db.lab/lot"),
+        ("/data/lot.sqlite", "/data/lot.sqlite"),
+        ("lot=2024.sqlite", "lot=2024.sqlite"),
+    ] {
+        let got = redact_db(db);
+        assert_eq!(got, want, "{db}");
+        assert!(!got.contains("s3") && !got.contains("k3y"), "{got}");
+    }
+}

@@ -1,6 +1,7 @@
 //! Model-file text: JSON in and out, the `content_sha256` seal, and files on disk.
 
 use super::*;
+use crate::input_file::{read_capped_to_string, InputKind};
 
 impl ModelFile {
     /// SHA-256 of the model's content (its compact JSON, fields in declaration order):
@@ -69,9 +70,11 @@ impl ModelFile {
             path: path.to_path_buf(),
             source: Box::new(e),
         };
-        let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Read {
-            path: path.to_path_buf(),
-            source,
+        let text = read_capped_to_string(path, InputKind::Model).map_err(|source| {
+            ModelFileError::Read {
+                path: path.to_path_buf(),
+                source,
+            }
         })?;
         let (m, _) = Self::parse(&text, false).map_err(in_file)?;
         m.save(path)?;
@@ -100,9 +103,11 @@ impl ModelFile {
     /// [`load`](Self::load), also saying whether the file was sealed (a caller warns on
     /// [`Seal::Absent`]; see [`Seal::warning`]).
     pub fn load_sealed(path: &Path) -> Result<(ModelFile, Seal), ModelFileError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Read {
-            path: path.to_path_buf(),
-            source,
+        let text = read_capped_to_string(path, InputKind::Model).map_err(|source| {
+            ModelFileError::Read {
+                path: path.to_path_buf(),
+                source,
+            }
         })?;
         Self::from_json_sealed(&text).map_err(|e| ModelFileError::InFile {
             path: path.to_path_buf(),

@@ -87,7 +87,9 @@ impl<'r, 'a, T: Real> Trainer<'r, 'a, T> {
         progress: &mut dyn FnMut(usize, f64),
     ) -> Result<TrainOutput, TrainError> {
         let cfg = self.cfg;
-        let mut loss_history = Vec::with_capacity(cfg.epochs);
+        // Grown as the epochs run, not reserved for the number asked: a mistyped
+        // `epochs` must not take memory before a single epoch is trained.
+        let mut loss_history = Vec::new();
         let mut val_loss_history = Vec::new();
         let mut best: Option<(f64, usize, Vec<f64>)> = None;
         let mut stop = StopReason::Epochs;

@@ -16,6 +16,10 @@ pub const DEFAULT_BIAS_WINDOW_S: f64 = targets::BIAS_WINDOW_S;
 pub const DEFAULT_SETTLE_S: f64 = targets::SETTLE_S;
 /// Default highest power of T in the `poly` bias model.
 pub const DEFAULT_POLY_TEMP_DEGREE: u8 = 3;
+/// Most training epochs one may ask for: a thousand times the published method's 1000
+/// (Adam steps), far beyond any loss that still falls, while the loss history of that many
+/// epochs stays a few megabytes.
+pub const MAX_EPOCHS: usize = 1_000_000;
 /// Default highest power of dT in the `poly` bias model.
 pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 /// Names of the deprecated `recipe` setting (the recipe methods' names).
@@ -173,11 +177,11 @@ impl std::fmt::Display for Deprecation {
 impl FitSettings {
     /// Check every value; the error names the setting and the rule.
     pub fn validate(&self) -> Result<(), SettingError> {
-        if self.epochs == Some(0) {
+        if let Some(e) = self.epochs.filter(|e| !(1..=MAX_EPOCHS).contains(e)) {
             return Err(SettingError::Invalid {
                 setting: "epochs",
-                value: "0".into(),
-                rule: Rule::AtLeastOne,
+                value: e.to_string(),
+                rule: Rule::Epochs,
             });
         }
         check("bias_window_s", self.bias_window_s, Rule::PositiveSeconds)?;
@@ -294,5 +298,38 @@ impl FitSettings {
             },
             note,
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An epoch count beyond the bound is refused with the setting, the value and the bound,
+    /// before anything is trained or reserved (`Vec::with_capacity(epochs)` aborted the
+    /// process at 1e11, and `usize::MAX` panicked with "capacity overflow").
+    #[test]
+    fn epochs_beyond_the_bound_are_refused_by_name() {
+        for e in [0, MAX_EPOCHS + 1, 100_000_000_000, usize::MAX] {
+            let s = FitSettings {
+                epochs: Some(e),
+                ..FitSettings::default()
+            };
+            let err = s.fit_config().unwrap_err();
+            assert_eq!(err.setting(), "epochs");
+            let msg = err.to_string();
+            assert_eq!(
+                msg,
+                format!("epochs must be a whole number from 1 to {MAX_EPOCHS}, not {e}")
+            );
+        }
+        for e in [1, 300, MAX_EPOCHS] {
+            let s = FitSettings {
+                epochs: Some(e),
+                ..FitSettings::default()
+            };
+            assert!(s.validate().is_ok(), "{e}");
+        }
+        assert!(Rule::Epochs.holds(MAX_EPOCHS as f64) && !Rule::Epochs.holds(0.5));
     }
 }

@@ -53,6 +53,8 @@ pub enum Rule {
     NonNegativeSeconds,
     /// An integer ≥ 1.
     AtLeastOne,
+    /// A number of training epochs: an integer from 1 to [`fit::MAX_EPOCHS`].
+    Epochs,
     /// A scale factor: finite and > 0 (gyro output over table rate, about 1).
     PositiveScaleFactor,
     /// A power-law noise exponent α: an integer from -4 to 2.
@@ -73,6 +75,8 @@ impl Rule {
             Rule::PositiveSeconds => "is not a positive number of seconds",
             Rule::NonNegativeSeconds => "is not zero or a positive number of seconds",
             Rule::AtLeastOne => "must be at least 1",
+            // Stated here as text; a test holds it equal to fit::MAX_EPOCHS.
+            Rule::Epochs => "must be a whole number from 1 to 1000000",
             Rule::PositiveScaleFactor => {
                 "is not a scale factor: give a positive number (gyro output over table rate, \
                  about 1)"
@@ -98,6 +102,7 @@ impl Rule {
             Rule::PositiveSeconds | Rule::PositiveScaleFactor => v.is_finite() && v > 0.0,
             Rule::NonNegativeSeconds => v.is_finite() && v >= 0.0,
             Rule::AtLeastOne => v >= 1.0,
+            Rule::Epochs => v.fract() == 0.0 && (1.0..=fit::MAX_EPOCHS as f64).contains(&v),
             Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
             Rule::Number | Rule::ColumnList => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
@@ -185,7 +190,7 @@ impl fmt::Display for SettingError {
                 setting,
                 value,
                 rule,
-            } if *rule == Rule::AtLeastOne => {
+            } if matches!(rule, Rule::AtLeastOne | Rule::Epochs) => {
                 write!(f, "{setting} {}, not {value}", rule.text())
             }
             SettingError::Invalid {

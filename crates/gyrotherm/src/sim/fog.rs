@@ -198,10 +198,12 @@ impl FogUnit {
 
     /// Read a JSON parameter file (partial override of the default unit).
     pub fn load(path: &std::path::Path) -> Result<FogUnit, SimError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SimError::Io {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        let text =
+            crate::input_file::read_capped_to_string(path, crate::input_file::InputKind::SimUnit)
+                .map_err(|e| SimError::Io {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
         FogUnit::from_json_str(&text, &path.display().to_string())
     }
 

@@ -283,10 +283,11 @@ pub fn nearest_figures(key: &str) -> Vec<&'static str> {
 impl Spec {
     /// Read and check the spec sheet at `path`.
     pub fn load(path: &Path) -> Result<Spec, SpecError> {
-        let bytes = std::fs::read(path).map_err(|source| SpecError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let bytes = crate::input_file::read_capped(path, crate::input_file::InputKind::Spec)
+            .map_err(|source| SpecError::Read {
+                path: path.to_path_buf(),
+                source,
+            })?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let (line, column) = {
                 let ok = &e.as_bytes()[..e.utf8_error().valid_up_to()];

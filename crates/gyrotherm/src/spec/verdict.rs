@@ -79,7 +79,13 @@ impl Verdict {
                 f.log
             ));
         }
-        out.push(format!("verdict: {} (spec {})", self.word(), self.spec));
+        // The name comes from the sheet: escaped as `lot list` escapes a unit, so that no
+        // control character (ESC, BEL) reaches the terminal.
+        out.push(format!(
+            "verdict: {} (spec {})",
+            self.word(),
+            self.spec.escape_debug()
+        ));
         out
     }
 }

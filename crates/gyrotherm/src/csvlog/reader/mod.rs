@@ -4,7 +4,9 @@
 //! path, [`super::chunk`]); at the first line the fast path cannot judge (a quote, a lone
 //! CR, an error) the csv crate takes over from that line, so errors keep their exact line,
 //! column and text. Either way reading costs no allocation per row; pass-through fields are
-//! handed out as raw bytes of the row.
+//! handed out as raw bytes of the row. A line longer than [`MAX_LINE_BYTES`] is an error
+//! ([`LogErrorKind::LineTooLong`](super::LogErrorKind::LineTooLong)) before it is held in
+//! memory, and a bad field is quoted in a message by at most its first characters.
 //!
 //! # Nominal sample period and gaps
 //! The nominal period is the median (the lower middle value for an even count) of the first
@@ -25,9 +27,10 @@ use std::cell::OnceCell;
 
 use super::chunk::{self, parse_lines, Layout, Row, MAX_BLOCK_BYTES, PARALLEL_MIN_BYTES};
 use super::columns::{check_options, map_columns, Columns};
-use super::error::{LogError, LogErrorKind as Kind};
+use super::error::{quoted_field, LogError, LogErrorKind as Kind};
 use super::gaps::{gap_verdict, Fill, GapVerdict, Sample};
 use super::number::{parse_f64, parse_f64_decimal_comma};
+use super::MAX_LINE_BYTES;
 use super::{ReadOptions, ReadReport};
 
 /// Number of leading time steps whose median is the nominal sample period.
@@ -74,7 +77,7 @@ use source::*;
 ///
 /// After an error the reader's state is unspecified: stop reading.
 pub struct LogReader<R> {
-    src: Source<R>,
+    src: Source<LineCap<R>>,
     /// The raw record of the current sample when it came from the read-ahead queue.
     record: ByteRecord,
     from_pending: bool,
@@ -113,7 +116,7 @@ impl<R: Read> LogReader<R> {
         fast: bool,
     ) -> Result<Self, LogError> {
         check_options(&path, opts)?;
-        let mut inner = reader;
+        let mut inner = LineCap::new(reader);
         // Read until the header line is complete, then parse it with the csv crate; a
         // header the fast path cannot judge (quotes, lone CR) sends the whole input
         // down the CSV path.

@@ -269,13 +269,14 @@ impl<R: Read> Source<R> {
     #[cold]
     pub(super) fn number_error(&self, raw: &[u8], i: usize, line: u64) -> LogError {
         let text = String::from_utf8_lossy(raw);
+        let quoted = quoted_field(raw);
         let parses = parse_f64(raw).is_some()
             || (self.decimal_comma && parse_f64_decimal_comma(raw).is_some());
         let (kind, message) = if parses {
             (
                 Kind::NonFinite,
                 format!(
-                    "{text:?} is not a finite number (NaN, infinite or out of range); \
+                    "{quoted} is not a finite number (NaN, infinite or out of range); \
                      fix the value or comment the line out with '#'"
                 ),
             )
@@ -295,7 +296,7 @@ impl<R: Read> Source<R> {
             (
                 Kind::NotANumber,
                 format!(
-                    "{text:?} is not a number; fix the value{hint} or comment the line out \
+                    "{quoted} is not a number; fix the value{hint} or comment the line out \
                      with '#'"
                 ),
             )
@@ -427,6 +428,9 @@ impl<R: Read> Read for Tail<R> {
 pub(super) fn csv_error(path: &Path, e: csv::Error, line_offset: u64) -> LogError {
     let line = e.position().map(|p| p.line() + line_offset);
     if let csv::ErrorKind::Io(io) = e.kind() {
+        if let Some(long) = LineTooLong::of(io) {
+            return LogError::line_too_long(path, long.line);
+        }
         LogError::new(Kind::Io, path, line, None, format!("cannot read: {io}"))
     } else {
         LogError::new(Kind::Csv, path, line, None, format!("malformed CSV: {e}"))
@@ -484,6 +488,9 @@ pub(super) fn read_retry<R: Read>(r: &mut R, buf: &mut [u8]) -> std::io::Result<
 }
 
 pub(super) fn io_error(path: &Path, e: std::io::Error) -> LogError {
+    if let Some(long) = LineTooLong::of(&e) {
+        return LogError::line_too_long(path, long.line);
+    }
     LogError::new(Kind::Io, path, None, None, format!("cannot read: {e}"))
 }
 
@@ -531,3 +538,98 @@ pub(super) fn read_header<S: Read>(
     let line = record_line(csv, &header);
     Ok((header, line))
 }
+
+/// The input with its lines capped at [`MAX_LINE_BYTES`]: every line before a longer one is
+/// handed on whole, then reading fails with [`LineTooLong`]. So neither path behind it (the
+/// fast path's block, the csv crate's record) ever holds more than one capped line: a file
+/// without line breaks (`/dev/zero`) is an error after 64 KiB instead of growing memory
+/// until the process is killed.
+pub(super) struct LineCap<R> {
+    inner: R,
+    /// Bytes of the current line read so far (since the last line break).
+    run: usize,
+    /// 1-based physical line now being read.
+    line: u64,
+    /// A line over the cap was met: every further read fails.
+    over: bool,
+}
+
+impl<R> LineCap<R> {
+    pub(super) fn new(inner: R) -> Self {
+        LineCap {
+            inner,
+            run: 0,
+            line: 1,
+            over: false,
+        }
+    }
+
+    fn too_long(&self) -> std::io::Error {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            LineTooLong { line: self.line },
+        )
+    }
+}
+
+impl<R: Read> Read for LineCap<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if self.over {
+            return Err(self.too_long());
+        }
+        let n = self.inner.read(buf)?;
+        let mut start = 0;
+        // A line with its break may hold MAX_LINE_BYTES bytes: its text at most one less.
+        for k in memchr::memchr_iter(b'\n', &buf[..n]) {
+            if self.run + (k - start) >= MAX_LINE_BYTES {
+                return self.stop(start);
+            }
+            self.run = 0;
+            self.line += 1;
+            start = k + 1;
+        }
+        if self.run + (n - start) >= MAX_LINE_BYTES {
+            return self.stop(start);
+        }
+        self.run += n - start;
+        Ok(n)
+    }
+}
+
+impl<R> LineCap<R> {
+    /// The line from `start` in the last read is over the cap: hand on the lines before it
+    /// (if any: 0 bytes would read as the end of the input), and fail from then on.
+    fn stop(&mut self, start: usize) -> std::io::Result<usize> {
+        self.over = true;
+        if start == 0 {
+            Err(self.too_long())
+        } else {
+            Ok(start)
+        }
+    }
+}
+
+/// The error [`LineCap`] reads fail with: line `line` is longer than [`MAX_LINE_BYTES`].
+#[derive(Debug)]
+pub(super) struct LineTooLong {
+    pub(super) line: u64,
+}
+
+impl LineTooLong {
+    /// The over-long line an I/O error stands for, if it is one.
+    pub(super) fn of(e: &std::io::Error) -> Option<&LineTooLong> {
+        e.get_ref()?.downcast_ref::<LineTooLong>()
+    }
+}
+
+impl std::fmt::Display for LineTooLong {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "line {} is longer than {MAX_LINE_BYTES} bytes",
+            self.line
+        )
+    }
+}
+
+impl std::error::Error for LineTooLong {}
