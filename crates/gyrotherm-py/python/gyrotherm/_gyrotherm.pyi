@@ -56,6 +56,15 @@ def fit_unit(
     progress: Optional[Any] = None,
 ) -> Tuple[RawUnitModel, Optional[str]]: ...
 
+def evaluate_log(
+    path: str,
+    options: Dict[str, Any],
+    column: str,
+    spec: Optional[str] = None,
+    tau_s: Optional[float] = None,
+    settle_s: Optional[float] = None,
+    reference_scale: Optional[float] = None,
+) -> Tuple[str, Optional[str]]: ...
 def evaluate_unit(
     path: str,
     options: Dict[str, Any],
