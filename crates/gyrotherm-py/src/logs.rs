@@ -150,7 +150,7 @@ fn evaluate_log(
     let opts = options.read_options()?;
     py.detach(|| {
         let name = path.display().to_string();
-        let metrics = |e: &dyn std::error::Error| {
+        let metrics = |e: &(dyn std::error::Error + 'static)| {
             MetricsError::new_err(format!("{name}: {}", gyrotherm::error_chain(e)))
         };
         let (mut log, _) = read(&path, &opts)

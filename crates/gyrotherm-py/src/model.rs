@@ -8,7 +8,7 @@ use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError
 use gyrotherm::compensate_lines::compensate_file;
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, Target};
-use gyrotherm::model::{ColumnsDef, ModelFile};
+use gyrotherm::model::{ColumnsDef, GivenColumns, ModelFile};
 use gyrotherm::settings::FitSettings;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -203,15 +203,28 @@ impl RawModel {
     }
 
     /// Compensate a CSV log into a CSV file exactly as `gyrotherm compensate --input --out`
-    /// does (same code, same bytes); returns (rows, ok, held, degraded, invalid, warnings).
+    /// does (same code, same bytes; the column options not in `given` are the model's own);
+    /// returns (rows, ok, held, degraded, invalid, warnings).
     fn compensate_csv(
         &self,
         py: Python<'_>,
         input: PathBuf,
         out: PathBuf,
         options: LogOptions,
+        given: Vec<String>,
     ) -> PyResult<(u64, u64, u64, u64, u64, Vec<String>)> {
-        let opts = options.read_options()?;
+        let named = |k: &str| given.iter().any(|g| g == k);
+        let given = GivenColumns {
+            time_col: named("time_col"),
+            gyro_col: named("gyro_col"),
+            temp_col: named("temp_col"),
+            table_col: named("table_col"),
+            gyro_unit: named("gyro_unit"),
+        };
+        let opts = self
+            .file
+            .read_options(&options.read_options()?, given)
+            .map_err(py_err::<ModelError>)?;
         let summary = py.detach(|| compensate_file(&self.file, &input, &out, &opts));
         let s = summary.map_err(|e| CompensationError::new_err(gyrotherm::error_chain(&e)))?;
         Ok((s.rows, s.ok, s.held, s.degraded, s.invalid, s.warnings))

@@ -198,3 +198,28 @@ def test_evaluate_one_column_is_the_cli_json(cli, logs, tmp_path):
     assert {k: v for k, v in got.items() if k != "column"} == {
         k: v for k, v in want.items() if k != "column"
     }
+
+
+def test_a_model_remembers_its_columns(cli, logs, tmp_path):
+    # Trained on renamed columns, the model reads them again without being told, in Python
+    # as in `gyrotherm compensate`; the file's names key read_log's arrays.
+    def renamed(name):
+        text = pathlib.Path(logs[name]).read_text()
+        header, rest = text.split("\n", 1)
+        p = tmp_path / f"{name}_renamed.csv"
+        p.write_text(header.replace("time_s", "t").replace("gyro_dps", "w_dps")
+                     .replace("temp_c", "T") + "\n" + rest)
+        return p
+
+    cols = dict(time_col="t", gyro_col="w_dps", temp_col="T")
+    m = gt.fit(static=renamed("static"), method="linear", **cols)
+    path = tmp_path / "m.json"
+    m.save(path)
+    assert json.loads(path.read_text())["columns"]["gyro_col"] == "w_dps"
+    held = renamed("heldout")
+    py_out, cli_out = tmp_path / "py.csv", tmp_path / "cli.csv"
+    gt.Model.load(path).compensate_csv(held, py_out)
+    cli("compensate", "--model", path, "--input", held, "--out", cli_out)
+    assert py_out.read_bytes() == cli_out.read_bytes()
+    log = gt.read_log(held, as_frame=False, **cols)
+    assert {"t", "w_dps", "T"} <= set(log)

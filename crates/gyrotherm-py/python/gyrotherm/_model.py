@@ -145,7 +145,8 @@ class Model:
         return CoverageVerdicts(codes, sigma)
 
     def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]:
-        """``gyrotherm compensate --input INPUT --out OUT`` with the same log options: every
+        """``gyrotherm compensate --input INPUT --out OUT`` with the same log options (a column
+        option not given is the model's, as the CLI reads it): every
         input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps``, ``status``, ``coverage`` and
         ``sigma_dph``. Returns
         the rows written, the count per status and the extrapolation warnings (also issued as
@@ -155,8 +156,9 @@ class Model:
                 "fill_gaps_max_s does not apply to compensate: the compensator bridges time gaps "
                 "itself and writes one output line per input line"
             )
+        # Columns not named here are the model's own (the ones it was trained on).
         rows, ok, held, degraded, invalid, warns = self._raw.compensate_csv(
-            os.fspath(input), os.fspath(out), read_options(options)
+            os.fspath(input), os.fspath(out), read_options(options), sorted(options)
         )
         _warn(warns)
         return {"rows": rows, "ok": ok, "held": held, "degraded": degraded,
