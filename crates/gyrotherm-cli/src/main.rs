@@ -59,7 +59,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // The matches are kept to tell a column option given from its default (`compensate`
+    // takes a model's own columns unless told otherwise).
+    let matches = <Cli as clap::CommandFactory>::command().get_matches();
+    let cli = <Cli as clap::FromArgMatches>::from_arg_matches(&matches).unwrap_or_else(|e| {
+        e.format(&mut <Cli as clap::CommandFactory>::command())
+            .exit()
+    });
     signals::remove_temp_files_on_termination();
     let result = match cli.command {
         Command::Demo(a) => cmd::demo::run(a),
@@ -67,7 +73,10 @@ fn main() -> ExitCode {
         Command::Allan(a) => cmd::allan::run(a),
         Command::Evaluate(a) => cmd::evaluate::run(a),
         Command::Train(a) => cmd::train::run(a),
-        Command::Compensate(a) => cmd::compensate::run(a),
+        Command::Compensate(a) => cmd::compensate::run(
+            a,
+            cmd::common::given_columns(matches.subcommand_matches("compensate")),
+        ),
         Command::Compare(a) => cmd::compare::run(a),
         Command::Report(a) => cmd::report::run(a),
         Command::Plan(a) => cmd::plan::run(a),

@@ -84,6 +84,7 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("READ_DEFAULTS", logs::read_defaults(py)?)?;
     let evaluate = gyrotherm::settings::EvaluateSettings::default();
     let evaluate_defaults = pyo3::types::PyDict::new(py);
+    evaluate_defaults.set_item("column", &evaluate.column)?;
     evaluate_defaults.set_item("tau_s", evaluate.tau_s)?;
     evaluate_defaults.set_item("settle_s", evaluate.settle_s)?;
     evaluate_defaults.set_item("reference_scale", evaluate.reference_scale)?;

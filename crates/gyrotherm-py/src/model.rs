@@ -8,7 +8,7 @@ use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError
 use gyrotherm::compensate_lines::compensate_file;
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, Target};
-use gyrotherm::model::ModelFile;
+use gyrotherm::model::{ColumnsDef, GivenColumns, ModelFile};
 use gyrotherm::settings::FitSettings;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -203,15 +203,28 @@ impl RawModel {
     }
 
     /// Compensate a CSV log into a CSV file exactly as `gyrotherm compensate --input --out`
-    /// does (same code, same bytes); returns (rows, ok, held, degraded, invalid, warnings).
+    /// does (same code, same bytes; the column options not in `given` are the model's own);
+    /// returns (rows, ok, held, degraded, invalid, warnings).
     fn compensate_csv(
         &self,
         py: Python<'_>,
         input: PathBuf,
         out: PathBuf,
         options: LogOptions,
+        given: Vec<String>,
     ) -> PyResult<(u64, u64, u64, u64, u64, Vec<String>)> {
-        let opts = options.read_options()?;
+        let named = |k: &str| given.iter().any(|g| g == k);
+        let given = GivenColumns {
+            time_col: named("time_col"),
+            gyro_col: named("gyro_col"),
+            temp_col: named("temp_col"),
+            table_col: named("table_col"),
+            gyro_unit: named("gyro_unit"),
+        };
+        let opts = self
+            .file
+            .read_options(&options.read_options()?, given)
+            .map_err(py_err::<ModelError>)?;
         let summary = py.detach(|| compensate_file(&self.file, &input, &out, &opts));
         let s = summary.map_err(|e| CompensationError::new_err(gyrotherm::error_chain(&e)))?;
         Ok((s.rows, s.ok, s.held, s.degraded, s.invalid, s.warnings))
@@ -240,18 +253,19 @@ impl RawModel {
             m.features.step_period_s,
             m.features.rate_lag_s
         );
-        s += &format!(
-            "  training range: temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min\n",
-            t.temp_range_c.min,
-            t.temp_range_c.max,
-            t.rate_range_c_per_s.min * 60.0,
-            t.rate_range_c_per_s.max * 60.0
-        );
-        if let Some(e) = t.epochs {
-            s += &format!("  epochs: {e}\n");
-        }
-        if let Some(l) = t.final_loss {
-            s += &format!("  final loss: {l:.4e}\n");
+        // From `fit`: what training said (`gyrotherm train`'s lines, the training range
+        // first); from a file: what the file tells.
+        if self.training_notes.is_empty() {
+            s += &format!(
+                "  training range: temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min\n",
+                t.temp_range_c.min,
+                t.temp_range_c.max,
+                t.rate_range_c_per_s.min * 60.0,
+                t.rate_range_c_per_s.max * 60.0
+            );
+            for line in m.describe() {
+                s += &format!("{line}\n");
+            }
         }
         if let Some(seed) = t.seed {
             s += &format!("  seed: {seed}\n");
@@ -470,30 +484,24 @@ fn fit(
                 }
             });
         };
-        let outcome = fit_model(&named, &cfg, &report)
+        let mut outcome = fit_model(&named, &cfg, &report)
             .map_err(|e| {
                 FitError::new_err(format!("training failed: {}", gyrotherm::error_chain(&e)))
             })?;
-        Ok(outcome)
+        // As `gyrotherm train` does: the columns are remembered, and what the fit did is
+        // told in the library's words.
+        outcome.model.columns = Some(ColumnsDef::of(&opts));
+        let notes: Vec<String> = outcome
+            .describe(&named, &cfg)
+            .into_iter()
+            .map(|l| l.trim_start().to_owned())
+            .collect();
+        Ok((outcome, notes))
     })?;
     if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
         return Err(e);
     }
-    let mut notes = Vec::new();
-    for (name, sub, t) in [
-        ("bias", &result.model.bias, &result.bias_training),
-        ("scale factor", &result.model.scale, &result.scale_training),
-    ] {
-        let Some(sub) = sub else { continue };
-        let mut line = format!("{name} model: {}", sub.kind());
-        if let Some(t) = t {
-            line += &format!(", {} epochs, final loss {:.4e}", t.epochs, t.final_loss);
-            if let Some(v) = t.lstm_verdict {
-                line += &format!("; LSTM {}", v.text());
-            }
-        }
-        notes.push(line);
-    }
+    let (result, notes) = result;
     Ok(RawModel {
         file: result.model,
         training_notes: notes,

@@ -2,6 +2,8 @@
 logs: the same model file bytes, the same compensated numbers to the last bit."""
 
 import csv
+import json
+import pathlib
 import warnings
 
 import numpy as np
@@ -140,15 +142,17 @@ def test_read_log_column_mapping_units_and_frame(tmp_path):
     p = tmp_path / "renamed.csv"
     p.write_text("# comment\nt,w_dph,T,label,x\n0,3600,20,a,1.5\n1,7200,20.5,b,2\n2,0,21,c,3\n")
     cols = gt.read_log(p, as_frame=False, time_col="t", gyro_col="w_dph", temp_col="T", gyro_unit="dph")
-    np.testing.assert_array_equal(cols["gyro_dps"], [1.0, 2.0, 0.0])
-    np.testing.assert_array_equal(cols["temp_c"], [20.0, 20.5, 21.0])
-    assert "table_dps" not in cols
+    # Under the file's names (the gyro converted to °/s), not renamed to gyro_dps.
+    np.testing.assert_array_equal(cols["w_dph"], [1.0, 2.0, 0.0])
+    np.testing.assert_array_equal(cols["T"], [20.0, 20.5, 21.0])
+    np.testing.assert_array_equal(cols["t"], [0.0, 1.0, 2.0])
+    assert "gyro_dps" not in cols and "table_dps" not in cols
     assert cols["label"] == ["a", "b", "c"]
     np.testing.assert_array_equal(cols["x"], [1.5, 2.0, 3.0])
     pd = pytest.importorskip("pandas")
     df = gt.read_log(p, time_col="t", gyro_col="w_dph", temp_col="T", gyro_unit="dph")
     assert isinstance(df, pd.DataFrame)
-    assert list(df.columns) == ["time_s", "gyro_dps", "temp_c", "label", "x"]
+    assert list(df.columns) == ["t", "w_dph", "T", "label", "x"]
     assert df.attrs["rows"] == 3 and df.attrs["sample_period_s"] == 1.0
 
 
@@ -157,3 +161,65 @@ def test_read_log_fills_gaps_when_asked(tmp_path):
     p.write_text("time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n")
     cols = gt.read_log(p, as_frame=False, fill_gaps_max_s=2)
     np.testing.assert_array_equal(cols["time_s"], [0.0, 1.0, 2.0, 3.0])
+
+
+def test_summary_of_a_least_squares_model_gives_lags_and_cross_validated_rms(cli, logs, tmp_path):
+    # A least-squares fit trains no LSTM: no "epochs: 0" or "final loss 0"; the lags and the
+    # cross-validated RMS `gyrotherm train` prints instead, in its words.
+    m = gt.fit(static=logs["static"], table=logs["table"])
+    text = m.summary()
+    assert "epochs" not in text and "final loss" not in text, text
+    out = tmp_path / "m.json"
+    train = cli("train", "--input", logs["static"], "--input", logs["table"], "--out", out)
+    said = [l.strip() for l in train.stderr.splitlines()[1:] if l.startswith("  ")]
+    assert said and all(l in text for l in said), (said, text)
+    assert "lag" in text and "cross-validated" in text, text
+    # From the file: the lags and the coverage map's cross-validated residual.
+    loaded = gt.Model.load(out).summary()
+    assert "epochs" not in loaded and "thermal lags:" in loaded, loaded
+    assert "cross-validated bias residual" in loaded, loaded
+
+
+def test_evaluate_one_column_is_the_cli_json(cli, logs, tmp_path):
+    # Parity with `gyrotherm evaluate --json` on a single-axis log, also with renamed columns.
+    want = json.loads(cli("evaluate", "--input", logs["heldout"], "--json").stdout)
+    assert gt.evaluate(logs["heldout"]) == want
+    text = pathlib.Path(logs["heldout"]).read_text()
+    header, rest = text.split("\n", 1)
+    renamed = tmp_path / "renamed.csv"
+    renamed.write_text(header.replace("gyro_dps", "w_dps").replace("temp_c", "T") + "\n" + rest)
+    got = gt.evaluate(renamed, gyro_col="w_dps", temp_col="T")
+    cli_got = json.loads(
+        cli("evaluate", "--input", renamed, "--gyro-col", "w_dps", "--temp-col", "T",
+            "--json").stdout
+    )
+    assert got == cli_got
+    assert got["column"] == "w_dps"
+    assert {k: v for k, v in got.items() if k != "column"} == {
+        k: v for k, v in want.items() if k != "column"
+    }
+
+
+def test_a_model_remembers_its_columns(cli, logs, tmp_path):
+    # Trained on renamed columns, the model reads them again without being told, in Python
+    # as in `gyrotherm compensate`; the file's names key read_log's arrays.
+    def renamed(name):
+        text = pathlib.Path(logs[name]).read_text()
+        header, rest = text.split("\n", 1)
+        p = tmp_path / f"{name}_renamed.csv"
+        p.write_text(header.replace("time_s", "t").replace("gyro_dps", "w_dps")
+                     .replace("temp_c", "T") + "\n" + rest)
+        return p
+
+    cols = dict(time_col="t", gyro_col="w_dps", temp_col="T")
+    m = gt.fit(static=renamed("static"), method="linear", **cols)
+    path = tmp_path / "m.json"
+    m.save(path)
+    assert json.loads(path.read_text())["columns"]["gyro_col"] == "w_dps"
+    held = renamed("heldout")
+    py_out, cli_out = tmp_path / "py.csv", tmp_path / "cli.csv"
+    gt.Model.load(path).compensate_csv(held, py_out)
+    cli("compensate", "--model", path, "--input", held, "--out", cli_out)
+    assert py_out.read_bytes() == cli_out.read_bytes()
+    log = gt.read_log(held, as_frame=False, **cols)
+    assert {"t", "w_dps", "T"} <= set(log)

@@ -76,7 +76,9 @@ def test_evaluate_unit_fails_when_one_axis_misses(unit_logs, unit_model, tmp_pat
 
 
 def test_evaluate_says_what_to_do(unit_logs, tmp_path):  # noqa: F811
-    with pytest.raises(gt.MetricsError, match="gyro_col and temp_col lists"):
+    # Without column lists a log is judged as one column, as `gyrotherm evaluate` does: a
+    # unit's log has no gyro_dps, and the error says so.
+    with pytest.raises(gt.LogError, match="gyro_dps"):
         gt.evaluate(unit_logs["heldout"])
     bad = tmp_path / "bad.toml"
     bad.write_text("[limits]\nbias_stabilty_dph = { max = 1 }\n")

@@ -97,21 +97,37 @@ fn check_alltau(kind: DevKind, file: &str) {
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn stable32_adev_alltau() {
     check_alltau(DevKind::Adev, "stable32_adev_alltau.txt");
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn stable32_oadev_alltau() {
     check_alltau(DevKind::Oadev, "stable32_oadev_alltau.txt");
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn stable32_mdev_alltau() {
     check_alltau(DevKind::Mdev, "stable32_mdev_alltau.txt");
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn stable32_hdev_alltau() {
     check_alltau(DevKind::Hdev, "stable32_hdev_alltau.txt");
 }
@@ -159,17 +175,29 @@ fn check_octave(kind: DevKind, file: &str) {
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn stable32_adev_octave_bounds() {
     check_octave(DevKind::Adev, "adev_octave.txt");
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn stable32_oadev_octave_bounds() {
     check_octave(DevKind::Oadev, "oadev_octave.txt");
 }
 
 /// METHOD.md: OADEV at τ = 1 s is 7.6106e-11 with 19981 terms.
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn ocxo_oadev_tau1_checked_value() {
     let Some(data) = reference("ocxo_frequency.txt") else {
         return;
@@ -345,6 +373,10 @@ fn max_m_is_last_with_terms() {
 /// Lag-1 autocorrelation noise ID (Riley & Greenhall 2004) gives Stable32's α at every octave
 /// τ with at least 30 averages (the method's range; Stable32 uses it there too).
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn stable32_noise_id_alpha() {
     for (kind, file) in [
         (DevKind::Adev, "adev_octave.txt"),
@@ -369,4 +401,11 @@ fn stable32_noise_id_alpha() {
         }
         assert_eq!(checked, 10, "{file}: octave τ with ≥ 30 averages");
     }
+}
+
+/// Without the reference data the tests above are ignored (the summary says why); under
+/// `CI=true` that is a failure.
+#[test]
+fn reference_data_is_present_under_ci() {
+    common::check_reference_data();
 }

@@ -71,6 +71,10 @@ fn compare(what: &str, got: &[f64], want: &[f64], tol: f64) -> f64 {
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn forward_matches_pytorch() {
     let Some(r) = load() else { return };
     let (i, h) = (
@@ -104,6 +108,10 @@ fn forward_matches_pytorch() {
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn loss_and_gradients_match_pytorch() {
     let Some(r) = load() else { return };
     let p = params(&r["params"], 2, 8);
@@ -146,6 +154,10 @@ fn loss_and_gradients_match_pytorch() {
 }
 
 #[test]
+#[cfg_attr(
+    no_reference_data,
+    ignore = "needs ../shared/reference (beside the checkout, or set GYROTHERM_SHARED)"
+)]
 fn adam_steps_match_pytorch() {
     let Some(r) = load() else { return };
     let mut p = params(&r["params"], 2, 8);
@@ -173,4 +185,11 @@ fn adam_steps_match_pytorch() {
             GRAD_REL_TOL,
         );
     }
+}
+
+/// Without the reference data the tests above are ignored (the summary says why); under
+/// `CI=true` that is a failure.
+#[test]
+fn reference_data_is_present_under_ci() {
+    common::check_reference_data();
 }

@@ -23,7 +23,8 @@ pub struct AllanArgs {
     pub input: PathBuf,
     #[command(flatten)]
     pub log: LogArgs,
-    /// Column to analyse: gyro_dps (default), temp_c, table_dps or any numeric extra column.
+    /// Column to analyse, by its name in the file: the gyro column (default; also called
+    /// gyro_dps, in °/s), the temperature or table column, or any numeric extra column.
     #[arg(long, default_value_t = AllanSettings::default().column)]
     pub column: String,
     /// Deviation.
@@ -68,16 +69,35 @@ impl AllanArgs {
     }
 }
 
-/// Reads the log and picks a numeric column; returns (log, values, sample period s). The
-/// gyro and temperature columns are moved out of the log to keep one copy in memory.
+/// A column read for `allan` and `evaluate`.
+pub(crate) struct ReadColumn {
+    /// The log, less the column taken (the gyro and temperature columns are moved out to
+    /// keep one copy in memory).
+    pub log: TestLog,
+    /// The column's values (a mapped gyro column in °/s).
+    pub values: Vec<f64>,
+    /// Sample period, s.
+    pub tau0_s: f64,
+    /// The name the log holds it under (`gyro_dps` for the mapped gyro column): the one whose
+    /// suffix gives its unit.
+    pub log_name: String,
+    /// The name in the file (the user's `--gyro-col`, not `gyro_dps`): what outputs call it.
+    pub name: String,
+}
+
+/// Reads the log and picks a numeric column, named as in the file or by its standard name
+/// (`gyro_dps` is the `--gyro-col` column, whatever its header).
 pub(crate) fn read_column(
     input: &Path,
     column: &str,
     log_args: &LogArgs,
-) -> anyhow::Result<(TestLog, Vec<f64>, f64)> {
+) -> anyhow::Result<ReadColumn> {
     let mut log = read_log_reporting(input, log_args)?;
+    let opts = log_args.read_options();
+    let log_name = opts.log_column(column).to_owned();
+    let name = opts.file_column(&log_name).to_owned();
     let values = log
-        .take_column(column)
+        .take_column(&log_name)
         .with_context(|| input.display().to_string())?;
     let tau0_s = log.sample_period_s();
     if !(tau0_s.is_finite() && tau0_s > 0.0) {
@@ -86,7 +106,19 @@ pub(crate) fn read_column(
             input.display()
         );
     }
-    Ok((log, values, tau0_s))
+    Ok(ReadColumn {
+        log,
+        values,
+        tau0_s,
+        log_name,
+        name,
+    })
+}
+
+/// The two names of the analysed column (see [`ReadColumn`]).
+struct ReadColumnNames {
+    log_name: String,
+    name: String,
 }
 
 /// `--json`: the curve and the noise terms as the library computed them.
@@ -118,15 +150,16 @@ fn plain_unit(column: &str) -> String {
 fn plot(
     path: &Path,
     args: &AllanArgs,
+    column: &ReadColumnNames,
     points: &[AllanPoint],
     noise: Option<&NoiseTerms>,
 ) -> anyhow::Result<()> {
-    let (factor, unit) = match rate_column_to_dph(&args.column) {
+    let (factor, unit) = match rate_column_to_dph(&column.log_name) {
         Some(f) => (f, "°/h".to_owned()),
-        None => (1.0, plain_unit(&args.column)),
+        None => (1.0, plain_unit(&column.log_name)),
     };
     let kind = args.kind;
-    let label = format!("{} of {}", kind.name().to_uppercase(), args.column);
+    let label = format!("{} of {}", kind.name().to_uppercase(), column.name);
     let curve = report::allan_curve(&label, points, factor);
     let lines = match (kind, noise) {
         (DevKind::Adev | DevKind::Oadev, Some(t)) => report::noise_lines(t, ""),
@@ -146,11 +179,20 @@ fn plot(
 
 pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
     super::common::refuse_outputs_over_inputs(args.plot.as_deref(), [args.input.as_path()])?;
-    let settings = args.settings();
+    let mut settings = args.settings();
     settings.validate()?;
     let kind = settings.kind;
     let mut w = std::io::stdout().lock();
-    let (_log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
+    let ReadColumn {
+        values,
+        tau0_s,
+        log_name,
+        name,
+        ..
+    } = read_column(&args.input, &args.column, &args.log)?;
+    // The unit (and so the noise terms) follows the name the log holds it under.
+    settings.column = log_name.clone();
+    let column = ReadColumnNames { log_name, name };
     let n_samples = values.len();
     let AllanAnalysis {
         points,
@@ -158,14 +200,14 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
         noise_from,
     } = settings
         .analyse(values, tau0_s)
-        .with_context(|| format!("{} of column {}", kind.name(), args.column))?;
+        .with_context(|| format!("{} of column {}", kind.name(), column.name))?;
     if let Some(path) = &args.plot {
-        plot(path, &args, &points, noise.as_ref())?;
+        plot(path, &args, &column, &points, noise.as_ref())?;
     }
     if args.json {
         let out = AllanJson {
             kind: kind.name(),
-            column: &args.column,
+            column: &column.name,
             samples: n_samples,
             tau0_s,
             confidence: allan::ONE_SIGMA_CI,
@@ -180,7 +222,7 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
         w,
         "{} of {} ({} samples, τ0 = {} s; 68.3 % bounds from Greenhall EDF)",
         kind.name().to_uppercase(),
-        args.column,
+        column.name,
         n_samples,
         tau0_s
     )?;

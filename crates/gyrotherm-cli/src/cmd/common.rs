@@ -8,6 +8,7 @@ use anyhow::Context as _;
 use clap::Args;
 use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
 use gyrotherm::fit::NamedLog;
+use gyrotherm::model::GivenColumns;
 use gyrotherm::settings::{read, Rule};
 
 /// How to read test logs: which columns hold what, the gyro unit, the gap policy (the
@@ -95,6 +96,21 @@ impl LogArgs {
             sample_period_s: self.sample_period_s,
             delimiter: self.delimiter,
         }
+    }
+}
+
+/// Which column options of [`LogArgs`] the command line named (`matches`: the subcommand's),
+/// as opposed to their defaults: those override a model's own columns.
+pub fn given_columns(matches: Option<&clap::ArgMatches>) -> GivenColumns {
+    let given = |id: &str| {
+        matches.is_some_and(|m| m.value_source(id) == Some(clap::parser::ValueSource::CommandLine))
+    };
+    GivenColumns {
+        time_col: given("time_col"),
+        gyro_col: given("gyro_col"),
+        temp_col: given("temp_col"),
+        table_col: given("table_col"),
+        gyro_unit: given("gyro_unit"),
     }
 }
 

@@ -10,7 +10,7 @@ use std::rc::Rc;
 
 use anyhow::Context as _;
 use gyrotherm::compensate_lines::{compensate_file, compensate_lines, Mode};
-use gyrotherm::model::{ModelFile, TempSensorDef};
+use gyrotherm::model::{GivenColumns, ModelFile, TempSensorDef};
 use gyrotherm_core::TempLimits;
 
 use super::common::LogArgs;
@@ -38,7 +38,9 @@ pub struct CompensateArgs {
     pub log: LogArgs,
 }
 
-pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
+/// `given`: the column options named on the command line; the others come from the model
+/// (the columns it was trained on), where it has them.
+pub fn run(args: CompensateArgs, given: GivenColumns) -> anyhow::Result<ExitCode> {
     super::common::refuse_outputs_over_inputs(
         args.out.as_deref(),
         [Some(args.model.as_path()), args.input.as_deref()]
@@ -66,7 +68,9 @@ pub fn run(args: CompensateArgs) -> anyhow::Result<ExitCode> {
              the first line); ignored"
         );
     }
-    let opts = args.log.read_options();
+    let opts = model
+        .read_options(&args.log.read_options(), given)
+        .with_context(|| format!("cannot use model {}", args.model.display()))?;
     let summary = if args.stream {
         let summary = stdio_stream(|input, output| {
             compensate_lines(

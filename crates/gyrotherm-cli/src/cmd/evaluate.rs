@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use gyrotherm::settings::{EvaluateSettings, Rule};
 
-use super::allan::read_column;
+use super::allan::{read_column, ReadColumn};
 use super::common::seconds;
 
 #[derive(Debug, clap::Args)]
@@ -17,7 +17,8 @@ pub struct EvaluateArgs {
     pub input: PathBuf,
     #[command(flatten)]
     pub log: super::common::LogArgs,
-    /// Rate column to judge: gyro_dps (default) or a numeric extra column (*_dps, *_dph, *_rad_s).
+    /// Rate column to judge, by its name in the file: the gyro column (default; also called
+    /// gyro_dps) or a numeric extra column (*_dps, *_dph, *_rad_s).
     #[arg(long, default_value_t = EvaluateSettings::default().column)]
     pub column: String,
     /// Smoothing time of the bias stability, s (default 100 s, or the multiple of the sample
@@ -49,14 +50,22 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     }
     let mut w = std::io::stdout().lock();
     let spec = super::verdict::load(args.spec.as_deref())?;
-    let (log, values, tau0_s) = read_column(&args.input, &args.column, &args.log)?;
+    let ReadColumn {
+        log,
+        values,
+        tau0_s,
+        log_name,
+        name,
+    } = read_column(&args.input, &args.column, &args.log)?;
     let settings = EvaluateSettings {
-        column: args.column.clone(),
+        column: log_name,
         tau_s: args.tau_s,
         settle_s: args.settle_s,
         reference_scale: args.reference_scale,
     };
-    let (e, tau) = settings.evaluate(&log, &values, tau0_s)?;
+    let (mut e, tau) = settings.evaluate(&log, &values, tau0_s)?;
+    // Named as in the file (the user's --gyro-col, not the standard `gyro_dps`).
+    e.column = name;
     if let Some(note) = tau.note(tau0_s) {
         eprintln!("gyrotherm: {note}");
     }

@@ -4,7 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, Target};
+use gyrotherm::fit::{fit_model, FitConfig, RecipeKind, Target};
+use gyrotherm::model::ColumnsDef;
 use gyrotherm::settings::fit::{self, RECIPE_NAMES};
 use gyrotherm::settings::{Deprecation, FitSettings, Method, Rule, DEFAULT_METHOD, METHODS};
 
@@ -145,6 +146,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         .map_err(anyhow::Error::new)
         .context("training failed")?;
     outcome.model.features.temp_sensor = temp_sensor;
+    // Remembered so that `compensate` reads a log of the same layout without the options.
+    outcome.model.columns = Some(ColumnsDef::of(&args.log.read_options()));
     outcome
         .model
         .save(&args.out)
@@ -167,71 +170,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         },
         started.elapsed().as_secs_f64()
     );
-    eprintln!(
-        "  training range: temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min",
-        m.training.temp_range_c.min,
-        m.training.temp_range_c.max,
-        m.training.rate_range_c_per_s.min * 60.0,
-        m.training.rate_range_c_per_s.max * 60.0
-    );
-    // The training runs of each target, in the order the fit saw them.
-    let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) =
-        named.iter().partition(|l| l.log.is_static());
-    for (name, sub, t, runs) in [
-        ("bias", &m.bias, &outcome.bias_training, &static_names),
-        (
-            "scale factor",
-            &m.scale,
-            &outcome.scale_training,
-            &table_names,
-        ),
-    ] {
-        let Some(sub) = sub else { continue };
-        eprintln!("  {name} model: {}", sub.kind());
-        let Some(t) = t else { continue };
-        if let Some(r) = &t.thermal {
-            eprintln!("    {}", r.describe());
-        }
-        if let Some(sel) = &t.selection {
-            eprintln!(
-                "    least-squares terms by time-segment cross-validation (RMS, * chosen): {}",
-                sel.describe()
-            );
-        }
-        if let Some(verdict) = t.lstm_verdict {
-            eprintln!(
-                "    LSTM: {} epochs, final loss {:.4e} (normalised MSE); {}",
-                t.epochs,
-                t.final_loss,
-                verdict.text()
-            );
-            if let Some(gate) = &t.run_gate {
-                let each: Vec<String> = gate
-                    .iter()
-                    .zip(runs.iter())
-                    .map(|(g, l)| format!("{} {:.1} %", l.name, 100.0 * g))
-                    .collect();
-                eprintln!(
-                    "    LSTM trained without each run, loss reduction on that run (needs {:.0} %): {}",
-                    100.0 * cfg.recipe.min_val_improvement,
-                    each.join(", ")
-                );
-            }
-        }
-    }
-    match (&m.coverage, &outcome.coverage_note) {
-        (Some(c), _) => eprintln!(
-            "  coverage: {} of {} (T, dT) cells covered ({:.2} °C × {:.3} °C/min cells), \
-             cross-validated bias residual {:.4} °/h RMS over {} folds",
-            c.covered_cells(),
-            c.n_temp * c.n_rate,
-            c.temp_cell_c,
-            c.rate_cell_c_per_s * 60.0,
-            c.pooled_rms_dph(),
-            c.folds
-        ),
-        (None, Some(note)) => eprintln!("  coverage: none: {note}"),
-        (None, None) => {}
+    for line in outcome.describe(&named, &cfg) {
+        eprintln!("{line}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -179,8 +179,9 @@ def evaluate(
     log: PathLike,
     model: Union[UnitModel, PathLike, None] = None,
     *,
-    spec: Optional[PathLike] = None,
     # Defaults: the library's (gyrotherm.EVALUATE_DEFAULTS), not restated here.
+    column: str = ...,
+    spec: Optional[PathLike] = None,
     tau_s: Optional[float] = ...,
     settle_s: float = ...,
     reference_scale: Optional[float] = ...,

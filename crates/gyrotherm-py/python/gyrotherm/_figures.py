@@ -9,6 +9,7 @@ import numpy as np
 
 from . import _gyrotherm as _g
 from ._logs import columns, read_log
+from ._logs import read_options as _read_options
 
 
 def _rates(rate_dps) -> np.ndarray:
@@ -57,11 +58,15 @@ def scale_factor(
     of each table rate are dropped.
     """
     if log is not None:
+        # read_log keys the columns by their names in the file.
+        names = ["time_s", "gyro_dps", "table_dps"]
         if isinstance(log, (str, bytes)) or hasattr(log, "__fspath__"):
+            opts = _read_options(read_options)
+            names = [opts["time_col"], opts["gyro_col"], opts["table_col"]]
             log = read_log(log, as_frame=False, **read_options)
         elif read_options:
             raise TypeError("log options apply only when log is a path")
-        time_s, gyro_dps, table_dps = columns(log, ["time_s", "gyro_dps", "table_dps"])
+        time_s, gyro_dps, table_dps = columns(log, names)
     if time_s is None or gyro_dps is None or table_dps is None:
         raise TypeError("give a log, or time_s, gyro_dps and table_dps arrays")
     t, g, w = (np.ascontiguousarray(a, dtype=np.float64) for a in (time_s, gyro_dps, table_dps))

@@ -56,6 +56,15 @@ def fit_unit(
     progress: Optional[Any] = None,
 ) -> Tuple[RawUnitModel, Optional[str]]: ...
 
+def evaluate_log(
+    path: str,
+    options: Dict[str, Any],
+    column: str,
+    spec: Optional[str] = None,
+    tau_s: Optional[float] = None,
+    settle_s: Optional[float] = None,
+    reference_scale: Optional[float] = None,
+) -> Tuple[str, Optional[str]]: ...
 def evaluate_unit(
     path: str,
     options: Dict[str, Any],
@@ -124,5 +133,5 @@ class RawModel:
     def compensate(
         self, time_s: _FloatArray, gyro_dps: _FloatArray, temp_c: _FloatArray
     ) -> Tuple[_FloatArray, _FloatArray, _FloatArray, npt.NDArray[np.uint8], List[str]]: ...
-    def compensate_csv(self, input: str, out: str, options: Dict[str, Any]) -> Tuple[int, int, int, int, int, List[str]]: ...
+    def compensate_csv(self, input: str, out: str, options: Dict[str, Any], given: List[str]) -> Tuple[int, int, int, int, int, List[str]]: ...
     def summary(self) -> str: ...

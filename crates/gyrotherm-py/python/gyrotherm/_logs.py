@@ -68,10 +68,10 @@ def _pandas():
 def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any):
     """Read and validate a test log (CSV) as ``gyrotherm`` commands do.
 
-    Columns come back in °/s (``gyro_unit`` converts), s and °C under the standard names
-    ``time_s``, ``gyro_dps``, ``temp_c`` (and ``table_dps`` for a rate-table log), whatever
-    they are called in the file; pass-through columns keep their names (numeric ones as float
-    arrays). Options: ``time_col``, ``gyro_col``, ``temp_col``, ``table_col``,
+    Columns come back in °/s (``gyro_unit`` converts), s and °C under their names in the file
+    (``time_col``, ``gyro_col``, ``temp_col`` and, for a rate-table log, ``table_col``: by
+    default ``time_s``, ``gyro_dps``, ``temp_c``, ``table_dps``); pass-through columns keep
+    their names too (numeric ones as float arrays). Options: ``time_col``, ``gyro_col``, ``temp_col``, ``table_col``,
     ``gyro_unit`` (``"dps"``, ``"dph"``, ``"rad/s"``), ``fill_gaps_max_s`` (max gap in s to
     interpolate), ``sample_period_s`` (s), ``delimiter`` (``","``, ``";"`` or ``"tab"``).
 

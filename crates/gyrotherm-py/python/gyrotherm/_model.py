@@ -146,7 +146,8 @@ class Model:
         return CoverageVerdicts(codes, sigma)
 
     def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]:
-        """``gyrotherm compensate --input INPUT --out OUT`` with the same log options: every
+        """``gyrotherm compensate --input INPUT --out OUT`` with the same log options (a column
+        option not given is the model's, as the CLI reads it): every
         input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps``, ``status``, ``coverage`` and
         ``sigma_dph``. Returns
         the rows written, the count per status and the extrapolation warnings (also issued as
@@ -156,8 +157,9 @@ class Model:
                 "fill_gaps_max_s does not apply to compensate: the compensator bridges time gaps "
                 "itself and writes one output line per input line"
             )
+        # Columns not named here are the model's own (the ones it was trained on).
         rows, ok, held, degraded, invalid, warns = self._raw.compensate_csv(
-            os.fspath(input), os.fspath(out), read_options(options)
+            os.fspath(input), os.fspath(out), read_options(options), sorted(options)
         )
         _warn(warns)
         return {"rows": rows, "ok": ok, "held": held, "degraded": degraded,
@@ -419,14 +421,23 @@ def evaluate(
     log: PathLike,
     model: Union["UnitModel", PathLike, None] = None,
     *,
+    column: str = EVALUATE_DEFAULTS["column"],
     spec: Optional[PathLike] = None,
     tau_s: Optional[float] = EVALUATE_DEFAULTS["tau_s"],
     settle_s: float = EVALUATE_DEFAULTS["settle_s"],
     reference_scale: Optional[float] = EVALUATE_DEFAULTS["reference_scale"],
     **log_options: Any,
 ) -> Dict[str, Any]:
-    """An inertial unit's figures per axis, as ``gyrotherm evaluate --json`` prints them with
-    ``--gyro-col``/``--temp-col`` lists, or ``--model UNIT.json`` (whose columns are read).
+    """A log's figures, as ``gyrotherm evaluate --json`` prints them.
+
+    A single-axis log (one ``gyro_col`` and ``temp_col``, no model): the figures of
+    ``column`` (the gyro column by default, or a numeric extra column named ``*_dps``,
+    ``*_dph`` or ``*_rad_s``), under ``evaluate --json``'s keys, with ``"column"`` the name in
+    the file; with ``spec`` also ``"verdict"``.
+
+    An inertial unit's figures per axis, with ``gyro_col``/``temp_col`` lists (the CLI's
+    ``--gyro-col``/``--temp-col``), or a ``model`` (``--model UNIT.json``, whose columns are
+    read).
 
     Returns ``{"tau_s": …, "axes": [...]}``, one dict per gyro column in column order:
     ``gyro``, ``temps`` (the sensors its model reads), ``raw`` and ``compensated`` (with a
@@ -442,11 +453,21 @@ def evaluate(
             model = UnitModel.load(model)
         raw_model = model._raw
     options = read_options(log_options)
+    import json
+
     if raw_model is None and not is_unit(options):
-        raise _g.MetricsError(
-            "evaluate judges an inertial unit per axis: give gyro_col and temp_col lists or a "
-            "UnitModel; for one column use bias_stability/scale_factor or `gyrotherm evaluate`"
+        text, note = _g.evaluate_log(
+            os.fspath(log),
+            options,
+            str(column),
+            None if spec is None else os.fspath(spec),
+            None if tau_s is None else float(tau_s),
+            float(settle_s),
+            None if reference_scale is None else float(reference_scale),
         )
+        if note is not None:
+            _warn([note])
+        return json.loads(text)
     text, note = _g.evaluate_unit(
         os.fspath(log),
         options,

@@ -108,6 +108,80 @@ pub struct FitOutcome {
     pub coverage_note: Option<String>,
 }
 
+impl FitOutcome {
+    /// What the fit did, one line each (indented as `gyrotherm train` prints them after the
+    /// file it wrote; Python's `Model.summary()` prints the same): the training range, then
+    /// per fitted target its model kind, the identified thermal lags and their
+    /// cross-validated RMS, the least-squares term choice, and LSTM epochs and loss only
+    /// where an LSTM was trained; last, the coverage map or why there is none. `logs` are the
+    /// training logs as given to [`fit_model`] (a run's figure names it).
+    pub fn describe(&self, logs: &[NamedLog], cfg: &FitConfig) -> Vec<String> {
+        let m = &self.model;
+        let mut out = vec![format!(
+            "  training range: temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min",
+            m.training.temp_range_c.min,
+            m.training.temp_range_c.max,
+            m.training.rate_range_c_per_s.min * 60.0,
+            m.training.rate_range_c_per_s.max * 60.0
+        )];
+        // The training runs of each target, in the order the fit saw them.
+        let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) =
+            logs.iter().partition(|l| l.log.is_static());
+        for (name, sub, t, runs) in [
+            ("bias", &m.bias, &self.bias_training, &static_names),
+            ("scale factor", &m.scale, &self.scale_training, &table_names),
+        ] {
+            let Some(sub) = sub else { continue };
+            out.push(format!("  {name} model: {}", sub.kind()));
+            let Some(t) = t else { continue };
+            if let Some(r) = &t.thermal {
+                out.push(format!("    {}", r.describe()));
+            }
+            if let Some(sel) = &t.selection {
+                out.push(format!(
+                    "    least-squares terms by time-segment cross-validation (RMS, * chosen): {}",
+                    sel.describe()
+                ));
+            }
+            if let Some(verdict) = t.lstm_verdict {
+                out.push(format!(
+                    "    LSTM: {} epochs, final loss {:.4e} (normalised MSE); {}",
+                    t.epochs,
+                    t.final_loss,
+                    verdict.text()
+                ));
+                if let Some(gate) = &t.run_gate {
+                    let each: Vec<String> = gate
+                        .iter()
+                        .zip(runs.iter())
+                        .map(|(g, l)| format!("{} {:.1} %", l.name, 100.0 * g))
+                        .collect();
+                    out.push(format!(
+                        "    LSTM trained without each run, loss reduction on that run (needs {:.0} %): {}",
+                        100.0 * cfg.recipe.min_val_improvement,
+                        each.join(", ")
+                    ));
+                }
+            }
+        }
+        match (&m.coverage, &self.coverage_note) {
+            (Some(c), _) => out.push(format!(
+                "  coverage: {} of {} (T, dT) cells covered ({:.2} °C × {:.3} °C/min cells), \
+                 cross-validated bias residual {:.4} °/h RMS over {} folds",
+                c.covered_cells(),
+                c.n_temp * c.n_rate,
+                c.temp_cell_c,
+                c.rate_cell_c_per_s * 60.0,
+                c.pooled_rms_dph(),
+                c.folds
+            )),
+            (None, Some(note)) => out.push(format!("  coverage: none: {note}")),
+            (None, None) => {}
+        }
+        out
+    }
+}
+
 /// The feature specification a method reads.
 pub fn feature_spec(cfg: &FitConfig) -> FeatureSpec {
     match cfg.method {
@@ -449,6 +523,7 @@ pub(crate) fn fit_model_with(
         scale: scale_model,
         training,
         coverage: None,
+        columns: None,
     };
     // What training covered, and the bias model's cross-validated error there.
     let coverage = model.bias.as_ref().filter(|_| coverage).map(|b| {

@@ -238,6 +238,9 @@ impl ModelFile {
         }
         let spec = self.features.to_spec()?;
         self.features.temp_sensor.to_core()?;
+        if let Some(c) = &self.columns {
+            c.validate()?;
+        }
         let nf = spec.n_features();
         if self.bias.is_none() && self.scale.is_none() {
             return Err(ModelFileError::invalid(

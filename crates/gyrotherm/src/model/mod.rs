@@ -24,7 +24,7 @@
 use crate::atomic_file::write_bytes_atomically;
 use crate::baseline::TermsError;
 use crate::baseline::{self, Terms};
-use crate::csvlog::TestLog;
+use crate::csvlog::{ReadOptions, TestLog};
 use crate::features::FeatureTable;
 use crate::json_keys::{check_unique_keys, DuplicateKey, KeyCheckError};
 use crate::nn::params::{LstmParams, ParamsError};
@@ -312,6 +312,92 @@ pub struct ModelFile {
     /// in older files and for LSTM bias models; see [`crate::coverage`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage: Option<crate::coverage::CoverageDef>,
+    /// The log columns (and gyro unit) the model was trained on, so that a log of the same
+    /// layout is compensated without naming them again (absent in older files: the options
+    /// given, or their defaults). Left out of the file when absent, so an older file's
+    /// `content_sha256` still matches.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub columns: Option<ColumnsDef>,
+}
+
+/// The columns of the logs a model was trained on: the header names of time, gyro output,
+/// temperature and rate table, and the unit of the gyro column (see [`ReadOptions`]).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnsDef {
+    pub time_col: String,
+    pub gyro_col: String,
+    pub temp_col: String,
+    pub table_col: String,
+    /// `dps`, `dph` or `rad/s`.
+    pub gyro_unit: String,
+}
+
+/// Which column options a user named (each one named overrides the model's
+/// [`ColumnsDef`]; the others come from the model).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct GivenColumns {
+    pub time_col: bool,
+    pub gyro_col: bool,
+    pub temp_col: bool,
+    pub table_col: bool,
+    pub gyro_unit: bool,
+}
+
+impl ColumnsDef {
+    /// The columns `opts` reads.
+    pub fn of(opts: &ReadOptions) -> ColumnsDef {
+        ColumnsDef {
+            time_col: opts.time_col.clone(),
+            gyro_col: opts.gyro_col.clone(),
+            temp_col: opts.temp_col.clone(),
+            table_col: opts.table_col.clone(),
+            gyro_unit: opts.gyro_unit.as_str().to_owned(),
+        }
+    }
+
+    /// `base` with these columns, except those `given` says the user named.
+    pub fn read_options(
+        &self,
+        base: &ReadOptions,
+        given: GivenColumns,
+    ) -> Result<ReadOptions, ModelFileError> {
+        let pick = |given: bool, flag: &String, mine: &String| {
+            if given {
+                flag.clone()
+            } else {
+                mine.clone()
+            }
+        };
+        let gyro_unit = if given.gyro_unit {
+            base.gyro_unit
+        } else {
+            self.gyro_unit
+                .parse()
+                .map_err(|e: String| ModelFileError::invalid("columns.gyro_unit", e))?
+        };
+        Ok(ReadOptions {
+            time_col: pick(given.time_col, &base.time_col, &self.time_col),
+            gyro_col: pick(given.gyro_col, &base.gyro_col, &self.gyro_col),
+            temp_col: pick(given.temp_col, &base.temp_col, &self.temp_col),
+            table_col: pick(given.table_col, &base.table_col, &self.table_col),
+            gyro_unit,
+            ..base.clone()
+        })
+    }
+
+    /// Checked: one column each, names a log can hold, a known gyro unit.
+    pub fn validate(&self) -> Result<(), ModelFileError> {
+        let opts = self.read_options(&ReadOptions::default(), GivenColumns::default())?;
+        if opts.is_multi_column() {
+            return Err(ModelFileError::invalid(
+                "columns",
+                "a single-axis model reads one gyro and one temperature column".to_owned(),
+            ));
+        }
+        opts.validate()
+            .map_err(|e| ModelFileError::invalid("columns", e.to_string()))
+    }
 }
 
 /// A model that cannot be read, checked or written: the file, the field and the value at
@@ -492,6 +578,55 @@ impl ModelFile {
             m if m.is_recipe() => "thermal-state LS",
             m => m.as_str(),
         }
+    }
+
+    /// Read options for a log to compensate with this model: the columns it was trained on,
+    /// except those the user named in `base` (`given`); `base` as it is for a file without
+    /// them.
+    pub fn read_options(
+        &self,
+        base: &ReadOptions,
+        given: GivenColumns,
+    ) -> Result<ReadOptions, ModelFileError> {
+        match &self.columns {
+            Some(c) => c.read_options(base, given),
+            None => Ok(base.clone()),
+        }
+    }
+
+    /// What the file tells of its fit, one indented line each (Python's `Model.summary()`):
+    /// the thermal lags the inputs use, LSTM epochs and final loss only where an LSTM was
+    /// trained (a least-squares fit has none), and the cross-validated bias residual of the
+    /// coverage map.
+    pub fn describe(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let lags = &self.features.lag_tau_s;
+        if !lags.is_empty() {
+            let each: Vec<String> = lags.iter().map(|l| format!("{l}")).collect();
+            out.push(format!("  thermal lags: {} s", each.join(", ")));
+        }
+        let t = &self.training;
+        if let (Some(e), Some(l)) = (t.epochs.filter(|&e| e > 0), t.final_loss) {
+            out.push(format!(
+                "  LSTM: {e} epochs, final loss {l:.4e} (normalised MSE)"
+            ));
+        }
+        match &self.coverage {
+            Some(c) => out.push(format!(
+                "  cross-validated bias residual: {:.4} °/h RMS over {} folds ({} of {} (T, dT) \
+                 cells covered)",
+                c.pooled_rms_dph(),
+                c.folds,
+                c.covered_cells(),
+                c.n_temp * c.n_rate
+            )),
+            None => {
+                if let Some(n) = crate::coverage::missing_note(self) {
+                    out.push(format!("  coverage: none: {n}"));
+                }
+            }
+        }
+        out
     }
 
     /// The core feature spec of this model.

@@ -75,6 +75,33 @@ impl ReadOptions {
             || self.temp_col.contains(COLUMN_LIST_SEPARATOR)
     }
 
+    /// The name a single-axis [`crate::csvlog::TestLog`] holds the file's column `name` under:
+    /// the mapped time, gyro, temperature and table columns under the standard names (the
+    /// gyro already in °/s), any other column under its own.
+    pub fn log_column<'a>(&self, name: &'a str) -> &'a str {
+        use crate::csvlog::{DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
+        match name {
+            n if n == self.gyro_col => GYRO_COL,
+            n if n == self.temp_col => TEMP_COL,
+            n if n == self.table_col => DEFAULT_TABLE_COL,
+            n if n == self.time_col => TIME_COL,
+            n => n,
+        }
+    }
+
+    /// The file's name of a [`crate::csvlog::TestLog`] column (`log_column`'s inverse): what a
+    /// result calls the column, so that it is the user's name, not the standard one.
+    pub fn file_column<'a>(&'a self, log_column: &'a str) -> &'a str {
+        use crate::csvlog::{DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
+        match log_column {
+            GYRO_COL => &self.gyro_col,
+            TEMP_COL => &self.temp_col,
+            DEFAULT_TABLE_COL => &self.table_col,
+            TIME_COL => &self.time_col,
+            n => n,
+        }
+    }
+
     /// Check the column lists (non-empty, distinct names; no name in both lists).
     pub(crate) fn validate_columns(&self) -> Result<(), SettingError> {
         let gyro = self.gyro_cols()?;
@@ -117,6 +144,22 @@ mod tests {
         };
         assert!(o.is_multi_column());
         assert!(o.validate_columns().is_err());
+    }
+
+    #[test]
+    fn a_column_keeps_the_files_name() {
+        let o = ReadOptions {
+            gyro_col: "w".into(),
+            temp_col: "T".into(),
+            ..ReadOptions::default()
+        };
+        assert_eq!(o.log_column("w"), "gyro_dps");
+        assert_eq!(o.log_column("T"), "temp_c");
+        assert_eq!(o.log_column("x_dph"), "x_dph");
+        assert_eq!(o.file_column("gyro_dps"), "w");
+        assert_eq!(o.file_column("temp_c"), "T");
+        assert_eq!(o.file_column("table_dps"), "table_dps");
+        assert_eq!(o.file_column("x_dph"), "x_dph");
     }
 
     #[test]

@@ -1,8 +1,12 @@
 //! Finding the shared reference data (`../shared/reference/` beside the checkout), and the
 //! NBS 1000-point set the Allan tests share.
 //!
-//! CI has it; a user's fresh clone does not. A test that needs a file gets `None` and prints
-//! `skipped: …` when it is missing, except under `CI=true`, where a missing file fails.
+//! CI has it; a user's fresh clone does not. The crate's build script sets
+//! `cfg(no_reference_data)` when the folder is absent, and each test that reads it carries
+//! `#[cfg_attr(no_reference_data, ignore = "needs ../shared/reference …")]`, so the summary
+//! lists it as ignored with the reason; [`check_reference_data`] (run by a test of its own in
+//! each such file) fails when the folder is absent and `CI=true`. A single file missing from
+//! a folder that is there gets `None` and a printed `skipped: …` (a failure under `CI=true`).
 
 #![allow(dead_code)] // each test file uses its own subset
 
@@ -41,6 +45,28 @@ pub fn reference_file(rel: &str) -> Option<PathBuf> {
             }
             println!("skipped: {why}");
             None
+        }
+    }
+}
+
+/// The test of each reference-reading file: with the folder absent (the other tests ignored),
+/// a failure under `CI=true`, where the data must be, and a failure when the folder has appeared
+/// since the build script looked (those tests would stay ignored without a word).
+pub fn check_reference_data() {
+    let ci = std::env::var("CI").as_deref() == Ok("true");
+    if cfg!(no_reference_data) {
+        assert!(
+            !ci,
+            "CI=true but the reference data is missing (looked for ../shared/reference beside \
+             the checkout; set GYROTHERM_SHARED to its folder): the tests that read it were \
+             ignored"
+        );
+        if let Some(d) = shared_dir().filter(|d| d.join("reference").is_dir()) {
+            panic!(
+                "{} is there now, but this build was configured without it (the tests that read \
+                 it are ignored): run `touch crates/gyrotherm/build.rs` and test again",
+                d.join("reference").display()
+            );
         }
     }
 }
