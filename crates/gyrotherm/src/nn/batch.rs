@@ -147,8 +147,12 @@ impl<T> WindowRef<'_, T> {
 /// One worker's buffers for a chunk of windows, grown as needed and reused.
 pub(crate) struct ChunkWork<T> {
     lay: Layout,
-    /// Inputs, column (t, b) at `(t·nb + b)·I`.
+    /// Inputs, column (t, b) at `(t·nb + b)·ip`, zero beyond the I inputs (see `ip`).
     x: Vec<T>,
+    /// `Wx` padded with zero columns to `ip` inputs.
+    wx: Vec<T>,
+    /// The gradient of the padded `Wx`.
+    gwx: Vec<T>,
     /// Tape, column (t, b) at `(t·nb + b)·7H`: `[i f g o | c | tanh c | h]`; the gate part
     /// holds δz after the backward pass.
     tape: Vec<T>,
@@ -164,6 +168,8 @@ impl<T: Gemm> ChunkWork<T> {
         ChunkWork {
             lay,
             x: Vec::new(),
+            wx: Vec::new(),
+            gwx: Vec::new(),
             tape: Vec::new(),
             y: Vec::new(),
             dy: Vec::new(),
@@ -178,6 +184,9 @@ impl<T: Gemm> ChunkWork<T> {
     /// gradient of the MSE over n counted steps) and returns the sum of squared errors.
     pub(crate) fn run(&mut self, p: &Packed<T>, wins: &[WindowRef<'_, T>], scale: f64) -> f64 {
         let Layout { i: ni, h: nh } = self.lay;
+        // Inputs padded with zeros to at least MATRIXMULTIPLY_MIN_DIM, so that the input
+        // products (over I) go to matrixmultiply too; the padding adds nothing.
+        let ip = ni.max(MATRIXMULTIPLY_MIN_DIM);
         let (g4, s) = (4 * nh, tape_stride(nh));
         let nb = wins.len();
         let len = wins.iter().map(|w| w.steps()).max().unwrap_or(0);
@@ -188,10 +197,10 @@ impl<T: Gemm> ChunkWork<T> {
         // Gather the inputs; steps past a shorter window's end are zero (padding: their dy is
         // zero and nothing flows back from beyond a window's end, so they add nothing).
         self.x.clear();
-        self.x.resize(cols * ni, T::ZERO);
+        self.x.resize(cols * ip, T::ZERO);
         for (b, w) in wins.iter().enumerate() {
             for t in 0..w.steps() {
-                let dst = (t * nb + b) * ni;
+                let dst = (t * nb + b) * ip;
                 self.x[dst..dst + ni].copy_from_slice(&w.x[t * ni..(t + 1) * ni]);
             }
         }
@@ -202,15 +211,18 @@ impl<T: Gemm> ChunkWork<T> {
         self.dc.resize(nh * nb, T::ZERO);
 
         // Forward. Input part of every step at once: Z = Wx · X.
-        let wx = Shape::cols(g4, ni, g4);
+        self.wx.clear();
+        self.wx.extend_from_slice(&p.wx[..g4 * ni]);
+        self.wx.resize(g4 * ip, T::ZERO);
+        let wx = Shape::cols(g4, ip, g4);
         let wh = Shape::cols(g4, nh, g4);
         T::gemm(
             &mut self.tape,
             Shape::cols(g4, cols, s),
-            &p.wx,
+            &self.wx,
             wx,
             &self.x,
-            Shape::cols(ni, cols, ni),
+            Shape::cols(ip, cols, ip),
             T::ZERO,
         );
         let two = T::ONE + T::ONE;
@@ -323,15 +335,20 @@ impl<T: Gemm> ChunkWork<T> {
             }
         }
         // Weight gradients over all steps and windows: ∂Wx += δZ·Xᵀ, ∂Wh += δZ[1..]·H[..-1]ᵀ.
+        self.gwx.clear();
+        self.gwx.resize(g4 * ip, T::ZERO);
         T::gemm(
-            &mut g.wx,
+            &mut self.gwx,
             wx,
             &self.tape,
             Shape::cols(g4, cols, s),
             &self.x,
-            Shape::cols(ni, cols, ni).t(),
-            T::ONE,
+            Shape::cols(ip, cols, ip).t(),
+            T::ZERO,
         );
+        for (a, d) in g.wx.iter_mut().zip(&self.gwx) {
+            *a += *d;
+        }
         if len > 1 {
             let shifted = (len - 1) * nb;
             T::gemm(
