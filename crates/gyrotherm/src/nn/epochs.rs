@@ -442,8 +442,7 @@ pub(crate) fn batch_grad<T: Gemm>(
             run_chunk(packed, scale, &mut work[0], c, r);
         }
     } else {
-        let mut jobs: Vec<Vec<(&[WindowRef<'_, T>], &mut (f64, Vec<f64>))>> =
-            (0..workers).map(|_| Vec::new()).collect();
+        let mut jobs: Vec<Vec<Job<'_, '_, T>>> = (0..workers).map(|_| Vec::new()).collect();
         for (k, (c, r)) in chunks.iter().zip(results.iter_mut()).enumerate() {
             jobs[k % workers].push((*c, r));
         }
@@ -475,6 +474,9 @@ pub(crate) fn batch_grad<T: Gemm>(
     }
     Ok(sum)
 }
+
+/// A worker's job: a chunk of windows and where its result goes.
+type Job<'c, 'w, T> = (&'c [WindowRef<'w, T>], &'c mut (f64, Vec<f64>));
 
 /// One chunk's sum of squared errors and gradient (flat f64) into `out`.
 fn run_chunk<T: Gemm>(
