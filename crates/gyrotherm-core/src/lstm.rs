@@ -678,6 +678,9 @@ mod tests {
         step_equals_reference::<1, 1>(7, 200, 100);
         step_equals_reference::<3, 5>(11, 200, 100);
         step_equals_reference::<12, 8>(13, 100, 100);
+        // The larger networks of the LSTM recipes (hidden size is a training setting).
+        step_equals_reference::<12, 32>(17, 20, 100);
+        step_equals_reference::<12, 64>(19, 8, 100);
     }
 
     /// Sweep e^x, σ and tanh against std f64 over [-30, 30] in steps of 1/1024 (e^x over

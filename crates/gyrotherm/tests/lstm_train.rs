@@ -3,7 +3,7 @@
 
 use gyrotherm::nn::{
     evaluate_mse, init_params, loss_and_grad, predict, train_lstm, train_normalised, train_pair,
-    Bptt, Precision, Sequence, StopReason, TrainConfig, WindowStart,
+    Bptt, LrSchedule, Precision, Sequence, StopReason, TrainConfig, WindowStart,
 };
 use gyrotherm_core::lstm::Lstm;
 
@@ -246,13 +246,20 @@ fn bad_input_is_refused_with_a_message() {
 
 /// The exported f32 flight network, stepped sample by sample, against the f64 training-side
 /// forward pass over a 30,000-step run (the export must agree within 1e-5 relative: f32 rounding over
-/// the run, far below a wrong weight's effect).
+/// the run, far below a wrong weight's effect), at the published size and at 32 and 64 hidden
+/// units (the flight crate's network is generic over its size).
 #[test]
 fn core_f32_matches_training_forward_over_30000_steps() {
+    core_matches_training::<8>(2024);
+    core_matches_training::<32>(2032);
+    core_matches_training::<64>(2064);
+}
+
+fn core_matches_training<const H: usize>(seed: u64) {
     // Error relative to max(|y_t|, RMS of y over the run): pointwise relative error is
     // meaningless where y crosses zero.
     const REL_TOL: f64 = 1e-5;
-    let mut p = init_params(2, 8, 2024);
+    let mut p = init_params(2, H, seed);
     // Weights of trained magnitude (gates driven out of their linear range).
     for v in p.w_ih.iter_mut().chain(&mut p.w_hh) {
         *v *= 3.0;
@@ -268,7 +275,7 @@ fn core_f32_matches_training_forward_over_30000_steps() {
         .collect();
     let want = predict(&p, &x).unwrap();
     let rms = (want.iter().map(|v| v * v).sum::<f64>() / want.len() as f64).sqrt();
-    let mut net = Lstm::new(&p.to_core::<2, 8>().unwrap());
+    let mut net = Lstm::new(&p.to_core::<2, H>().unwrap());
     let mut worst = (0.0f64, 0usize);
     for (t, xt) in x.chunks_exact(2).enumerate() {
         let got = net.step(&[xt[0] as f32, xt[1] as f32]).unwrap() as f64;
@@ -279,15 +286,80 @@ fn core_f32_matches_training_forward_over_30000_steps() {
     }
     let t = worst.1;
     println!(
-        "max rel err {:e} at step {t} (y {}, rms {rms})",
+        "H {H}: max rel err {:e} at step {t} (y {}, rms {rms})",
         worst.0, want[t]
     );
     assert!(
         worst.0 <= REL_TOL,
-        "step {t}: want {}, rel err {:e}",
+        "H {H}, step {t}: want {}, rel err {:e}",
         want[t],
         worst.0
     );
+}
+
+/// Minibatch truncated BPTT on sampled windows (the recipe of larger networks: windows with
+/// a burn-in, clipped Adam steps with cosine decay): the same parameters to the bit on one and
+/// on three workers (chunks are summed in a fixed order), in f64 and f32, and it learns the
+/// lagged bias: the last batches' loss under a fifth of the first's.
+#[test]
+fn sampled_minibatch_training_is_deterministic_and_learns() {
+    let temp = chamber_temp_c(6000);
+    let (x, y) = (inputs(&temp), lagged_bias(&temp));
+    let zx = gyrotherm::nn::ZScore::fit(&x, 2);
+    let zy = gyrotherm::nn::ZScore::fit(&y, 1);
+    let xn: Vec<f64> = x
+        .iter()
+        .enumerate()
+        .map(|(k, v)| zx.apply(k % 2, *v))
+        .collect();
+    let yn: Vec<f64> = y.iter().map(|v| zy.apply(0, *v)).collect();
+    let runs = [
+        Sequence::new(&xn[..8000], &yn[..4000]),
+        Sequence::new(&xn[8000..], &yn[4000..]),
+    ];
+    for precision in [Precision::F64, Precision::F32] {
+        let cfg = |threads| TrainConfig {
+            hidden_size: 16,
+            epochs: 120,
+            lr: 5e-3,
+            clip_grad_norm: Some(1.0),
+            bptt: Bptt::Sampled {
+                window: 300,
+                burn_in: 100,
+                batch: 20,
+            },
+            lr_schedule: LrSchedule::Cosine,
+            precision,
+            threads,
+            seed: 5,
+            ..TrainConfig::default()
+        };
+        let one = train_lstm(&runs, &[], 2, &cfg(1), &mut |_, _| {}).unwrap();
+        let three = train_lstm(&runs, &[], 2, &cfg(3), &mut |_, _| {}).unwrap();
+        assert_eq!(one, three, "{precision:?}: one worker and three differ");
+        let h = &one.loss_history;
+        assert_eq!(h.len(), 120);
+        let mean = |s: &[f64]| s.iter().sum::<f64>() / s.len() as f64;
+        let (first, last) = (mean(&h[..5]), mean(&h[h.len() - 10..]));
+        println!("{precision:?}: first batches {first:.4}, last {last:.4}");
+        assert!(last < 0.2 * first, "{precision:?}: loss {first} -> {last}");
+    }
+}
+
+/// Sampled windows need some run longer than the burn-in; the error says what to change.
+#[test]
+fn sampled_training_refuses_runs_no_longer_than_the_burn_in() {
+    let (x, y) = small_problem();
+    let cfg = TrainConfig {
+        bptt: Bptt::Sampled {
+            window: 5000,
+            burn_in: y.len(),
+            batch: 4,
+        },
+        ..TrainConfig::default()
+    };
+    let e = train_lstm(&[Sequence::new(&x, &y)], &[], 2, &cfg, &mut |_, _| {}).unwrap_err();
+    assert!(e.to_string().contains("lower the burn-in"), "{e}");
 }
 
 #[test]

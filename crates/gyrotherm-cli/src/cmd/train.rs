@@ -39,6 +39,9 @@ pub struct FitArgs {
     /// Random seed of the LSTM initialisation and window order.
     #[arg(long, default_value_t = fit::DEFAULT_SEED)]
     pub seed: u64,
+    /// Hidden units of the method's LSTM (8 as published; 1 to 128).
+    #[arg(long, default_value_t = fit::DEFAULT_HIDDEN)]
+    pub hidden: usize,
     /// Bias target smoothing window, s (centred moving average; 100 s as published).
     #[arg(long, alias = "bias-window", default_value_t = fit::DEFAULT_BIAS_WINDOW_S,
           value_parser = seconds("bias_window_s", Rule::PositiveSeconds))]
@@ -71,6 +74,7 @@ impl FitArgs {
             recipe: self.recipe,
             epochs: self.epochs,
             seed: self.seed,
+            hidden: self.hidden,
             bias_window_s: self.bias_window_s,
             settle_s: self.settle_s,
             poly_temp_degree: self.poly_temp_degree,

@@ -165,6 +165,7 @@ def fit(
     recipe: Optional[str] = ...,  # deprecated: the recipes are methods
     epochs: Optional[int] = ...,
     seed: int = ...,
+    hidden: int = ...,
     bias_window_s: float = ...,
     settle_s: float = ...,
     poly_temp_degree: int = ...,
@@ -198,6 +199,7 @@ def compare(
     recipe: Optional[str] = ...,
     epochs: Optional[int] = ...,
     seed: int = ...,
+    hidden: int = ...,
     bias_window_s: float = ...,
     settle_s: float = ...,
     poly_temp_degree: int = ...,

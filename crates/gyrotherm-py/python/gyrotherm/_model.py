@@ -339,6 +339,7 @@ def fit(
     recipe: Optional[str] = _FIT["recipe"],
     epochs: Optional[int] = _FIT["epochs"],
     seed: int = _FIT["seed"],
+    hidden: int = _FIT["hidden"],
     bias_window_s: float = _FIT["bias_window_s"],
     settle_s: float = _FIT["settle_s"],
     poly_temp_degree: int = _FIT["poly_temp_degree"],
@@ -382,7 +383,7 @@ def fit(
     if not static_paths and not table_paths:
         raise _g.FitError("no training logs given; pass static=[...] and/or table=[...]")
     settings = _fit_settings(
-        method, recipe, epochs, seed, bias_window_s, settle_s, poly_temp_degree,
+        method, recipe, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
         poly_rate_degree, cross, validate_on_runs,
     )
     options = read_options(log_options)
@@ -485,8 +486,8 @@ def evaluate(
 
 
 def _fit_settings(
-    method, recipe, epochs, seed, bias_window_s, settle_s, poly_temp_degree, poly_rate_degree,
-    cross, validate_on_runs,
+    method, recipe, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
+    poly_rate_degree, cross, validate_on_runs,
 ) -> Dict[str, Any]:
     """The fit keywords of :func:`fit` and :func:`compare` as the binding's settings."""
     return {
@@ -494,6 +495,7 @@ def _fit_settings(
         "recipe": None if recipe is None else str(recipe),
         "epochs": None if epochs is None else int(epochs),
         "seed": int(seed),
+        "hidden": int(hidden),
         "bias_window_s": float(bias_window_s),
         "settle_s": float(settle_s),
         "poly_temp_degree": int(poly_temp_degree),
@@ -514,6 +516,7 @@ def compare(
     recipe: Optional[str] = _FIT["recipe"],
     epochs: Optional[int] = _FIT["epochs"],
     seed: int = _FIT["seed"],
+    hidden: int = _FIT["hidden"],
     bias_window_s: float = _FIT["bias_window_s"],
     settle_s: float = _FIT["settle_s"],
     poly_temp_degree: int = _FIT["poly_temp_degree"],
@@ -546,7 +549,7 @@ def compare(
     if not train_paths or not test_paths:
         raise _g.FitError("give training logs (train=[...]) and held-out logs (test=[...])")
     settings = _fit_settings(
-        method, recipe, epochs, seed, bias_window_s, settle_s, poly_temp_degree,
+        method, recipe, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
         poly_rate_degree, cross, validate_on_runs,
     )
     text, notes = _g.compare_unit(

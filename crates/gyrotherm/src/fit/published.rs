@@ -34,6 +34,7 @@ pub(crate) fn fit(
         .map(|t| Sequence::new(&t.table.rows, &t.target).with_mask(&t.mask))
         .collect();
     let cfg = TrainConfig {
+        hidden_size: recipe.hidden,
         epochs: recipe.epochs,
         lr: recipe.lr,
         seed,

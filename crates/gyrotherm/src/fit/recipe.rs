@@ -84,6 +84,9 @@ pub struct RecipeSettings {
     pub epochs: usize,
     /// Adam learning rate (0.01 as published).
     pub lr: f64,
+    /// Hidden units of the LSTM (8 as published:
+    /// [`DEFAULT_HIDDEN`](crate::settings::fit::DEFAULT_HIDDEN)).
+    pub hidden: usize,
     /// `Residual`: steps per truncated-BPTT window.
     pub window: usize,
     /// `Residual`: leading steps of each window (and of each block) left out of the loss.

@@ -36,6 +36,7 @@ impl RecipeSettings {
             kind: RecipeKind::Residual,
             epochs: 300,
             lr: 0.003,
+            hidden: crate::settings::fit::DEFAULT_HIDDEN,
             window: 1000,
             burn_in: 200,
             batch: 4,
@@ -302,6 +303,7 @@ pub(crate) fn fit_lstm_on_base(
     }
     let (tr, va) = (seqs(&train_blocks), seqs(&val_blocks));
     let cfg = TrainConfig {
+        hidden_size: recipe.hidden,
         epochs: recipe.epochs,
         lr: recipe.lr,
         seed,

@@ -69,6 +69,14 @@ impl Adam {
     }
 }
 
+/// The cosine-decayed learning rate before Adam step `step` (from 0) of `total`:
+/// `lr·(1 + cos(π·step/total))/2`, PyTorch's `CosineAnnealingLR(T_max = total, eta_min = 0)`
+/// in closed form (Loshchilov & Hutter 2017, eq. 5, without restarts).
+pub fn cosine_lr(lr: f64, step: usize, total: usize) -> f64 {
+    let frac = step as f64 / total.max(1) as f64;
+    lr * (1.0 + (std::f64::consts::PI * frac).cos()) / 2.0
+}
+
 /// Scale `grad` so that its Euclidean norm is at most `max_norm`, as
 /// `torch.nn.utils.clip_grad_norm_`: coefficient max_norm / (‖g‖ + 1e-6), applied when < 1.
 /// Returns the norm before clipping.
@@ -99,6 +107,16 @@ mod tests {
         let mut g = [0.3, 0.4];
         clip_grad_norm(&mut g, 1.0);
         assert_eq!(g, [0.3, 0.4]);
+    }
+
+    /// Loshchilov & Hutter 2017, eq. 5 (η_min = 0, no restart): η_max at the start, half of
+    /// it midway, zero at the end.
+    #[test]
+    fn cosine_lr_runs_from_lr_to_zero() {
+        assert_eq!(cosine_lr(0.01, 0, 10), 0.01);
+        assert!((cosine_lr(0.01, 5, 10) - 0.005).abs() < 1e-18);
+        assert!(cosine_lr(0.01, 10, 10).abs() < 1e-18);
+        assert!(cosine_lr(0.01, 2, 10) > cosine_lr(0.01, 3, 10));
     }
 
     #[test]

@@ -101,19 +101,33 @@ pub(crate) fn check_problem(
             return Err(TrainError::ClipGradNorm { value: c });
         }
     }
-    if let Bptt::Truncated {
-        window,
-        burn_in,
-        batch,
-        ..
-    } = cfg.bptt
-    {
+    let windowed = match cfg.bptt {
+        Bptt::Full => None,
+        Bptt::Truncated {
+            window,
+            burn_in,
+            batch,
+            ..
+        }
+        | Bptt::Sampled {
+            window,
+            burn_in,
+            batch,
+        } => Some((window, burn_in, batch)),
+    };
+    if let Some((window, burn_in, batch)) = windowed {
         if window <= burn_in || batch == 0 {
             return Err(TrainError::Window {
                 window,
                 burn_in,
                 batch,
             });
+        }
+    }
+    if let Bptt::Sampled { burn_in, .. } = cfg.bptt {
+        // A window counts its steps from `burn_in` on: some run must be longer than that.
+        if runs.iter().all(|r| r.steps() <= burn_in) {
+            return Err(TrainError::RunsTooShort { burn_in });
         }
     }
     Ok(())

@@ -68,6 +68,33 @@ pub enum Bptt {
         /// Where window start states come from.
         start: WindowStart,
     },
+    /// Minibatch truncated BPTT over windows drawn at random: one epoch is one Adam step on
+    /// `batch` windows of `window` steps, each start drawn uniformly over every start in the
+    /// training runs (a run shorter than `window` is one window, whole). Every window starts
+    /// from zero state and its first `burn_in` steps are left out of the loss. The windows of
+    /// a batch run side by side as matrix products, split over all cores; the result does not
+    /// depend on the number of cores.
+    Sampled {
+        /// Steps per window (> burn_in).
+        window: usize,
+        /// Leading steps of each window left out of the loss.
+        burn_in: usize,
+        /// Windows per Adam step (≥ 1).
+        batch: usize,
+    },
+}
+
+/// How the learning rate changes over the Adam steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LrSchedule {
+    /// `lr` throughout (the published recipe).
+    #[default]
+    Constant,
+    /// Cosine decay from `lr` to 0 over the planned Adam steps S: before step k (from 0) the
+    /// rate is `lr·(1 + cos(π k / S))/2`, as PyTorch's `CosineAnnealingLR(T_max = S,
+    /// eta_min = 0)`. S is `epochs` for full and sampled BPTT, `epochs` times the batches per
+    /// epoch for tiled truncated BPTT.
+    Cosine,
 }
 
 /// Start state of a truncated-BPTT window.
@@ -119,6 +146,11 @@ pub struct TrainConfig {
     /// With validation runs: stop after this many epochs without a new best validation loss.
     /// Default None (run all epochs, still return the best parameters).
     pub patience: Option<usize>,
+    /// Learning-rate schedule. Default [`LrSchedule::Constant`].
+    pub lr_schedule: LrSchedule,
+    /// Worker threads of [`Bptt::Sampled`] (0: one per core). The result is the same for
+    /// any number. Default 0.
+    pub threads: usize,
     /// Start the output layer (`w_out`, `b_out`) at zero, so the untrained network predicts
     /// the target mean: for a residual network, epoch 0 is then "no correction", and early
     /// stopping on validation can choose it. Default false (PyTorch init throughout).
@@ -140,6 +172,8 @@ impl Default for TrainConfig {
             bptt: Bptt::Full,
             precision: Precision::F32,
             patience: None,
+            lr_schedule: LrSchedule::Constant,
+            threads: 0,
             zero_output_init: false,
         }
     }
@@ -163,7 +197,8 @@ pub struct TrainOutput {
     /// else the last.
     pub params: LstmParams,
     /// Training MSE per epoch (full BPTT: of the parameters before that epoch's Adam step;
-    /// truncated: mean over the epoch's batches).
+    /// truncated: mean over the epoch's batches; sampled: of the epoch's batch, before its
+    /// step).
     pub loss_history: Vec<f64>,
     /// Validation MSE per epoch (of the parameters before that epoch's step); empty without
     /// validation runs.

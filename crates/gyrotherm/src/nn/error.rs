@@ -63,6 +63,12 @@ pub enum TrainError {
         burn_in: usize,
         batch: usize,
     },
+    /// Sampled windows: no training run is longer than the burn-in, so no window has a step
+    /// in the loss.
+    RunsTooShort { burn_in: usize },
+    /// Sampled windows: no batch with a counted step was drawn (the loss mask leaves too few
+    /// steps past the burn-ins).
+    NoCountedWindow { tries: usize },
     /// The parameters became non-finite at an Adam step.
     DivergedAtStep { step: u64 },
     /// The loss became non-finite at an epoch.
@@ -161,6 +167,16 @@ impl std::fmt::Display for TrainError {
                 f,
                 "truncated BPTT needs window > burn_in and batch ≥ 1 (window {window}, burn_in \
                  {burn_in}, batch {batch})"
+            ),
+            TrainError::RunsTooShort { burn_in } => write!(
+                f,
+                "every training run has at most burn_in = {burn_in} steps, so no window has a \
+                 step in the loss; lower the burn-in or give longer runs"
+            ),
+            TrainError::NoCountedWindow { tries } => write!(
+                f,
+                "{tries} batches of windows drawn in a row had no step in the loss (the loss \
+                 mask leaves too few steps past the burn-ins); lower the burn-in or unmask more"
             ),
             TrainError::DivergedAtStep { step } => write!(
                 f,

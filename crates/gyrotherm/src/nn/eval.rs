@@ -1,8 +1,10 @@
 //! Evaluating a network outside training: forward passes, MSE, loss and gradient (for
 //! gradient checks and comparison with other frameworks), and the flat parameter vector.
 
+use super::batch::{Gemm, WindowRef};
 use super::checks::check_runs;
 use super::config::{Precision, Sequence};
+use super::epochs::batch_grad;
 use super::error::TrainError;
 use super::kernel::Kernel;
 use super::lstm::{forward, param_count, tape_stride, Layout, Packed};
@@ -151,6 +153,65 @@ pub(crate) fn loss_and_grad_in(
         Precision::F32 => Kernel::<f32>::new(lay, runs).full_grad(&theta, runs, &mut grad),
     };
     Ok((loss, unflatten(&grad, lay.i, lay.h)))
+}
+
+/// Loss and gradient of `params` over a batch of windows, as one step of minibatch truncated
+/// BPTT ([`Bptt::Sampled`](super::Bptt::Sampled)) computes them: every window from zero state,
+/// its first `burn_in` steps (and its masked steps) out of the loss, the MSE over the counted
+/// steps of all windows together; batched matrix products on up to `threads` workers (0: one
+/// per core). Returns (MSE, gradient as an `LstmParams`). Windows may differ in length.
+pub fn batch_loss_and_grad(
+    params: &LstmParams,
+    windows: &[Sequence<'_>],
+    burn_in: usize,
+    precision: Precision,
+    threads: usize,
+) -> Result<(f64, LstmParams), TrainError> {
+    params.validate()?;
+    check_runs("training", windows, params.input_size)?;
+    let lay = Layout {
+        i: params.input_size,
+        h: params.hidden_size,
+    };
+    let theta = flatten(params);
+    let mut grad = vec![0.0; lay.len()];
+    let loss = match precision {
+        Precision::F64 => batch_in::<f64>(lay, &theta, windows, burn_in, threads, &mut grad),
+        Precision::F32 => batch_in::<f32>(lay, &theta, windows, burn_in, threads, &mut grad),
+    }?;
+    Ok((loss, unflatten(&grad, lay.i, lay.h)))
+}
+
+fn batch_in<T: Gemm>(
+    lay: Layout,
+    theta: &[f64],
+    windows: &[Sequence<'_>],
+    burn_in: usize,
+    threads: usize,
+    grad: &mut [f64],
+) -> Result<f64, TrainError> {
+    let mut packed = Packed::<T>::new(lay);
+    packed.load(theta);
+    let xs: Vec<Vec<T>> = windows
+        .iter()
+        .map(|w| w.inputs.iter().map(|v| T::from_f64(*v)).collect())
+        .collect();
+    let wins: Vec<WindowRef<'_, T>> = windows
+        .iter()
+        .zip(&xs)
+        .map(|(w, x)| WindowRef {
+            x,
+            target: w.target,
+            counted_from: burn_in,
+            mask: w.loss_mask,
+        })
+        .collect();
+    let n: usize = wins.iter().map(|w| w.counted()).sum();
+    if n == 0 {
+        return Err(TrainError::AllMasked { set: "training" });
+    }
+    let sum = batch_grad(&packed, &wins, n, threads, &mut Vec::new(), grad)?;
+    Ok(sum / n as f64)
 }
 
 #[cfg(test)]

@@ -22,6 +22,16 @@ pub(crate) struct Kernel<T> {
 impl<T: Real> Kernel<T> {
     pub(crate) fn new(lay: Layout, runs: &[Sequence<'_>]) -> Self {
         let longest = runs.iter().map(|r| r.steps()).max().unwrap_or(0);
+        Self::with_tape(lay, runs, longest)
+    }
+
+    /// The runs' inputs in T and the packed weights, without the whole-run tape (for
+    /// training on sampled windows, whose tapes are the batch kernel's).
+    pub(crate) fn inputs_only(lay: Layout, runs: &[Sequence<'_>]) -> Self {
+        Self::with_tape(lay, runs, 0)
+    }
+
+    fn with_tape(lay: Layout, runs: &[Sequence<'_>], longest: usize) -> Self {
         Kernel {
             lay,
             packed: Packed::new(lay),

@@ -140,12 +140,12 @@ pub(crate) fn exp_f32(x: f32) -> f32 {
 }
 
 #[inline(always)]
-fn sigmoid<T: Real>(z: T) -> T {
+pub(crate) fn sigmoid<T: Real>(z: T) -> T {
     T::ONE / (T::ONE + (-z).exp())
 }
 
 #[inline(always)]
-fn tanh<T: Real>(z: T) -> T {
+pub(crate) fn tanh<T: Real>(z: T) -> T {
     let two = T::ONE + T::ONE;
     two * sigmoid(two * z) - T::ONE
 }
@@ -196,13 +196,13 @@ impl Layout {
 pub(crate) struct Packed<T> {
     pub lay: Layout,
     /// `wx[k·4H + r]` = `w_ih[r][k]`.
-    wx: Vec<T>,
+    pub(crate) wx: Vec<T>,
     /// `wh[m·4H + r]` = `w_hh[r][m]`.
-    wh: Vec<T>,
+    pub(crate) wh: Vec<T>,
     /// `b_ih + b_hh`.
-    b: Vec<T>,
-    w_out: Vec<T>,
-    b_out: T,
+    pub(crate) b: Vec<T>,
+    pub(crate) w_out: Vec<T>,
+    pub(crate) b_out: T,
 }
 
 impl<T: Real> Packed<T> {
@@ -251,11 +251,12 @@ impl<T: Real> Packed<T> {
 #[derive(Debug, Clone)]
 pub(crate) struct Grads<T> {
     lay: Layout,
-    wx: Vec<T>,
-    wh: Vec<T>,
-    b: Vec<T>,
-    w_out: Vec<T>,
-    b_out: T,
+    /// Same layout as [`Packed`]'s.
+    pub(crate) wx: Vec<T>,
+    pub(crate) wh: Vec<T>,
+    pub(crate) b: Vec<T>,
+    pub(crate) w_out: Vec<T>,
+    pub(crate) b_out: T,
 }
 
 impl<T: Real> Grads<T> {

@@ -12,9 +12,12 @@
 //! - `eval`: [`predict`], [`evaluate_mse`], [`loss_and_grad`] outside training.
 //! - `lstm`, `kernel`, `checks`: the hand-written forward pass and backpropagation through
 //!   time (f32 or f64), its buffers, and the input checks.
+//! - `batch`: the same over a batch of windows side by side, as matrix products (minibatch
+//!   truncated BPTT, [`Bptt::Sampled`]).
 //! - `error`: [`TrainError`].
 
 pub mod adam;
+mod batch;
 mod checks;
 mod config;
 mod epochs;
@@ -26,9 +29,13 @@ pub mod params;
 mod train;
 pub mod zscore;
 
-pub use config::{Bptt, Precision, Sequence, StopReason, TrainConfig, TrainOutput, WindowStart};
+pub use config::{
+    Bptt, LrSchedule, Precision, Sequence, StopReason, TrainConfig, TrainOutput, WindowStart,
+};
 pub use error::TrainError;
-pub use eval::{evaluate_mse, loss_and_grad, predict, predict_with_state, RunOutput};
+pub use eval::{
+    batch_loss_and_grad, evaluate_mse, loss_and_grad, predict, predict_with_state, RunOutput,
+};
 pub use params::{init_params, LstmParams, ParamsError};
 pub use train::{train_lstm, train_normalised, train_pair, NormalisedFit};
 pub use zscore::ZScore;

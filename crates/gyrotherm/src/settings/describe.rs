@@ -89,6 +89,7 @@ pub fn fit_options() -> Vec<OptionSpec> {
         },
         opt("epochs", d.epochs.map(|e| e.to_string())),
         opt("seed", Some(d.seed.to_string())),
+        opt("hidden", Some(d.hidden.to_string())),
         opt("bias_window_s", Some(d.bias_window_s.to_string())),
         opt("settle_s", Some(d.settle_s.to_string())),
         opt("poly_temp_degree", Some(d.poly_temp_degree.to_string())),

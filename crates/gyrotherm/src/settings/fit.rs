@@ -22,6 +22,12 @@ pub const DEFAULT_POLY_TEMP_DEGREE: u8 = 3;
 pub const MAX_EPOCHS: usize = 1_000_000;
 /// Default highest power of dT in the `poly` bias model.
 pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
+/// Default hidden units of the LSTM recipes: 8, as published (He et al. 2024, §2).
+pub const DEFAULT_HIDDEN: usize = 8;
+/// Most hidden units the LSTM recipes take (a 128-unit network has 70,000 parameters; the
+/// flight crate's fixed-size network then needs 290 KB).
+pub const MAX_HIDDEN: usize = 128;
+
 /// Names of the deprecated `recipe` setting (the recipe methods' names).
 pub const RECIPE_NAMES: [&str; 5] = ["thermal", "residual", "generic", "direct", "published"];
 
@@ -112,6 +118,8 @@ pub struct FitSettings {
     pub epochs: Option<usize>,
     /// Random seed of the LSTM initialisation and window order.
     pub seed: u64,
+    /// Hidden units of the method's LSTM ([`DEFAULT_HIDDEN`], 1 to [`MAX_HIDDEN`]).
+    pub hidden: usize,
     /// Bias target smoothing window, s (centred moving average).
     pub bias_window_s: f64,
     /// Time dropped at the start of each rate-table segment, s.
@@ -134,6 +142,7 @@ impl Default for FitSettings {
             recipe: None,
             epochs: None,
             seed: DEFAULT_SEED,
+            hidden: DEFAULT_HIDDEN,
             bias_window_s: DEFAULT_BIAS_WINDOW_S,
             settle_s: DEFAULT_SETTLE_S,
             poly_temp_degree: DEFAULT_POLY_TEMP_DEGREE,
@@ -184,6 +193,7 @@ impl FitSettings {
                 rule: Rule::Epochs,
             });
         }
+        check("hidden", self.hidden as f64, Rule::HiddenUnits)?;
         check("bias_window_s", self.bias_window_s, Rule::PositiveSeconds)?;
         check("settle_s", self.settle_s, Rule::NonNegativeSeconds)?;
         self.resolve().map(|_| ())
@@ -235,6 +245,7 @@ impl FitSettings {
             r.epochs = e;
         }
         r.validate_on_runs = self.validate_on_runs;
+        r.hidden = self.hidden;
         r
     }
 

@@ -67,6 +67,8 @@ pub enum Rule {
     Finite,
     /// A list of column names (one, or several separated by commas).
     ColumnList,
+    /// Hidden units of an LSTM: a whole number from 1 to [`fit::MAX_HIDDEN`].
+    HiddenUnits,
 }
 
 impl Rule {
@@ -93,6 +95,10 @@ impl Rule {
                 "is not a list of column names: give one name, or distinct names separated by \
                  commas"
             }
+            Rule::HiddenUnits => {
+                "is not a number of hidden units: give a whole number from 1 to 128 (8 as \
+                 published)"
+            }
         }
     }
 
@@ -107,6 +113,7 @@ impl Rule {
             Rule::Number | Rule::ColumnList => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
+            Rule::HiddenUnits => v.fract() == 0.0 && (1.0..=fit::MAX_HIDDEN as f64).contains(&v),
         }
     }
 }
