@@ -118,7 +118,10 @@ pub struct FitSettings {
     pub epochs: Option<usize>,
     /// Random seed of the LSTM initialisation and window order.
     pub seed: u64,
-    /// Hidden units of the method's LSTM ([`DEFAULT_HIDDEN`], 1 to [`MAX_HIDDEN`]).
+    /// Hidden units of the method's LSTM ([`DEFAULT_HIDDEN`]). The trainer takes 1 to
+    /// [`MAX_HIDDEN`], but a model file must run in flight, whose network is built for
+    /// [`gyrotherm_core::compensator::HIDDEN`] units: until the flight crate and its exports
+    /// take other sizes, [`FitSettings::validate`] accepts that size only.
     pub hidden: usize,
     /// Bias target smoothing window, s (centred moving average).
     pub bias_window_s: f64,

@@ -96,8 +96,9 @@ impl Rule {
                  commas"
             }
             Rule::HiddenUnits => {
-                "is not a number of hidden units: give a whole number from 1 to 128 (8 as \
-                 published)"
+                "is not a number of hidden units the flight compensator runs: give 8 (as \
+                 published); the trainer (`nn`) takes up to 128, but flight code and its exports \
+                 are built for 8 today"
             }
         }
     }
@@ -113,7 +114,7 @@ impl Rule {
             Rule::Number | Rule::ColumnList => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
-            Rule::HiddenUnits => v.fract() == 0.0 && (1.0..=fit::MAX_HIDDEN as f64).contains(&v),
+            Rule::HiddenUnits => v == gyrotherm_core::compensator::HIDDEN as f64,
         }
     }
 }
