@@ -80,6 +80,7 @@ fn lstm_model() -> ModelFile {
         scale: Some(lstm_sub(&mut rng, 2, 8)),
         training: training(),
         coverage: None,
+        coverage_note: None,
     }
 }
 
@@ -102,6 +103,7 @@ fn poly_model() -> ModelFile {
             ..training()
         },
         coverage: None,
+        coverage_note: None,
     }
 }
 
@@ -389,6 +391,7 @@ fn fitted_baseline_saves_and_flies() {
             inputs: vec!["synthetic".into()],
         },
         coverage: None,
+        coverage_note: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("linear.json");
@@ -434,6 +437,7 @@ fn residual_model(reads_base: bool, lstm_inputs: usize) -> ModelFile {
         scale: None,
         training: training(),
         coverage: None,
+        coverage_note: None,
     }
 }
 

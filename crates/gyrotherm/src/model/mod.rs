@@ -312,6 +312,10 @@ pub struct ModelFile {
     /// in older files and for LSTM bias models; see [`crate::coverage`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage: Option<crate::coverage::CoverageDef>,
+    /// Why training stored no coverage map (absent when it stored one, and in files written
+    /// before the reason was kept), so that a later command gives the reason training gave.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage_note: Option<String>,
 }
 
 /// A model that cannot be read, checked or written: the file, the field and the value at
