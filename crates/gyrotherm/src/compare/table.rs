@@ -36,16 +36,15 @@ impl Comparison {
     pub fn headline(&self, cfg: &CompareConfig) -> Vec<String> {
         let mut out = Vec::new();
         for t in &self.tests {
-            let (figure, unit, value): (String, &str, fn(&Performance) -> Option<f64>) =
-                if t.is_static {
-                    (
-                        format!("bias stability (τ = {} s)", fmt_num(cfg.tau_s)),
-                        "°/h",
-                        |p| p.bias_stability_dph,
-                    )
-                } else {
-                    ("max |K(t) − 1|".to_owned(), "ppm", |p| p.sf_error_ppm)
-                };
+            let (figure, unit, value): (String, &str, FigureOf) = if t.is_static {
+                (
+                    format!("bias stability (τ = {} s)", fmt_num(cfg.tau_s)),
+                    "°/h",
+                    |p| p.bias_stability_dph,
+                )
+            } else {
+                ("max |K(t) − 1|".to_owned(), "ppm", |p| p.sf_error_ppm)
+            };
             let Some(raw) = value(&t.raw).filter(|v| v.is_finite()) else {
                 continue;
             };
@@ -168,6 +167,9 @@ impl Comparison {
         }
     }
 }
+
+/// Reads one figure of an output column.
+type FigureOf = fn(&Performance) -> Option<f64>;
 
 /// The cell of a column whose fit on the training logs failed.
 pub const NOT_FITTED_CELL: &str = "not fitted";

@@ -194,7 +194,7 @@ pub fn bias_figure(path: &Path, d: &BiasData) -> Result<FigureFiles, ReportError
     let color = |i: usize| MODEL_COLORS[i % MODEL_COLORS.len()];
     let mut top = vec![Series::line("measured", d.time_s, d.measured_dph).with_color(GREY)];
     top.extend(d.predicted.iter().enumerate().map(|(i, p)| {
-        Series::line(&format!("{} predicted", p.label), d.time_s, p.values_dph).with_color(color(i))
+        Series::line(format!("{} predicted", p.label), d.time_s, p.values_dph).with_color(color(i))
     }));
     let bottom = d
         .predicted
@@ -202,7 +202,7 @@ pub fn bias_figure(path: &Path, d: &BiasData) -> Result<FigureFiles, ReportError
         .zip(&residuals)
         .enumerate()
         .map(|(i, (p, r))| {
-            Series::line(&format!("measured − {}", p.label), d.time_s, r).with_color(color(i))
+            Series::line(format!("measured − {}", p.label), d.time_s, r).with_color(color(i))
         })
         .collect();
     write_figure(
