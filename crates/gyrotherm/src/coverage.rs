@@ -312,12 +312,29 @@ pub fn push_verdict<W: std::io::Write>(
 }
 
 /// What to tell the user when a model file carries no coverage map: nothing when it does.
+/// The reason is the one training gave (kept in the file); a file without it was written
+/// before gyrotherm stored maps or their reasons.
 pub fn missing_note(model: &crate::model::ModelFile) -> Option<String> {
-    model.coverage.is_none().then(|| {
-        "the model file has no coverage map (written before gyrotherm stored one, or its bias \
-         model is an LSTM alone): the coverage and sigma_dph columns stay empty; re-train to \
-         get them"
-            .to_owned()
+    if model.coverage.is_some() {
+        return None;
+    }
+    Some(match &model.coverage_note {
+        Some(why) => {
+            // The file may have been edited: no control character reaches the terminal.
+            let why: String = why
+                .chars()
+                .take(400)
+                .map(|c| if c.is_control() { '?' } else { c })
+                .collect();
+            format!(
+                "the model file has no coverage map ({why}): the coverage and sigma_dph \
+                 columns stay empty"
+            )
+        }
+        None => "the model file has no coverage map (written before gyrotherm stored one, or \
+                 its bias model is an LSTM alone): the coverage and sigma_dph columns stay \
+                 empty; re-train to get them"
+            .to_owned(),
     })
 }
 

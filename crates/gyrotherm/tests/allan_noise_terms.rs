@@ -161,3 +161,57 @@ fn white_only_curve_has_no_rrw() {
         "ARW want {want} got {got}"
     );
 }
+
+/// A curve shaped as a real BMI270 log's: white noise (slope −½), then a short bump at
+/// τ ≈ 3.2 s (a local maximum: slope 0 there), then a flat floor at long τ. The bias
+/// instability is read at the floor, the lowest σ of the flat region, not at the bump,
+/// although the bump's points carry far more EDF (short τ).
+///
+/// The curve is built analytically, in °/h: σ²(τ) = N²/τ + F² + b(τ) with N = 300 °/h·√s,
+/// F = 72 °/h and b a Gaussian bump in log τ (height 379² − 600²/3.2 − 72² (°/h)², centred at
+/// 3.2 s, width 0.3 decades; σ(3.2 s) = 379 °/h). Octave τ from 0.2 s to 409.6 s; EDF ∝ 1/τ as for white noise.
+/// Past the bump σ falls monotonically towards F, so its lowest flat point is the last one,
+/// τ = 409.6 s: B = σ(409.6 s)/√(2 ln 2/π) (IEEE Std 952-1997 Annex C).
+#[test]
+fn bias_instability_is_the_floor_not_a_short_bump() {
+    let (n, f) = (300.0f64, 72.0f64);
+    let (tau_b, height, width) = (3.2f64, 379f64.powi(2) - n * n / 3.2 - f * f, 0.3f64);
+    let sigma = |tau: f64| {
+        let z = (tau / tau_b).log10() / width;
+        (n * n / tau + f * f + height * (-0.5 * z * z).exp()).sqrt()
+    };
+    let taus: Vec<f64> = (0..12).map(|k| 0.2 * 2f64.powi(k)).collect();
+    let points: Vec<gyrotherm::allan::AllanPoint> = taus
+        .iter()
+        .enumerate()
+        .map(|(k, &tau)| gyrotherm::allan::AllanPoint {
+            m: 1 << k,
+            tau_s: tau,
+            dev: sigma(tau),
+            n: 100_000 >> k,
+            alpha: 0,
+            edf: 100_000.0 / tau,
+            lo: f64::NAN,
+            hi: f64::NAN,
+        })
+        .collect();
+    // The synthetic curve has the shape the test is about: a flat top near 3.2 s and a
+    // flat floor at the long end.
+    assert!(sigma(3.2) > sigma(1.6) && sigma(3.2) > sigma(6.4));
+    let b = noise_terms(&points, 1.0)
+        .bias_instability_dph
+        .expect("a flat region");
+    let tau_last = *taus.last().unwrap();
+    let want = sigma(tau_last) / (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt();
+    assert!(
+        (b.tau_read_s - tau_last).abs() <= 1e-12 * tau_last,
+        "B read at τ = {} s",
+        b.tau_read_s
+    );
+    assert!(
+        (b.value - want).abs() <= 1e-9 * want,
+        "B = {} °/h, want {want} °/h (the floor), not the bump's ~{} °/h",
+        b.value,
+        379.0 / 0.6643
+    );
+}

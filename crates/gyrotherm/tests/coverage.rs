@@ -110,6 +110,7 @@ fn coverage_is_stored_sealed_and_older_files_load_without_it() {
     // the hash of a model without a map does not see the field at all.
     let old = ModelFile {
         coverage: None,
+        coverage_note: None,
         ..model.clone()
     };
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -137,5 +138,40 @@ fn a_map_the_core_refuses_is_refused_at_load() {
     assert!(
         chain.contains("coverage") && chain.contains("no covered cell"),
         "{chain}"
+    );
+}
+
+/// A least-squares model trained on logs too short to map keeps training's reason: a later
+/// command (compensate, Python) says that reason, not "written before gyrotherm stored one,
+/// or an LSTM alone", which is not true of a fresh least-squares file.
+#[test]
+fn a_fresh_model_without_a_map_says_why_training_made_none() {
+    let mut st = sim("seed-shock", 1, false);
+    // The first 3500 s of the run (the hold at 22 °C and the start of the first ramp): a
+    // least-squares model fits, its cross-validation folds do not.
+    let n = 3500.min(st.len());
+    st.time_s.truncate(n);
+    st.gyro_dps.truncate(n);
+    st.temp_c.truncate(n);
+    let named = [NamedLog {
+        name: "short",
+        log: &st,
+    }];
+    let fit = fit_model(&named, &FitConfig::new(Method::Thermal), &|_, _, _| {}).unwrap();
+    assert!(fit.model.coverage.is_none(), "a 3500 s log was mapped");
+    let why = fit
+        .coverage_note
+        .clone()
+        .expect("training says why there is no map");
+    let (back, seal) = ModelFile::from_json_sealed(&fit.model.to_json().unwrap()).unwrap();
+    assert_eq!(seal, Seal::Verified);
+    let note = missing_note(&back).unwrap();
+    assert!(
+        note.contains(&why),
+        "note {note:?} lacks training's reason {why:?}"
+    );
+    assert!(
+        !note.contains("written before") && !note.contains("LSTM alone"),
+        "{note}"
     );
 }

@@ -408,7 +408,7 @@ fn gap_is_an_error_by_default() {
         Some("time_s"),
         "gap of 4 s from 10 s to 14 s",
     );
-    assert!(e.message.contains("--fill-gaps MAX_S"), "{e}");
+    assert!(e.message.contains("--fill-gaps-max-s MAX_S"), "{e}");
     // 1.5 periods exactly is not a gap.
     let text = format!("time_s,gyro_dps,temp_c\n{}11.5,0,20\n", rows_1hz(11));
     assert_eq!(ok(&text, &default()).0.len(), 12);
@@ -470,7 +470,7 @@ fn gap_filling_interpolates_and_counts() {
         LogErrorKind::GapTooLong,
         Some(13),
         Some("time_s"),
-        "longer than the --fill-gaps limit of 3 s",
+        "longer than the --fill-gaps-max-s limit of 3 s",
     );
 }
 
@@ -510,7 +510,7 @@ fn bad_options_are_refused() {
         LogErrorKind::BadOptions,
         None,
         None,
-        "--fill-gaps must be a positive number",
+        "--fill-gaps-max-s must be a positive number",
     );
     let opts = ReadOptions {
         gyro_col: "time_s".into(),

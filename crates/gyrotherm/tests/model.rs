@@ -81,6 +81,7 @@ fn lstm_model() -> ModelFile {
         training: training(),
         coverage: None,
         columns: None,
+        coverage_note: None,
     }
 }
 
@@ -104,6 +105,7 @@ fn poly_model() -> ModelFile {
         },
         coverage: None,
         columns: None,
+        coverage_note: None,
     }
 }
 
@@ -392,6 +394,7 @@ fn fitted_baseline_saves_and_flies() {
         },
         coverage: None,
         columns: None,
+        coverage_note: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("linear.json");
@@ -438,6 +441,7 @@ fn residual_model(reads_base: bool, lstm_inputs: usize) -> ModelFile {
         training: training(),
         coverage: None,
         columns: None,
+        coverage_note: None,
     }
 }
 

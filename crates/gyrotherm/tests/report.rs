@@ -102,6 +102,7 @@ fn check_png(files: &FigureFiles) {
         colours.len()
     );
     check_legends(files, &img);
+    check_lines_inside(files, &img);
     // The y-axis title is drawn rotated in the leftmost ~40 px, where nothing else is drawn:
     // dark pixels there are glyphs, so text renders.
     let dark_in_margin = (0..40)
@@ -150,6 +151,16 @@ fn check_legends(files: &FigureFiles, img: &image::RgbImage) {
         let top = (l.x0..l.x1 - 1)
             .filter(|&x| img.get_pixel(x as u32, l.y0 as u32).0 == border)
             .count() as i32;
+        // The text stays inside its box: the right edge is whole (text drawn past the box
+        // would cover it).
+        let right = (l.y0..l.y1)
+            .filter(|&y| img.get_pixel((l.x1 - 1) as u32, y as u32).0 == border)
+            .count() as i32;
+        assert_eq!(
+            right,
+            l.y1 - l.y0,
+            "{name}: legend of panel {k}: the right edge of {l:?} is crossed"
+        );
         assert!(
             top * 10 >= (l.x1 - l.x0 - 1) * 9,
             "{name}: legend of panel {k}: {top} of {} pixels of its top edge {l:?} are the \
@@ -157,6 +168,41 @@ fn check_legends(files: &FigureFiles, img: &image::RgbImage) {
             l.x1 - l.x0 - 1
         );
     }
+}
+
+/// The series colours of the figures (the plot palette, Okabe & Ito 2008, darkened), which no
+/// axis, grid or text uses.
+const SERIES_RGB: [[u8; 3]; 7] = [
+    [0, 90, 170],
+    [213, 94, 0],
+    [0, 140, 100],
+    [150, 80, 150],
+    [200, 150, 0],
+    [86, 160, 220],
+    [180, 40, 40],
+];
+
+/// Lines stay inside their plotting area: no pixel of a series colour outside every panel's
+/// plotting area and legend box (a line crossing the frame, or a stroke spiking out of it).
+fn check_lines_inside(files: &FigureFiles, img: &image::RgbImage) {
+    let inside = |x: i32, y: i32| {
+        files
+            .layout
+            .iter()
+            .any(|p| p.plot.contains(x, y) || p.legend.is_some_and(|l| l.contains(x, y)))
+    };
+    let outside: Vec<(u32, u32)> = img
+        .enumerate_pixels()
+        .filter(|(x, y, px)| SERIES_RGB.contains(&px.0) && !inside(*x as i32, *y as i32))
+        .map(|(x, y, _)| (x, y))
+        .take(5)
+        .collect();
+    assert!(
+        outside.is_empty(),
+        "{}: series pixels outside the plotting area, e.g. {outside:?} (plot areas {:?})",
+        files.png.display(),
+        files.layout.iter().map(|p| p.plot).collect::<Vec<_>>()
+    );
 }
 
 /// SVG: starts with `<svg`, has the stated size, contains each given text, is closed.
@@ -264,7 +310,10 @@ fn write_all_figures(dir: &Path, train: &Run, test: &Run) -> Written {
         &BiasData {
             time_s: &test.time_s,
             measured_dph: &test.gyro_dph,
-            predicted_dph: &predicted,
+            predicted: &[NamedSeries {
+                label: "law",
+                values_dph: &predicted,
+            }],
         },
     )
     .unwrap();
@@ -339,6 +388,11 @@ fn write_all_figures(dir: &Path, train: &Run, test: &Run) -> Written {
                 },
                 NamedSeries {
                     label: "LSTM",
+                    values_dph: &after,
+                },
+                // A label ending in a full stop, at the end of the legend's row.
+                NamedSeries {
+                    label: "LSTM, He et al.",
                     values_dph: &after,
                 },
             ],
@@ -421,6 +475,8 @@ fn report_over_two_synthetic_runs() {
 
     let content = ReportContent {
         title: "gyrotherm report <test> & check".into(),
+        headline: vec!["every model is worse than <raw>".into()],
+        table_notes: vec!["poly: not fitted: <singular>".into()],
         table: Some(Table {
             headers: vec![
                 "method".into(),
@@ -454,6 +510,23 @@ fn report_over_two_synthetic_runs() {
     assert!(!html.contains("<test>"), "raw markup leaked into the page");
     assert!(html.contains("&lt;-40, 60&gt;"), "warning not escaped");
     assert!(html.contains("&lt;no data&gt;"), "note not shown escaped");
+    // The headline comes first, above the comparison; a column's note right under it.
+    let headline = html
+        .find("<p class=\"headline\">every model is worse than &lt;raw&gt;</p>")
+        .expect("headline shown escaped");
+    let table = html.find("<table class=\"comparison\">").unwrap();
+    let note = html
+        .find("<li>poly: not fitted: &lt;singular&gt;</li>")
+        .expect("table note shown escaped");
+    assert!(headline < table && table < note);
+    // A table wider than the page (many model columns at 1400 px) scrolls in its own box
+    // instead of running past the page's edge.
+    assert!(html.contains("div.table-wrap{max-width:100%;overflow-x:auto}"));
+    assert_eq!(
+        html.matches("<div class=\"table-wrap\">\n<table").count(),
+        html.matches("<table").count(),
+        "every table sits in a scrolling box"
+    );
     assert!(!html.contains("<script"), "page must hold no script");
     assert!(
         !html.contains("http://") && !html.contains("https://"),
@@ -514,6 +587,7 @@ fn report_creates_missing_dir_and_rejects_missing_figure() {
             png: "nope.png".into(),
             svg: None,
             caption: String::new(),
+            number: None,
         }],
         ..Default::default()
     };
@@ -527,6 +601,7 @@ fn report_creates_missing_dir_and_rejects_missing_figure() {
             png: "../escape.png".into(),
             svg: None,
             caption: String::new(),
+            number: None,
         }],
         ..Default::default()
     };
@@ -560,7 +635,10 @@ fn bad_data_is_an_error_naming_the_series() {
         &BiasData {
             time_s: &[0.0, 1.0, 2.0],
             measured_dph: &[1.0, 2.0],
-            predicted_dph: &[1.0, 2.0, 3.0],
+            predicted: &[NamedSeries {
+                label: "m",
+                values_dph: &[1.0, 2.0, 3.0],
+            }],
         },
     )
     .unwrap_err()

@@ -224,6 +224,20 @@ fn full_report_over_simulated_logs_draws_every_figure() {
         html.contains(&format!("<td>{sf:.1}</td>")),
         "raw SF error {sf:.1} missing"
     );
+    // Figure 4 shows every model's predicted bias, the report's main (recipe) model and the
+    // published LSTM both.
+    let fig4 = html
+        .split("<figcaption>Figure 4. ")
+        .nth(1)
+        .and_then(|c| c.split("</figcaption>").next())
+        .expect("figure 4 captioned");
+    for label in &s.methods {
+        assert!(
+            fig4.contains(&gyrotherm::report::html::escape(label.label)),
+            "figure 4 leaves out {}: {fig4}",
+            label.label
+        );
+    }
     // Metadata: the digest the model file carries.
     for f in &cmp.fits {
         assert!(html.contains(&f.model.training.data_digest_sha256));
@@ -277,8 +291,8 @@ fn full_report_over_simulated_logs_draws_every_figure() {
 
 #[test]
 fn figures_that_cannot_apply_are_noted_not_errors() {
-    // Static logs only and no LSTM: no loss curve, no predicted bias (LSTM), no scale-factor
-    // or rate-table figure.
+    // Static logs only and no LSTM: no loss curve, no scale-factor or rate-table figure. The
+    // predicted bias is drawn for every model (least-squares ones too).
     let train = vec![("train.csv".to_owned(), sim(5, false))];
     let test = vec![("test.csv".to_owned(), sim(6, false))];
     let (train_n, test_n) = (named(&train), named(&test));
@@ -291,12 +305,22 @@ fn figures_that_cannot_apply_are_noted_not_errors() {
     let index = write_full_report(dir.path(), &train_n, &test_n, &cmp, &cfg).expect("report");
     let html = std::fs::read_to_string(&index).unwrap();
     // The coverage figures need only a model with a least-squares bias: both have maps.
-    let drawn = [0usize, 1, 6, 7, 8, 9];
+    let drawn = [0usize, 1, 3, 6, 7, 8, 9];
     for (k, (stem, size)) in FIGURE_STEMS.iter().zip(STATED_SIZE).enumerate() {
         let png = dir.path().join(format!("{stem}.png"));
+        // One number, one figure: a drawn figure's caption and a note on a figure not drawn
+        // use the figure's own number, so no two figures on the page share one.
+        let caption = format!("<figcaption>Figure {}. ", k + 1);
         if drawn.contains(&k) {
             check_png(&png, size);
+            assert_eq!(
+                html.matches(&caption).count(),
+                1,
+                "figure {} ({stem}) is not captioned as such",
+                k + 1
+            );
         } else {
+            assert!(!html.contains(&caption), "figure {} is not drawn", k + 1);
             assert!(!png.exists(), "{stem} should not be drawn");
             assert!(
                 html.contains(&format!("Figure {} (", k + 1)),

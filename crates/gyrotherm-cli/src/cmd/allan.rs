@@ -145,6 +145,27 @@ fn plain_unit(column: &str) -> String {
     }
 }
 
+/// Unit of a column's values, read from its name as [`rate_column_to_dph`] reads it.
+fn column_unit(column: &str) -> String {
+    if column.ends_with("_dps") {
+        "°/s".to_owned()
+    } else if column.ends_with("_dph") {
+        "°/h".to_owned()
+    } else if column.ends_with("_rad_s") || column.ends_with("_rps") {
+        "rad/s".to_owned()
+    } else {
+        plain_unit(column)
+    }
+}
+
+/// `x` to 12 significant digits, printed in the shortest form that reads back as that: a
+/// sample period from time stamps (0.20000000000000284 s) prints as 0.2 s.
+fn short_num(x: f64) -> String {
+    format!("{:.11e}", x)
+        .parse::<f64>()
+        .map_or_else(|_| x.to_string(), |r| r.to_string())
+}
+
 /// `--plot`: the curve in °/h for rate columns (else the column's unit), the noise terms as
 /// slope lines when they were read from this curve (ADEV/OADEV); PNG and SVG, atomically.
 fn plot(
@@ -224,12 +245,19 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
         kind.name().to_uppercase(),
         column.name,
         n_samples,
-        tau0_s
+        short_num(tau0_s)
     )?;
+    let unit = column_unit(&args.column);
     writeln!(
         w,
         "{:>12} {:>10} {:>10} {:>5} {:>13} {:>13} {:>13}",
-        "tau_s", "m", "n", "alpha", "lo", "dev", "hi"
+        "tau (s)",
+        "m",
+        "n",
+        "alpha",
+        format!("lo ({unit})"),
+        format!("dev ({unit})"),
+        format!("hi ({unit})")
     )?;
     for p in &points {
         writeln!(

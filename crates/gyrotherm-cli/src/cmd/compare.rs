@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::compare::{compare, Candidate, CompareConfig, Comparison};
+use gyrotherm::compare::{compare_with_stages, Candidate, CompareConfig, Comparison, Stage};
 use gyrotherm::fit::NamedLog;
 use gyrotherm::settings::{Method, DEFAULT_METHOD};
 
@@ -66,7 +66,7 @@ impl ColumnArgs {
     }
 }
 
-/// `--tau` if given, else the default for the held-out logs
+/// `--tau-s` if given, else the default for the held-out logs
 /// ([`gyrotherm::compare::default_tau_s`]), said on stderr when it is not 100 s.
 pub fn resolve_tau(tau: Option<f64>, test: &[NamedLog]) -> f64 {
     tau_or_default(tau, || gyrotherm::compare::default_tau_s(test))
@@ -82,7 +82,7 @@ pub fn tau_or_default(tau: Option<f64>, default: impl FnOnce() -> (f64, Option<f
     if let Some(period) = adjusted_to {
         eprintln!(
             "gyrotherm: τ = {t} s, the multiple of the {period} s sample period nearest 100 s \
-             (100 s is not one; give --tau to choose)"
+             (100 s is not one; give --tau-s to choose)"
         );
     }
     t
@@ -106,9 +106,48 @@ pub fn run_comparison(
         .max()
         .unwrap_or(0);
     let bars = TrainingBars::new(!keys.is_empty(), epochs, &keys);
-    let result = compare(train, test, cfg, &|key, t, e, l| bars.update(key, t, e, l));
+    // A comparison fits several models and can run for minutes: say each step on stderr,
+    // as `train` says what it fitted, so a long run is never silent.
+    let stage = |s: Stage| match s {
+        Stage::Fitting { key, index, of } => bars.println(&format!(
+            "gyrotherm: fitting {key} ({} of {of}) on {} training log{}…",
+            index + 1,
+            train.len(),
+            if train.len() == 1 { "" } else { "s" }
+        )),
+        Stage::Fitted { key, ok, seconds } => bars.println(&format!(
+            "gyrotherm: {key} {} in {seconds:.1} s",
+            if ok { "fitted" } else { "could not be fitted" }
+        )),
+        Stage::Judging { log } => bars.println(&format!("gyrotherm: judging {log}…")),
+        _ => {}
+    };
+    let result = compare_with_stages(
+        train,
+        test,
+        cfg,
+        &|key, t, e, l| bars.update(key, t, e, l),
+        &stage,
+    );
     bars.finish();
-    result.context("comparison failed")
+    let cmp = result.context("comparison failed")?;
+    // The rest of the table is computed: the exit status stays 0, and each column that has
+    // no figures is said here, naming the method and the cause.
+    for f in &cmp.failed {
+        eprintln!(
+            "gyrotherm: warning: the {} column was not fitted: {}",
+            f.key, f.reason
+        );
+    }
+    for t in &cmp.tests {
+        for f in &t.failed {
+            eprintln!(
+                "gyrotherm: warning: the {} column failed on {}: {}",
+                f.key, t.name, f.reason
+            );
+        }
+    }
+    Ok(cmp)
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
@@ -182,6 +221,9 @@ pub fn print_table(
     cmp: &Comparison,
     cfg: &CompareConfig,
 ) -> std::io::Result<()> {
+    for line in cmp.headline(cfg) {
+        writeln!(w, "NOTE: {line}")?;
+    }
     for line in cmp.model_lines() {
         writeln!(w, "{line}")?;
     }

@@ -59,12 +59,12 @@ pub fn run(args: CompensateArgs, given: GivenColumns) -> anyhow::Result<ExitCode
     }
     anyhow::ensure!(
         args.log.fill_gaps_max_s.is_none(),
-        "--fill-gaps does not apply to compensate: the compensator bridges time gaps itself and \
+        "--fill-gaps-max-s does not apply to compensate: the compensator bridges time gaps itself and \
          writes one output line per input line"
     );
     if args.log.sample_period_s.is_some() {
         eprintln!(
-            "gyrotherm: note: --sample-period is not needed by compensate (output starts with \
+            "gyrotherm: note: --sample-period-s is not needed by compensate (output starts with \
              the first line); ignored"
         );
     }

@@ -145,7 +145,7 @@ pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
     if args.stream {
         anyhow::ensure!(
             args.log.fill_gaps_max_s.is_none(),
-            "--fill-gaps does not apply to compensate --stream: the compensators bridge time \
+            "--fill-gaps-max-s does not apply to compensate --stream: the compensators bridge time \
              gaps themselves and write one output line per input line"
         );
         let opts = args.log.read_options();
@@ -168,7 +168,7 @@ pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
     };
     anyhow::ensure!(
         args.log.fill_gaps_max_s.is_none(),
-        "--fill-gaps does not apply to compensate: the compensators bridge time gaps themselves \
+        "--fill-gaps-max-s does not apply to compensate: the compensators bridge time gaps themselves \
          and write one output line per input line"
     );
     let summary = compensate_imu_file(&model, input, out, &args.log.read_options())?;

@@ -47,6 +47,14 @@ impl TrainingBars {
         }
     }
 
+    /// Print a line on stderr above the bars (they would otherwise overwrite it).
+    pub fn println(&self, line: &str) {
+        match self.bars.first() {
+            Some((_, _, b)) => b.suspend(|| eprintln!("{line}")),
+            None => eprintln!("{line}"),
+        }
+    }
+
     /// Finish all bars.
     pub fn finish(&self) {
         for (_, _, b) in &self.bars {

@@ -57,6 +57,11 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         .as_ref()
         .map(|s| gyrotherm::spec::judge_comparison(s, &cmp, &test_named, &cfg))
         .transpose()?;
+    let started = std::time::Instant::now();
+    eprintln!(
+        "gyrotherm: drawing the figures and writing the report in {}…",
+        args.out.display()
+    );
     let index = write_full_report_with(
         &args.out,
         &train_named,
@@ -66,6 +71,11 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         &gap_warnings,
     )
     .with_context(|| format!("cannot write the report in {}", args.out.display()))?;
+    eprintln!(
+        "gyrotherm: wrote {} in {:.1} s",
+        index.display(),
+        started.elapsed().as_secs_f64()
+    );
     let mut out = std::io::stdout().lock();
     print_table(&mut out, &cmp, &cfg)?;
     if let Some(v) = &verdicts {

@@ -12,8 +12,9 @@
 //! Each line is fitted with its slope fixed (least squares in log σ, weighted by each point's
 //! EDF) over the contiguous run of points whose local slope (mean of the two neighbouring
 //! segments) is within ±[`SLOPE_TOL`] of the term's slope; of several runs the one with the
-//! largest total EDF is used. B is read at the minimum of the best flat run. A term with no
-//! such point is None.
+//! largest total EDF is used. B is read at the lowest point of the flat region (every point
+//! whose local slope is within the tolerance of 0), wherever it lies. A term with no such
+//! point is None.
 
 use super::AllanPoint;
 
@@ -118,6 +119,33 @@ fn fixed_slope_read(
     Some((sigma, sel[0].ln_tau.exp(), sel[sel.len() - 1].ln_tau.exp()))
 }
 
+/// Bias instability: the lowest σ of the flat region, i.e. of every point whose local slope
+/// is within ±[`SLOPE_TOL`] of 0 (IEEE Std 952 reads B at the curve's flat minimum). Not the
+/// heaviest flat run: at short τ the points carry the most EDF, so a short bump there (a
+/// local maximum, slope 0) would outweigh the floor at long τ and be read as B. The fit
+/// range is the flat run holding that point.
+fn bias_instability(pts: &[LogPoint], local: &[f64]) -> Option<NoiseTerm> {
+    let flat = |i: usize| (local[i] - 0.0).abs() <= SLOPE_TOL;
+    let min = (0..pts.len())
+        .filter(|&i| flat(i))
+        .min_by(|&a, &b| pts[a].ln_sigma.total_cmp(&pts[b].ln_sigma))?;
+    let (mut lo, mut hi) = (min, min);
+    while lo > 0 && flat(lo - 1) {
+        lo -= 1;
+    }
+    while hi + 1 < pts.len() && flat(hi + 1) {
+        hi += 1;
+    }
+    Some(NoiseTerm {
+        value: pts[min].ln_sigma.exp()
+            / (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt(),
+        tau_read_s: pts[min].ln_tau.exp(),
+        fit_tau_min_s: pts[lo].ln_tau.exp(),
+        fit_tau_max_s: pts[hi].ln_tau.exp(),
+    })
+    .filter(|t| t.value.is_finite())
+}
+
 /// Noise terms from an ADEV/OADEV curve. `to_dph` converts the curve's unit to °/h
 /// (3600 for °/s, 1 for °/h, 3600·180/π for rad/s). Points with non-finite or non-positive
 /// σ are ignored.
@@ -157,21 +185,7 @@ pub fn noise_terms(points: &[AllanPoint], to_dph: f64) -> NoiseTerms {
     let rrw = term(0.5, 3.0, 60.0);
     let quant = term(-1.0, 3f64.sqrt(), 1.0); // σ[°/h at √3 s] = Q[°]·3600 = Q[arcsec]
     let ramp = term(1.0, 2f64.sqrt(), 3600.0); // R[°/h²] = σ[°/s²]·3600² = σ[°/h]·3600
-                                               // Bias instability: the minimum of the best flat run.
-    let bias = best_run(&pts, &local, 0.0).and_then(|run| {
-        let sel = &pts[run];
-        let min = sel
-            .iter()
-            .min_by(|a, b| a.ln_sigma.total_cmp(&b.ln_sigma))?;
-        Some(NoiseTerm {
-            value: min.ln_sigma.exp()
-                / (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt(),
-            tau_read_s: min.ln_tau.exp(),
-            fit_tau_min_s: sel[0].ln_tau.exp(),
-            fit_tau_max_s: sel[sel.len() - 1].ln_tau.exp(),
-        })
-        .filter(|t| t.value.is_finite())
-    });
+    let bias = bias_instability(&pts, &local);
     NoiseTerms {
         arw_deg_rt_h: arw,
         bias_instability_dph: bias,

@@ -17,7 +17,7 @@ mod summary;
 mod table;
 
 pub use summary::{ComparisonSummary, ModelSummary, TestSummary};
-pub use table::{ComparisonTable, TableBlock, TableFigure, TableRow};
+pub use table::{ComparisonTable, TableBlock, TableFigure, TableRow, FAILED_CELL, NOT_FITTED_CELL};
 
 use std::fmt;
 
@@ -207,8 +207,24 @@ pub struct TestResult {
     /// Bias stability of the noise-only truth column, °/h (simulated logs).
     pub floor_dph: Option<f64>,
     pub methods: Vec<MethodResult>,
+    /// Columns fitted on the training logs that could not be compensated or judged on this
+    /// log, with why (absent from [`TestResult::methods`]).
+    pub failed: Vec<FailedColumn>,
     /// Extrapolation warnings (test range outside the training range), per method.
     pub warnings: Vec<String>,
+}
+
+/// A column of the comparison that could not be computed, and why. The rest of the table
+/// is computed without it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FailedColumn {
+    /// [`Candidate::key`].
+    pub key: &'static str,
+    /// Its name in the table: [`PUBLISHED_LABEL`] or the method's name (a model that was
+    /// never fitted holds nothing to name it by).
+    pub label: &'static str,
+    /// The error and its causes, as one line.
+    pub reason: String,
 }
 
 /// The whole comparison.
@@ -218,6 +234,9 @@ pub struct Comparison {
     pub fits: Vec<FitOutcome>,
     /// Key and name of each column, beside [`Comparison::fits`].
     pub columns: Vec<Column>,
+    /// Columns whose fit on the training logs failed, in table order: not in
+    /// [`Comparison::fits`]; the table shows them as not fitted, with why.
+    pub failed: Vec<FailedColumn>,
     pub tests: Vec<TestResult>,
 }
 
@@ -238,11 +257,13 @@ pub enum CompareError {
     NoCandidates,
     /// Two columns would fit the same thing (`key`).
     DuplicateColumn { key: &'static str },
-    /// Fitting the column `key` on the training logs failed.
+    /// Fitting the column `key` on the training logs failed (the only column asked for).
     Fit {
         key: &'static str,
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// No column could be fitted: each column and why.
+    NoColumnFitted { failed: Vec<FailedColumn> },
     /// Compensating the held-out log `log` failed.
     Compensate {
         log: String,
@@ -266,6 +287,13 @@ impl fmt::Display for CompareError {
                 )
             }
             CompareError::Fit { key, .. } => write!(f, "{key} fit"),
+            CompareError::NoColumnFitted { failed } => {
+                let each: Vec<String> = failed
+                    .iter()
+                    .map(|c| format!("{}: {}", c.key, c.reason))
+                    .collect();
+                write!(f, "no method could be fitted ({})", each.join("; "))
+            }
             CompareError::Compensate { log, .. } => write!(f, "{log}"),
             CompareError::Performance { log, .. } => write!(f, "{log}"),
         }
@@ -279,7 +307,9 @@ impl std::error::Error for CompareError {
                 Some(source.as_ref())
             }
             CompareError::Performance { source, .. } => Some(source),
-            CompareError::NoCandidates | CompareError::DuplicateColumn { .. } => None,
+            CompareError::NoCandidates
+            | CompareError::DuplicateColumn { .. }
+            | CompareError::NoColumnFitted { .. } => None,
         }
     }
 }
@@ -375,11 +405,46 @@ pub fn performance(
 
 /// Fit every configured column on `train` and judge each on every log of `test`.
 /// `progress(key, target, epoch, loss)` reports LSTM training ([`Candidate::key`]).
+///
+/// A column whose fit fails, or whose model cannot compensate or be judged on a held-out
+/// log, is recorded with why ([`Comparison::failed`], [`TestResult::failed`]) and the rest
+/// of the table is computed; only when no column can be fitted is it an error.
 pub fn compare(
     train: &[NamedLog],
     test: &[NamedLog],
     cfg: &CompareConfig,
     progress: &(dyn Fn(&'static str, Target, usize, f64) + Sync),
+) -> Result<Comparison, CompareError> {
+    compare_with_stages(train, test, cfg, progress, &|_| {})
+}
+
+/// A step of [`compare_with_stages`], for a progress line.
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub enum Stage<'a> {
+    /// Fitting column `key` (`index` of `of`, 0-based) begins.
+    Fitting {
+        key: &'static str,
+        index: usize,
+        of: usize,
+    },
+    /// Column `key` was fitted (`ok`) or not, in `seconds`.
+    Fitted {
+        key: &'static str,
+        ok: bool,
+        seconds: f64,
+    },
+    /// Judging held-out log `log` begins.
+    Judging { log: &'a str },
+}
+
+/// [`compare`], telling `stage` as each column is fitted and each held-out log judged.
+pub fn compare_with_stages(
+    train: &[NamedLog],
+    test: &[NamedLog],
+    cfg: &CompareConfig,
+    progress: &(dyn Fn(&'static str, Target, usize, f64) + Sync),
+    stage: &dyn Fn(Stage),
 ) -> Result<Comparison, CompareError> {
     if cfg.candidates.is_empty() {
         return Err(CompareError::NoCandidates);
@@ -392,14 +457,39 @@ pub fn compare(
     }
     let mut fits = Vec::new();
     let mut columns = Vec::new();
-    for (c, &key) in cfg.candidates.iter().zip(&keys) {
+    let mut failed = Vec::new();
+    let mut first_error = None;
+    for (index, (c, &key)) in cfg.candidates.iter().zip(&keys).enumerate() {
+        stage(Stage::Fitting {
+            key,
+            index,
+            of: keys.len(),
+        });
+        let started = std::time::Instant::now();
         let fc = c.fit_config(&cfg.fit);
-        let fit = fit_model(train, &fc, &|t, e, l| progress(key, t, e, l)).map_err(|e| {
-            CompareError::Fit {
-                key,
-                source: e.into(),
+        let fit = fit_model(train, &fc, &|t, e, l| progress(key, t, e, l));
+        stage(Stage::Fitted {
+            key,
+            ok: fit.is_ok(),
+            seconds: started.elapsed().as_secs_f64(),
+        });
+        let fit = match fit {
+            Ok(f) => f,
+            Err(e) => {
+                let label = if c.is_published(&cfg.fit) {
+                    PUBLISHED_LABEL
+                } else {
+                    key
+                };
+                failed.push(FailedColumn {
+                    key,
+                    label,
+                    reason: crate::error_chain(&e),
+                });
+                first_error.get_or_insert((key, e));
+                continue;
             }
-        })?;
+        };
         let label = if c.is_published(&cfg.fit) {
             PUBLISHED_LABEL
         } else {
@@ -408,8 +498,18 @@ pub fn compare(
         columns.push(Column { key, label });
         fits.push(fit);
     }
+    if fits.is_empty() {
+        return Err(match (failed.len(), first_error) {
+            (1, Some((key, e))) => CompareError::Fit {
+                key,
+                source: e.into(),
+            },
+            _ => CompareError::NoColumnFitted { failed },
+        });
+    }
     let mut tests = Vec::new();
     for t in test {
+        stage(Stage::Judging { log: t.name });
         let perf_err = |source| CompareError::Performance {
             log: t.name.to_owned(),
             source,
@@ -424,14 +524,29 @@ pub fn compare(
             _ => None,
         };
         let mut methods = Vec::new();
+        let mut failed_here = Vec::new();
         let mut warnings = Vec::new();
         for (fit, col) in fits.iter().zip(&columns) {
-            let comp = compensate_log(&fit.model, t.log).map_err(|e| CompareError::Compensate {
-                log: t.name.to_owned(),
-                source: e.into(),
-            })?;
-            let performance = performance(t.log, &comp.gyro_comp_dps, cfg.tau_s, cfg.settle_s)
-                .map_err(perf_err)?;
+            let judged = compensate_log(&fit.model, t.log)
+                .map_err(|e| crate::error_chain(&e))
+                .and_then(|comp| {
+                    performance(t.log, &comp.gyro_comp_dps, cfg.tau_s, cfg.settle_s)
+                        .map(|p| (comp, p))
+                        .map_err(|e| {
+                            format!("its output cannot be judged: {}", crate::error_chain(&e))
+                        })
+                });
+            let (comp, performance) = match judged {
+                Ok(x) => x,
+                Err(reason) => {
+                    failed_here.push(FailedColumn {
+                        key: col.key,
+                        label: col.label,
+                        reason,
+                    });
+                    continue;
+                }
+            };
             for w in extrapolation_warnings(&fit.model, t.log) {
                 let w = format!("{} ({} model): {w}", t.name, col.label);
                 if !warnings.contains(&w) {
@@ -452,12 +567,14 @@ pub fn compare(
             raw,
             floor_dph,
             methods,
+            failed: failed_here,
             warnings,
         });
     }
     Ok(Comparison {
         fits,
         columns,
+        failed,
         tests,
     })
 }

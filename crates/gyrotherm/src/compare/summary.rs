@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::{CompareConfig, Comparison, Performance};
+use super::{CompareConfig, Comparison, FailedColumn, Performance};
 
 /// The comparison as `gyrotherm compare --json` prints it: per held-out log the raw and
 /// per-method performance, per model what was fitted and how its training went.
@@ -12,8 +12,13 @@ use super::{CompareConfig, Comparison, Performance};
 pub struct ComparisonSummary {
     /// Bias-stability smoothing time, s.
     pub tau_s: f64,
+    /// What to read first: one line per held-out log on which every model judged is worse
+    /// than the raw output ([`Comparison::headline`]); empty otherwise.
+    pub headline: Vec<String>,
     pub tests: Vec<TestSummary>,
     pub models: Vec<ModelSummary>,
+    /// Columns whose fit failed, with why (not in `models`, nor in any test's `methods`).
+    pub failed: Vec<FailedColumn>,
 }
 
 /// One held-out log in a [`ComparisonSummary`].
@@ -27,6 +32,8 @@ pub struct TestSummary {
     /// Keyed by column ([`Candidate::key`](super::Candidate::key): `"linear"`, `"poly"`,
     /// `"lstm"`, `"published"`).
     pub methods: BTreeMap<&'static str, Performance>,
+    /// Fitted columns that could not compensate or be judged on this log, with why.
+    pub failed: Vec<FailedColumn>,
     pub warnings: Vec<String>,
 }
 
@@ -63,6 +70,8 @@ impl Comparison {
     pub fn summary(&self, cfg: &CompareConfig) -> ComparisonSummary {
         ComparisonSummary {
             tau_s: cfg.tau_s,
+            headline: self.headline(cfg),
+            failed: self.failed.clone(),
             tests: self
                 .tests
                 .iter()
@@ -76,6 +85,7 @@ impl Comparison {
                         .iter()
                         .map(|m| (m.key, m.performance.clone()))
                         .collect(),
+                    failed: t.failed.clone(),
                     warnings: t.warnings.clone(),
                 })
                 .collect(),

@@ -30,24 +30,83 @@ impl Comparison {
             .collect()
     }
 
+    /// One line per held-out log on which every model judged has a worse figure than the
+    /// raw output (bias stability on a static log, max |K(t) − 1| on a rate-table log): the
+    /// first thing a reader must know, said above the table. Empty when some model helps.
+    pub fn headline(&self, cfg: &CompareConfig) -> Vec<String> {
+        let mut out = Vec::new();
+        for t in &self.tests {
+            let (figure, unit, value): (String, &str, FigureOf) = if t.is_static {
+                (
+                    format!("bias stability (τ = {} s)", fmt_num(cfg.tau_s)),
+                    "°/h",
+                    |p| p.bias_stability_dph,
+                )
+            } else {
+                ("max |K(t) − 1|".to_owned(), "ppm", |p| p.sf_error_ppm)
+            };
+            let Some(raw) = value(&t.raw).filter(|v| v.is_finite()) else {
+                continue;
+            };
+            let judged: Vec<(&str, f64)> = t
+                .methods
+                .iter()
+                .filter_map(|m| Some((m.label, value(&m.performance).filter(|v| v.is_finite())?)))
+                .collect();
+            let Some(&(best_label, best)) = judged.iter().min_by(|a, b| a.1.total_cmp(&b.1)) else {
+                continue;
+            };
+            if best > raw {
+                out.push(format!(
+                    "every model is worse than the raw output on {}: {figure} raw {raw:.5} {unit}, \
+                     best model ({best_label}) {best:.5} {unit}: compensation makes this log worse",
+                    t.name
+                ));
+            }
+        }
+        out
+    }
+
     /// The results table, built once for every rendering.
     pub fn table(&self, cfg: &CompareConfig) -> ComparisonTable {
         let mut columns = vec!["raw".to_owned()];
         columns.extend(self.columns.iter().map(|c| c.label.to_owned()));
-        let empty = Performance::default();
+        // Columns that could not be fitted keep their place, each cell saying so; the note
+        // under the table gives why.
+        columns.extend(self.failed.iter().map(|c| c.label.to_owned()));
+        let notes = self
+            .failed
+            .iter()
+            .map(|c| format!("{}: not fitted: {}", c.label, c.reason))
+            .collect();
         let blocks = self
             .tests
             .iter()
             .map(|t| {
-                let all: Vec<&Performance> = std::iter::once(&t.raw)
+                // None: the column has no figures on this log (failed on it, or not fitted).
+                let all: Vec<Option<&Performance>> = std::iter::once(Some(&t.raw))
                     .chain(self.columns.iter().map(|c| {
                         t.methods
                             .iter()
                             .find(|r| r.key == c.key)
-                            .map_or(&empty, |r| &r.performance)
+                            .map(|r| &r.performance)
                     }))
                     .collect();
-                let cells = |f: &dyn Fn(&Performance) -> String| all.iter().map(|p| f(p)).collect();
+                let failed_here = |i: usize| {
+                    let key = self.columns[i - 1].key;
+                    t.failed.iter().any(|f| f.key == key)
+                };
+                let cells = |f: &dyn Fn(&Performance) -> String| -> Vec<String> {
+                    all.iter()
+                        .enumerate()
+                        .map(|(i, p)| match p {
+                            Some(p) => f(p),
+                            None if failed_here(i) => FAILED_CELL.to_owned(),
+                            None => "-".to_owned(),
+                        })
+                        .chain(self.failed.iter().map(|_| NOT_FITTED_CELL.to_owned()))
+                        .collect()
+                };
                 let mut rows = Vec::new();
                 if t.is_static {
                     rows.push(TableRow {
@@ -93,12 +152,29 @@ impl Comparison {
                     is_static: t.is_static,
                     has_floor: t.floor_dph.is_some(),
                     rows,
+                    notes: t
+                        .failed
+                        .iter()
+                        .map(|c| format!("{}: failed on this log: {}", c.label, c.reason))
+                        .collect(),
                 }
             })
             .collect();
-        ComparisonTable { columns, blocks }
+        ComparisonTable {
+            columns,
+            blocks,
+            notes,
+        }
     }
 }
+
+/// Reads one figure of an output column.
+type FigureOf = fn(&Performance) -> Option<f64>;
+
+/// The cell of a column whose fit on the training logs failed.
+pub const NOT_FITTED_CELL: &str = "not fitted";
+/// The cell of a fitted column that could not compensate or be judged on a held-out log.
+pub const FAILED_CELL: &str = "failed";
 
 fn cell(v: Option<f64>, digits: usize) -> String {
     match v {
@@ -114,6 +190,8 @@ pub struct ComparisonTable {
     /// Output columns: `raw`, then each column's name ([`Column::label`](super::Column)).
     pub columns: Vec<String>,
     pub blocks: Vec<TableBlock>,
+    /// Why a column has no figures at all (its fit failed), one line per such column.
+    pub notes: Vec<String>,
 }
 
 /// The rows of one held-out log.
@@ -124,6 +202,8 @@ pub struct TableBlock {
     /// Whether the log carries the noise-only truth column (a noise-floor column).
     pub has_floor: bool,
     pub rows: Vec<TableRow>,
+    /// Why a column has no figures on this log, one line per such column.
+    pub notes: Vec<String>,
 }
 
 /// One figure across the outputs.
@@ -248,6 +328,15 @@ impl ComparisonTable {
                 }
                 writeln!(w)?;
             }
+            for n in &b.notes {
+                writeln!(w, "  {n}")?;
+            }
+            writeln!(w)?;
+        }
+        for n in &self.notes {
+            writeln!(w, "{n}")?;
+        }
+        if !self.notes.is_empty() {
             writeln!(w)?;
         }
         Ok(())

@@ -45,7 +45,7 @@ pub(super) fn check_options(path: &Path, opts: &ReadOptions) -> Result<(), LogEr
     }
     if let Some(v) = opts.fill_gaps_max_s {
         if !(v.is_finite() && v > 0.0) {
-            return Err(bad("--fill-gaps", v));
+            return Err(bad("--fill-gaps-max-s", v));
         }
     }
     if let Some(v) = opts.sample_period_s {

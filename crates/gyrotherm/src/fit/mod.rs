@@ -524,6 +524,7 @@ pub(crate) fn fit_model_with(
         training,
         coverage: None,
         columns: None,
+        coverage_note: None,
     };
     // What training covered, and the bias model's cross-validated error there.
     let coverage = model.bias.as_ref().filter(|_| coverage).map(|b| {
@@ -538,7 +539,11 @@ pub(crate) fn fit_model_with(
         Some(Err(e)) => (None, Some(crate::error_chain(&e))),
         None => (None, Some("no bias model: no coverage map".to_owned())),
     };
-    let model = ModelFile { coverage, ..model };
+    let model = ModelFile {
+        coverage,
+        coverage_note: coverage_note.clone(),
+        ..model
+    };
     if own_bias {
         model.validate()?;
     }

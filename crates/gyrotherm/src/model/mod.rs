@@ -318,6 +318,10 @@ pub struct ModelFile {
     /// `content_sha256` still matches.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub columns: Option<ColumnsDef>,
+    /// Why training stored no coverage map (absent when it stored one, and in files written
+    /// before the reason was kept), so that a later command gives the reason training gave.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage_note: Option<String>,
 }
 
 /// The columns of the logs a model was trained on: the header names of time, gyro output,

@@ -146,43 +146,72 @@ pub fn loss_figure(path: &Path, curves: &[LossCurve]) -> Result<FigureFiles, Rep
     write_figure(path, &one_panel("Training loss", "epoch", p))
 }
 
-/// Data of figure 4: the bias network on the held-out run.
+/// Data of figure 4: each model's bias prediction on the held-out run.
 #[derive(Debug, Clone, Copy)]
 pub struct BiasData<'a> {
     pub time_s: &'a [f64],
     /// Measured bias, °/h.
     pub measured_dph: &'a [f64],
-    /// Predicted bias, °/h.
-    pub predicted_dph: &'a [f64],
+    /// Predicted bias, °/h, one series per model (the default model's first), each labelled
+    /// by the model's name.
+    pub predicted: &'a [NamedSeries<'a>],
 }
 
-/// Figure 4: predicted and measured bias (°/h, top) and the residual measured − predicted
-/// (°/h, bottom) against time. 1000 × 800 px.
+/// Colours of the models' series in figure 4, one per model in order (the measured bias
+/// is grey).
+const MODEL_COLORS: [(u8, u8, u8); 7] = [
+    ORANGE,
+    BLUE,
+    GREEN,
+    (150, 80, 150),
+    (200, 150, 0),
+    (86, 160, 220),
+    (180, 40, 40),
+];
+
+/// Figure 4: each model's predicted and the measured bias (°/h, top) and each residual
+/// measured − predicted (°/h, bottom) against time. 1000 × 800 px.
 pub fn bias_figure(path: &Path, d: &BiasData) -> Result<FigureFiles, ReportError> {
     check_len("bias: measured_dph", d.time_s, d.measured_dph)?;
-    check_len("bias: predicted_dph", d.time_s, d.predicted_dph)?;
-    let residual: Vec<f64> = d
-        .measured_dph
+    for p in d.predicted {
+        check_len(
+            &format!("bias: predicted_dph of {}", p.label),
+            d.time_s,
+            p.values_dph,
+        )?;
+    }
+    let residuals: Vec<Vec<f64>> = d
+        .predicted
         .iter()
-        .zip(d.predicted_dph)
-        .map(|(m, p)| m - p)
+        .map(|p| {
+            d.measured_dph
+                .iter()
+                .zip(p.values_dph)
+                .map(|(m, p)| m - p)
+                .collect()
+        })
+        .collect();
+    let color = |i: usize| MODEL_COLORS[i % MODEL_COLORS.len()];
+    let mut top = vec![Series::line("measured", d.time_s, d.measured_dph).with_color(GREY)];
+    top.extend(d.predicted.iter().enumerate().map(|(i, p)| {
+        Series::line(format!("{} predicted", p.label), d.time_s, p.values_dph).with_color(color(i))
+    }));
+    let bottom = d
+        .predicted
+        .iter()
+        .zip(&residuals)
+        .enumerate()
+        .map(|(i, (p, r))| {
+            Series::line(format!("measured − {}", p.label), d.time_s, r).with_color(color(i))
+        })
         .collect();
     write_figure(
         path,
         &two_panels(
             "Bias: predicted against measured (held-out run)",
             TIME_LABEL,
-            panel(
-                "bias (°/h)",
-                vec![
-                    Series::line("measured", d.time_s, d.measured_dph).with_color(GREY),
-                    Series::line("predicted", d.time_s, d.predicted_dph).with_color(ORANGE),
-                ],
-            ),
-            panel(
-                "residual (°/h)",
-                vec![Series::line("measured − predicted", d.time_s, &residual).with_color(BLUE)],
-            ),
+            panel("bias (°/h)", top),
+            panel("residual (°/h)", bottom),
         ),
     )
 }

@@ -184,7 +184,13 @@ impl<B: DrawingBackend> DrawingBackend for GlyphFix<B> {
             };
             let bounds = outline.px_bounds();
             // Vertical placement as plotters draws it (baseline at size / 2 below the top).
-            let (gx, gy) = (bounds.min.x as i32, (size / 2.0 + bounds.min.y) as i32);
+            // Rounded down for every glyph alike: truncating towards zero moved a glyph
+            // reaching above `size / 2` (most letters) one pixel lower than one that does
+            // not (".", ","), so a full stop sat above the baseline ("et al·").
+            let (gx, gy) = (
+                bounds.min.x.floor() as i32,
+                (size / 2.0 + bounds.min.y).floor() as i32,
+            );
             let mut pixels = Vec::new();
             outline.draw(|x, y, coverage| {
                 if coverage > 0.0 {
@@ -201,5 +207,47 @@ impl<B: DrawingBackend> DrawingBackend for GlyphFix<B> {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plotters::prelude::*;
+
+    /// "l." drawn at the legend's size (15 px, odd, so `size / 2` is a half pixel): the full
+    /// stop and the l both stand on the baseline, so their lowest inked rows are the same.
+    /// DejaVu Sans: neither glyph has a descender.
+    #[test]
+    fn a_full_stop_sits_on_the_baseline() {
+        ensure_font().unwrap();
+        let (w, h) = (60u32, 40u32);
+        let mut rgb = vec![255u8; (w * h * 3) as usize];
+        {
+            let root =
+                GlyphFix::new(BitMapBackend::with_buffer(&mut rgb, (w, h))).into_drawing_area();
+            let style: TextStyle = (FONT_FAMILY, 15).into_font().into();
+            root.draw_text("l.", &style.color(&BLACK), (10, 10))
+                .unwrap();
+            root.present().unwrap();
+        }
+        let ink = |x: u32, y: u32| rgb[((y * w + x) * 3) as usize] < 128;
+        let columns_with_ink: Vec<u32> = (0..w).filter(|&x| (0..h).any(|y| ink(x, y))).collect();
+        // The two glyphs are separated by at least one blank column.
+        let split = columns_with_ink
+            .windows(2)
+            .find(|p| p[1] > p[0] + 1)
+            .map(|p| p[1])
+            .expect("two glyphs");
+        let lowest = |xs: std::ops::Range<u32>| {
+            xs.flat_map(|x| (0..h).filter(move |&y| ink(x, y)))
+                .max()
+                .unwrap()
+        };
+        assert_eq!(
+            lowest(0..split),
+            lowest(split..w),
+            "l and . on different baselines"
+        );
     }
 }

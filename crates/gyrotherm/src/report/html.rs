@@ -25,6 +25,10 @@ pub struct ReportFigure {
     /// SVG file name, linked.
     pub svg: Option<String>,
     pub caption: String,
+    /// Its number on the page (None: its place among the figures). A report whose notes
+    /// name figures that were not drawn numbers every figure, so that "Figure 5" means one
+    /// plot whether it was drawn or not.
+    pub number: Option<usize>,
 }
 
 impl ReportFigure {
@@ -40,6 +44,7 @@ impl ReportFigure {
             png: name(&files.png),
             svg: Some(name(&files.svg)),
             caption: caption.into(),
+            number: None,
         }
     }
 }
@@ -48,8 +53,12 @@ impl ReportFigure {
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReportContent {
     pub title: String,
+    /// What to read first (e.g. every model worse than raw), shown under the title.
+    pub headline: Vec<String>,
     /// The comparison table of `gyrotherm compare`.
     pub table: Option<Table>,
+    /// Notes under the comparison table (why a column has no figures).
+    pub table_notes: Vec<String>,
     /// Settings shared by all models, key then value (shown above [`ReportContent::models`]).
     pub metadata: Vec<(String, String)>,
     /// The models side by side: one column per model, one row per field.
@@ -70,7 +79,9 @@ th{background:#eee}td:first-child,th:first-child{text-align:left}dl{display:grid
 grid-template-columns:max-content auto;gap:.2em 1.2em}dt{font-weight:bold}dd{margin:0;\
 font-family:monospace}ul.warnings li{color:#8a4b00}figure{margin:1.2em 0}\
 figure img{max-width:100%;border:1px solid #ddd}figcaption{font-size:.95em;color:#444}\
-table.models td{text-align:left;overflow-wrap:anywhere}table.models th{text-align:left}";
+table.models td{text-align:left;overflow-wrap:anywhere}table.models th{text-align:left}\
+div.table-wrap{max-width:100%;overflow-x:auto}p.headline{font-weight:bold;color:#a00;\
+border-left:4px solid #a00;background:#fff4f4;padding:.4em .8em}";
 
 /// Write `dir/index.html` for `content` (creating `dir` if missing) and return its path.
 /// Every referenced image must already exist in `dir`: a missing one is an error naming it,
@@ -122,9 +133,19 @@ pub fn render_html(c: &ReportContent) -> String {
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <title>{title}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<h1>{title}</h1>\n"
     );
+    for line in &c.headline {
+        let _ = writeln!(h, "<p class=\"headline\">{}</p>", escape(line));
+    }
     if let Some(t) = &c.table {
         h.push_str("<h2>Comparison</h2>\n");
         push_table(&mut h, t, "comparison");
+    }
+    if !c.table_notes.is_empty() {
+        h.push_str("<ul class=\"table-notes\">\n");
+        for n in &c.table_notes {
+            let _ = writeln!(h, "<li>{}</li>", escape(n));
+        }
+        h.push_str("</ul>\n");
     }
     if !c.metadata.is_empty() || c.models.is_some() {
         h.push_str("<h2>Model</h2>\n");
@@ -158,7 +179,7 @@ pub fn render_html(c: &ReportContent) -> String {
             h,
             "<figure>\n<img src=\"{}\" alt=\"{caption}\">\n<figcaption>Figure {}. {caption}",
             escape(&f.png),
-            i + 1
+            f.number.unwrap_or(i + 1)
         );
         if let Some(svg) = &f.svg {
             let _ = write!(h, " (<a href=\"{}\">SVG</a>)", escape(svg));
@@ -178,7 +199,12 @@ pub fn render_html(c: &ReportContent) -> String {
 
 /// `t` as an HTML table of class `class`; rows shorter than the headers are padded.
 pub(crate) fn push_table(h: &mut String, t: &Table, class: &str) {
-    let _ = write!(h, "<table class=\"{class}\">\n<thead><tr>");
+    // A table wider than the page scrolls inside its own box rather than overflowing the
+    // page (many model columns, long figure names).
+    let _ = write!(
+        h,
+        "<div class=\"table-wrap\">\n<table class=\"{class}\">\n<thead><tr>"
+    );
     for head in &t.headers {
         let _ = write!(h, "<th>{}</th>", escape(head));
     }
@@ -192,7 +218,7 @@ pub(crate) fn push_table(h: &mut String, t: &Table, class: &str) {
         }
         h.push_str("</tr>\n");
     }
-    h.push_str("</tbody>\n</table>\n");
+    h.push_str("</tbody>\n</table>\n</div>\n");
 }
 
 /// Escape `& < > " '` for text and attribute values.

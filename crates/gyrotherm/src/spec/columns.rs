@@ -34,10 +34,14 @@ pub fn judge_comparison(
         noise_terms: spec.needs_noise_terms(),
     };
     let mut out = Vec::new();
-    for (c, col) in cmp.columns.iter().enumerate() {
+    for col in &cmp.columns {
         let mut measured = Vec::new();
         for (t, r) in test.iter().zip(&cmp.tests) {
-            let m = &r.methods[c];
+            // A column that could not compensate this log has no output to judge here; the
+            // table and the warnings say why.
+            let Some(m) = r.methods.iter().find(|m| m.key == col.key) else {
+                continue;
+            };
             let f = measure(t.log, &m.compensated.gyro_comp_dps, &opts).map_err(|source| {
                 SpecError::Measure {
                     log: t.name.to_string(),

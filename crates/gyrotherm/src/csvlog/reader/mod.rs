@@ -357,8 +357,8 @@ impl<R: Read> LogReader<R> {
                 Some(line),
                 Some(t_col),
                 format!(
-                    "{what}, longer than the --fill-gaps limit of {max} s; split the log at \
-                     this line or raise --fill-gaps if interpolating {dt} s is acceptable"
+                    "{what}, longer than the --fill-gaps-max-s limit of {max} s; split the log at \
+                     this line or raise --fill-gaps-max-s if interpolating {dt} s is acceptable"
                 ),
             )),
             GapVerdict::NotAllowed => Err(LogError::new(
@@ -367,7 +367,7 @@ impl<R: Read> LogReader<R> {
                 Some(line),
                 Some(t_col),
                 format!(
-                    "{what}; split the log at this line, or pass --fill-gaps MAX_S to \
+                    "{what}; split the log at this line, or pass --fill-gaps-max-s MAX_S to \
                      interpolate gaps up to MAX_S seconds"
                 ),
             )),
@@ -395,7 +395,7 @@ impl<R: Read> LogReader<R> {
                     "the given sample period {period} s disagrees with the log's time steps: \
                      {mismatches} of its first {} steps are more than {GAP_FACTOR} times longer \
                      or shorter (median step {median} s); give the log's own period or leave \
-                     --sample-period out",
+                     --sample-period-s out",
                     steps.len()
                 ),
             ));

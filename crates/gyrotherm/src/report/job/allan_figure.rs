@@ -34,6 +34,9 @@ pub(super) fn allan_report_figure(
     let mut curves = vec![allan_curve("raw", &raw, DPS_TO_DPH)];
     let mut lines = noise_lines(&allan::noise_terms(&raw, DPS_TO_DPH), "raw");
     let mut terms_from = "raw";
+    // Figure 8 is drawn without the compensated curve when that one cannot be computed: its
+    // caption says so (a "not drawn" note would name a figure the page shows).
+    let mut left_out = String::new();
     if let Some(m) = compensated_result(r) {
         match oadev(&m.compensated.gyro_comp_dps) {
             Ok(p) => {
@@ -42,7 +45,7 @@ pub(super) fn allan_report_figure(
                 lines = noise_lines(&allan::noise_terms(&p, DPS_TO_DPH), label);
                 terms_from = label;
             }
-            Err(e) => b.note(8, &format!("compensated curve of {} left out: {e}", l.name)),
+            Err(e) => left_out = format!(" The {} compensated curve is left out: {e}.", m.label),
         }
     }
     let files = allan_figure(&b.path(7), &curves, &lines, "°/h")?;
@@ -50,7 +53,8 @@ pub(super) fn allan_report_figure(
         &files,
         format!(
             "Overlapping Allan deviation (octave τ) of {} (°/h), 68.3 % confidence bars; dashed \
-             lines: noise terms identified on the {terms_from} curve (IEEE Std 952 annex C).",
+             lines: noise terms identified on the {terms_from} curve (IEEE Std 952 annex C).\
+             {left_out}",
             l.name
         ),
     );

@@ -125,9 +125,16 @@ pub fn write_full_report_with(
     let mut warnings = grouped_warnings(test, cmp);
     warnings.extend(extra_warnings.iter().cloned());
 
+    let table = cmp.table(cfg);
+    let mut table_notes = table.notes.clone();
+    for b in &table.blocks {
+        table_notes.extend(b.notes.iter().map(|n| format!("{}: {n}", b.log)));
+    }
     let content = ReportContent {
         title: "gyrotherm report: thermal compensation of held-out logs".to_owned(),
-        table: Some(comparison_table(cmp, cfg)),
+        headline: cmp.headline(cfg),
+        table: Some(tables::results_table(&table)),
+        table_notes,
         metadata: shared_settings(train, cmp, cfg),
         models: Some(model_table(cmp, cfg)),
         warnings,
@@ -261,41 +268,67 @@ fn fig_training_loss(b: &mut Builder, cmp: &Comparison) -> Result<(), ReportErro
     Ok(())
 }
 
-/// Figure 4: predicted against measured bias on the static held-out log.
+/// Figure 4: predicted against measured bias on the static held-out log, for every model
+/// of the comparison (the report's main column first, so the default model is never left
+/// out for an LSTM).
 fn fig_bias(
     b: &mut Builder,
     static_pair: Option<(&NamedLog, &TestResult)>,
     cfg: &CompareConfig,
 ) -> Result<(), ReportError> {
-    match (static_pair, static_pair.and_then(|(_, r)| lstm_result(r))) {
-        (None, _) => b.note(4, "no static held-out log given"),
-        (Some(_), None) => b.note(4, "no LSTM model was fitted"),
-        (Some((l, _)), Some(m)) => {
-            match centred_moving_average(&l.log.time_s, &l.log.gyro_dps, cfg.fit.bias_window_s) {
-                Err(e) => b.note(4, &format!("cannot smooth {}: {e}", l.name)),
-                Ok(s) => {
-                    let measured = to_dph(&s.values);
-                    let predicted = to_dph(&m.compensated.bias_dps);
-                    let files = bias_figure(
-                        &b.path(3),
-                        &BiasData {
-                            time_s: &l.log.time_s,
-                            measured_dph: &measured,
-                            predicted_dph: &predicted,
-                        },
-                    )?;
-                    b.add(
-                        &files,
-                        format!(
-                            "Bias of {} (°/h): measured (centred {} s moving average of the raw \
-                             output) against predicted (LSTM bias network through the flight \
-                             compensator), and the residual.",
-                            l.name,
-                            fmt_num(cfg.fit.bias_window_s)
-                        ),
-                    );
-                }
-            }
+    let Some((l, r)) = static_pair else {
+        b.note(4, "no static held-out log given");
+        return Ok(());
+    };
+    let main = compensated_result(r);
+    let shown: Vec<&MethodResult> = main
+        .into_iter()
+        .chain(
+            r.methods
+                .iter()
+                .filter(|m| main.is_none_or(|s| s.key != m.key)),
+        )
+        .collect();
+    if shown.is_empty() {
+        b.note(4, "no compensation method was fitted");
+        return Ok(());
+    }
+    match centred_moving_average(&l.log.time_s, &l.log.gyro_dps, cfg.fit.bias_window_s) {
+        Err(e) => b.note(4, &format!("cannot smooth {}: {e}", l.name)),
+        Ok(s) => {
+            let measured = to_dph(&s.values);
+            let predicted: Vec<Vec<f64>> = shown
+                .iter()
+                .map(|m| to_dph(&m.compensated.bias_dps))
+                .collect();
+            let series: Vec<NamedSeries> = shown
+                .iter()
+                .zip(&predicted)
+                .map(|(m, v)| NamedSeries {
+                    label: m.label,
+                    values_dph: v,
+                })
+                .collect();
+            let files = bias_figure(
+                &b.path(3),
+                &BiasData {
+                    time_s: &l.log.time_s,
+                    measured_dph: &measured,
+                    predicted: &series,
+                },
+            )?;
+            let names: Vec<&str> = shown.iter().map(|m| m.label).collect();
+            b.add(
+                &files,
+                format!(
+                    "Bias of {} (°/h): measured (centred {} s moving average of the raw \
+                     output) against predicted by each model's bias part through the flight \
+                     compensator ({}), and the residuals.",
+                    l.name,
+                    fmt_num(cfg.fit.bias_window_s),
+                    names.join(", ")
+                ),
+            );
         }
     }
     Ok(())
@@ -403,8 +436,16 @@ impl Builder<'_> {
     pub(super) fn path(&self, index: usize) -> PathBuf {
         self.dir.join(FIGURE_STEMS[index])
     }
+    /// A figure written at [`Builder::path`], numbered as its place in [`FIGURE_STEMS`]
+    /// (the numbers [`Builder::note`] uses).
     pub(super) fn add(&mut self, files: &FigureFiles, caption: String) {
-        self.figures.push(ReportFigure::from_files(files, caption));
+        let mut f = ReportFigure::from_files(files, caption);
+        let stem = files.png.file_stem().and_then(|s| s.to_str());
+        f.number = FIGURE_STEMS
+            .iter()
+            .position(|s| Some(*s) == stem)
+            .map(|i| i + 1);
+        self.figures.push(f);
     }
     /// Figure `number` (1-based) was not drawn, because of `why`.
     pub(super) fn note(&mut self, number: usize, why: &str) {

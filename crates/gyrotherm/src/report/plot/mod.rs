@@ -345,7 +345,13 @@ where
         .iter()
         .flat_map(|p| &p.series)
         .flat_map(|s| s.x.iter().copied());
-    let (x0, x1) = padded_range(xs, fig.log_x, fig.log_x || has_markers);
+    let (mut x0, mut x1) = padded_range(xs, fig.log_x, fig.log_x || has_markers);
+    if !(fig.log_x || has_markers) {
+        // A line starting or ending on the first or last x would lie on the frame, its
+        // 2 px stroke crossing it: a margin of 1 % of the span keeps it inside.
+        let m = 0.01 * (x1 - x0);
+        (x0, x1) = (x0 - m, x1 + m);
+    }
     let legend_font: TextStyle = (FONT_FAMILY, LEGEND_FONT_PX).into_font().into();
     let mut layouts = Vec::with_capacity(fig.panels.len());
     for (area, panel) in areas.iter().zip(&fig.panels) {
