@@ -29,8 +29,9 @@ use gyrotherm_core::compensator::{Corrected, Status};
 use gyrotherm_core::unit::Unit;
 
 use crate::compensate_lines::{
-    lines_to_file, parse_number, read_header, read_line_capped, record, split_and_time,
-    too_long_error, Fields, FileError, LineCheck, LineRead, LinesError, Mode, MAX_LINE_BYTES,
+    check_added_columns, lines_to_file, parse_number, read_header, read_line_capped, record,
+    split_and_time, too_long_error, Fields, FileError, LineCheck, LineRead, LinesError, Mode,
+    MAX_LINE_BYTES,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
@@ -158,6 +159,7 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
     let delimiter = opts.delimiter;
     let decimal_comma = delimiter != b',';
     let added = output_columns(model);
+    check_added_columns(&headers, added.iter().map(String::as_str), source, line_no)?;
     let mut writer = LogWriter::with_delimiter(
         output,
         headers

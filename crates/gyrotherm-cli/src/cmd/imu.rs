@@ -47,6 +47,14 @@ pub fn read_imu_logs_with(
                         report.filled_samples
                     );
                 }
+                if report.zero_table {
+                    eprintln!(
+                        "gyrotherm: {}: the table-rate column {} is all zeros: read as a \
+                         static run",
+                        p.display(),
+                        opts.table_col
+                    );
+                }
                 out.push((p.display().to_string(), log));
             }
             Err(e) => {
