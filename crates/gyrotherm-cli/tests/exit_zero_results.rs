@@ -98,7 +98,7 @@ fn plan_writes_only_profiles_simulate_reads() {
                 "--max-rate-c-per-min",
                 "5",
             ][..],
-            "not a temperature a flight reaches",
+            "temp_max_c = 1e308 °C is not a temperature a flight reaches",
         ),
         (
             &[

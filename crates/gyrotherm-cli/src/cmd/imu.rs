@@ -163,6 +163,9 @@ pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             )
         })?;
         eprintln!("gyrotherm: {}", summary.describe(&model));
+        for w in &summary.warnings {
+            eprintln!("gyrotherm: warning: {w}");
+        }
         return Ok(ExitCode::SUCCESS);
     }
     let (Some(input), Some(out)) = (&args.input, &args.out) else {

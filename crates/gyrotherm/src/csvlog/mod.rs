@@ -32,6 +32,7 @@ pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
 };
+pub(crate) use writer::short_f64;
 pub use writer::{format_f64, LogWriter};
 
 use std::fs::File;

@@ -76,11 +76,7 @@ impl fmt::Display for MetricsError {
             MetricsError::TauTooLong { tau_s, samples, sample_period_s, stop_segments } => {
                 let duration_s = *samples as f64 * sample_period_s;
                 // 1e300 s, not three hundred digits.
-                let tau_s = if tau_s.abs() >= 1e9 {
-                    format!("{tau_s:e}")
-                } else {
-                    tau_s.to_string()
-                };
+                let tau_s = crate::csvlog::short_f64(*tau_s);
                 if *stop_segments {
                     write!(
                         f,

@@ -65,6 +65,9 @@ pub enum Rule {
     Finite,
     /// A list of column names (one, or several separated by commas).
     ColumnList,
+    /// A temperature a flight reaches, °C: from absolute zero to
+    /// [`plan::MAX_ENVELOPE_C`].
+    FlightTemperature,
 }
 
 impl Rule {
@@ -89,6 +92,9 @@ impl Rule {
                 "is not a list of column names: give one name, or distinct names separated by \
                  commas"
             }
+            Rule::FlightTemperature => {
+                "°C is not a temperature a flight reaches: give -273.15 to 1000 °C"
+            }
         }
     }
 
@@ -102,6 +108,7 @@ impl Rule {
             Rule::Number | Rule::ColumnList => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
+            Rule::FlightTemperature => (plan::ABSOLUTE_ZERO_C..=plan::MAX_ENVELOPE_C).contains(&v),
         }
     }
 }
@@ -211,7 +218,8 @@ pub fn check(setting: &'static str, v: f64, rule: Rule) -> Result<f64, SettingEr
     } else {
         Err(SettingError::Invalid {
             setting,
-            value: v.to_string(),
+            // 1e308, not 309 digits.
+            value: crate::csvlog::short_f64(v),
             rule,
         })
     }

@@ -309,7 +309,10 @@ impl FogUnit {
             if v != 0.0 && !(lo..=hi).contains(&v) {
                 return bad(
                     f,
-                    format!("{v} {unit} is not a {what}: give 0 (none) or {lo} to {hi} {unit}"),
+                    format!(
+                        "{} {unit} is not a {what}: give 0 (none) or {lo:e} to {hi} {unit}",
+                        crate::csvlog::short_f64(v)
+                    ),
                 );
             }
         }
