@@ -117,7 +117,8 @@ pub fn envelope_of(log: &TestLog) -> Result<Envelope, PlanError> {
         .into_iter()
         .filter(|r| r.is_finite())
         .fold(0.0f64, |m, r| m.max(r.abs()));
-    if !(rate > 0.0) {
+    // The fold starts at 0 and keeps finite rates only: 0 is a flat flight.
+    if rate == 0.0 {
         return Err(PlanError::FlatFlight {
             samples: log.time_s.len(),
         });

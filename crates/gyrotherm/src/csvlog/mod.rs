@@ -475,7 +475,7 @@ fn check_log(path: &Path, log: &TestLog, opts: WriteOptions) -> Result<(), LogEr
         let may_be_nan = name == TEMP_COL && opts.allow_nan_temperature;
         if let Some(i) = v
             .iter()
-            .position(|x| !x.is_finite() && !(may_be_nan && x.is_nan()))
+            .position(|x| !(x.is_finite() || may_be_nan && x.is_nan()))
         {
             return Err(bad(
                 Some(name),
