@@ -125,7 +125,8 @@ def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
         (lambda: gt.bias_stability(np.ones(1000), 1.0, 2.5), gt.MetricsError,
          "τ = 2.5 s is not a positive integer multiple of the sample period 1 s"),
         (lambda: gt.bias_stability(np.ones(150), 1.0, 100), gt.MetricsError,
-         "150 samples give fewer than two means of 100 samples"),
+         "τ = 100 s is longer than half the log .*: the bias stability needs at least two "
+         "τ-means; give τ at most 75 s"),
         (lambda: gt.bias_stability(np.ones(150), 0.0), gt.MetricsError, "rate_hz = 0 is not a positive finite sample rate"),
         (lambda: gt.noise_terms([np.nan] * 10, 1.0), gt.AllanError, "sample 0 is NaN"),
         (lambda: gt.scale_factor(time_s=np.arange(10.0), gyro_dps=np.zeros(10), table_dps=np.zeros(9)),

@@ -32,8 +32,9 @@ use gyrotherm_core::compensator::{Corrected, Status};
 use gyrotherm_core::unit::Unit;
 
 use crate::compensate_lines::{
-    lines_to_file, parse_number, read_header, read_line_capped, record, split_and_time,
-    too_long_error, Fields, FileError, LineCheck, LineRead, LinesError, Mode, MAX_LINE_BYTES,
+    check_added_columns, lines_to_file, parse_number, read_header, read_line_capped, record,
+    split_and_time, too_long_error, Cadence, Fields, FileError, LineCheck, LineRead, LinesError,
+    Mode, MAX_LINE_BYTES,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
@@ -87,6 +88,8 @@ pub struct ImuLinesSummary {
     /// Per axis, in the model's order: lines ok, held, degraded, invalid, fallback (the
     /// codes of [`Status`]).
     pub per_axis: Vec<[u64; 5]>,
+    /// What the lines do not show: time steps longer than the compensator runs at.
+    pub warnings: Vec<String>,
 }
 
 impl ImuLinesSummary {
@@ -176,6 +179,7 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
     let delimiter = opts.delimiter;
     let decimal_comma = delimiter != b',';
     let added = output_columns(model);
+    check_added_columns(&headers, added.iter().map(String::as_str), source, line_no)?;
     let mut writer = LogWriter::with_delimiter(
         output,
         headers
@@ -192,6 +196,10 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
     let mut fields = Fields::default();
     let mut buf = Vec::new();
     let mut last_time: Option<(f64, u64)> = None;
+    // The axes share one time axis; the first axis's compensator steps as they all do.
+    let mut cadence = unit
+        .axis(0)
+        .map(|a| Cadence::new(a.first().spec(), a.first().limits().degraded_after_s));
     let mut gyro = vec![0.0; n_axes];
     let mut temps = vec![0.0; ci.len()];
     // A line with no usable output: its fields (or empty ones), every axis invalid.
@@ -275,6 +283,9 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
                 continue;
             }
         };
+        if let (Some((t0, _)), Some(c)) = (last_time, cadence.as_mut()) {
+            c.step(time_s - t0, mode, source, line_no)?;
+        }
         last_time = Some((time_s, line_no));
         let out: [Corrected; MAX_STREAM_AXES] = unit.step(time_s, &gyro, &temps);
         for k in 0..fields.len() {
@@ -300,6 +311,10 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
             None,
             "no data rows after the header; the log is empty or holds only comments".into(),
         ));
+    }
+    if let Some(c) = cadence.as_mut() {
+        c.finish(mode, source, line_no)?;
+        summary.warnings.extend(c.warning());
     }
     Ok(summary)
 }

@@ -478,7 +478,8 @@ pub(crate) fn too_long_error(source: &Path, line: u64) -> LinesError {
     ))
 }
 
-/// The header: everything up to the first line that is neither blank nor a comment, checked
+/// The header: everything up to the first line that is neither blank nor a comment (and its
+/// continuation lines, when a quoted name holds a line break), parsed and checked
 /// by the log reader with `opts` (column mapping and its messages). Returns the column names
 /// and the number of lines read.
 pub(crate) fn read_header<R: BufRead>(
@@ -489,6 +490,11 @@ pub(crate) fn read_header<R: BufRead>(
     let mut head = Vec::new();
     let mut line_no = 0u64;
     let mut buf = Vec::new();
+    // Where the header line starts in `head`, once found: a quoted name may hold a line
+    // break, so the header ends at the first line break outside quotes, as the log reader
+    // (which parses it below) sees it.
+    let mut header_start: Option<usize> = None;
+    let mut fields = Fields::default();
     loop {
         match read_line_capped(input, &mut buf, MAX_LINE_BYTES)? {
             LineRead::Eof => break,
@@ -500,14 +506,161 @@ pub(crate) fn read_header<R: BufRead>(
             // Comments before the header count too: they are kept for the header check.
             return Err(too_long_error(source, line_no));
         }
+        let start = header_start.unwrap_or(head.len());
         head.extend_from_slice(&buf);
         let t = buf.trim_ascii();
-        if !t.is_empty() && !t.starts_with(b"#") {
+        if header_start.is_none() && (t.is_empty() || t.starts_with(b"#")) {
+            continue;
+        }
+        header_start = Some(start);
+        let header = &head[start..];
+        let header = header.strip_suffix(b"\n").unwrap_or(header);
+        let header = header.strip_suffix(b"\r").unwrap_or(header);
+        if fields.split(header, opts.delimiter) {
             break;
         }
     }
     let r = LogReader::new(&head[..], source, opts).map_err(LinesError::Log)?;
     Ok((r.headers().to_vec(), line_no))
+}
+
+/// Steps a file's cadence is judged on: the median of the first ones, so that a gap or two
+/// (which the compensator bridges) does not count.
+const CADENCE_STEPS: usize = 10;
+
+/// The time steps of a run, against the longest sample period the compensator runs at
+/// ([`crate::features::max_sample_period_s`], and at most its `degraded_after_s`): a log
+/// sampled more sparsely is held or degraded on almost every line, which would read as
+/// temperature faults.
+#[derive(Debug)]
+pub(crate) struct Cadence {
+    max_s: f64,
+    rate_lag_s: f64,
+    first: Vec<f64>,
+    judged: bool,
+    steps: u64,
+    slow: u64,
+}
+
+impl Cadence {
+    pub(crate) fn new(spec: &gyrotherm_core::features::FeatureSpec, degraded_after_s: f64) -> Self {
+        Cadence {
+            max_s: crate::features::max_sample_period_s(spec).min(degraded_after_s),
+            rate_lag_s: spec.rate_lag_s,
+            first: Vec::with_capacity(CADENCE_STEPS),
+            judged: false,
+            steps: 0,
+            slow: 0,
+        }
+    }
+
+    /// A step of `dt` s between two lines; in [`Mode::Strict`], the error once the first
+    /// steps show the log is sampled too sparsely.
+    pub(crate) fn step(
+        &mut self,
+        dt: f64,
+        mode: Mode,
+        source: &Path,
+        line: u64,
+    ) -> Result<(), LinesError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Ok(());
+        }
+        self.steps += 1;
+        self.slow += u64::from(dt > self.max_s);
+        if self.first.len() < CADENCE_STEPS {
+            self.first.push(dt);
+            if self.first.len() == CADENCE_STEPS && mode == Mode::Strict {
+                return self.judge(source, line);
+            }
+        }
+        Ok(())
+    }
+
+    /// At the end of a file: the judgement, if fewer than [`CADENCE_STEPS`] steps came.
+    pub(crate) fn finish(
+        &mut self,
+        mode: Mode,
+        source: &Path,
+        line: u64,
+    ) -> Result<(), LinesError> {
+        if mode == Mode::Strict && !self.first.is_empty() {
+            return self.judge(source, line);
+        }
+        Ok(())
+    }
+
+    fn judge(&mut self, source: &Path, line: u64) -> Result<(), LinesError> {
+        if std::mem::replace(&mut self.judged, true) {
+            return Ok(());
+        }
+        let mid = self.first.len() / 2;
+        let period = *self.first.select_nth_unstable_by(mid, f64::total_cmp).1;
+        if period <= self.max_s {
+            return Ok(());
+        }
+        Err(LinesError::Log(LogError::new(
+            LogErrorKind::SampledTooSparsely,
+            source,
+            Some(line),
+            None,
+            format!(
+                "one sample every {period} s ({} Hz, median of the first steps); the model \
+                 steps every second and reads dT over {} s, so it needs at least one sample \
+                 every {} s ({} Hz); every line would be held or degraded: log faster, or \
+                 resample",
+                1.0 / period,
+                self.rate_lag_s,
+                self.max_s,
+                1.0 / self.max_s
+            ),
+        )))
+    }
+
+    /// The warning for a stream with steps longer than the compensator runs at.
+    pub(crate) fn warning(&self) -> Option<String> {
+        (self.slow > 0).then(|| {
+            format!(
+                "{} of {} time steps are longer than {} s, more sparsely than the model runs \
+                 (it reads dT over {} s): the lines after them are held or degraded for that, \
+                 not for a temperature fault",
+                self.slow, self.steps, self.max_s, self.rate_lag_s
+            )
+        })
+    }
+}
+
+/// Refuses a log whose header already has a column compensation adds (a log compensated
+/// before): the output would hold two columns of one name, and a reader would take either.
+pub(crate) fn check_added_columns<'a>(
+    headers: &[String],
+    added: impl IntoIterator<Item = &'a str>,
+    source: &Path,
+    line_no: u64,
+) -> Result<(), LinesError> {
+    let clash: Vec<&str> = added
+        .into_iter()
+        .filter(|a| headers.iter().any(|h| h == a))
+        .collect();
+    if clash.is_empty() {
+        return Ok(());
+    }
+    Err(LinesError::Log(LogError::new(
+        LogErrorKind::DuplicateColumn,
+        source,
+        Some(line_no),
+        Some(clash[0]),
+        format!(
+            "the log already has the column{} {} that compensation adds (was it compensated \
+             before?); compensate the raw log, or rename those columns",
+            if clash.len() == 1 { "" } else { "s" },
+            clash
+                .iter()
+                .map(|c| format!("`{c}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    )))
 }
 
 /// Compensate `input` (CSV with a header) into `output`; see the module doc. `source` names
@@ -542,6 +695,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             "a mapped column is missing from the header",
         )));
     };
+    check_added_columns(&headers, OUTPUT_COLUMNS, source, line_no)?;
     let gyro_scale = opts.gyro_unit.dps_per_unit();
     let delimiter = opts.delimiter;
     let decimal_comma = delimiter != b',';
@@ -559,6 +713,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     let mut last_time: Option<(f64, u64)> = None;
     let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
     let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut cadence = Cadence::new(comp.spec(), comp.limits().degraded_after_s);
     let check = LineCheck {
         source,
         headers: &headers,
@@ -615,6 +770,9 @@ pub fn compensate_lines<R: BufRead, W: Write>(
         })();
         let c: Option<Corrected> = match parsed {
             Ok((t, g, temp)) => {
+                if let Some((t0, _)) = last_time {
+                    cadence.step(t - t0, mode, source, line_no)?;
+                }
                 last_time = Some((t, line_no));
                 Some(comp.step(t, g, temp))
             }
@@ -671,9 +829,11 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             "no data rows after the header; the log is empty or holds only comments".into(),
         ));
     }
+    cadence.finish(mode, source, line_no)?;
     if temp_seen.0 <= temp_seen.1 {
         summary.warnings = crate::compensate::range_warnings(model, temp_seen, rate_seen);
     }
+    summary.warnings.extend(cadence.warning());
     Ok(summary)
 }
 

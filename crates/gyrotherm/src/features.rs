@@ -11,6 +11,14 @@ pub use gyrotherm_core::features::{
     FeatureKind, FeaturePipeline, FeatureSpec, LagOutputs, SpecError, MAX_FEATURES, MAX_LAGS,
 };
 
+/// The longest sample period a model with feature spec `spec` runs at, s: its dT window
+/// (`rate_lag_s`, 20 s published), and at least its step period. The model steps on the time
+/// axis and reads dT as the temperature difference over the window; a log sampled more
+/// sparsely has no sample inside a window, so every step bridges a gap.
+pub fn max_sample_period_s(spec: &FeatureSpec) -> f64 {
+    spec.rate_lag_s.max(spec.step_period_s)
+}
+
 /// Per-step model inputs of one log.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeatureTable {

@@ -54,6 +54,12 @@ pub enum PlanError {
     Compensate(crate::compensate::CompensateError),
     /// The fit's coverage map is refused by the flight crate.
     Coverage(gyrotherm_core::coverage::CoverageError),
+    /// The flight log's temperature never changes (or it has one sample): no rate to plan
+    /// ramps for.
+    FlatFlight { samples: usize },
+    /// The proposed profile breaks a limit of `simulate --profile-file` (the message of
+    /// [`Profile::parse`] on the text `plan --out` writes).
+    Profile(crate::sim::SimError),
 }
 
 impl fmt::Display for PlanError {
@@ -68,6 +74,19 @@ impl fmt::Display for PlanError {
             PlanError::Fit(_) => f.write_str("fitting the training logs"),
             PlanError::Compensate(_) => f.write_str("stepping the flight through the fit"),
             PlanError::Coverage(e) => write!(f, "the fit's coverage map: {e}"),
+            PlanError::FlatFlight { samples } => write!(
+                f,
+                "the flight log's temperature does not change ({samples} sample{}), so it \
+                 gives no largest |dT| to plan ramps for: give --max-rate-c-per-min",
+                if *samples == 1 { "" } else { "s" }
+            ),
+            PlanError::Profile(e) => write!(
+                f,
+                "the proposed profile is not one `simulate --profile-file` accepts: {e}; a \
+                 ramp longer than its longest segment ({} s) needs a faster \
+                 --max-rate-c-per-min or --chamber-max-rate-c-per-min",
+                crate::sim::profile::MAX_SEGMENT_S
+            ),
         }
     }
 }
@@ -75,7 +94,8 @@ impl fmt::Display for PlanError {
 impl std::error::Error for PlanError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            PlanError::Setting(e) => Some(e),
+            // Transparent: the setting's message is this error's own.
+            PlanError::Setting(e) => e.source(),
             PlanError::Fit(e) => Some(e),
             PlanError::Compensate(e) => Some(e),
             _ => None,
@@ -97,6 +117,12 @@ pub fn envelope_of(log: &TestLog) -> Result<Envelope, PlanError> {
         .into_iter()
         .filter(|r| r.is_finite())
         .fold(0.0f64, |m, r| m.max(r.abs()));
+    // The fold starts at 0 and keeps finite rates only: 0 is a flat flight.
+    if rate == 0.0 {
+        return Err(PlanError::FlatFlight {
+            samples: log.time_s.len(),
+        });
+    }
     Ok(Envelope {
         temp_min_c: lo,
         temp_max_c: hi,
@@ -104,10 +130,31 @@ pub fn envelope_of(log: &TestLog) -> Result<Envelope, PlanError> {
     })
 }
 
+/// The envelope of a flight whose temperature does not change, with the rate given.
+fn flat_envelope(log: &TestLog, max_rate_c_per_min: f64) -> Envelope {
+    let t = log
+        .temp_c
+        .iter()
+        .copied()
+        .find(|t| t.is_finite())
+        .unwrap_or(ROOM_C);
+    Envelope {
+        temp_min_c: t,
+        temp_max_c: t,
+        max_rate_c_per_min,
+    }
+}
+
 /// The envelope to plan for: the settings' values where given, else the flight's.
 pub fn resolve_envelope(flight: Option<&TestLog>, s: &PlanSettings) -> Result<Envelope, PlanError> {
     s.validate().map_err(PlanError::Setting)?;
-    let from_flight = flight.map(envelope_of).transpose()?;
+    // A flight's flat temperature matters only when its rate is what is planned for.
+    let from_flight = match flight.map(envelope_of).transpose() {
+        Err(PlanError::FlatFlight { .. }) if s.max_rate_c_per_min.is_some() => {
+            flight.map(|log| flat_envelope(log, s.max_rate_c_per_min.unwrap_or(0.0)))
+        }
+        r => r?,
+    };
     let pick = |given: Option<f64>, f: fn(&Envelope) -> f64| {
         given
             .or(from_flight.as_ref().map(f))
@@ -338,12 +385,16 @@ pub fn propose(env: &Envelope, s: &PlanSettings) -> Result<Plan, PlanError> {
         }
     }
     go(ROOM_C.clamp(lo, hi), slowest, &mut segments);
-    Ok(Plan {
+    let plan = Plan {
         temp_lo_c: lo,
         temp_hi_c: hi,
         max_rate_c_per_min: rate,
         rates_c_per_min: rates,
         segments,
         notes,
-    })
+    };
+    // What `plan --out` writes must be a profile `simulate --profile-file` reads: checked by
+    // its own parser, so the two sets of limits cannot drift apart.
+    Profile::parse(&plan.profile_text(), "plan").map_err(PlanError::Profile)?;
+    Ok(plan)
 }

@@ -43,7 +43,12 @@ fn bias_stability_matches_nbs_tau_means() {
     let e = bias_stability_dph(&y, 0.5, 5.2).unwrap_err();
     assert!(e.to_string().contains("integer multiple"), "{e}");
     let e = bias_stability_dph(&y, 1.0, 600.0).unwrap_err();
-    assert!(e.to_string().contains("fewer than two means"), "{e}");
+    // Said in seconds (τ and the log's length), not in samples per mean.
+    assert!(
+        e.to_string()
+            .contains("τ = 600 s is longer than half the log"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -50,6 +50,14 @@ pub fn read_imu_logs_with(
                         report.filled_samples
                     );
                 }
+                if report.zero_table {
+                    eprintln!(
+                        "gyrotherm: {}: the table-rate column {} is all zeros: read as a \
+                         static run",
+                        p.display(),
+                        opts.table_col
+                    );
+                }
                 out.push((p.display().to_string(), log));
             }
             Err(e) => {
@@ -161,6 +169,9 @@ pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
             )
         })?;
         eprintln!("gyrotherm: {}", summary.describe(&model));
+        for w in &summary.warnings {
+            eprintln!("gyrotherm: warning: {w}");
+        }
         return Ok(ExitCode::SUCCESS);
     }
     let (Some(input), Some(out)) = (&args.input, &args.out) else {

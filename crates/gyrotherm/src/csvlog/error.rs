@@ -49,6 +49,8 @@ pub enum LogErrorKind {
     BadOptions,
     /// `write_log` was given an inconsistent or non-finite log.
     BadLog,
+    /// The log is sampled more sparsely than the model steps (compensation).
+    SampledTooSparsely,
 }
 
 /// A log that cannot be read: file, line, column and what to do.

@@ -54,6 +54,9 @@ pub(super) enum GapVerdict {
     Fill(usize),
     /// Longer than the fill limit (s).
     TooLong(f64),
+    /// Within the fill limit, but it would take this many samples, more than
+    /// [`MAX_FILL_SAMPLES_PER_GAP`].
+    TooManySamples(f64),
     /// No filling asked for.
     NotAllowed,
 }
@@ -64,10 +67,9 @@ pub(super) fn gap_verdict(dt: f64, period: f64, fill_max_s: Option<f64>) -> GapV
     let n_f = (dt / period).round() - 1.0;
     match fill_max_s {
         // dt > 1.5 period, so n_f >= 1.
-        Some(max) if dt <= max && n_f <= MAX_FILL_SAMPLES_PER_GAP as f64 => {
-            GapVerdict::Fill((n_f as usize).max(1))
-        }
-        Some(max) => GapVerdict::TooLong(max),
+        Some(max) if dt > max => GapVerdict::TooLong(max),
+        Some(_) if n_f > MAX_FILL_SAMPLES_PER_GAP as f64 => GapVerdict::TooManySamples(n_f),
+        Some(_) => GapVerdict::Fill((n_f as usize).max(1)),
         None => GapVerdict::NotAllowed,
     }
 }

@@ -209,10 +209,24 @@ pub fn read_imu_log(
             values: take(t, 1.0, "temperature")?,
         });
     }
-    let table = log.table_dps.take().map(|values| NamedSeries {
-        name: opts.table_col.clone(),
-        values,
-    });
+    // A table column of zeros is a static run, as a single-axis log's is
+    // ([`super::TestLog::is_static`]): no table turned, so no axis to find.
+    let zero_table = log
+        .table_dps
+        .as_ref()
+        .is_some_and(|t| t.iter().all(|v| *v == 0.0));
+    let table = log
+        .table_dps
+        .take()
+        .filter(|_| !zero_table)
+        .map(|values| NamedSeries {
+            name: opts.table_col.clone(),
+            values,
+        });
+    let report = ReadReport {
+        zero_table,
+        ..report
+    };
     let table_axis = match (&table, table_axis) {
         (None, _) => None,
         (Some(_), Some(a)) => Some(parse_table_axis(a, &gyro_cols).map_err(options)?),

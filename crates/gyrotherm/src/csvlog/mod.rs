@@ -32,6 +32,7 @@ pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
 };
+pub(crate) use writer::short_f64;
 pub use writer::{format_f64, LogWriter};
 
 use std::fs::File;
@@ -284,6 +285,9 @@ pub struct ReadReport {
     pub max_step_jitter: f64,
     /// Line of the step with that jitter.
     pub max_jitter_line: Option<u64>,
+    /// The table-rate column holds only zeros: an inertial unit's log read as a static run
+    /// ([`read_imu_log`] leaves its `table` out).
+    pub zero_table: bool,
 }
 
 impl ReadReport {
@@ -412,8 +416,9 @@ pub fn write_log(path: &Path, log: &TestLog) -> Result<(), LogError> {
 /// What [`write_log_with`] lets through that [`write_log`] refuses.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct WriteOptions {
-    /// Write a non-finite temperature as `NaN` (a simulated temperature-sensor fault; the
-    /// flight compensator rides through it, the strict reader refuses it).
+    /// Write a NaN temperature as `NaN` (a simulated temperature-sensor fault; the flight
+    /// compensator rides through it, the strict reader refuses it). Infinities are refused
+    /// all the same.
     pub allow_nan_temperature: bool,
 }
 
@@ -471,8 +476,12 @@ fn check_log(path: &Path, log: &TestLog, opts: WriteOptions) -> Result<(), LogEr
                 format!("{} values but {n} timestamps; not written", v.len()),
             ));
         }
+        // A sensor fault reads as NaN; an infinity is a computation gone wrong, never written.
         let may_be_nan = name == TEMP_COL && opts.allow_nan_temperature;
-        if let Some(i) = v.iter().position(|x| !x.is_finite() && !may_be_nan) {
+        if let Some(i) = v
+            .iter()
+            .position(|x| !(x.is_finite() || may_be_nan && x.is_nan()))
+        {
             return Err(bad(
                 Some(name),
                 format!(

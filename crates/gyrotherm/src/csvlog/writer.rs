@@ -192,3 +192,10 @@ pub fn format_f64(buf: &mut Vec<u8>, v: f64) {
         write!(buf, "{v}")
     };
 }
+
+/// `v` as [`format_f64`] writes it, as text for a message: 1e300, not 301 digits.
+pub(crate) fn short_f64(v: f64) -> String {
+    let mut buf = Vec::new();
+    format_f64(&mut buf, v);
+    String::from_utf8_lossy(&buf).into_owned()
+}

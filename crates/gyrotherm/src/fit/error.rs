@@ -51,6 +51,20 @@ pub enum FitError {
     },
     /// The training thread of one target panicked.
     ThreadPanicked { target: Target },
+    /// Run `run` is sampled every `period_s` (median step), more sparsely than the models
+    /// can step (`max_s`).
+    SampledTooSparsely {
+        run: String,
+        period_s: f64,
+        max_s: f64,
+    },
+    /// Static run `run` (no table column, or one of zeros) has a gyro output spanning
+    /// `span_dps`, more than a thermal bias can.
+    StaticRunTurns {
+        run: String,
+        span_dps: f64,
+        has_table: bool,
+    },
 }
 
 impl std::fmt::Display for FitError {
@@ -108,6 +122,35 @@ impl std::fmt::Display for FitError {
             FitError::ThreadPanicked { target } => {
                 write!(f, "{} training thread panicked", target.as_str())
             }
+            FitError::SampledTooSparsely {
+                run,
+                period_s,
+                max_s,
+            } => write!(
+                f,
+                "{run}: one sample every {period_s} s ({} Hz); the models step every second \
+                 and read dT over {max_s} s, so they need at least one sample every {max_s} s \
+                 ({} Hz): log faster, or resample",
+                1.0 / period_s,
+                1.0 / max_s
+            ),
+            FitError::StaticRunTurns {
+                run,
+                span_dps,
+                has_table,
+            } => write!(
+                f,
+                "{run}: read as a static run ({}), but its gyro output spans {span_dps:.3} °/s \
+                 (1st to 99th percentile), more than a thermal bias can ({} °/s): it looks \
+                 like a rate-table run; name its table-rate column with --table-col, or check \
+                 the gyro column and its unit",
+                if *has_table {
+                    "its table-rate column is all zeros"
+                } else {
+                    "no table-rate column"
+                },
+                super::MAX_STATIC_SPAN_DPS
+            ),
         }
     }
 }

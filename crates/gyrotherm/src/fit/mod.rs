@@ -337,9 +337,58 @@ pub fn uses_identification(cfg: &FitConfig) -> bool {
     cfg.method.is_recipe() && cfg.recipe.kind == RecipeKind::Thermal
 }
 
+/// Widest span a static run's gyro output may have, °/s, from its 1st to its 99th
+/// percentile: 5 °/s (18,000 °/h). A gyro's thermal bias stays far inside it (a navigation
+/// FOG drifts below 1 °/h over −40…+85 °C, a consumer MEMS gyro about 1 °/s), while a rate
+/// table turns at ±1 to ±400 °/s: a wider span is a rate-table run read without its table
+/// column, whose rates a bias model would fit as bias.
+pub const MAX_STATIC_SPAN_DPS: f64 = 5.0;
+
+/// Refuses training logs the models cannot learn from: one sampled more sparsely than the
+/// models step ([`crate::features::max_sample_period_s`]), and a static one whose gyro output
+/// spans more than [`MAX_STATIC_SPAN_DPS`].
+pub(crate) fn check_logs(logs: &[NamedLog], spec: &FeatureSpec) -> Result<(), FitError> {
+    let max_s = crate::features::max_sample_period_s(spec);
+    for l in logs {
+        let period_s = l.log.sample_period_s();
+        if period_s > max_s {
+            return Err(FitError::SampledTooSparsely {
+                run: l.name.to_owned(),
+                period_s,
+                max_s,
+            });
+        }
+        if targets::is_static(l.log) {
+            if let Some(span_dps) = percentile_span(&l.log.gyro_dps) {
+                if span_dps > MAX_STATIC_SPAN_DPS {
+                    return Err(FitError::StaticRunTurns {
+                        run: l.name.to_owned(),
+                        span_dps,
+                        has_table: l.log.table_dps.is_some(),
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The 1st to 99th percentile span of the finite values (None: fewer than two).
+fn percentile_span(v: &[f64]) -> Option<f64> {
+    let mut x: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if x.len() < 2 {
+        return None;
+    }
+    let n = x.len() - 1;
+    let hi = *x.select_nth_unstable_by(n * 99 / 100, f64::total_cmp).1;
+    let lo = *x.select_nth_unstable_by(n / 100, f64::total_cmp).1;
+    Some(hi - lo)
+}
+
 /// The `thermal` recipe's identification on the training logs (the first part of
 /// [`fit_model`]).
 pub fn identify(logs: &[NamedLog], cfg: &FitConfig) -> Result<thermal::Identified, FitError> {
+    check_logs(logs, &feature_spec(cfg))?;
     let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
     Ok(thermal::identify(
         &named,
@@ -357,6 +406,7 @@ pub(crate) fn identify_every(
     cfg: &FitConfig,
     every: usize,
 ) -> Result<thermal::Identified, FitError> {
+    check_logs(logs, &feature_spec(cfg))?;
     let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
     Ok(thermal::identify_every(
         &named,
@@ -401,6 +451,7 @@ pub(crate) fn fit_model_with(
     let spec = identified
         .as_ref()
         .map_or_else(|| feature_spec(cfg), |id| id.spec);
+    check_logs(logs, &spec)?;
     let statics = logs.iter().filter(|l| targets::is_static(l.log)).count();
     let made = made.filter(|(b, s)| b.len() == statics && s.len() == logs.len() - statics);
     if let Some((_, scale)) = made {

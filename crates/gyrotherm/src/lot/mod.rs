@@ -220,6 +220,9 @@ pub enum LotError {
     },
     /// The spec could not be applied (a limited figure no log gives).
     Spec(spec::SpecError),
+    /// A unit name that cannot name a unit: empty, only white space, white space around it
+    /// (`A1` and ` A1` would be two units) or a control character.
+    UnitName { name: String, why: &'static str },
     /// The database file does not exist (`lot list`/`lot report` never create one).
     Missing { db: String },
     /// The file is not an SQLite database (or is damaged).
@@ -287,13 +290,17 @@ fn write_chain(f: &mut fmt::Formatter<'_>, e: &dyn std::error::Error) -> fmt::Re
 impl fmt::Display for LotError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            LotError::Read { path, source } => write!(f, "{}: {source}", path.display()),
-            LotError::Model { path, source } => write!(f, "{}: {source}", path.display()),
+            // The cause follows through `source()`, as `{:#}` and `error_chain` print it.
+            LotError::Read { path, .. } => write!(f, "cannot read {}", path.display()),
+            LotError::Model { path, .. } => write!(f, "{}", path.display()),
             LotError::Measure { log, source } => {
                 write!(f, "{log}: ")?;
                 write_chain(f, source)
             }
             LotError::Spec(e) => write!(f, "{e}"),
+            LotError::UnitName { name, why } => {
+                write!(f, "unit name {name:?} {why}; give the unit's serial number")
+            }
             LotError::Missing { db } => write!(
                 f,
                 "{db}: no such lot database; `gyrotherm lot add --db {db} …` creates it"
@@ -355,7 +362,8 @@ impl std::error::Error for LotError {
         match self {
             LotError::Read { source, .. } => Some(source),
             LotError::Model { source, .. } => Some(source.as_ref()),
-            LotError::Spec(e) => Some(e),
+            // Transparent: the spec's message is this error's own.
+            LotError::Spec(e) => e.source(),
             _ => None,
         }
     }
@@ -531,6 +539,27 @@ pub struct UnitInputs<'a, L = (PathBuf, TestLog)> {
     pub settle_s: f64,
 }
 
+/// `name` if it can name a unit in a lot: not empty, no white space around it, no control
+/// character. The stores check every run they record; the judging functions trim the name
+/// first, so ` A1 ` and `A1` are one unit.
+pub fn check_unit_name(name: &str) -> Result<&str, LotError> {
+    let bad = |why| {
+        Err(LotError::UnitName {
+            name: name.to_owned(),
+            why,
+        })
+    };
+    if name.trim().is_empty() {
+        bad("is empty")
+    } else if name.chars().any(char::is_control) {
+        bad("holds a control character")
+    } else if name.trim() != name {
+        bad("has white space before or after it")
+    } else {
+        Ok(name)
+    }
+}
+
 /// SHA-256 of a file's bytes, hex.
 pub fn file_sha256(path: &Path) -> Result<String, LotError> {
     let bytes = std::fs::read(path).map_err(|source| LotError::Read {
@@ -543,6 +572,7 @@ pub fn file_sha256(path: &Path) -> Result<String, LotError> {
 /// Judge one unit: compensate each held-out log with its model, measure every figure, judge
 /// against the spec; the [`Run`] to record (dated now), and the spec's verdict when given.
 pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotError> {
+    check_unit_name(u.unit.trim())?;
     let (text, model_sha256) = u.model_text()?;
     let (model, _) = ModelFile::from_json_sealed(&text).map_err(|e| u.model_err(e.into()))?;
     let content = model.content_digest().map_err(|e| u.model_err(e.into()))?;
@@ -667,7 +697,7 @@ impl<L> UnitInputs<'_, L> {
     ) -> Run {
         Run {
             id: 0,
-            unit: self.unit.to_string(),
+            unit: self.unit.trim().to_string(),
             tested_at_unix_ms: now_unix_ms(),
             gyrotherm_version: env!("CARGO_PKG_VERSION").to_string(),
             station: self.station.to_string(),
@@ -712,6 +742,7 @@ pub struct ImuRunVerdict {
 /// ([`crate::imu_judge::judge_unit_figures`]); the [`Run`] to record (dated now, a row per
 /// axis in [`Run::axes`], each figure with its axis) and the verdicts when a spec is given.
 pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>), LotError> {
+    check_unit_name(u.unit.trim())?;
     let (text, model_sha256) = u.model_text()?;
     let model = ImuModel::from_json(&text).map_err(|e| u.model_err(e.into()))?;
     let content = model.content_digest().map_err(|e| u.model_err(e.into()))?;

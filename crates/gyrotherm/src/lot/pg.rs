@@ -111,6 +111,7 @@ fn pg_error(db: &str, e: postgres::Error) -> LotError {
 
 impl LotStore for PgStore {
     fn add(&mut self, run: &Run) -> Result<i64, LotError> {
+        super::check_unit_name(&run.unit)?;
         let db = self.db.clone();
         let e = |x| pg_error(&db, x);
         let mut tx = self.client.transaction().map_err(e)?;

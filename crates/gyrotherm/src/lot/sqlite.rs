@@ -187,6 +187,7 @@ fn db_error(db: &str, e: rusqlite::Error, busy_timeout_ms: u64) -> LotError {
 
 impl LotStore for SqliteStore {
     fn add(&mut self, run: &Run) -> Result<i64, LotError> {
+        super::check_unit_name(&run.unit)?;
         let db = self.db();
         let wait = self.busy_timeout_ms;
         let e = |x| db_error(&db, x, wait);

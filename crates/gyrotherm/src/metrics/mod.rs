@@ -45,6 +45,14 @@ pub enum MetricsError {
         samples: usize,
         samples_per_mean: usize,
     },
+    /// τ leaves fewer than two means in the `samples` samples (every `sample_period_s`) used:
+    /// the whole log, or its stop segments after the settle time.
+    TauTooLong {
+        tau_s: f64,
+        samples: usize,
+        sample_period_s: f64,
+        stop_segments: bool,
+    },
 }
 
 impl fmt::Display for MetricsError {
@@ -65,6 +73,28 @@ impl fmt::Display for MetricsError {
                 f,
                 "{samples} samples give fewer than two means of {samples_per_mean} samples; use a shorter τ or a longer log"
             ),
+            MetricsError::TauTooLong { tau_s, samples, sample_period_s, stop_segments } => {
+                let duration_s = *samples as f64 * sample_period_s;
+                // 1e300 s, not three hundred digits.
+                let tau_s = crate::csvlog::short_f64(*tau_s);
+                if *stop_segments {
+                    write!(
+                        f,
+                        "τ = {tau_s} s leaves fewer than two τ-means in the stop segments \
+                         ({samples} samples of {sample_period_s} s = {duration_s} s after the \
+                         settle time; a mean never spans a table rate): use a shorter τ or \
+                         longer stops"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "τ = {tau_s} s is longer than half the log ({samples} samples of \
+                         {sample_period_s} s = {duration_s} s): the bias stability needs at \
+                         least two τ-means; give τ at most {} s",
+                        duration_s / 2.0
+                    )
+                }
+            }
         }
     }
 }
@@ -168,7 +198,16 @@ pub fn bias_stability_dph(
     tau_s: f64,
 ) -> Result<BiasStability, MetricsError> {
     let m = samples_per_mean(sample_period_s, tau_s)?;
-    let (std, means) = tau_means_std(rate_dps, m)?;
+    let (std, means) = tau_means_std(rate_dps, m).map_err(|e| match e {
+        // In seconds: τ far beyond the log gives a sample count no one can read.
+        MetricsError::TooShort { samples, .. } => MetricsError::TauTooLong {
+            tau_s,
+            samples,
+            sample_period_s,
+            stop_segments: false,
+        },
+        e => e,
+    })?;
     Ok(BiasStability {
         bias_stability_dph: std * DPS_TO_DPH,
         tau_s,
@@ -207,9 +246,11 @@ pub(crate) fn stop_segment_bias_dph(
         used.extend(samples);
     }
     if means.len() < 2 {
-        return Err(MetricsError::TooShort {
+        return Err(MetricsError::TauTooLong {
+            tau_s,
             samples: used.len(),
-            samples_per_mean: m,
+            sample_period_s: period,
+            stop_segments: true,
         });
     }
     Ok((

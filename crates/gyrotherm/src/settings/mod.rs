@@ -69,6 +69,9 @@ pub enum Rule {
     ColumnList,
     /// Hidden units of an LSTM: a whole number from 1 to [`fit::MAX_HIDDEN`].
     HiddenUnits,
+    /// A temperature a flight reaches, °C: from absolute zero to
+    /// [`plan::MAX_ENVELOPE_C`].
+    FlightTemperature,
 }
 
 impl Rule {
@@ -100,6 +103,9 @@ impl Rule {
                  published); the trainer (`nn`) takes up to 128, but flight code and its exports \
                  are built for 8 today"
             }
+            Rule::FlightTemperature => {
+                "°C is not a temperature a flight reaches: give -273.15 to 1000 °C"
+            }
         }
     }
 
@@ -115,6 +121,7 @@ impl Rule {
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
             Rule::HiddenUnits => v == gyrotherm_core::compensator::HIDDEN as f64,
+            Rule::FlightTemperature => (plan::ABSOLUTE_ZERO_C..=plan::MAX_ENVELOPE_C).contains(&v),
         }
     }
 }
@@ -224,7 +231,8 @@ pub fn check(setting: &'static str, v: f64, rule: Rule) -> Result<f64, SettingEr
     } else {
         Err(SettingError::Invalid {
             setting,
-            value: v.to_string(),
+            // 1e308, not 309 digits.
+            value: crate::csvlog::short_f64(v),
             rule,
         })
     }

@@ -35,6 +35,12 @@ pub const ROOM_C: f64 = 22.0;
 /// temperature cell of a ramp gets at least this many seconds at 1 Hz, by repeating it.
 pub const MIN_CELL_S: f64 = super::coverage::MIN_CELL_STEPS as f64;
 
+/// Absolute zero, °C: no envelope temperature below it.
+pub const ABSOLUTE_ZERO_C: f64 = -273.15;
+/// Hottest envelope temperature accepted, °C: far above any flight (and any chamber's
+/// [`crate::sim::profile::TARGET_RANGE_C`]); beyond it a value is a typo, not a flight.
+pub const MAX_ENVELOPE_C: f64 = 1000.0;
+
 /// The settings of one plan.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanSettings {
@@ -67,10 +73,13 @@ impl Default for PlanSettings {
 
 impl PlanSettings {
     /// Check the settings: finite temperatures, positive rates, each minimum below its
-    /// maximum.
+    /// maximum; the chamber's set points and ramp within what `simulate --profile-file`
+    /// accepts ([`crate::sim::profile::TARGET_RANGE_C`], [`crate::sim::profile::MAX_RAMP_C_PER_MIN`]), since
+    /// the plan is written as such a profile; the envelope's temperatures physical (above
+    /// absolute zero, below [`MAX_ENVELOPE_C`]).
     pub fn validate(&self) -> Result<(), SettingError> {
-        check_opt("temp_min_c", self.temp_min_c, Rule::Finite)?;
-        check_opt("temp_max_c", self.temp_max_c, Rule::Finite)?;
+        check_opt("temp_min_c", self.temp_min_c, Rule::FlightTemperature)?;
+        check_opt("temp_max_c", self.temp_max_c, Rule::FlightTemperature)?;
         check_opt(
             "max_rate_c_per_min",
             self.max_rate_c_per_min,
@@ -83,6 +92,34 @@ impl PlanSettings {
             self.chamber_max_rate_c_per_min,
             Rule::PositiveRate,
         )?;
+        let (lo, hi) = crate::sim::profile::TARGET_RANGE_C;
+        let out = |setting: &'static str, v: f64, why: String| SettingError::Conflict {
+            setting,
+            other: "the simulator's profile limits",
+            why: format!("{} {why}", crate::csvlog::short_f64(v)),
+        };
+        if self.chamber_min_c < lo {
+            return Err(out(
+                "chamber_min_c",
+                self.chamber_min_c,
+                format!("°C is below the coldest set point a profile may have, {lo} °C"),
+            ));
+        }
+        if self.chamber_max_c > hi {
+            return Err(out(
+                "chamber_max_c",
+                self.chamber_max_c,
+                format!("°C is above the hottest set point a profile may have, {hi} °C"),
+            ));
+        }
+        let max_ramp = crate::sim::profile::MAX_RAMP_C_PER_MIN;
+        if self.chamber_max_rate_c_per_min > max_ramp {
+            return Err(out(
+                "chamber_max_rate_c_per_min",
+                self.chamber_max_rate_c_per_min,
+                format!("°C/min is faster than a profile may ramp, {max_ramp} °C/min"),
+            ));
+        }
         if self.chamber_min_c >= self.chamber_max_c {
             return Err(SettingError::Conflict {
                 setting: "chamber_min_c",

@@ -183,6 +183,39 @@ impl Default for FogUnit {
     }
 }
 
+/// A field of [`FogUnit`] that is a quantum: name, getter, its range when not 0, unit, what.
+type Quantum = (
+    &'static str,
+    fn(&FogUnit) -> f64,
+    (f64, f64),
+    &'static str,
+    &'static str,
+);
+
+/// The quanta a unit may have. Temperature sensors resolve 0.0001 °C (a 24-bit RTD
+/// converter) to 1 °C (a coarse thermistor); 1e-6 to 10 °C spans them with room. FOG pulse
+/// weights are about 0.01 to 10 arcsec; 1e-6 to 3600 arcsec spans them with room.
+const QUANTA: [Quantum; 2] = [
+    (
+        "sensor_resolution_c",
+        |u| u.sensor_resolution_c,
+        (1e-6, 10.0),
+        "°C",
+        "temperature sensor resolution",
+    ),
+    (
+        "pulse_arcsec",
+        |u| u.pulse_arcsec,
+        (1e-6, 3600.0),
+        "arcsec",
+        "pulse weight",
+    ),
+];
+
+/// Largest temperature-sensor offset or noise (1σ) a unit may have, °C: beyond it the
+/// logged temperature no longer follows the unit's (chamber set points span −80 to 180 °C).
+pub const MAX_SENSOR_ERROR_C: f64 = 100.0;
+
 impl FogUnit {
     /// Parse a JSON parameter file's text: the given fields override the default unit's.
     pub fn from_json_str(text: &str, source: &str) -> Result<FogUnit, SimError> {
@@ -207,7 +240,9 @@ impl FogUnit {
         FogUnit::from_json_str(&text, &path.display().to_string())
     }
 
-    /// Checks every field: finite; time constants > 0; noise terms and resolution ≥ 0.
+    /// Checks every field: finite; time constants > 0; noise terms and resolution ≥ 0; the
+    /// quanta 0 or within a real part's range; the sensor's offset and noise at most
+    /// [`MAX_SENSOR_ERROR_C`].
     pub fn validate(&self) -> Result<(), SimError> {
         let bad = |field: &str, message: String| {
             Err(SimError::Unit {
@@ -266,6 +301,36 @@ impl FogUnit {
         for (f, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(f, format!("{v} must be finite and >= 0"));
+            }
+        }
+        // A quantum is 0 (none) or within what a real part has: a reading divided by a
+        // quantum far below it overflows (1e-320 °C makes every temperature infinite), and
+        // one far above it leaves nothing of the signal.
+        for (f, v, (lo, hi), unit, what) in QUANTA {
+            let v = v(self);
+            if v != 0.0 && !(lo..=hi).contains(&v) {
+                return bad(
+                    f,
+                    format!(
+                        "{} {unit} is not a {what}: give 0 (none) or {lo:e} to {hi} {unit}",
+                        crate::csvlog::short_f64(v)
+                    ),
+                );
+            }
+        }
+        let sensor = [
+            ("sensor_offset_c", self.sensor_offset_c.abs()),
+            ("sensor_noise_c", self.sensor_noise_c),
+        ];
+        for (f, v) in sensor {
+            if v > MAX_SENSOR_ERROR_C {
+                return bad(
+                    f,
+                    format!(
+                        "{v} °C is beyond {MAX_SENSOR_ERROR_C} °C, more than a working \
+                         temperature sensor's error"
+                    ),
+                );
             }
         }
         Ok(())

@@ -218,7 +218,10 @@ impl Profile {
             if !(duration_s > 0.0 && duration_s <= MAX_SEGMENT_S) {
                 return Err(err(
                     line_no,
-                    format!("duration_s {duration_s} must be > 0 and at most {MAX_SEGMENT_S} s"),
+                    format!(
+                        "duration_s {} must be > 0 and at most {MAX_SEGMENT_S} s",
+                        crate::csvlog::short_f64(duration_s)
+                    ),
                 ));
             }
             if !(TARGET_RANGE_C.0..=TARGET_RANGE_C.1).contains(&target_c) {

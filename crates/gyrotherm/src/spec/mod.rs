@@ -122,12 +122,9 @@ pub enum SpecError {
 impl fmt::Display for SpecError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SpecError::Read { path, source } => {
-                write!(
-                    f,
-                    "{}: cannot read the spec sheet: {source}",
-                    path.display()
-                )
+            // The cause follows through `source()`.
+            SpecError::Read { path, .. } => {
+                write!(f, "{}: cannot read the spec sheet", path.display())
             }
             SpecError::Syntax {
                 path,
@@ -188,21 +185,36 @@ impl fmt::Display for SpecError {
                 Ok(())
             }
             SpecError::NotMeasured { key, from, logs } => {
-                let need = match from {
-                    LogKind::Static => "a static log",
-                    LogKind::RateTable => "a rate-table log",
-                    LogKind::Any => "a log long enough for it",
+                let logs = if logs.is_empty() {
+                    "none".to_string()
+                } else {
+                    logs.join(", ")
                 };
-                write!(
-                    f,
-                    "the spec limits `{key}` but no held-out log gives it (it needs {need}; \
-                     logs: {}); add such a log or remove the limit",
-                    if logs.is_empty() {
-                        "none".to_string()
-                    } else {
-                        logs.join(", ")
-                    }
-                )
+                match from {
+                    // A static log was maybe given: its Allan curve is where the term is read,
+                    // and a curve can lack the term's part, so "needs a static log" would name
+                    // the wrong cause.
+                    LogKind::Static => write!(
+                        f,
+                        "the spec limits `{key}` but no held-out log gives it (logs: {logs}): \
+                         it is read from the Allan curve of a static log ({}), and no log's \
+                         curve showed it; a rate-table log has no such curve, and a static \
+                         log's curve lacks the part when its output does not vary (a constant \
+                         log) or it is too short; add a static log that shows it or remove the \
+                         limit",
+                        figure(key).map_or("", |d| d.what)
+                    ),
+                    LogKind::RateTable | LogKind::Any => write!(
+                        f,
+                        "the spec limits `{key}` but no held-out log gives it (it needs {}; \
+                         logs: {logs}); add such a log or remove the limit",
+                        if *from == LogKind::RateTable {
+                            "a rate-table log"
+                        } else {
+                            "a log long enough for it"
+                        }
+                    ),
+                }
             }
         }
     }

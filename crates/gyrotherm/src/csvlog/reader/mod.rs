@@ -28,7 +28,7 @@ use std::cell::OnceCell;
 use super::chunk::{self, parse_lines, Layout, Row, MAX_BLOCK_BYTES, PARALLEL_MIN_BYTES};
 use super::columns::{check_options, map_columns, Columns};
 use super::error::{quoted_field, LogError, LogErrorKind as Kind};
-use super::gaps::{gap_verdict, Fill, GapVerdict, Sample};
+use super::gaps::{gap_verdict, Fill, GapVerdict, Sample, MAX_FILL_SAMPLES_PER_GAP};
 use super::number::{parse_f64, parse_f64_decimal_comma};
 use super::MAX_LINE_BYTES;
 use super::{ReadOptions, ReadReport};
@@ -359,6 +359,18 @@ impl<R: Read> LogReader<R> {
                 format!(
                     "{what}, longer than the --fill-gaps-max-s limit of {max} s; split the log at \
                      this line or raise --fill-gaps-max-s if interpolating {dt} s is acceptable"
+                ),
+            )),
+            GapVerdict::TooManySamples(n) => Err(LogError::new(
+                Kind::GapTooLong,
+                &self.src.path,
+                Some(line),
+                Some(t_col),
+                format!(
+                    "{what}: filling it would take {n} samples, more than the \
+                     {MAX_FILL_SAMPLES_PER_GAP} one gap may be filled with, whatever the fill \
+                     limit; check the sample period and the time column, or split the log at \
+                     this line"
                 ),
             )),
             GapVerdict::NotAllowed => Err(LogError::new(
