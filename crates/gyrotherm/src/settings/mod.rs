@@ -18,6 +18,9 @@
 //!   ([`TempSensorDef`](crate::model::TempSensorDef)).
 //! - [`coverage`]: the training-region map and the 1σ estimate `train` stores
 //!   ([`CoverageSettings`](coverage::CoverageSettings)).
+//! - [`autopilot`]: which IMU and axis an autopilot parameter file is for, and (PX4) its
+//!   device id ([`AutopilotSettings`](autopilot::AutopilotSettings)).
+//! - [`kalibr`]: the ROS topic named in a Kalibr noise file.
 //! - [`plan`]: the flight envelope and the chamber's limits of `gyrotherm plan`
 //!   ([`PlanSettings`](plan::PlanSettings)).
 //! - [`describe`](mod@describe): every setting of every job with its default and accepted values, as the
@@ -25,12 +28,14 @@
 //!   their equality can be tested.
 
 pub mod allan;
+pub mod autopilot;
 pub mod columns;
 pub mod compensate;
 pub mod coverage;
 pub mod describe;
 pub mod evaluate;
 pub mod fit;
+pub mod kalibr;
 pub mod method;
 pub mod plan;
 pub mod read;
@@ -65,6 +70,12 @@ pub enum Rule {
     Finite,
     /// A list of column names (one, or several separated by commas).
     ColumnList,
+    /// An IMU instance the autopilot calibrates.
+    ImuInstance,
+    /// A 32-bit device id.
+    DeviceId,
+    /// A ROS topic name.
+    RosTopic,
 }
 
 impl Rule {
@@ -89,6 +100,18 @@ impl Rule {
                 "is not a list of column names: give one name, or distinct names separated by \
                  commas"
             }
+            Rule::ImuInstance => {
+                "is not an IMU the autopilot calibrates: ArduPilot takes 0 to 2 (INS_TCAL1 to \
+                 INS_TCAL3), PX4 0 to 3 (TC_G0 to TC_G3)"
+            }
+            Rule::DeviceId => {
+                "is not a device id: give the gyro's 32-bit DEVICE_ID as PX4 reports it \
+                 (decimal, or hexadecimal with 0x)"
+            }
+            Rule::RosTopic => {
+                "is not a ROS topic name: a letter or `/` first, then letters, digits, `_` \
+                 and `/` (such as /imu0)"
+            }
         }
     }
 
@@ -99,7 +122,11 @@ impl Rule {
             Rule::NonNegativeSeconds => v.is_finite() && v >= 0.0,
             Rule::AtLeastOne => v >= 1.0,
             Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
-            Rule::Number | Rule::ColumnList => true,
+            Rule::Number
+            | Rule::ColumnList
+            | Rule::ImuInstance
+            | Rule::DeviceId
+            | Rule::RosTopic => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
         }
