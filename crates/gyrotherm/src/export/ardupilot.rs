@@ -73,8 +73,9 @@ pub fn generate(
         text: String::new(),
         fit,
         steady,
-        error_means: "error after the constant the firmware's boot-time gyro calibration \
-                      removes; add the error at that temperature",
+        error_means: "error after the best constant, which the firmware's boot-time gyro \
+                      calibration takes out: with the error at the boot temperature, up to twice \
+                      this",
     };
     let mut text = export.header(
         "ArduPilot gyro temperature calibration, written by gyrotherm export --target ardupilot",

@@ -461,8 +461,9 @@ impl AutopilotExport {
             let name = axis_name(i);
             out.push(match f {
                 Some(f) => format!(
-                    "  axis {name}: fit error max {:.4} {deg}/h, RMS {:.4} {deg}/h",
-                    f.max_dph, f.rms_dph
+                    "  axis {name}: fit error max {} {deg}/h, RMS {} {deg}/h",
+                    dph_text(f.max_dph),
+                    dph_text(f.rms_dph)
                 ),
                 None => format!("  axis {name}: zero coefficients (not corrected)"),
             });
@@ -496,6 +497,15 @@ impl AutopilotExport {
             }
         }
         t
+    }
+}
+
+/// An error in °/h for the summary: four decimals, or three significant digits below 0.01.
+fn dph_text(v: f64) -> String {
+    if v >= 0.01 {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.2e}")
     }
 }
 
