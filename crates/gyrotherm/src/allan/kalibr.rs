@@ -6,7 +6,7 @@
 //!   value at τ = 1 s of the slope −½ line ([`super::noise_terms`]'s angle random walk).
 //! - `gyroscope_random_walk`, rad/s²/√Hz: the rate random walk K, σ(τ) = K·√(τ/3), so K is the
 //!   value at τ = 3 s of the slope +½ line (its rate random walk).
-//! - `update_rate`, Hz: the log's sample rate, 1/τ0.
+//! - `update_rate`, Hz: the log's sample rate, 1/τ0, to six significant digits.
 //! - `rostopic`: the IMU topic Kalibr reads from the bag (a setting).
 //!
 //! Each line is fitted with its slope fixed over the run of points that lie on it (see
@@ -153,7 +153,9 @@ pub fn kalibr_noise(
     terms: &NoiseTerms,
     tau0_s: f64,
 ) -> Result<KalibrNoise, KalibrError> {
-    let update_rate_hz = 1.0 / tau0_s;
+    // Six significant digits: time stamps such as i·0.01 give τ0 a round-off in the 13th
+    // digit that would otherwise show as 100.00000000000909 Hz.
+    let update_rate_hz: f64 = format!("{:.5e}", 1.0 / tau0_s).parse().unwrap_or(f64::NAN);
     if !(update_rate_hz.is_finite() && update_rate_hz > 0.0) {
         return Err(KalibrError::SamplePeriod(tau0_s));
     }

@@ -210,7 +210,7 @@ fn notes_of(model: &ModelFile, notes: &mut Vec<&'static str>) {
 /// One axis's flight compensator, stepped at a constant temperature.
 enum AxisComp {
     Single(gyrotherm_core::compensator::Compensator),
-    Unit(gyrotherm_core::multi::AxisCompensator, usize),
+    Unit(Box<gyrotherm_core::multi::AxisCompensator>, usize),
 }
 
 impl AxisComp {
@@ -314,7 +314,7 @@ pub fn steady_bias(
                 let has_bias = a.model.bias.is_some() || a.more.iter().any(|m| m.bias.is_some());
                 if has_bias {
                     let c = u.axis_compensator(a).map_err(ExportError::Unit)?;
-                    comps[i] = Some(AxisComp::Unit(c, u.temp_cols.len()));
+                    comps[i] = Some(AxisComp::Unit(Box::new(c), u.temp_cols.len()));
                 }
             }
             let digest = u.content_digest().map_err(ExportError::Unit)?;
