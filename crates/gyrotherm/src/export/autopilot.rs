@@ -209,7 +209,7 @@ fn notes_of(model: &ModelFile, notes: &mut Vec<&'static str>) {
 
 /// One axis's flight compensator, stepped at a constant temperature.
 enum AxisComp {
-    Single(gyrotherm_core::compensator::Compensator),
+    Single(Box<gyrotherm_core::compensator::Compensator>),
     Unit(Box<gyrotherm_core::multi::AxisCompensator>, usize),
 }
 
@@ -290,7 +290,7 @@ pub fn steady_bias(
             let c = crate::compensate::compensator(m).map_err(ExportError::Flight)?;
             let mut comps: [Option<AxisComp>; 3] = [None, None, None];
             if m.bias.is_some() {
-                comps[settings.axis.index()] = Some(AxisComp::Single(c));
+                comps[settings.axis.index()] = Some(AxisComp::Single(Box::new(c)));
             }
             let r = m.training.temp_range_c;
             let digest = m.content_digest().map_err(ExportError::Model)?;
