@@ -16,7 +16,8 @@ import pytest
 import gyrotherm as gt
 
 # Flags that name files or pick an output format: not settings.
-NOT_SETTINGS = {"--input", "--out", "--model", "--spec", "--json", "--plot", "--stream", "--help"}
+NOT_SETTINGS = {"--input", "--out", "--model", "--spec", "--json", "--plot", "--stream", "--help",
+                "--kalibr"}
 # Python's fit() keywords that are not settings of the model.
 PY_NOT_SETTINGS = {"static", "table", "progress", "log_options"}
 

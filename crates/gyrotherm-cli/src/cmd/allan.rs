@@ -11,6 +11,7 @@ use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseTerms, TauSet};
 use gyrotherm::csvlog::{rate_column_to_dph, TestLog};
 use gyrotherm::report;
 use gyrotherm::settings::allan as allan_settings;
+use gyrotherm::settings::kalibr as kalibr_settings;
 use gyrotherm::settings::{AllanAnalysis, AllanSettings};
 use serde::Serialize;
 
@@ -46,6 +47,14 @@ pub struct AllanArgs {
     /// as FILE.png, with FILE.svg beside it.
     #[arg(long, value_name = "FILE.png")]
     pub plot: Option<PathBuf>,
+    /// Also write Kalibr's IMU noise file (gyroscope_noise_density, gyroscope_random_walk,
+    /// update_rate, rostopic) as FILE, read from this Allan deviation curve (oadev or adev).
+    #[arg(long, value_name = "FILE.yaml")]
+    pub kalibr: Option<PathBuf>,
+    /// The IMU topic the Kalibr file names.
+    #[arg(long, default_value = kalibr_settings::DEFAULT_ROSTOPIC,
+          value_parser = |s: &str| kalibr_settings::parse_rostopic(s))]
+    pub rostopic: String,
 }
 
 /// The deviations in `--help` order (the library's name list).
@@ -198,11 +207,60 @@ fn plot(
     Ok(())
 }
 
+/// `--kalibr`: the noise file, atomically, and its figures with their bounds on stderr.
+fn write_kalibr(
+    path: &Path,
+    args: &AllanArgs,
+    points: &[AllanPoint],
+    noise: Option<&NoiseTerms>,
+    tau0_s: f64,
+) -> anyhow::Result<()> {
+    let Some(terms) = noise else {
+        bail!(
+            "--kalibr needs a rate column (named *_dps, *_dph or *_rad_s), not {}",
+            args.column
+        );
+    };
+    let k = allan::kalibr::kalibr_noise(points, terms, tau0_s)
+        .with_context(|| format!("cannot write the Kalibr file {}", path.display()))?;
+    let text = allan::kalibr::kalibr_yaml(&k, &args.rostopic);
+    gyrotherm::atomic_file::write_bytes_atomically(path, text.as_bytes())
+        .with_context(|| format!("cannot write the Kalibr file {}", path.display()))?;
+    for (key, unit, t) in [
+        ("gyroscope_noise_density", "rad/s/√Hz", &k.noise_density),
+        ("gyroscope_random_walk", "rad/s²/√Hz", &k.random_walk),
+    ] {
+        let bounds = if t.lo.is_finite() && t.hi.is_finite() {
+            format!(
+                "68.3 % bounds {:.4e} .. {:.4e}, EDF {:.1}",
+                t.lo, t.hi, t.edf
+            )
+        } else {
+            "no EDF for bounds".to_owned()
+        };
+        eprintln!(
+            "gyrotherm: {key} {:.4e} {unit} (τ = {} s on the line fitted over τ {:.4} .. {:.4} s; {bounds})",
+            t.value, t.tau_read_s, t.fit_tau_min_s, t.fit_tau_max_s
+        );
+    }
+    eprintln!(
+        "gyrotherm: wrote {} (update_rate {} Hz, rostopic {}; no accelerometer keys: not measured)",
+        path.display(),
+        k.update_rate_hz,
+        args.rostopic
+    );
+    Ok(())
+}
+
 pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
     super::common::refuse_outputs_over_inputs(args.plot.as_deref(), [args.input.as_path()])?;
     let mut settings = args.settings();
     settings.validate()?;
     let kind = settings.kind;
+    // Checked before the log is read: Kalibr's figures are defined on the Allan deviation.
+    if args.kalibr.is_some() && !matches!(kind, DevKind::Oadev | DevKind::Adev) {
+        bail!("--kalibr reads the Allan deviation: use --kind oadev (the default) or adev");
+    }
     let mut w = std::io::stdout().lock();
     let ReadColumn {
         values,
@@ -224,6 +282,9 @@ pub fn run(args: AllanArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("{} of column {}", kind.name(), column.name))?;
     if let Some(path) = &args.plot {
         plot(path, &args, &column, &points, noise.as_ref())?;
+    }
+    if let Some(path) = &args.kalibr {
+        write_kalibr(path, &args, &points, noise.as_ref(), tau0_s)?;
     }
     if args.json {
         let out = AllanJson {

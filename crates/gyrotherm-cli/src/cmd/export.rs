@@ -1,15 +1,18 @@
 //! `gyrotherm export`: write a model as flight code, C99 (`gyrotherm_model.h`,
-//! `gyrotherm_model.c`) or a Rust module for gyrotherm-core (`gyrotherm_model.rs`). See
-//! `gyrotherm::export`.
+//! `gyrotherm_model.c`) or a Rust module for gyrotherm-core (`gyrotherm_model.rs`), or as an
+//! autopilot's gyro temperature-calibration parameters (ArduPilot `gyro_tcal.parm`, PX4
+//! `gyro_tc.params`). See `gyrotherm::export`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context as _;
+use anyhow::{bail, Context as _};
+use gyrotherm::export::autopilot::{self, ModelRef};
 use gyrotherm::export::unit::{column_map, export_imu};
-use gyrotherm::export::{export, Lang};
+use gyrotherm::export::{export, ExportTarget, Lang, EXPORT_TARGETS};
 use gyrotherm::imu_model::ImuModel;
 use gyrotherm::model::ModelFile;
+use gyrotherm::settings::autopilot::{self as ap, AutopilotSettings, GyroAxis, GYRO_AXES};
 
 use super::common::choice;
 
@@ -18,23 +21,75 @@ pub struct ExportArgs {
     /// Model file written by `gyrotherm train`.
     #[arg(long)]
     pub model: PathBuf,
-    /// Target language.
-    #[arg(long, value_parser = choice::<Lang>([Lang::C, Lang::Rust].map(|l| (l.as_str(), l.help()))))]
-    pub lang: Lang,
+    /// What to write.
+    #[arg(long, required_unless_present = "lang", conflicts_with = "lang",
+          value_parser = choice::<ExportTarget>(EXPORT_TARGETS.map(|t| (t.as_str(), t.help()))))]
+    pub target: Option<ExportTarget>,
+    /// Deprecated spelling of `--target c|rust`, kept for one release.
+    #[arg(long, hide = true,
+          value_parser = choice::<Lang>([Lang::C, Lang::Rust].map(|l| (l.as_str(), l.help()))))]
+    pub lang: Option<Lang>,
     /// Output directory (created if missing).
     #[arg(long)]
     pub out: PathBuf,
+    /// ardupilot, px4: the autopilot's IMU, from 0 (ArduPilot INS_TCAL<N+1>, PX4 TC_G<N>);
+    /// default 0.
+    #[arg(long, value_name = "N", value_parser = |s: &str| ap::parse_instance(s))]
+    pub instance: Option<u8>,
+    /// ardupilot, px4: the autopilot axis a single-gyro model fills; the other two get zero
+    /// coefficients (a unit model's three axes are X, Y, Z in its column order); default x.
+    #[arg(long, value_parser = choice::<GyroAxis>(GYRO_AXES.map(|a| (a.as_str(), ""))))]
+    pub axis: Option<GyroAxis>,
+    /// px4: the gyro's device id (DEVICE_ID of sensor_gyro, or CAL_GYRO<N>_ID), decimal or
+    /// 0x hexadecimal; PX4 applies the parameters to the gyro with this id only.
+    #[arg(long, value_name = "ID", value_parser = |s: &str| ap::parse_device_id(s))]
+    pub device_id: Option<u32>,
+}
+
+impl ExportArgs {
+    /// The library's autopilot settings (its defaults where a flag is absent).
+    fn autopilot_settings(&self) -> AutopilotSettings {
+        let d = AutopilotSettings::default();
+        AutopilotSettings {
+            instance: self.instance.unwrap_or(d.instance),
+            axis: self.axis.unwrap_or(d.axis),
+            device_id: self.device_id.or(d.device_id),
+        }
+    }
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
-    if super::imu::is_imu_model(&args.model)? {
+    let target = match (args.target, args.lang) {
+        (Some(t), _) => t,
+        (None, Some(l)) => {
+            eprintln!(
+                "gyrotherm: warning: --lang is deprecated and will be removed: use --target {l}"
+            );
+            ExportTarget::from(l)
+        }
+        (None, None) => bail!("give --target"),
+    };
+    let is_imu = super::imu::is_imu_model(&args.model)?;
+    let Some(lang) = target.lang() else {
+        return run_autopilot(&args, target, is_imu);
+    };
+    for (given, flag) in [
+        (args.instance.is_some(), "--instance"),
+        (args.axis.is_some(), "--axis"),
+        (args.device_id.is_some(), "--device-id"),
+    ] {
+        if given {
+            bail!("{flag} is for --target ardupilot or px4, not {target}");
+        }
+    }
+    if is_imu {
         let (model, seal) = ImuModel::load_sealed(&args.model)
             .map_err(anyhow::Error::new)
             .with_context(|| format!("cannot use model {}", args.model.display()))?;
         if let Some(w) = seal.warning(&args.model) {
             eprintln!("gyrotherm: warning: {w}");
         }
-        let files = export_imu(&model, args.lang, &args.out)?;
+        let files = export_imu(&model, lang, &args.out)?;
         for f in files {
             eprintln!("gyrotherm: wrote {}", f.display());
         }
@@ -50,10 +105,55 @@ pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
     if let Some(w) = seal.warning(&args.model) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    let lang = args.lang;
     let files = export(&model, lang, &args.out)?;
     for f in files {
         eprintln!("gyrotherm: wrote {}", f.display());
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--target ardupilot|px4`: the polynomial fitted to the model's steady-state bias, its fit
+/// and what it leaves out on stderr, the parameter file in `--out`.
+fn run_autopilot(
+    args: &ExportArgs,
+    target: ExportTarget,
+    is_imu: bool,
+) -> anyhow::Result<ExitCode> {
+    let settings = args.autopilot_settings();
+    let cannot = || format!("cannot use model {}", args.model.display());
+    let export = if is_imu {
+        let (model, seal) = ImuModel::load_sealed(&args.model)
+            .map_err(anyhow::Error::new)
+            .with_context(cannot)?;
+        if let Some(w) = seal.warning(&args.model) {
+            eprintln!("gyrotherm: warning: {w}");
+        }
+        if args.axis.is_some() {
+            eprintln!(
+                "gyrotherm: warning: --axis is for a single-gyro model; the unit's axes are X, \
+                 Y, Z in its column order:"
+            );
+            for (axis, gyro) in ["X", "Y", "Z"].iter().zip(&model.gyro_cols) {
+                eprintln!("  {axis} = {gyro}");
+            }
+        }
+        autopilot::generate(ModelRef::Unit(&model), target, &settings)
+    } else {
+        let (model, seal) = ModelFile::load_sealed(&args.model).map_err(anyhow::Error::new)?;
+        if let Some(w) = seal.warning(&args.model) {
+            eprintln!("gyrotherm: warning: {w}");
+        }
+        autopilot::generate(ModelRef::Single(&model), target, &settings)
+    }
+    .map_err(anyhow::Error::new)
+    .with_context(cannot)?;
+    for line in export.summary() {
+        match line.strip_prefix("warning: ") {
+            Some(w) => eprintln!("gyrotherm: warning: {w}"),
+            None => eprintln!("gyrotherm: {line}"),
+        }
+    }
+    let path = autopilot::write(&export, &args.out)?;
+    eprintln!("gyrotherm: wrote {}", path.display());
     Ok(ExitCode::SUCCESS)
 }

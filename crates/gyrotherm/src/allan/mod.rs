@@ -22,6 +22,7 @@
 //! over a stream of chunks (a log larger than memory) in O(m_max) memory.
 
 mod edf;
+pub mod kalibr;
 pub mod noise_id;
 mod phase;
 mod streaming;

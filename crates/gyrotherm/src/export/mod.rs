@@ -10,9 +10,15 @@
 //! arithmetic (`FLT_EVAL_METHOD == 0`: x86-64 SSE, Cortex-M4F), its outputs equal
 //! `gyrotherm compensate --stream` to the last bit.
 
+pub mod ardupilot;
+pub mod autopilot;
 pub mod c;
+pub mod px4;
 pub mod rust;
+pub mod target;
 pub mod unit;
+
+pub use target::{ExportTarget, EXPORT_TARGETS, EXPORT_TARGET_NAMES};
 
 use std::path::{Path, PathBuf};
 
@@ -36,6 +42,8 @@ pub enum ExportError {
     Flight(CompensateError),
     /// An inertial-unit model fails its checks, or one of its axes cannot be exported.
     Unit(crate::imu_model::ImuError),
+    /// The model cannot be written as autopilot parameters.
+    Autopilot(autopilot::AutopilotError),
     /// Writing an output file failed.
     Io {
         path: PathBuf,
@@ -50,6 +58,7 @@ impl std::fmt::Display for ExportError {
                 f.write_str("model cannot be exported")
             }
             ExportError::Unit(_) => f.write_str("inertial-unit model cannot be exported"),
+            ExportError::Autopilot(_) => f.write_str("cannot write autopilot parameters"),
             ExportError::Io { path, .. } => write!(f, "cannot write {}", path.display()),
         }
     }
@@ -62,6 +71,7 @@ impl std::error::Error for ExportError {
             ExportError::Model(e) => Some(e),
             ExportError::Flight(e) => Some(e),
             ExportError::Unit(e) => Some(e),
+            ExportError::Autopilot(e) => Some(e),
         }
     }
 }

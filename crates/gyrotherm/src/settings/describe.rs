@@ -118,6 +118,7 @@ pub fn allan_options() -> Vec<OptionSpec> {
             ..choice("taus", &d.taus.to_string(), &TAU_SET_NAMES)
         },
         opt("alpha", d.alpha.map(|a| a.to_string())),
+        opt("rostopic", Some(super::kalibr::DEFAULT_ROSTOPIC.to_owned())),
     ]
 }
 

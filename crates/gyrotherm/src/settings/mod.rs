@@ -18,6 +18,9 @@
 //!   ([`TempSensorDef`](crate::model::TempSensorDef)).
 //! - [`coverage`]: the training-region map and the 1σ estimate `train` stores
 //!   ([`CoverageSettings`](coverage::CoverageSettings)).
+//! - [`autopilot`]: which IMU and axis an autopilot parameter file is for, and (PX4) its
+//!   device id ([`AutopilotSettings`](autopilot::AutopilotSettings)).
+//! - [`kalibr`]: the ROS topic named in a Kalibr noise file.
 //! - [`plan`]: the flight envelope and the chamber's limits of `gyrotherm plan`
 //!   ([`PlanSettings`](plan::PlanSettings)).
 //! - [`describe`](mod@describe): every setting of every job with its default and accepted values, as the
@@ -25,12 +28,14 @@
 //!   their equality can be tested.
 
 pub mod allan;
+pub mod autopilot;
 pub mod columns;
 pub mod compensate;
 pub mod coverage;
 pub mod describe;
 pub mod evaluate;
 pub mod fit;
+pub mod kalibr;
 pub mod method;
 pub mod plan;
 pub mod read;
@@ -72,6 +77,12 @@ pub enum Rule {
     /// A temperature a flight reaches, °C: from absolute zero to
     /// [`plan::MAX_ENVELOPE_C`].
     FlightTemperature,
+    /// An IMU instance the autopilot calibrates.
+    ImuInstance,
+    /// A 32-bit device id.
+    DeviceId,
+    /// A ROS topic name.
+    RosTopic,
 }
 
 impl Rule {
@@ -106,6 +117,18 @@ impl Rule {
             Rule::FlightTemperature => {
                 "°C is not a temperature a flight reaches: give -273.15 to 1000 °C"
             }
+            Rule::ImuInstance => {
+                "is not an IMU the autopilot calibrates: ArduPilot takes 0 to 2 (INS_TCAL1 to \
+                 INS_TCAL3), PX4 0 to 3 (TC_G0 to TC_G3)"
+            }
+            Rule::DeviceId => {
+                "is not a device id: give the gyro's 32-bit DEVICE_ID as PX4 reports it \
+                 (decimal, or hexadecimal with 0x)"
+            }
+            Rule::RosTopic => {
+                "is not a ROS topic name: a letter or `/` first, then letters, digits, `_` \
+                 and `/` (such as /imu0)"
+            }
         }
     }
 
@@ -117,7 +140,11 @@ impl Rule {
             Rule::AtLeastOne => v >= 1.0,
             Rule::Epochs => v.fract() == 0.0 && (1.0..=fit::MAX_EPOCHS as f64).contains(&v),
             Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
-            Rule::Number | Rule::ColumnList => true,
+            Rule::Number
+            | Rule::ColumnList
+            | Rule::ImuInstance
+            | Rule::DeviceId
+            | Rule::RosTopic => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
             Rule::HiddenUnits => v == gyrotherm_core::compensator::HIDDEN as f64,
