@@ -35,6 +35,9 @@ produce() {
     mkdir -p "$out"
     cd "$out"
     local g=("$bin")
+    # The export target's flag: `--target` where the binary has it, else the older `--lang`.
+    local lang=--lang
+    if "$bin" export --help 2>/dev/null | grep -q -- '--target'; then lang=--target; fi
     # Logs: one gyro (static, table, held-out, faults), an inertial unit (static, table, flight).
     "${g[@]}" simulate --profile seed-shock --seed 1 --out s.csv
     "${g[@]}" simulate --profile seed-shock --seed 2 --table-rate 20 --out t.csv
@@ -54,8 +57,8 @@ produce() {
             --out "m-$m.json"
         "${g[@]}" compensate --model "m-$m.json" --input held.csv --out "c-$m.csv"
         "${g[@]}" compensate --model "m-$m.json" --stream <faults.csv >"cs-$m.csv"
-        "${g[@]}" export --model "m-$m.json" --lang c --out "x-$m-c" >/dev/null
-        "${g[@]}" export --model "m-$m.json" --lang rust --out "x-$m-rust" >/dev/null
+        "${g[@]}" export --model "m-$m.json" "$lang" c --out "x-$m-c" >/dev/null
+        "${g[@]}" export --model "m-$m.json" "$lang" rust --out "x-$m-rust" >/dev/null
     done
     # Units: 3 axes × 4 sensors, and 1 axis × 2 sensors.
     "${g[@]}" train --input us.csv --input ut.csv --gyro-col gyro_x_dps,gyro_y_dps,gyro_z_dps \
@@ -66,8 +69,8 @@ produce() {
     for u in u3 u1; do
         "${g[@]}" compensate --model "$u.json" --input uf.csv --out "c-$u.csv"
         "${g[@]}" compensate --model "$u.json" --stream <uf.csv >"cs-$u.csv"
-        "${g[@]}" export --model "$u.json" --lang c --out "x-$u-c" >/dev/null
-        "${g[@]}" export --model "$u.json" --lang rust --out "x-$u-rust" >/dev/null
+        "${g[@]}" export --model "$u.json" "$lang" c --out "x-$u-c" >/dev/null
+        "${g[@]}" export --model "$u.json" "$lang" rust --out "x-$u-rust" >/dev/null
     done
     cd - >/dev/null
 }

@@ -35,7 +35,7 @@ echo "qemu: $(qemu-system-arm --version | head -1); machine mps2-an386 (Cortex-M
 fail=0
 for m in linear poly thermal published; do
     dir="$work/$m"
-    $bin export --model "$work/$m.json" --lang c --out "$dir" 2>/dev/null
+    $bin export --model "$work/$m.json" --target c --out "$dir" 2>/dev/null
     arm-none-eabi-gcc "${CFLAGS[@]}" -I "$dir" crates/gyrotherm-cli/tests/export_c/driver.c \
         "$dir/gyrotherm_model.c" "$work/startup.o" -T bench/m4/mps2.ld --specs=rdimon.specs \
         -Wl,--gc-sections -o "$dir/driver.elf" -lm

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Flash and RAM of `gyrotherm export --lang c` models on a Cortex-M4F, with Debian's
+# Flash and RAM of `gyrotherm export --target c` models on a Cortex-M4F, with Debian's
 # gcc-arm-none-eabi (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi).
 # Usage: bench/m4_size.sh
 # Models: linear, poly and the default `thermal` method (ridge on identified thermal states)
@@ -39,7 +39,7 @@ echo "arm-none-eabi-gcc $(arm-none-eabi-gcc -dumpversion); flags: ${CFLAGS[*]}"
 printf '%-10s %-20s %6s %6s %6s %8s %8s %7s %14s\n' model parts text data bss flash RAM stack "linked +flash"
 for m in linear poly thermal published; do
     dir="$work/$m"
-    $bin export --model "$work/$m.json" --lang c --out "$dir" 2>/dev/null
+    $bin export --model "$work/$m.json" --target c --out "$dir" 2>/dev/null
     arm-none-eabi-gcc "${CFLAGS[@]}" -c "$dir/gyrotherm_model.c" -o "$dir/model.o"
     # Upper bound on gt_step's stack: the sum of every function's frame in the file.
     stack=$(awk '{s += $(NF-1)} END {print s}' "$dir/model.su")
@@ -68,7 +68,7 @@ done
 $bin train --method thermal --gyro-col gyro_x_dps,gyro_y_dps,gyro_z_dps \
     --temp-col temp_case_c,temp_x_c,temp_y_c,temp_z_c "${inputs[@]}" --out "$work/imu.json" 2>/dev/null
 dir="$work/imu"
-$bin export --model "$work/imu.json" --lang c --out "$dir" 2>/dev/null
+$bin export --model "$work/imu.json" --target c --out "$dir" 2>/dev/null
 arm-none-eabi-gcc "${CFLAGS[@]}" -c "$dir/gyrotherm_model.c" -o "$dir/model.o"
 stack=$(awk '{s += $(NF-1)} END {print s}' "$dir/model.su")
 read -r text data bss _ < <(arm-none-eabi-size "$dir/model.o" | awk 'NR==2')

@@ -96,10 +96,11 @@ fn messages_name_the_flags_help_shows() {
     let mut named = Vec::new();
     named_flags(&root.join("src"), &mut named);
     named_flags(&root.join("../gyrotherm/src"), &mut named);
-    // `--recipe` is hidden on purpose: it is named only to say it is deprecated.
+    // `--recipe` and `--lang` are hidden on purpose: they are named only to say they are
+    // deprecated.
     let hidden: Vec<String> = named
         .iter()
-        .filter(|(_, _, f)| !shown.contains(f) && f != "--recipe")
+        .filter(|(_, _, f)| !shown.contains(f) && f != "--recipe" && f != "--lang")
         .map(|(file, line, f)| format!("{file}:{line}: {f}"))
         .collect();
     assert!(

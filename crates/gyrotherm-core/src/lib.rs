@@ -16,7 +16,7 @@
 //!   each with its own lags, on the compensator's time axis and fault handling.
 //! - [`coverage`]: the training region in (T, dT) and a per-sample verdict (inside, edge,
 //!   outside) with a 1σ estimate of the residual bias error.
-//! - [`static_model`]: a model as plain static data (`gyrotherm export --lang rust`).
+//! - [`static_model`]: a model as plain static data (`gyrotherm export --target rust`).
 //! - [`unit`](mod@unit): an inertial unit, one compensator per gyro axis, each on its own temperature
 //!   sensor, stepped together.
 //! - [`error`]: what the core refuses instead of panicking.

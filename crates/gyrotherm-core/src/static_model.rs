@@ -1,4 +1,4 @@
-//! A compensation model as plain static data: what `gyrotherm export --lang rust` writes, so
+//! A compensation model as plain static data: what `gyrotherm export --target rust` writes, so
 //! flight code builds its [`Compensator`] without parsing JSON.
 //!
 //! ```

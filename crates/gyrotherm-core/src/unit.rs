@@ -144,7 +144,7 @@ impl<const N: usize> Unit<N> {
         Ok(())
     }
 
-    /// The unit of exported static models (`gyrotherm export --lang rust` of a unit model
+    /// The unit of exported static models (`gyrotherm export --target rust` of a unit model
     /// whose axes read one sensor each): axis `i` runs `models[i]` on temperature channel
     /// `channels[i]` of `n_temps`.
     pub fn from_static(
