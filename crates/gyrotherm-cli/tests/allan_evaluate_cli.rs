@@ -36,7 +36,7 @@ fn allan_json_matches_nist_oadev() {
     let v: Value = serde_json::from_str(&out).expect("JSON");
     assert_eq!(v["kind"], "oadev");
     let pts = v["points"].as_array().unwrap();
-    // NIST SP 1065 OADEV of the NBS set (METHOD.md); terms N + 1 − 2m.
+    // NIST SP 1065 OADEV of the NBS set (docs/method.md §6); terms N + 1 − 2m.
     let want = [
         (1.0, 2.922319e-01, 999),
         (10.0, 9.159953e-02, 981),

@@ -14,7 +14,7 @@ TOL = 1e-9  # relative, against allantools
 
 
 def nbs1000():
-    """NIST SP 1065 pp. 107-108 (METHOD.md): n0 = 1234567890, n_{i+1} = 16807·n_i mod
+    """NIST SP 1065 pp. 107-108 (docs/method.md §6): n0 = 1234567890, n_{i+1} = 16807·n_i mod
     2147483647, y_i = n_i / 2147483647, i = 0..999."""
     n = [1234567890]
     for _ in range(999):
@@ -62,7 +62,7 @@ def test_nbs1000_equals_allantools(func, data_type, taus):
     assert_same(want, got, f"{func} {data_type} {taus}")
 
 
-# NIST SP 1065 table, restated in METHOD.md (7 significant digits).
+# NIST SP 1065 table, restated in docs/method.md §6 (7 significant digits).
 NBS_TABLE = {
     "adev": [2.922319e-01, 9.965736e-02, 3.897804e-02],
     "oadev": [2.922319e-01, 9.159953e-02, 3.241343e-02],

@@ -11,7 +11,7 @@ from test_allan import nbs1000
 
 @pytest.mark.parametrize("tau,want", [(1, 2.884664e-01), (10, 9.296352e-02), (100, 3.206656e-02)])
 def test_bias_stability_is_the_std_of_tau_means(tau, want):
-    """METHOD.md: std dev (n − 1) of τ-means of NBS-1000; bias_stability is in °/h of °/s."""
+    """docs/method.md §6: std dev (n − 1) of τ-means of NBS-1000; bias_stability is in °/h of °/s."""
     y, _ = nbs1000()
     assert gt.bias_stability(y, 1.0, tau) / 3600.0 == pytest.approx(want, rel=2e-6)
 

@@ -1,5 +1,5 @@
 //! Allan-family deviations against outside references:
-//! - the NBS/NIST 1000-point set (NIST SP 1065 pp. 107-108, values restated in METHOD.md);
+//! - the NBS/NIST 1000-point set (NIST SP 1065 pp. 107-108, values restated in docs/method.md §6);
 //! - Stable32's results on a real 19,982-point OCXO record (`reference/allan/`, from the
 //!   allantools test data), every τ of the `*_alltau` files and the octave confidence bounds.
 
@@ -70,7 +70,7 @@ fn check_alltau(kind: DevKind, file: &str) {
         return;
     };
     let y = ocxo_fractional_frequency(&data);
-    assert_eq!(y.len(), 19_982, "OCXO record length (METHOD.md)");
+    assert_eq!(y.len(), 19_982, "OCXO record length (docs/method.md §6)");
     let x = phase_from_rate(&y);
     let rows = stable32_rows(&table);
     assert!(rows.len() > 200, "{file}: only {} rows parsed", rows.len());
@@ -132,7 +132,7 @@ fn stable32_hdev_alltau() {
     check_alltau(DevKind::Hdev, "stable32_hdev_alltau.txt");
 }
 
-/// The octave files come from a differently normalised copy of the data (METHOD.md): σ and
+/// The octave files come from a differently normalised copy of the data (docs/method.md §6): σ and
 /// the Greenhall-EDF bounds agree to about 2e-3 relative.
 const OCTAVE_TOL: f64 = 2e-3;
 
@@ -192,7 +192,7 @@ fn stable32_oadev_octave_bounds() {
     check_octave(DevKind::Oadev, "oadev_octave.txt");
 }
 
-/// METHOD.md: OADEV at τ = 1 s is 7.6106e-11 with 19981 terms.
+/// docs/method.md §6: OADEV at τ = 1 s is 7.6106e-11 with 19981 terms.
 #[test]
 #[cfg_attr(
     no_reference_data,
@@ -235,11 +235,11 @@ fn nbs_generator_check_values() {
     assert_eq!(
         n,
         vec![395_529_916, 1_209_410_747, 633_705_974],
-        "METHOD.md n1..n3"
+        "docs/method.md §6 n1..n3"
     );
 }
 
-/// NIST SP 1065 pp. 107-108 values (METHOD.md table) are printed to 7 digits: 1e-6 relative.
+/// NIST SP 1065 pp. 107-108 values (docs/method.md §6 table) are printed to 7 digits: 1e-6 relative.
 const NBS_TOL: f64 = 1e-6;
 
 #[test]

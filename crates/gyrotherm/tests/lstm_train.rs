@@ -40,7 +40,7 @@ fn inputs(temp_c: &[f64]) -> Vec<f64> {
 }
 
 /// Bias of a gyro whose coil lags the case by a first-order time constant of 150 s: a static
-/// term in the coil temperature plus a Shupe term in its rate (METHOD.md, "The problem").
+/// term in the coil temperature plus a Shupe term in its rate (docs/method.md §1).
 fn lagged_bias(temp_c: &[f64]) -> Vec<f64> {
     let mut coil = temp_c[0];
     temp_c

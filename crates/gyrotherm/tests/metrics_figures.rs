@@ -1,4 +1,4 @@
-//! Gyro figures (IEEE Std 952 / GJB 2426A definitions, METHOD.md) on data whose answer is
+//! Gyro figures (IEEE Std 952 / GJB 2426A definitions, docs/method.md §5) on data whose answer is
 //! known from a reference (NBS set) or by construction.
 
 use gyrotherm::metrics::{
@@ -20,7 +20,7 @@ fn bias_is_mean_in_dph() {
     assert!(e.to_string().contains("sample 1"), "{e}");
 }
 
-/// NIST SP 1065 (METHOD.md): std (n−1) of τ-means of the NBS set is 9.296352e-02 at m = 10.
+/// NIST SP 1065 (docs/method.md §6): std (n−1) of τ-means of the NBS set is 9.296352e-02 at m = 10.
 #[test]
 fn bias_stability_matches_nbs_tau_means() {
     let mut n: u64 = 1_234_567_890;

@@ -7,7 +7,7 @@ use gyrotherm::sim::{simulate_series, SimConfig, SimSeries};
 use nalgebra::{DMatrix, DVector};
 
 /// Bias stability, °/h: sample standard deviation (n-1) of consecutive non-overlapping
-/// `tau_s` means of `x_dps` (IEEE Std 952 / GJB 2426A definition, METHOD.md).
+/// `tau_s` means of `x_dps` (IEEE Std 952 / GJB 2426A definition, docs/method.md §5).
 fn bias_stability_dph(x_dps: &[f64], rate_hz: f64, tau_s: f64) -> f64 {
     let m = (tau_s * rate_hz).round() as usize;
     let means: Vec<f64> = x_dps

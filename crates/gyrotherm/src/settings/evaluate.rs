@@ -5,7 +5,7 @@ use super::{Rule, SettingError};
 use crate::csvlog::{rate_column_to_dph, TestLog, GYRO_COL};
 use crate::metrics::{self, Evaluation, EvaluationError, EvaluationOptions};
 
-/// The preferred bias-stability smoothing time, s (100 s, He et al. 2024 and METHOD.md).
+/// The preferred bias-stability smoothing time, s (100 s, He et al. 2024 and docs/method.md §4).
 pub const PREFERRED_TAU_S: f64 = crate::compare::BIAS_STABILITY_TAU_S;
 /// Default time dropped at the start of each rate-table segment, s.
 pub const DEFAULT_SETTLE_S: f64 = crate::targets::SETTLE_S;
