@@ -37,11 +37,8 @@ use crate::compensate_lines::{
     Mode, MAX_LINE_BYTES,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
+pub use crate::imu_model::MAX_STREAM_AXES;
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
-
-/// Most gyro axes a unit model can have in the ground stream (flight code fixes its own
-/// capacity, three by default: [`gyrotherm_core::unit::MAX_AXES`]).
-pub const MAX_STREAM_AXES: usize = 16;
 
 /// The ground stream's unit: the core's, with room for [`MAX_STREAM_AXES`] axes.
 pub type StreamUnit = Unit<MAX_STREAM_AXES>;

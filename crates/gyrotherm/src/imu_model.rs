@@ -32,7 +32,6 @@ use gyrotherm_core::features::LagOutputs;
 use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 
 use crate::compensate::compensator;
-use crate::compensate_imu_lines::MAX_STREAM_AXES;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
@@ -45,6 +44,11 @@ use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
 use crate::CompensateError;
+
+/// Most gyro axes a unit model can have: the capacity of the ground stream's unit, which
+/// `compensate` runs, checked at `train` and at load (flight code fixes its own capacity,
+/// three by default: [`gyrotherm_core::unit::MAX_AXES`]).
+pub const MAX_STREAM_AXES: usize = 16;
 
 /// Version of the inertial-unit file layout when an axis reads several sensors.
 pub const IMU_FORMAT_VERSION: u32 = 2;
