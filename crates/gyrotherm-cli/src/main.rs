@@ -83,7 +83,14 @@ fn main() -> ExitCode {
         Command::Model(a) => cmd::model::run(a),
         Command::Export(a) => cmd::export::run(a),
         Command::Settings(a) => cmd::settings::run(a),
-        Command::Lot(a) => cmd::lot::run(a),
+        Command::Lot(a) => cmd::lot::run(
+            a,
+            cmd::common::given_columns(
+                matches
+                    .subcommand_matches("lot")
+                    .and_then(|m| m.subcommand_matches("add")),
+            ),
+        ),
     };
     match result {
         Ok(code) => code,

@@ -124,7 +124,58 @@ fn a_model_remembers_the_columns_it_was_trained_on() {
     ]);
     assert_eq!(code, 2);
     assert!(err.contains('t') && err.contains("column"), "{err}");
+
+    // `lot add` reads the logs with the model's columns too, with no column options.
+    let db = dir.path().join("lot.sqlite");
+    let (code, out, err) = outcome(&[
+        "lot",
+        "add",
+        "--db",
+        db.to_str().unwrap(),
+        "--unit",
+        "U-1",
+        "--model",
+        model.to_str().unwrap(),
+        "--test",
+        held.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "lot add with the model's own columns: {out}{err}");
+    // A column option given still overrides: the renamed log has no `gyro_dps`.
+    let (code, _, err) = outcome(&[
+        "lot",
+        "add",
+        "--db",
+        db.to_str().unwrap(),
+        "--unit",
+        "U-2",
+        "--model",
+        model.to_str().unwrap(),
+        "--test",
+        held.to_str().unwrap(),
+        "--gyro-col",
+        "gyro_dps",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("gyro_dps"), "{err}");
     let _ = train_std;
+}
+
+#[test]
+fn a_log_without_time_stamps_is_told_why_a_sample_period_cannot_stand_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("no_time.csv");
+    std::fs::write(&log, "gyro_dps,temp_c\n0.01,22\n0.01,22\n0.01,22\n").unwrap();
+    let (code, _, err) = outcome(&[
+        "evaluate",
+        "--input",
+        log.to_str().unwrap(),
+        "--sample-period-s",
+        "1",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("time_s"), "{err}");
+    assert!(err.contains("--sample-period-s"), "{err}");
+    assert!(err.contains("--time-col"), "{err}");
 }
 
 #[test]

@@ -463,3 +463,43 @@ fn an_arw_limit_on_a_constant_static_log_says_the_curve_lacks_it() {
         "{err}"
     );
 }
+
+/// `plan` and `compensate` measure a log's temperature rate differently (a 100 s moving
+/// average for the chamber plan, the model's own dT window for extrapolation); each says
+/// which, so the two figures for one flight are not read as a contradiction.
+#[test]
+fn plan_and_compensate_name_the_rate_they_print() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let train = simulate_args(d, "ramp.csv", &["--profile", "slow-ramp", "--seed", "1"]);
+    let flight = simulate_args(d, "flight.csv", &["--profile", "airborne", "--seed", "2"]);
+    let model = d.join("m.json");
+    let (code, _, err) = outcome(&[
+        "train",
+        "--method",
+        "linear",
+        "--input",
+        p(&train),
+        "--out",
+        p(&model),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let out = d.join("comp.csv");
+    let (code, _, err) = outcome(&[
+        "compensate",
+        "--model",
+        p(&model),
+        "--input",
+        p(&flight),
+        "--out",
+        p(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("temperature rate (the model's dT over 20 s)"),
+        "the airborne flight is faster than the slow ramp: {err}"
+    );
+    let (code, plan, err) = outcome(&["plan", "--flight", p(&flight)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(plan.contains("rate of its 100 s moving average"), "{plan}");
+}

@@ -81,15 +81,18 @@ pub(crate) fn range_warnings(
     rate_c_per_s: (f64, f64),
 ) -> Vec<String> {
     let t = &model.training;
-    let checks = [
-        ("temperature", "°C", temp_c, t.temp_range_c, 1.0),
-        (
-            "temperature rate",
-            "°C/min",
-            rate_c_per_s,
-            t.rate_range_c_per_s,
-            60.0,
+    // Name the rate by its window: the model's dT is not the rate a report or `plan` shows
+    // (those smooth over 100 s), and the two differ on a fast shock.
+    let rate = match model.feature_spec() {
+        Ok(spec) => format!(
+            "temperature rate (the model's dT over {} s)",
+            crate::csvlog::short_f64(spec.rate_lag_s)
         ),
+        Err(_) => "temperature rate".to_owned(),
+    };
+    let checks = [
+        ("temperature".to_owned(), "°C", temp_c, t.temp_range_c, 1.0),
+        (rate, "°C/min", rate_c_per_s, t.rate_range_c_per_s, 60.0),
     ];
     let mut out = Vec::new();
     for (what, unit, (lo, hi), range, scale) in checks {

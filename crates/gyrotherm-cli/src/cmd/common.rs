@@ -124,7 +124,12 @@ pub fn read_log_noting_gaps(
     path: &Path,
     args: &LogArgs,
 ) -> anyhow::Result<(TestLog, Option<String>)> {
-    let (log, report) = csvlog::read_log(path, &args.read_options())
+    read_log_with(path, &args.read_options())
+}
+
+/// [`read_log_noting_gaps`] with read options `opts` (a model's columns, for example).
+pub fn read_log_with(path: &Path, opts: &ReadOptions) -> anyhow::Result<(TestLog, Option<String>)> {
+    let (log, report) = csvlog::read_log(path, opts)
         .with_context(|| format!("cannot use log {}", path.display()))?;
     let warning = (report.filled_gaps > 0).then(|| {
         format!(
@@ -150,10 +155,19 @@ pub fn read_logs(
     args: &LogArgs,
     warnings: &mut Vec<String>,
 ) -> anyhow::Result<Vec<(String, TestLog)>> {
+    read_logs_with(paths, &args.read_options(), warnings)
+}
+
+/// [`read_logs`] with read options `opts`.
+pub fn read_logs_with(
+    paths: &[PathBuf],
+    opts: &ReadOptions,
+    warnings: &mut Vec<String>,
+) -> anyhow::Result<Vec<(String, TestLog)>> {
     let mut out = Vec::new();
     let mut failed = 0;
     for p in paths {
-        match read_log_noting_gaps(p, args) {
+        match read_log_with(p, opts) {
             Ok((log, warning)) => {
                 warnings.extend(warning);
                 out.push((p.display().to_string(), log));

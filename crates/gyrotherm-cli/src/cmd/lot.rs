@@ -8,8 +8,9 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use gyrotherm::lot::{self, judge_unit, open_store, UnitInputs};
+use gyrotherm::model::GivenColumns;
 
-use super::common::{read_logs, LogArgs};
+use super::common::{read_logs_with, LogArgs};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -97,15 +98,16 @@ pub struct ReportArgs {
     pub title: String,
 }
 
-pub fn run(args: LotArgs) -> anyhow::Result<ExitCode> {
+/// `given`: the column options `lot add`'s command line named (they override a model's own).
+pub fn run(args: LotArgs, given: GivenColumns) -> anyhow::Result<ExitCode> {
     match args.command {
-        LotCommand::Add(a) => add(*a),
+        LotCommand::Add(a) => add(*a, given),
         LotCommand::List(a) => list(a),
         LotCommand::Report(a) => report(a),
     }
 }
 
-fn add(a: AddArgs) -> anyhow::Result<ExitCode> {
+fn add(a: AddArgs, given: GivenColumns) -> anyhow::Result<ExitCode> {
     let spec = super::verdict::load(a.spec.as_deref())?;
     if super::imu::is_imu_model(&a.model)? {
         return add_unit(a, spec);
@@ -116,8 +118,14 @@ fn add(a: AddArgs) -> anyhow::Result<ExitCode> {
          (`gyrotherm train` with the same lists), whose columns lot add then reads",
         a.model.display()
     );
+    // The columns the model was trained with, unless the command line names others.
+    let model = gyrotherm::ModelFile::load(&a.model)
+        .with_context(|| format!("cannot use model {}", a.model.display()))?;
+    let opts = model
+        .read_options(&a.log.read_options(), given)
+        .with_context(|| format!("cannot use model {}", a.model.display()))?;
     let mut warnings = Vec::new();
-    let logs = read_logs(&a.test, &a.log, &mut warnings)?;
+    let logs = read_logs_with(&a.test, &opts, &mut warnings)?;
     for w in &warnings {
         eprintln!("gyrotherm: warning: {w}");
     }

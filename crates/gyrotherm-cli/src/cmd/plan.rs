@@ -76,9 +76,14 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
         env.temp_max_c,
         env.max_rate_c_per_min,
         if flight.is_some() {
-            " (flight log)"
+            // Say which rate: the model's dT (what `compensate` warns with) is shorter and
+            // reads faster on a shock.
+            format!(
+                " (flight log; rate of its {} s moving average)",
+                gyrotherm::report::TEMP_RATE_SMOOTHING_S
+            )
         } else {
-            ""
+            String::new()
         }
     )?;
     writeln!(

@@ -170,7 +170,18 @@ fn missing_column(
             break;
         }
     }
-    if !headers.is_empty() && headers.iter().all(|h| parse_f64(h.as_bytes()).is_some()) {
+    let looks_like_data =
+        !headers.is_empty() && headers.iter().all(|h| parse_f64(h.as_bytes()).is_some());
+    if flag == "--time-col" && !looks_like_data {
+        // A sample period cannot stand in for time stamps: the stamps are how a dropped
+        // sample or a logger stall is seen (and ridden through) rather than silently closed up.
+        message.push_str(
+            " (time stamps cannot be replaced by --sample-period-s: they are how dropped \
+             samples and stalls are found; if the logger wrote none, add a column of sample \
+             index × period and say so in the test record)",
+        );
+    }
+    if looks_like_data {
         message.push_str(
             " (the first line looks like data: add a header row such as time_s,gyro_dps,temp_c)",
         );

@@ -41,7 +41,7 @@ pub use job::{
     allan_curve, comparison_table, grouped_warnings, input_names, model_table, noise_lines,
     results_table, scale_factor_points, shared_settings, temperature_rate_c_per_min,
     write_full_report, write_full_report_with, ScalePoints, FIGURE_STEMS, FIGURE_WINDOW_S,
-    NOT_APPLICABLE,
+    NOT_APPLICABLE, TEMP_RATE_SMOOTHING_S,
 };
 pub use plot::{
     figure_layout, figure_paths, write_figure, Figure, FigureFiles, Panel, PanelLayout, PixelRect,

@@ -47,7 +47,7 @@ use crate::sim::CHAMBER_TEMP_COL;
 /// Averaging window of the raw-output and compensation figures, s (He et al. 2024 use 100 s).
 pub const FIGURE_WINDOW_S: f64 = 100.0;
 /// Smoothing of the gyro temperature before differentiating it for figure 1, s.
-const TEMP_RATE_SMOOTHING_S: f64 = 100.0;
+pub const TEMP_RATE_SMOOTHING_S: f64 = 100.0;
 /// Half-span of the central difference of the smoothed temperature, s.
 const TEMP_RATE_HALF_SPAN_S: f64 = 5.0;
 
