@@ -514,46 +514,6 @@ pub(crate) fn axis_name(i: usize) -> &'static str {
     ["X", "Y", "Z"].get(i).copied().unwrap_or("?")
 }
 
-/// The parameter file of `model` for an autopilot `target` (ArduPilot or PX4), with its fit
-/// (see the module doc). Nothing is written.
-pub fn generate(
-    model: ModelRef<'_>,
-    target: ExportTarget,
-    settings: &AutopilotSettings,
-) -> Result<AutopilotExport, ExportError> {
-    // The settings are checked before the (longer) steady-state computation.
-    let check = |instances| {
-        settings
-            .validate(instances)
-            .map_err(AutopilotError::Setting)
-    };
-    match target {
-        ExportTarget::Ardupilot => check(crate::settings::autopilot::ARDUPILOT_INSTANCES)?,
-        ExportTarget::Px4 => {
-            check(crate::settings::autopilot::PX4_INSTANCES)?;
-            settings.device_id.ok_or(AutopilotError::NoDeviceId)?;
-        }
-        ExportTarget::C | ExportTarget::Rust => {
-            return Err(AutopilotError::NotAutopilot(target).into())
-        }
-    }
-    let steady = steady_bias(model, settings)?;
-    match target {
-        ExportTarget::Px4 => super::px4::generate(steady, settings),
-        _ => super::ardupilot::generate(steady, settings),
-    }
-}
-
-/// Write `export` into `dir` (created if missing), atomically; returns the path.
-pub fn write(export: &AutopilotExport, dir: &Path) -> Result<PathBuf, ExportError> {
-    let files = vec![(export.file_name, export.text.clone())];
-    let mut paths = super::write_files(files, dir)?;
-    paths.pop().ok_or_else(|| ExportError::Io {
-        path: dir.to_path_buf(),
-        source: std::io::Error::other("nothing written"),
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
