@@ -6,7 +6,7 @@
 use gyrotherm_core::coverage::{Coverage, Verdict};
 
 use crate::compensate::{compensator, CompensateError};
-use crate::coverage::CoverageDef;
+use crate::model::CoverageDef;
 use crate::csvlog::TestLog;
 use crate::model::ModelFile;
 

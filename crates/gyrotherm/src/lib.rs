@@ -58,6 +58,7 @@ pub mod csvlog;
 pub mod export;
 pub mod features;
 pub mod fit;
+pub mod imu_error;
 pub mod imu_judge;
 pub mod imu_model;
 pub mod input_file;
