@@ -83,6 +83,7 @@ pub use features::{FeatureSpec, FeatureTable};
 pub use fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog, RecipeKind, RecipeSettings};
 pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
 pub use settings::{FitSettings, SettingError};
+pub(crate) use settings::Rule;
 pub use sim::{simulate, SimConfig};
 pub use targets::TargetSet;
 
