@@ -30,7 +30,7 @@ use crate::imu_model::{
 };
 use crate::metrics::Evaluation;
 use crate::model::TempSensorDef;
-use crate::report::html::Table;
+use crate::string_table::Table;
 use crate::settings::evaluate::{EvaluateError, EvaluateSettings, ResolvedTau};
 use crate::spec::{self, MeasureOptions, Spec, SpecError, Verdict};
 

@@ -72,6 +72,7 @@ pub mod plan;
 pub mod report;
 pub mod settings;
 pub mod sim;
+pub mod string_table;
 pub mod spec;
 pub mod table_segments;
 pub mod targets;
