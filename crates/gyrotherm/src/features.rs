@@ -5,8 +5,8 @@
 //! [`crate::moving_average`] and is re-exported here.
 
 use crate::csvlog::TestLog;
-pub use crate::moving_average::{centred_moving_average, MovingAverageError, Smoothed};
 use crate::moving_average::windowed_mean;
+pub use crate::moving_average::{centred_moving_average, MovingAverageError, Smoothed};
 use gyrotherm_core::error::InputError;
 pub use gyrotherm_core::features::{
     FeatureKind, FeaturePipeline, FeatureSpec, LagOutputs, SpecError, MAX_FEATURES, MAX_LAGS,

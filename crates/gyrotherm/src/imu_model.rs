@@ -35,6 +35,7 @@ use crate::compensate::compensator;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
+pub use crate::imu_error::ImuError;
 use crate::model::{
     content_digest_of, parse_sealed, ModelFile, Seal, SealedTextError, SubModel, Target,
     TempSensorDef, CHECKSUM_KEY,
@@ -42,7 +43,6 @@ use crate::model::{
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
-pub use crate::imu_error::ImuError;
 
 /// Most gyro axes a unit model can have: the capacity of the ground stream's unit, which
 /// `compensate` runs, checked at `train` and at load (flight code fixes its own capacity,

@@ -97,8 +97,8 @@ pub mod plan;
 pub mod report;
 pub mod settings;
 pub mod sim;
-pub mod string_table;
 pub mod spec;
+pub mod string_table;
 pub mod table_segments;
 pub mod targets;
 
@@ -108,8 +108,8 @@ pub use csvlog::{read_log, write_log, LogError, ReadOptions, TestLog};
 pub use features::{FeatureSpec, FeatureTable};
 pub use fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog, RecipeKind, RecipeSettings};
 pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
-pub use settings::{FitSettings, SettingError};
 pub(crate) use settings::Rule;
+pub use settings::{FitSettings, SettingError};
 pub use sim::{simulate, SimConfig};
 pub use targets::TargetSet;
 

@@ -10,10 +10,10 @@
 
 use std::path::Path;
 
+use super::column_list::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::number::{parse_f64, parse_f64_decimal_comma};
 use super::{ExtraColumn, LogWriter, ReadOptions, ReadReport, TestLog, TIME_COL};
-use super::column_list::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
 
 /// A named column of numbers.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 
 pub use super::steady_bias::{
-    cubic, fit_cubic, steady_bias, AutopilotError, AutopilotExport, FitError, ModelRef,
-    SteadyBias, GRID_POINTS, MIN_RANGE_C, RAD_PER_DEG,
+    cubic, fit_cubic, steady_bias, AutopilotError, AutopilotExport, FitError, ModelRef, SteadyBias,
+    GRID_POINTS, MIN_RANGE_C, RAD_PER_DEG,
 };
 use super::{ExportError, ExportTarget};
 use crate::settings::autopilot::AutopilotSettings;

@@ -39,10 +39,10 @@ use super::html::{write_report, ReportContent, ReportFigure};
 use super::plot::FigureFiles;
 use super::ReportError;
 use crate::compare::{CompareConfig, Comparison, MethodResult, TestResult};
-use crate::fit::NamedLog;
-use crate::metrics::DPS_TO_DPH;
 pub use crate::features::temperature_rate_c_per_min;
 use crate::features::TEMP_RATE_SMOOTHING_S;
+use crate::fit::NamedLog;
+use crate::metrics::DPS_TO_DPH;
 use crate::moving_average::centred_moving_average;
 use crate::sim::CHAMBER_TEMP_COL;
 
