@@ -25,7 +25,6 @@
 //! order.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 use gyrotherm_core::features::FeatureKind;
 
