@@ -1,6 +1,6 @@
 //! The autopilot targets, `--target ardupilot` ([`super::ardupilot`]) and `--target px4`
 //! ([`super::px4`]): a model's parameter file for either, with its fit ([`generate`]), and
-//! writing it ([`write`]). What the two share, the steady-state bias and the cubic fitted to
+//! writing it ([`write()`]). What the two share, the steady-state bias and the cubic fitted to
 //! it, is [`super::steady_bias`] (its names are re-exported here).
 
 use std::path::{Path, PathBuf};
