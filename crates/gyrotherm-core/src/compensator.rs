@@ -119,6 +119,10 @@ pub struct NormalisedLstm {
     target_std: f64,
 }
 
+/// Most sensors one axis reads (the first included): the bound
+/// [`ModelError::Sensors`] states, and the size of [`crate::multi::AxisCompensator`]'s parts.
+pub const MAX_SENSORS: usize = 4;
+
 /// Why a model cannot be built.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -136,7 +140,7 @@ pub enum ModelError {
     /// LSTM weights refused (wrong shape or not finite).
     Weights(crate::lstm::WeightError),
     /// A further sensor of an axis ([`crate::multi::AxisCompensator::with_sensor`]): more
-    /// than [`crate::multi::MAX_SENSORS`], one already read, or a step period or rate lag
+    /// than [`MAX_SENSORS`], one already read, or a step period or rate lag
     /// other than the first sensor's.
     Sensors,
 }
@@ -158,7 +162,7 @@ impl core::fmt::Display for ModelError {
                 f,
                 "further sensors: at most {} per axis, each read once, with the first \
                  sensor's step period and rate lag",
-                crate::multi::MAX_SENSORS
+                MAX_SENSORS
             ),
         }
     }

@@ -39,8 +39,8 @@ use crate::compensator::{
 };
 use crate::features::{FeaturePipeline, FeatureSpec};
 
-/// Most sensors one axis reads (the first included).
-pub const MAX_SENSORS: usize = 4;
+// Defined beside the model error that states the bound; the axis is its one user.
+pub use crate::compensator::MAX_SENSORS;
 
 /// A further sensor of an axis: its pipeline and its parts of B and K.
 #[derive(Debug, Clone)]

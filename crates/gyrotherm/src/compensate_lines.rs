@@ -115,7 +115,7 @@ pub enum LinesError {
     Model(crate::compensate::CompensateError),
     /// An inertial-unit model cannot be turned into the flight unit, or the log lacks one of
     /// its columns.
-    Unit(crate::imu_model::ImuError),
+    Unit(crate::imu_error::ImuError),
     /// The input (header, or a malformed line in [`Mode::Strict`]): file, line, column, fix.
     Log(LogError),
     /// Reading the input or writing the output failed.
@@ -736,7 +736,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                 writer.push_raw(b"");
             }
             writer.push_raw(Status::Invalid.as_str().as_bytes());
-            crate::coverage::push_verdict(&mut writer, None);
+            push_verdict(&mut writer, None);
             summary.count(Status::Invalid);
             summary.malformed += 1;
             writer.end_row()?;
@@ -796,7 +796,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                 if let Some(v) = verdict {
                     summary.coverage[v.coverage as usize] += 1;
                 }
-                crate::coverage::push_verdict(&mut writer, verdict);
+                push_verdict(&mut writer, verdict);
                 if c.status == Status::Ok {
                     if let Some([t, r, ..]) = comp.features().map(|f| f.as_slice()) {
                         temp_seen = (temp_seen.0.min(*t), temp_seen.1.max(*t));
@@ -813,7 +813,7 @@ pub fn compensate_lines<R: BufRead, W: Write>(
                     writer.push_raw(b"");
                 }
                 writer.push_raw(Status::Invalid.as_str().as_bytes());
-                crate::coverage::push_verdict(&mut writer, None);
+                push_verdict(&mut writer, None);
                 summary.count(Status::Invalid);
                 summary.malformed += 1;
             }
@@ -835,6 +835,23 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     }
     summary.warnings.extend(cadence.warning());
     Ok(summary)
+}
+
+/// The `coverage` and `sigma_dph` fields of an output row (both empty without a verdict).
+fn push_verdict<W: std::io::Write>(
+    writer: &mut crate::csvlog::LogWriter<W>,
+    verdict: Option<gyrotherm_core::coverage::Verdict>,
+) {
+    match verdict {
+        Some(v) => {
+            writer.push_raw(v.coverage.as_str().as_bytes());
+            writer.push_f64(v.sigma_dph);
+        }
+        None => {
+            writer.push_raw(b"");
+            writer.push_raw(b"");
+        }
+    }
 }
 
 #[cfg(test)]

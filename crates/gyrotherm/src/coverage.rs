@@ -10,108 +10,19 @@
 //! [`SHRINK_STEPS`](crate::settings::coverage::SHRINK_STEPS) steps, times
 //! [`SIGMA_SCALE`](crate::settings::coverage::SIGMA_SCALE), where the cell holds at least
 //! [`MIN_CELL_STEPS`](crate::settings::coverage::MIN_CELL_STEPS) steps (0, not covered,
-//! otherwise). The flight crate's [`CoverageMap`] turns it into a per-sample verdict.
-//!
-//! In the file (`"coverage"`, absent in files written before it, and for LSTM bias models,
-//! which cannot be re-fitted per fold in reasonable time):
-//! ```json
-//! "coverage": {"temp_min_c": -45.0, "temp_cell_c": 6.5, "n_temp": 16,
-//!              "rate_min_c_per_s": -0.06, "rate_cell_c_per_s": 0.01, "n_rate": 12,
-//!              "folds": 5, "count": [...], "rms_dph": [...], "sigma_dph": [...],
-//!              "growth_per_cell": 0.5}
-//! ```
-//! with one value per cell, row-major by temperature.
+//! otherwise). The flight crate's [`CoverageMap`](gyrotherm_core::coverage::CoverageMap)
+//! turns it into a per-sample verdict. The file's form of the map, [`CoverageDef`], is
+//! defined with the model file it sits in.
 
 use std::fmt;
 
-use gyrotherm_core::coverage::{CoverageError, CoverageMap, Grid, Verdict};
-use serde::{Deserialize, Serialize};
+use gyrotherm_core::coverage::CoverageError;
 
 use crate::baseline::{self, LsqError};
-use crate::model::SubModel;
+pub use crate::model::{missing_coverage_note as missing_note, CoverageDef};
+use crate::model::{ModelFile, SubModel};
 pub use crate::settings::coverage::CoverageSettings;
 use crate::targets::TargetSet;
-
-/// The coverage map in the model file (see the module doc).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CoverageDef {
-    /// Lower edge of the first temperature cell, °C.
-    pub temp_min_c: f64,
-    /// Temperature cell width, °C.
-    pub temp_cell_c: f64,
-    /// Temperature cells.
-    pub n_temp: usize,
-    /// Lower edge of the first rate cell, °C/s.
-    pub rate_min_c_per_s: f64,
-    /// Rate cell width, °C/s.
-    pub rate_cell_c_per_s: f64,
-    /// Rate cells.
-    pub n_rate: usize,
-    /// Cross-validation folds.
-    pub folds: usize,
-    /// Held-out steps per cell.
-    pub count: Vec<u64>,
-    /// RMS of the held-out residual per cell, °/h (0 where the count is 0).
-    pub rms_dph: Vec<f64>,
-    /// σ per cell, °/h (0: not covered).
-    pub sigma_dph: Vec<f64>,
-    /// Growth of σ per cell of distance outside the covered cells.
-    pub growth_per_cell: f64,
-}
-
-impl CoverageDef {
-    /// The grid geometry.
-    pub fn grid(&self) -> Grid {
-        Grid {
-            temp_min_c: self.temp_min_c,
-            temp_cell_c: self.temp_cell_c,
-            n_temp: self.n_temp,
-            rate_min_c_per_s: self.rate_min_c_per_s,
-            rate_cell_c_per_s: self.rate_cell_c_per_s,
-            n_rate: self.n_rate,
-        }
-    }
-
-    /// The flight crate's map, checked (also the count and RMS lists' lengths).
-    pub fn to_core(&self) -> Result<CoverageMap, CoverageError> {
-        let n = self.n_temp.saturating_mul(self.n_rate);
-        if self.count.len() != n || self.rms_dph.len() != n {
-            return Err(CoverageError::SigmaLength);
-        }
-        if self.rms_dph.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err(CoverageError::Sigma);
-        }
-        CoverageMap::new(self.grid(), &self.sigma_dph, self.growth_per_cell)
-    }
-
-    /// Covered cells.
-    pub fn covered_cells(&self) -> usize {
-        self.sigma_dph.iter().filter(|s| **s > 0.0).count()
-    }
-
-    /// Pooled RMS of the held-out residual over all cells, °/h.
-    pub fn pooled_rms_dph(&self) -> f64 {
-        let (ss, n) = self
-            .count
-            .iter()
-            .zip(&self.rms_dph)
-            .fold((0.0, 0u64), |(ss, n), (&c, &r)| {
-                (ss + c as f64 * r * r, n + c)
-            });
-        (ss / n.max(1) as f64).sqrt()
-    }
-
-    /// The same map with other σ scale and growth (for calibration): σ of every cell times
-    /// `scale`.
-    pub fn rescaled(&self, scale: f64, growth_per_cell: f64) -> CoverageDef {
-        CoverageDef {
-            sigma_dph: self.sigma_dph.iter().map(|s| s * scale).collect(),
-            growth_per_cell,
-            ..self.clone()
-        }
-    }
-}
 
 /// Why no coverage map was made.
 #[derive(Debug)]
@@ -294,55 +205,11 @@ pub fn cross_validated(
     Ok(def)
 }
 
-/// The `coverage` and `sigma_dph` fields of an output row (both empty without a verdict).
-pub fn push_verdict<W: std::io::Write>(
-    writer: &mut crate::csvlog::LogWriter<W>,
-    verdict: Option<Verdict>,
-) {
-    match verdict {
-        Some(v) => {
-            writer.push_raw(v.coverage.as_str().as_bytes());
-            writer.push_f64(v.sigma_dph);
-        }
-        None => {
-            writer.push_raw(b"");
-            writer.push_raw(b"");
-        }
-    }
-}
-
-/// What to tell the user when a model file carries no coverage map: nothing when it does.
-/// The reason is the one training gave (kept in the file); a file without it was written
-/// before gyrotherm stored maps or their reasons.
-pub fn missing_note(model: &crate::model::ModelFile) -> Option<String> {
-    if model.coverage.is_some() {
-        return None;
-    }
-    Some(match &model.coverage_note {
-        Some(why) => {
-            // The file may have been edited: no control character reaches the terminal.
-            let why: String = why
-                .chars()
-                .take(400)
-                .map(|c| if c.is_control() { '?' } else { c })
-                .collect();
-            format!(
-                "the model file has no coverage map ({why}): the coverage and sigma_dph \
-                 columns stay empty"
-            )
-        }
-        None => "the model file has no coverage map (written before gyrotherm stored one, or \
-                 its bias model is an LSTM alone): the coverage and sigma_dph columns stay \
-                 empty; re-train to get them"
-            .to_owned(),
-    })
-}
-
 /// Shares of the samples of `log` whose verdict is inside, edge and outside (in that order,
 /// of the samples with a verdict) under `model`'s map, stepped by the flight compensator as
 /// `compensate` steps it; None when the model has no map or no sample got a verdict.
 pub fn shares(
-    model: &crate::model::ModelFile,
+    model: &ModelFile,
     log: &crate::csvlog::TestLog,
 ) -> Result<Option<[f64; 3]>, crate::compensate::CompensateError> {
     let Some(map) = model.coverage.as_ref().and_then(|c| c.to_core().ok()) else {

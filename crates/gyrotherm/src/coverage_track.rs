@@ -6,8 +6,8 @@
 use gyrotherm_core::coverage::{Coverage, Verdict};
 
 use crate::compensate::{compensator, CompensateError};
-use crate::coverage::CoverageDef;
 use crate::csvlog::TestLog;
+use crate::model::CoverageDef;
 use crate::model::ModelFile;
 
 /// One value per sample of the log (NaN / None before the compensator's first feature

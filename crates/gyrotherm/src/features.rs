@@ -5,6 +5,7 @@
 //! [`crate::moving_average`] and is re-exported here.
 
 use crate::csvlog::TestLog;
+use crate::moving_average::windowed_mean;
 pub use crate::moving_average::{centred_moving_average, MovingAverageError, Smoothed};
 use gyrotherm_core::error::InputError;
 pub use gyrotherm_core::features::{
@@ -228,6 +229,44 @@ pub fn extract(log: &TestLog, spec: &FeatureSpec) -> Result<FeatureTable, Featur
     extract_series(&log.time_s, &log.temp_c, spec)
 }
 
+/// Smoothing of the gyro temperature before it is differentiated (report figure 1, `plan`), s.
+pub const TEMP_RATE_SMOOTHING_S: f64 = 100.0;
+/// Half-span of the central difference of the smoothed temperature, s.
+const TEMP_RATE_HALF_SPAN_S: f64 = 5.0;
+
+/// Gyro temperature rate, °C/min: the `TEMP_RATE_SMOOTHING_S` centred moving average
+/// ([`centred_moving_average`]) differentiated
+/// by a central difference over ±`TEMP_RATE_HALF_SPAN_S` (one-sided at the ends).
+pub fn temperature_rate_c_per_min(time_s: &[f64], temp_c: &[f64]) -> Vec<f64> {
+    let n = time_s.len().min(temp_c.len());
+    // The symmetric shrinking window keeps a ramp unbiased up to the ends; a log it refuses
+    // (non-finite or non-increasing samples) gets the plain windowed mean.
+    let smooth = centred_moving_average(&time_s[..n], &temp_c[..n], TEMP_RATE_SMOOTHING_S)
+        .map(|s| s.values)
+        .unwrap_or_else(|_| windowed_mean(&time_s[..n], &temp_c[..n], TEMP_RATE_SMOOTHING_S));
+    let dt = if n >= 2 {
+        (time_s[n - 1] - time_s[0]) / (n - 1) as f64
+    } else {
+        1.0
+    };
+    let k = if dt.is_finite() && dt > 0.0 {
+        ((TEMP_RATE_HALF_SPAN_S / dt).round() as usize).max(1)
+    } else {
+        1
+    };
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(k), (i + k).min(n.saturating_sub(1)));
+            let span = time_s[b] - time_s[a];
+            if b > a && span > 0.0 {
+                (smooth[b] - smooth[a]) / span * 60.0
+            } else {
+                f64::NAN
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -255,5 +294,17 @@ mod tests {
             assert!(bound <= t.len());
         }
         assert_eq!(step_bound(&[], 1.0), 0);
+    }
+
+    #[test]
+    fn temperature_rate_of_a_ramp() {
+        // T = 20 + 0.05·t (°C, t in s) is 3 °C/min everywhere
+        // (a linear trend passes the symmetric centred average unchanged, ends included).
+        let t: Vec<f64> = (0..2000).map(|i| i as f64).collect();
+        let temp: Vec<f64> = t.iter().map(|x| 20.0 + 0.05 * x).collect();
+        let rate = temperature_rate_c_per_min(&t, &temp);
+        for (i, r) in rate.iter().enumerate() {
+            assert!((r - 3.0).abs() < 1e-9, "sample {i}: want 3 °C/min got {r}");
+        }
     }
 }

@@ -30,9 +30,9 @@ use crate::imu_model::{
 };
 use crate::metrics::Evaluation;
 use crate::model::TempSensorDef;
-use crate::report::html::Table;
 use crate::settings::evaluate::{EvaluateError, EvaluateSettings, ResolvedTau};
 use crate::spec::{self, MeasureOptions, Spec, SpecError, Verdict};
+use crate::string_table::Table;
 
 /// Why a unit's figures could not be computed.
 #[derive(Debug)]

@@ -25,7 +25,7 @@
 //! [`MAX_STREAM_AXES`] axes, each on a gyro column of its own.
 
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use gyrotherm_core::compensator::{Compensator, Status};
 use gyrotherm_core::features::LagOutputs;
@@ -35,15 +35,14 @@ use crate::compensate::compensator;
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
-use crate::json_keys::DuplicateKey;
+pub use crate::imu_error::ImuError;
 use crate::model::{
-    content_digest_of, parse_sealed, ModelFile, ModelFileError, Seal, SealedTextError, SubModel,
-    SubModelError, Target, TempSensorDef, CHECKSUM_KEY,
+    content_digest_of, parse_sealed, ModelFile, Seal, SealedTextError, SubModel, Target,
+    TempSensorDef, CHECKSUM_KEY,
 };
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
-use crate::CompensateError;
 
 /// Most gyro axes a unit model can have: the capacity of the ground stream's unit, which
 /// `compensate` runs, checked at `train` and at load (flight code fixes its own capacity,
@@ -123,95 +122,6 @@ pub struct ImuModel {
     pub temp_cols: Vec<String>,
     /// One entry per gyro column, same order.
     pub axes: Vec<ImuAxis>,
-}
-
-/// Why an inertial-unit model cannot be fitted, read, written or applied.
-#[derive(Debug)]
-#[non_exhaustive]
-pub enum ImuError {
-    /// Fitting axis `gyro` on sensor `temp` failed.
-    Fit {
-        gyro: String,
-        temp: String,
-        source: Box<FitError>,
-    },
-    /// The model of axis `gyro` is not valid.
-    Axis {
-        gyro: String,
-        source: Box<ModelFileError>,
-    },
-    /// The file's structure is inconsistent (the message says what).
-    Layout(String),
-    /// Further sensor `temp` of axis `gyro`: its part of the bias or scale factor is not
-    /// valid.
-    FurtherSensor {
-        gyro: String,
-        temp: String,
-        part: Target,
-        source: Box<SubModelError>,
-    },
-    /// The text is not an inertial-unit model (JSON error, or a field).
-    Json(serde_json::Error),
-    /// An object names a key twice: which value counts would depend on the reader, and the
-    /// content hash covers only one.
-    DuplicateKey(DuplicateKey),
-    /// `content_sha256` does not match the content.
-    Checksum { found: String, computed: String },
-    /// The log lacks a column the model needs.
-    MissingColumn { column: String, role: &'static str },
-    /// The compensator of axis `gyro` could not be built.
-    Compensate {
-        gyro: String,
-        source: Box<CompensateError>,
-    },
-    /// A file could not be read or written.
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-}
-
-impl std::fmt::Display for ImuError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ImuError::Fit { gyro, temp, .. } => {
-                write!(f, "fitting axis {gyro} on sensor {temp} failed")
-            }
-            ImuError::Axis { gyro, .. } => write!(f, "the model of axis {gyro}"),
-            ImuError::Layout(m) => write!(f, "{m}"),
-            ImuError::FurtherSensor {
-                gyro, temp, part, ..
-            } => write!(f, "axis {gyro}: further sensor {temp}, {}", part.as_str()),
-            ImuError::Json(_) => write!(f, "not an inertial-unit model file"),
-            ImuError::DuplicateKey(d) => d.fmt(f),
-            ImuError::Checksum { found, computed } => write!(
-                f,
-                "{CHECKSUM_KEY} {found} does not match the content ({computed}): the file was \
-                 changed after it was written"
-            ),
-            ImuError::MissingColumn { column, role } => write!(
-                f,
-                "the log has no {role} column {column:?}, which the model needs (name the \
-                 columns with --gyro-col/--temp-col as at training)"
-            ),
-            ImuError::Compensate { gyro, .. } => write!(f, "axis {gyro}"),
-            ImuError::Io { path, .. } => write!(f, "{}", path.display()),
-        }
-    }
-}
-
-impl std::error::Error for ImuError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            ImuError::Fit { source, .. } => Some(source.as_ref()),
-            ImuError::Axis { source, .. } => Some(source.as_ref()),
-            ImuError::FurtherSensor { source, .. } => Some(source.as_ref()),
-            ImuError::Json(e) => Some(e),
-            ImuError::Compensate { source, .. } => Some(source.as_ref()),
-            ImuError::Io { source, .. } => Some(source),
-            _ => None,
-        }
-    }
 }
 
 /// Whether model-file text is an inertial unit's (it has [`IMU_VERSION_KEY`]).

@@ -1,35 +1,60 @@
 //! gyrotherm: the ground library for temperature compensation of fiber optic gyroscopes.
 //!
-//! Data flows one way, and each step is one module (no module imports one further down):
+//! Data flows one way, from the test log to what the engineer reads and what flies:
 //!
 //! ```text
-//! log ──► features ──► targets ──► fit ──► model ──► compensate ──► figures
-//! csvlog  features     targets     fit     model     compensate     compare, report
-//!  (sim)                           ├ baseline (least squares)
+//! log ──► features ──► targets ──► fit ──► model ──► compensate ──► figures ──► report
+//! csvlog  features     targets     fit     model     compensate     compare     report
+//!  (sim)                           ├ baseline (least squares)                   export, lot
 //!                                  └ nn (LSTM training)
 //! ```
 //!
+//! The modules, from the ground up: each imports only modules listed before it (the one
+//! exception is [`settings`], see its line). The fit fills the model file and checks it as
+//! flight code runs it, so the file type and the compensator sit below the fit.
+//!
+//! - [`atomic_file`]: writing an output so that nothing is lost (temporary file, then rename).
+//! - [`input_file`]: reading the small input files (models, spec sheets, profiles).
+//! - [`json_keys`]: a JSON object that names a key twice.
+//! - [`string_table`]: a table of strings, as results are printed.
+//! - [`moving_average`]: the one centred moving average on a time axis.
+//! - [`table_segments`]: the one segmentation of a rate-table log by commanded rate.
+//! - [`allan`]: Allan-family deviations of rate data, with confidence intervals.
+//! - [`nn`]: the LSTM network on the ground: parameters, training, evaluation.
 //! - [`csvlog`]: the test-log CSV format (read, validate, write): [`read_log`] → [`TestLog`].
-//! - [`sim`]: thermal-chamber + FOG simulator, a source of logs ([`simulate`]).
-//! - [`features`]: the model inputs (temperature, its rate, thermal-state lags) of a log
+//! - [`sim`]: the thermal-chamber + FOG simulator, a source of logs ([`simulate`]).
+//! - [`features`]: the model inputs of a log (temperature, its rate, thermal lags)
 //!   ([`FeatureSpec`], [`FeatureTable`]).
+//! - [`metrics`]: the standard gyro figures (IEEE Std 952 / GJB 2426A).
 //! - [`targets`]: what the models learn: bias from static runs, scale factor from rate-table
 //!   runs ([`TargetSet`]).
-//! - [`fit`]: fit a compensation model from training logs ([`fit_model`], [`FitConfig`],
-//!   [`RecipeSettings`]); least squares is [`baseline`], the LSTM network and its training
-//!   [`nn`].
-//! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]).
-//! - [`compensate`]: run the flight compensator (`gyrotherm-core`) over a log or a CSV
-//!   stream with a status per line ([`compensate_log`], [`compensate_lines`](mod@compensate_lines)).
-//! - [`allan`], [`metrics`]: the standard gyro figures (IEEE Std 952 / GJB 2426A).
-//! - [`compare`]: held-out comparison of methods (the numbers); [`report`]: the pictures and
-//!   the HTML report.
-//! - [`moving_average`], [`table_segments`]: the one centred moving average and the one
-//!   rate-table segmentation every step above uses.
+//! - [`baseline`]: least-squares fits over monomials of the features.
+//! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]), with the coverage
+//!   map it carries.
+//! - [`compensate`]: the flight compensator (`gyrotherm-core`) run over a log
+//!   ([`compensate_log`]).
+//! - [`coverage`]: what training covered: the cross-validated coverage map, and a log's
+//!   shares inside it.
+//! - [`coverage_track`]: a log's path through a model's coverage map, sample by sample.
+//! - [`fit`]: fitting a compensation model from training logs ([`fit_model`], [`FitConfig`],
+//!   [`RecipeSettings`]).
+//! - [`compare`]: held-out comparison of methods: the numbers of the results table.
+//! - [`spec`]: spec sheets: limits on the standard figures, and a run's verdict.
 //! - [`settings`]: what a user can choose for each job, with every default, list of values
-//!   and check defined once (the command line and Python only translate).
-//! - [`atomic_file`]: the output helper: every output is written to a temporary file and
-//!   renamed into place.
+//!   and check defined once (the command line and Python only translate). `csvlog`, `model`,
+//!   `coverage`, `fit` and `compare` take names from it (its error type, the method names,
+//!   defaults) while it imports some of them: the one place where imports still run both
+//!   ways.
+//! - [`imu_error`]: why an inertial-unit model cannot be fitted, read, written or applied.
+//! - [`compensate_lines`](mod@compensate_lines): a CSV stream compensated line by line, with a
+//!   status per line.
+//! - [`imu_model`]: one model file for an inertial unit: a model per gyro axis.
+//! - [`compensate_imu_lines`]: an inertial unit's CSV stream compensated line by line.
+//! - [`imu_judge`]: the standard figures and verdicts of an inertial unit, axis by axis.
+//! - [`plan`]: what the training logs cover of a flight's envelope, and the runs still needed.
+//! - [`report`]: the figures and the HTML report.
+//! - [`export`]: a model as flight code (C, Rust) or autopilot parameters.
+//! - [`lot`]: the test station's record of units judged against their spec sheet.
 //!
 //! ```no_run
 //! use gyrotherm::{compensate_log, fit_model, read_log, FitConfig, Method, ModelFile, NamedLog};
@@ -58,6 +83,7 @@ pub mod csvlog;
 pub mod export;
 pub mod features;
 pub mod fit;
+pub mod imu_error;
 pub mod imu_judge;
 pub mod imu_model;
 pub mod input_file;
@@ -72,6 +98,7 @@ pub mod report;
 pub mod settings;
 pub mod sim;
 pub mod spec;
+pub mod string_table;
 pub mod table_segments;
 pub mod targets;
 
@@ -81,6 +108,7 @@ pub use csvlog::{read_log, write_log, LogError, ReadOptions, TestLog};
 pub use features::{FeatureSpec, FeatureTable};
 pub use fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog, RecipeKind, RecipeSettings};
 pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
+pub(crate) use settings::Rule;
 pub use settings::{FitSettings, SettingError};
 pub use sim::{simulate, SimConfig};
 pub use targets::TargetSet;

@@ -105,7 +105,7 @@ impl std::error::Error for PlanError {
 
 /// The envelope of a flight log: its sensor temperature's extremes and the largest |rate|
 /// of the report's temperature rate (100 s smoothing, so the sensor's 0.0625 °C steps do not
-/// read as rates; [`crate::report::temperature_rate_c_per_min`]).
+/// read as rates; [`crate::features::temperature_rate_c_per_min`]).
 pub fn envelope_of(log: &TestLog) -> Result<Envelope, PlanError> {
     let finite = || log.temp_c.iter().copied().filter(|t| t.is_finite());
     let lo = finite().fold(f64::INFINITY, f64::min);
@@ -113,7 +113,7 @@ pub fn envelope_of(log: &TestLog) -> Result<Envelope, PlanError> {
     if !(lo.is_finite() && hi.is_finite()) {
         return Err(PlanError::EmptyFlight);
     }
-    let rate = crate::report::temperature_rate_c_per_min(&log.time_s, &log.temp_c)
+    let rate = crate::features::temperature_rate_c_per_min(&log.time_s, &log.temp_c)
         .into_iter()
         .filter(|r| r.is_finite())
         .fold(0.0f64, |m, r| m.max(r.abs()));

@@ -80,7 +80,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
             // reads faster on a shock.
             format!(
                 " (flight log; rate of its {} s moving average)",
-                gyrotherm::report::TEMP_RATE_SMOOTHING_S
+                gyrotherm::features::TEMP_RATE_SMOOTHING_S
             )
         } else {
             String::new()

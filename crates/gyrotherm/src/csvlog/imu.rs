@@ -1,5 +1,5 @@
 //! An inertial unit's log: several gyro and temperature columns in one file
-//! ([`crate::settings::columns`] says how they are named).
+//! ([`super::column_list`] says how they are named).
 //!
 //! Reading goes through [`read_log`](super::read_log) with the first gyro and the first
 //! temperature column, so time, gaps, separators and those two columns get every check of a
@@ -10,10 +10,10 @@
 
 use std::path::Path;
 
+use super::column_list::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::number::{parse_f64, parse_f64_decimal_comma};
 use super::{ExtraColumn, LogWriter, ReadOptions, ReadReport, TestLog, TIME_COL};
-use crate::settings::columns::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
 
 /// A named column of numbers.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -17,6 +17,7 @@
 //! period is the median of the first [`PERIOD_ESTIMATE_STEPS`] steps; see [`LogReader`]).
 
 mod chunk;
+mod column_list;
 mod columns;
 mod error;
 mod gaps;
@@ -25,6 +26,9 @@ mod number;
 mod reader;
 mod writer;
 
+pub use column_list::{
+    parse_table_axis, split_columns, COLUMN_LIST_SEPARATOR, TABLE_AXIS_SLOPE_RANGE,
+};
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
 pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
@@ -232,7 +236,7 @@ pub struct ReadOptions {
     /// Header of the time column (s).
     pub time_col: String,
     /// Header of the gyro column (unit: `gyro_unit`), or of several, comma-separated (an
-    /// inertial unit's log: [`read_imu_log`]; see [`crate::settings::columns`]).
+    /// inertial unit's log: [`read_imu_log`]; see [`split_columns`]).
     pub gyro_col: String,
     /// Header of the temperature column (°C), or of several, comma-separated.
     pub temp_col: String,

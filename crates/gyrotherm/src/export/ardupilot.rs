@@ -19,11 +19,11 @@
 //! Only the gyro coefficients are written; the accelerometer's (`INS_TCAL{n}_ACC*`) are left
 //! as they are on the vehicle.
 
-use super::autopilot::{fit_cubic, AutopilotExport, FitError, SteadyBias, RAD_PER_DEG};
+use super::steady_bias::{fit_cubic, AutopilotExport, FitError, SteadyBias, RAD_PER_DEG};
 use super::ExportError;
 use crate::settings::autopilot::{AutopilotSettings, ARDUPILOT_INSTANCES};
 
-use super::autopilot::AutopilotError;
+use super::steady_bias::AutopilotError;
 
 /// The file written.
 pub const FILE_NAME: &str = "gyro_tcal.parm";

@@ -15,6 +15,7 @@ pub mod autopilot;
 pub mod c;
 pub mod px4;
 pub mod rust;
+pub mod steady_bias;
 pub mod target;
 pub mod unit;
 

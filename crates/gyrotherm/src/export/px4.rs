@@ -15,7 +15,7 @@
 //! is absolute, so X0 is written and the fit error includes it. TREF is the middle of the
 //! training range.
 
-use super::autopilot::{
+use super::steady_bias::{
     cubic, fit_cubic, AutopilotError, AutopilotExport, FitError, SteadyBias, RAD_PER_DEG,
 };
 use super::ExportError;

@@ -309,9 +309,9 @@ pub struct ModelFile {
     /// Training facts.
     pub training: TrainingInfo,
     /// The (T, dT) region training covered and the cross-validated bias error there (absent
-    /// in older files and for LSTM bias models; see [`crate::coverage`]).
+    /// in older files and for LSTM bias models; see [`CoverageDef`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub coverage: Option<crate::coverage::CoverageDef>,
+    pub coverage: Option<CoverageDef>,
     /// The log columns (and gyro unit) the model was trained on, so that a log of the same
     /// layout is compensated without naming them again (absent in older files: the options
     /// given, or their defaults). Left out of the file when absent, so an older file's
@@ -625,7 +625,7 @@ impl ModelFile {
                 c.n_temp * c.n_rate
             )),
             None => {
-                if let Some(n) = crate::coverage::missing_note(self) {
+                if let Some(n) = missing_coverage_note(self) {
                     out.push(format!("  coverage: none: {n}"));
                 }
             }
@@ -639,11 +639,40 @@ impl ModelFile {
     }
 }
 
+/// What to tell the user when a model file carries no coverage map: nothing when it does.
+/// The reason is the one training gave (kept in the file); a file without it was written
+/// before gyrotherm stored maps or their reasons.
+pub fn missing_coverage_note(model: &ModelFile) -> Option<String> {
+    if model.coverage.is_some() {
+        return None;
+    }
+    Some(match &model.coverage_note {
+        Some(why) => {
+            // The file may have been edited: no control character reaches the terminal.
+            let why: String = why
+                .chars()
+                .take(400)
+                .map(|c| if c.is_control() { '?' } else { c })
+                .collect();
+            format!(
+                "the model file has no coverage map ({why}): the coverage and sigma_dph \
+                 columns stay empty"
+            )
+        }
+        None => "the model file has no coverage map (written before gyrotherm stored one, or \
+                 its bias model is an LSTM alone): the coverage and sigma_dph columns stay \
+                 empty; re-train to get them"
+            .to_owned(),
+    })
+}
+
 mod checks;
+mod coverage_map;
 mod flight;
 mod seal;
 
 pub use checks::SubModelError;
+pub use coverage_map::CoverageDef;
 pub use flight::{padded_core_lstm, target_model, CompensateError};
 use seal::supported_list;
 pub(crate) use seal::{content_digest_of, parse_sealed, SealedTextError};

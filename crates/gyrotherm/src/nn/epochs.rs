@@ -11,10 +11,9 @@ use super::config::{
     Bptt, LrSchedule, Sequence, StopReason, TrainConfig, TrainOutput, WindowStart,
 };
 use super::error::TrainError;
-use super::eval::{flatten, unflatten};
 use super::kernel::Kernel;
 use super::lstm::{backward, forward, tape_stride, Layout, Packed};
-use super::params::init_params;
+use super::params::{flatten, init_params, unflatten};
 
 /// Batches drawn in a row with no counted step before sampled training gives up.
 const MAX_EMPTY_DRAWS: usize = 1000;

@@ -1,5 +1,5 @@
 //! Evaluating a network outside training: forward passes, MSE, loss and gradient (for
-//! gradient checks and comparison with other frameworks), and the flat parameter vector.
+//! gradient checks and comparison with other frameworks).
 
 use super::batch::{Gemm, WindowRef};
 use super::checks::check_runs;
@@ -7,38 +7,8 @@ use super::config::{Precision, Sequence};
 use super::epochs::batch_grad;
 use super::error::TrainError;
 use super::kernel::Kernel;
-use super::lstm::{forward, param_count, tape_stride, Layout, Packed};
-use super::params::LstmParams;
-
-/// Flat parameter vector in PyTorch order (w_ih, w_hh, b_ih, b_hh, w_out, b_out).
-pub(crate) fn flatten(p: &LstmParams) -> Vec<f64> {
-    let mut v = Vec::with_capacity(param_count(p.input_size, p.hidden_size));
-    v.extend_from_slice(&p.w_ih);
-    v.extend_from_slice(&p.w_hh);
-    v.extend_from_slice(&p.b_ih);
-    v.extend_from_slice(&p.b_hh);
-    v.extend_from_slice(&p.w_out);
-    v.push(p.b_out);
-    v
-}
-
-/// Inverse of [`flatten`]; `theta` must hold `param_count(I, H)` values.
-pub(crate) fn unflatten(theta: &[f64], input_size: usize, hidden_size: usize) -> LstmParams {
-    let lay = Layout {
-        i: input_size,
-        h: hidden_size,
-    };
-    LstmParams {
-        input_size,
-        hidden_size,
-        w_ih: theta[lay.w_ih()].to_vec(),
-        w_hh: theta[lay.w_hh()].to_vec(),
-        b_ih: theta[lay.b_ih()].to_vec(),
-        b_hh: theta[lay.b_hh()].to_vec(),
-        w_out: theta[lay.w_out()].to_vec(),
-        b_out: theta[lay.b_out()],
-    }
-}
+use super::lstm::{forward, tape_stride, Layout, Packed};
+use super::params::{flatten, unflatten, LstmParams};
 
 /// Forward-only MSE of `params` over `runs` (mean over counted steps), in the given kernel
 /// precision; for validation and checks.

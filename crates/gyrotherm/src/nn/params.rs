@@ -8,6 +8,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::lstm::{param_count, Layout};
+
 /// Parameters of one LSTM layer with a one-output linear head. Row-major matrices.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LstmParams {
@@ -226,4 +228,34 @@ pub fn init_params(input_size: usize, hidden_size: usize, seed: u64) -> LstmPara
         *v = rng.gen_range(-k..k);
     }
     p
+}
+
+/// Flat parameter vector in PyTorch order (w_ih, w_hh, b_ih, b_hh, w_out, b_out).
+pub(crate) fn flatten(p: &LstmParams) -> Vec<f64> {
+    let mut v = Vec::with_capacity(param_count(p.input_size, p.hidden_size));
+    v.extend_from_slice(&p.w_ih);
+    v.extend_from_slice(&p.w_hh);
+    v.extend_from_slice(&p.b_ih);
+    v.extend_from_slice(&p.b_hh);
+    v.extend_from_slice(&p.w_out);
+    v.push(p.b_out);
+    v
+}
+
+/// Inverse of [`flatten`]; `theta` must hold `param_count(I, H)` values.
+pub(crate) fn unflatten(theta: &[f64], input_size: usize, hidden_size: usize) -> LstmParams {
+    let lay = Layout {
+        i: input_size,
+        h: hidden_size,
+    };
+    LstmParams {
+        input_size,
+        hidden_size,
+        w_ih: theta[lay.w_ih()].to_vec(),
+        w_hh: theta[lay.w_hh()].to_vec(),
+        b_ih: theta[lay.b_ih()].to_vec(),
+        b_hh: theta[lay.b_hh()].to_vec(),
+        w_out: theta[lay.w_out()].to_vec(),
+        b_out: theta[lay.b_out()],
+    }
 }

@@ -8,14 +8,7 @@ use std::path::{Path, PathBuf};
 use super::plot::FigureFiles;
 use super::ReportError;
 use crate::atomic_file::write_bytes_atomically;
-
-/// A table of strings: the comparison of methods (method, bias stability °/h, scale-factor
-/// error ppm, ...). Rows shorter than the headers are padded with empty cells.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Table {
-    pub headers: Vec<String>,
-    pub rows: Vec<Vec<String>>,
-}
+pub use crate::string_table::Table;
 
 /// A figure of the report: file names relative to the report folder.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -60,7 +60,7 @@ pub fn log_options() -> Vec<OptionSpec> {
     let d = ReadOptions::default();
     vec![
         // Which listed gyro column a rate-table log drives (default: the one that follows
-        // the table, `settings::columns`); a column name, so no list of values.
+        // the table, `csvlog::column_list`); a column name, so no list of values.
         opt("table_axis", None),
         opt("time_col", Some(d.time_col)),
         opt("gyro_col", Some(d.gyro_col)),

@@ -29,7 +29,6 @@
 
 pub mod allan;
 pub mod autopilot;
-pub mod columns;
 pub mod compensate;
 pub mod coverage;
 pub mod describe;

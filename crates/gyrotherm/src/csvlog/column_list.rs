@@ -9,8 +9,10 @@
 //! [`TABLE_AXIS_SLOPE_RANGE`]), or the one named by `--table-axis GYRO_COL`
 //! ([`parse_table_axis`]); give one table log per axis.
 
-use super::{Rule, SettingError};
-use crate::csvlog::ReadOptions;
+use super::{ReadOptions, DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
+// Named at the crate root, not in `settings`, whose modules read `ReadOptions`: the log
+// format takes the settings' error type only, not the modules that describe the options.
+use crate::{Rule, SettingError};
 
 /// Separator of the names in a column list.
 pub const COLUMN_LIST_SEPARATOR: char = ',';
@@ -79,7 +81,6 @@ impl ReadOptions {
     /// the mapped time, gyro, temperature and table columns under the standard names (the
     /// gyro already in °/s), any other column under its own.
     pub fn log_column<'a>(&self, name: &'a str) -> &'a str {
-        use crate::csvlog::{DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
         match name {
             n if n == self.gyro_col => GYRO_COL,
             n if n == self.temp_col => TEMP_COL,
@@ -92,7 +93,6 @@ impl ReadOptions {
     /// The file's name of a [`crate::csvlog::TestLog`] column (`log_column`'s inverse): what a
     /// result calls the column, so that it is the user's name, not the standard one.
     pub fn file_column<'a>(&'a self, log_column: &'a str) -> &'a str {
-        use crate::csvlog::{DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
         match log_column {
             GYRO_COL => &self.gyro_col,
             TEMP_COL => &self.temp_col,
