@@ -14,7 +14,7 @@ use gyrotherm::settings::{Method, DEFAULT_METHOD};
 use super::common::LogArgs;
 use super::common::{named, read_logs};
 use super::progress::TrainingBars;
-use super::train::{deprecation_text, method_parser, FitArgs};
+use super::train::{method_parser, warn_deprecated, FitArgs};
 
 #[derive(Debug, clap::Args)]
 pub struct CompareArgs {
@@ -26,7 +26,7 @@ pub struct CompareArgs {
     pub test: Vec<PathBuf>,
     /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
     /// sample period nearest to it when 100 s is not one; said on stderr).
-    #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
+    #[arg(long, value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
     pub tau_s: Option<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]
@@ -53,15 +53,12 @@ pub struct ColumnArgs {
 }
 
 impl ColumnArgs {
-    /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`;
-    /// a deprecated spelling is said on stderr.
+    /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`.
     pub fn compare_config(&self, fit: &FitArgs, tau_s: f64) -> anyhow::Result<CompareConfig> {
         let (cfg, note) = fit
             .settings(DEFAULT_METHOD)
             .compare_config(self.methods.as_deref(), tau_s)?;
-        if let Some(n) = note {
-            eprintln!("gyrotherm: warning: {}", deprecation_text(n));
-        }
+        warn_deprecated(note);
         Ok(cfg)
     }
 }

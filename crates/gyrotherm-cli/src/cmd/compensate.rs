@@ -191,19 +191,19 @@ impl Write for DeferredFlush<'_> {
 #[derive(Debug, Clone, clap::Args)]
 pub struct TempSensorArgs {
     /// Lowest plausible temperature reading, °C.
-    #[arg(long, alias = "temp-min", value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.min_c)]
+    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.min_c)]
     pub temp_min_c: f64,
     /// Highest plausible temperature reading, °C.
-    #[arg(long, alias = "temp-max", value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.max_c)]
+    #[arg(long, value_name = "C", allow_negative_numbers = true, default_value_t = TempLimits::DEFAULT.max_c)]
     pub temp_max_c: f64,
     /// Fastest plausible temperature change, °C/s.
-    #[arg(long, alias = "temp-max-rate", value_name = "C_PER_S", default_value_t = TempLimits::DEFAULT.max_rate_c_per_s)]
+    #[arg(long, value_name = "C_PER_S", default_value_t = TempLimits::DEFAULT.max_rate_c_per_s)]
     pub temp_max_rate_c_per_s: f64,
     /// Temperature change always allowed between two readings (noise, resolution), °C.
-    #[arg(long, alias = "temp-step-allowance", value_name = "C", default_value_t = TempLimits::DEFAULT.step_allowance_c)]
+    #[arg(long, value_name = "C", default_value_t = TempLimits::DEFAULT.step_allowance_c)]
     pub temp_step_allowance_c: f64,
     /// Seconds without a good temperature before the output is `degraded` instead of `held`.
-    #[arg(long, alias = "degraded-after", value_name = "S", default_value_t = TempLimits::DEFAULT.degraded_after_s)]
+    #[arg(long, value_name = "S", default_value_t = TempLimits::DEFAULT.degraded_after_s)]
     pub degraded_after_s: f64,
 }
 

@@ -23,10 +23,10 @@ pub struct EvaluateArgs {
     pub column: String,
     /// Smoothing time of the bias stability, s (default 100 s, or the multiple of the sample
     /// period nearest to it when 100 s is not one).
-    #[arg(long, alias = "tau", value_parser = seconds("tau_s", Rule::PositiveSeconds))]
+    #[arg(long, value_parser = seconds("tau_s", Rule::PositiveSeconds))]
     pub tau_s: Option<f64>,
     /// Time dropped at the start of each rate-table segment, s.
-    #[arg(long, alias = "settle", default_value_t = EvaluateSettings::default().settle_s,
+    #[arg(long, default_value_t = EvaluateSettings::default().settle_s,
           value_parser = seconds("settle_s", Rule::NonNegativeSeconds))]
     pub settle_s: f64,
     /// Room-temperature scale factor for the thermal error (default: first rate segment's).

@@ -27,7 +27,7 @@ pub struct ReportArgs {
     pub out: PathBuf,
     /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
     /// sample period nearest to it when 100 s is not one; said on stderr).
-    #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
+    #[arg(long, value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
     pub tau_s: Option<f64>,
     #[doc = "Spec sheet (TOML) to judge every model column against; exit 1 when a column misses a limit."]
     #[arg(long, value_name = "SPEC.toml", long_help = super::verdict::SPEC_HELP)]

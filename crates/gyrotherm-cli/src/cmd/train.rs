@@ -4,22 +4,20 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, FitConfig, RecipeKind, Target};
+use gyrotherm::fit::{fit_model, FitConfig, Target};
 use gyrotherm::model::ColumnsDef;
-use gyrotherm::settings::fit::{self, RECIPE_NAMES};
-use gyrotherm::settings::{Deprecation, FitSettings, Method, Rule, DEFAULT_METHOD, METHODS};
+use gyrotherm::settings::fit;
+use gyrotherm::settings::{FitSettings, Method, Rule, DEFAULT_METHOD, METHODS};
 
-use super::common::{choice, named, read_logs, seconds, LogArgs};
+use super::common::{named, read_logs, seconds, LogArgs};
 
-/// The `--method` parser: the library's methods with their help, and the deprecated `lstm`
-/// accepted but not listed.
+/// The `--method` parser: the library's methods with their help.
 pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
     use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
     PossibleValuesParser::new(
         METHODS
             .iter()
-            .map(|m| PossibleValue::new(m.as_str()).help(m.help()))
-            .chain([PossibleValue::new(Method::Lstm.as_str()).hide(true)]),
+            .map(|m| PossibleValue::new(m.as_str()).help(m.help())),
     )
     .try_map(|s| s.parse::<Method>())
 }
@@ -29,10 +27,6 @@ use super::progress::TrainingBars;
 /// [`FitSettings`] (defaults, names and checks are the library's).
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
-    /// Deprecated (one release): the recipe of the former `lstm` method, now a method of its
-    /// own (`--method lstm --recipe residual` is `--method residual`).
-    #[arg(long, hide = true, value_parser = choice::<RecipeKind>(RECIPE_NAMES.map(|n| (n, ""))))]
-    pub recipe: Option<RecipeKind>,
     /// Training epochs of the method's LSTM (default: the method's own).
     #[arg(long)]
     pub epochs: Option<usize>,
@@ -43,11 +37,11 @@ pub struct FitArgs {
     #[arg(long, default_value_t = fit::DEFAULT_HIDDEN)]
     pub hidden: usize,
     /// Bias target smoothing window, s (centred moving average; 100 s as published).
-    #[arg(long, alias = "bias-window", default_value_t = fit::DEFAULT_BIAS_WINDOW_S,
+    #[arg(long, default_value_t = fit::DEFAULT_BIAS_WINDOW_S,
           value_parser = seconds("bias_window_s", Rule::PositiveSeconds))]
     pub bias_window_s: f64,
     /// Time dropped at the start of each rate-table segment, s.
-    #[arg(long, alias = "settle", default_value_t = fit::DEFAULT_SETTLE_S,
+    #[arg(long, default_value_t = fit::DEFAULT_SETTLE_S,
           value_parser = seconds("settle_s", Rule::NonNegativeSeconds))]
     pub settle_s: f64,
     /// Highest power of T in the `poly` bias model.
@@ -71,7 +65,9 @@ impl FitArgs {
     pub fn settings(&self, method: Method) -> FitSettings {
         FitSettings {
             method,
-            recipe: self.recipe,
+            // The command line names the method itself; the library's deprecated recipe
+            // setting is never given.
+            recipe: None,
             epochs: self.epochs,
             seed: self.seed,
             hidden: self.hidden,
@@ -84,28 +80,20 @@ impl FitArgs {
         }
     }
 
-    /// The library's fit configuration for `method`; a deprecated spelling is said on stderr.
+    /// The library's fit configuration for `method`.
     pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
         let (cfg, note) = self.settings(method).fit_config()?;
-        if let Some(n) = note {
-            eprintln!("gyrotherm: warning: {}", deprecation_text(n));
-        }
+        warn_deprecated(note);
         Ok(cfg)
     }
 }
 
-/// A deprecation in the command line's words.
-pub fn deprecation_text(d: Deprecation) -> String {
-    match d {
-        Deprecation::LstmMethod { now } => {
-            format!("--method lstm is deprecated: use --method {now} (same model)")
-        }
-        Deprecation::Recipe { now } => {
-            format!("--recipe is deprecated: the recipes are methods now; use --method {now}")
-        }
-        Deprecation::RecipeIgnored { method } => {
-            format!("--recipe is deprecated, and --method {method} has none: ignored")
-        }
+/// A deprecated spelling the library resolved, said on stderr. The command line passes none
+/// (`--method` lists only the current names and no recipe is given); the library's note is
+/// still said rather than dropped should it report one.
+pub fn warn_deprecated(note: Option<gyrotherm::settings::Deprecation>) {
+    if let Some(n) = note {
+        eprintln!("gyrotherm: warning: {n}");
     }
 }
 
