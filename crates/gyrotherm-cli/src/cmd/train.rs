@@ -4,118 +4,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, FitConfig, Target};
+use gyrotherm::fit::{fit_model, Target};
 use gyrotherm::model::ColumnsDef;
-use gyrotherm::settings::fit;
-use gyrotherm::settings::{FitSettings, Method, Rule, DEFAULT_METHOD, METHODS};
 
-use super::common::{named, read_logs, seconds, LogArgs};
-
-/// The `--method` parser: the library's methods with their help.
-pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
-    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
-    PossibleValuesParser::new(
-        METHODS
-            .iter()
-            .map(|m| PossibleValue::new(m.as_str()).help(m.help())),
-    )
-    .try_map(|s| s.parse::<Method>())
-}
+use super::args::TrainArgs;
+use super::common::{named, read_logs};
 use super::progress::TrainingBars;
-
-/// Fitting options shared by `train`, `compare`, `report` and `demo`: the library's
-/// [`FitSettings`] (defaults, names and checks are the library's).
-#[derive(Debug, Clone, clap::Args)]
-pub struct FitArgs {
-    /// Training epochs of the method's LSTM (default: the method's own).
-    #[arg(long)]
-    pub epochs: Option<usize>,
-    /// Random seed of the LSTM initialisation and window order.
-    #[arg(long, default_value_t = fit::DEFAULT_SEED)]
-    pub seed: u64,
-    /// Hidden units of the method's LSTM (8 as published; 1 to 128).
-    #[arg(long, default_value_t = fit::DEFAULT_HIDDEN)]
-    pub hidden: usize,
-    /// Bias target smoothing window, s (centred moving average; 100 s as published).
-    #[arg(long, default_value_t = fit::DEFAULT_BIAS_WINDOW_S,
-          value_parser = seconds("bias_window_s", Rule::PositiveSeconds))]
-    pub bias_window_s: f64,
-    /// Time dropped at the start of each rate-table segment, s.
-    #[arg(long, default_value_t = fit::DEFAULT_SETTLE_S,
-          value_parser = seconds("settle_s", Rule::NonNegativeSeconds))]
-    pub settle_s: f64,
-    /// Highest power of T in the `poly` bias model.
-    #[arg(long, default_value_t = fit::DEFAULT_POLY_TEMP_DEGREE)]
-    pub poly_temp_degree: u8,
-    /// Highest power of dT in the `poly` bias model.
-    #[arg(long, default_value_t = fit::DEFAULT_POLY_RATE_DEGREE)]
-    pub poly_rate_degree: u8,
-    /// Leave the T·dT cross term out of the `poly` bias model.
-    #[arg(long)]
-    pub no_cross: bool,
-    /// With two or more static (or rate-table) training logs: keep the residual LSTM only if,
-    /// trained without each log in turn, it also improves that log (slower: one more training
-    /// per log; reports each log's figure).
-    #[arg(long)]
-    pub validate_on_runs: bool,
-}
-
-impl FitArgs {
-    /// The library's settings for `method`.
-    pub fn settings(&self, method: Method) -> FitSettings {
-        FitSettings {
-            method,
-            // The command line names the method itself; the library's deprecated recipe
-            // setting is never given.
-            recipe: None,
-            epochs: self.epochs,
-            seed: self.seed,
-            hidden: self.hidden,
-            bias_window_s: self.bias_window_s,
-            settle_s: self.settle_s,
-            poly_temp_degree: self.poly_temp_degree,
-            poly_rate_degree: self.poly_rate_degree,
-            cross: !self.no_cross,
-            validate_on_runs: self.validate_on_runs,
-        }
-    }
-
-    /// The library's fit configuration for `method`.
-    pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
-        let (cfg, note) = self.settings(method).fit_config()?;
-        warn_deprecated(note);
-        Ok(cfg)
-    }
-}
-
-/// A deprecated spelling the library resolved, said on stderr. The command line passes none
-/// (`--method` lists only the current names and no recipe is given); the library's note is
-/// still said rather than dropped should it report one.
-pub fn warn_deprecated(note: Option<gyrotherm::settings::Deprecation>) {
-    if let Some(n) = note {
-        eprintln!("gyrotherm: warning: {n}");
-    }
-}
-
-#[derive(Debug, clap::Args)]
-pub struct TrainArgs {
-    /// Training log (CSV); repeat for several. Static logs train the bias model, logs with
-    /// table_dps the scale-factor model.
-    #[arg(long, required = true)]
-    pub input: Vec<PathBuf>,
-    /// Fitting method.
-    #[arg(long, default_value_t = DEFAULT_METHOD, value_parser = method_parser())]
-    pub method: Method,
-    #[command(flatten)]
-    pub fit: FitArgs,
-    /// Model file to write (JSON).
-    #[arg(long)]
-    pub out: PathBuf,
-    #[command(flatten)]
-    pub log: LogArgs,
-    #[command(flatten)]
-    pub sensor: super::compensate::TempSensorArgs,
-}
 
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     super::common::refuse_outputs_over_inputs(
