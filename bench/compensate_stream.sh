@@ -16,7 +16,7 @@ $bin simulate --profile fast-cycle --seed 3 --rate-hz "$rate_hz" --out "$work/ru
 lines=$(($(wc -l < "$work/run.csv") - 1))
 bytes=$(wc -c < "$work/run.csv")
 start=$(date +%s.%N)
-$bin compensate --stream --sample-period "$(python3 -c "print(1/$rate_hz)")" --model "$work/model.json" < "$work/run.csv" > "$work/out.csv"
+$bin compensate --stream --sample-period-s "$(python3 -c "print(1/$rate_hz)")" --model "$work/model.json" < "$work/run.csv" > "$work/out.csv"
 end=$(date +%s.%N)
 python3 - "$start" "$end" "$lines" "$bytes" <<'PY'
 import sys

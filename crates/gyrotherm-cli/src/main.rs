@@ -34,15 +34,15 @@ enum Command {
     /// Allan deviation (ADEV, OADEV, MDEV, HDEV) of a rate column, with noise terms.
     Allan(cmd::allan::AllanArgs),
     /// Bias, bias stability and (rate-table logs) scale-factor figures of a log.
-    Evaluate(cmd::evaluate::EvaluateArgs),
+    Evaluate(cmd::args::EvaluateArgs),
     /// Fit a compensation model (thermal-state, LSTM, linear or polynomial) to test logs.
-    Train(cmd::train::TrainArgs),
+    Train(cmd::args::TrainArgs),
     /// Apply a fitted model to a log (batch, or --stream on stdin/stdout).
-    Compensate(cmd::compensate::CompensateArgs),
+    Compensate(cmd::args::CompensateArgs),
     /// Fit every method on training logs and judge them on a held-out log.
-    Compare(cmd::compare::CompareArgs),
+    Compare(cmd::args::CompareArgs),
     /// Write an HTML report with figures for a held-out comparison.
-    Report(cmd::report::ReportArgs),
+    Report(cmd::args::ReportArgs),
     /// What the training logs cover of a flight's (T, dT) envelope; a chamber profile that
     /// covers it.
     Plan(cmd::plan::PlanArgs),

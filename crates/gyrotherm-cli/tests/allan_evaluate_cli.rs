@@ -101,7 +101,7 @@ fn evaluate_json_static_and_table() {
         "evaluate",
         "--input",
         log.to_str().unwrap(),
-        "--tau",
+        "--tau-s",
         "10",
         "--json",
     ]);
@@ -129,7 +129,7 @@ fn evaluate_json_static_and_table() {
         "evaluate",
         "--input",
         tlog.to_str().unwrap(),
-        "--tau",
+        "--tau-s",
         "10",
         "--json",
     ]);

@@ -1,6 +1,6 @@
 //! The bridges to autopilots and ROS, through the real binary: `export --target ardupilot|px4`
 //! (the fit printed, what the polynomial leaves out, the file written atomically into
-//! `--out`), the deprecated `--lang` still working with a warning, flags refused where they
+//! `--out`), the removed `--lang` refused in favour of `--target`, flags refused where they
 //! mean nothing, and `allan --kalibr` (the file written with the figures the library reads,
 //! bounds printed, a bad topic refused).
 
@@ -89,18 +89,28 @@ fn export_writes_autopilot_parameters_with_the_fit_printed() {
 }
 
 #[test]
-fn lang_still_works_with_a_warning_and_autopilot_flags_are_refused_for_code() {
+fn lang_is_refused_and_autopilot_flags_are_refused_for_code() {
     let dir = tempfile::tempdir().unwrap();
     let model = thermal_model(dir.path());
     let out = dir.path().join("c");
-    let r = run_ok(
+    let r = gyrotherm()
+        .args(["export", "--lang", "c", "--model"])
+        .arg(&model)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_exit(&r, 2);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("unexpected argument '--lang'"), "{err}");
+    assert!(!out.exists(), "nothing written");
+    run_ok(
         gyrotherm()
-            .args(["export", "--lang", "c", "--model"])
+            .args(["export", "--target", "c", "--model"])
             .arg(&model)
             .arg("--out")
             .arg(&out),
     );
-    assert!(String::from_utf8_lossy(&r.stderr).contains("--lang is deprecated"));
     assert!(out.join("gyrotherm_model.c").exists());
     let r = gyrotherm()
         .args(["export", "--target", "c", "--axis", "y", "--model"])
@@ -116,7 +126,7 @@ fn lang_still_works_with_a_warning_and_autopilot_flags_are_refused_for_code() {
     for t in ["ardupilot", "px4", "rust"] {
         assert!(help.contains(t), "{help}");
     }
-    assert!(!help.contains("--lang"), "deprecated: hidden\n{help}");
+    assert!(!help.contains("--lang"), "removed\n{help}");
 }
 
 /// Standard normal pairs: SplitMix64 (Steele, Lea & Flood 2014) and the Box–Muller

@@ -308,19 +308,26 @@ fn compare_shows_the_published_recipe_beside_the_default() {
         cols,
         ["figure", "raw", "LSTM, He et al.", "linear", "noise floor"]
     );
-    // The deprecated `--recipe published` makes the default recipe column (and the
-    // deprecated `lstm` in `--methods`) the published one: asking for both is refused, and
-    // the default columns hold it once.
-    let out = compare(&["--recipe", "published", "--methods", "lstm,published"])
+    // A column asked for twice is refused.
+    let out = compare(&["--methods", "published,published"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("published column is asked for twice"), "{err}");
-    let out = run_ok(&mut compare(&["--recipe", "published", "--json"]));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["models"].as_array().unwrap().len(), 3);
-    assert_eq!(v["models"][2]["label"], "LSTM, He et al.");
+    // The removed spellings (`--recipe R`, method `lstm`) are refused by the parser, which
+    // names the current ones.
+    let out = compare(&["--recipe", "published"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unexpected argument '--recipe'"), "{err}");
+    let out = compare(&["--methods", "lstm,published"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("invalid value 'lstm'") && err.contains("thermal"),
+        "{err}"
+    );
 }
 
 /// `--validate-on-runs` with two static logs: the output names each log with its figure for
@@ -450,7 +457,7 @@ fn simulate_random_unit_writes_its_parameters() {
 }
 
 /// A log at one sample per 15 s (100 s is no multiple of it): evaluate takes the multiple
-/// nearest 100 s, 105 s = 7 × 15 s, and says so; `--tau` still chooses.
+/// nearest 100 s, 105 s = 7 × 15 s, and says so; `--tau-s` still chooses.
 #[test]
 fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
     let dir = tempfile::tempdir().unwrap();
@@ -474,7 +481,7 @@ fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("nearest 100 s"));
     let out = run_ok(
         gyrotherm()
-            .args(["evaluate", "--json", "--tau", "150", "--input"])
+            .args(["evaluate", "--json", "--tau-s", "150", "--input"])
             .arg(&path),
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -483,7 +490,7 @@ fn evaluate_coarse_log_takes_the_nearest_multiple_of_the_period() {
 
 /// `compare` and `report` on logs at one sample per 15 s: the default τ is the multiple of
 /// the period nearest 100 s, 105 s = 7 × 15 s (as `evaluate` takes it), said on stderr, and
-/// every column gets its figure; `--tau` still chooses.
+/// every column gets its figure; `--tau-s` still chooses.
 #[test]
 fn compare_and_report_take_the_nearest_multiple_of_a_coarse_period() {
     let dir = tempfile::tempdir().unwrap();
@@ -526,7 +533,7 @@ fn compare_and_report_take_the_nearest_multiple_of_a_coarse_period() {
             "{k}"
         );
     }
-    let out = run_ok(args("compare").args(["--json", "--tau", "150"]));
+    let out = run_ok(args("compare").args(["--json", "--tau-s", "150"]));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["tau_s"].as_f64(), Some(150.0));
     assert!(!String::from_utf8_lossy(&out.stderr).contains("nearest 100 s"));

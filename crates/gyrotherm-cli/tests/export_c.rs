@@ -1,4 +1,4 @@
-//! `gyrotherm export --lang c`: the generated C, built with gcc `-std=c99 -O2
+//! `gyrotherm export --target c`: the generated C, built with gcc `-std=c99 -O2
 //! -ffp-contract=off -Wall -Wextra -Werror -pedantic` together with a small driver
 //! (tests/export_c/driver.c), gives the same rate, bias, scale factor and status as
 //! `gyrotherm compensate --stream`, to the last bit (parsed doubles compared), and the same
@@ -243,7 +243,7 @@ fn generated_c_equals_compensate_stream_to_the_last_bit() {
         let out_dir = d.join(format!("c_{name}"));
         run_ok(
             gyrotherm()
-                .args(["export", "--lang", "c", "--model"])
+                .args(["export", "--target", "c", "--model"])
                 .arg(model)
                 .arg("--out")
                 .arg(&out_dir),

@@ -1,4 +1,4 @@
-//! `gyrotherm export --lang c` of inertial-unit models: the generated C (`gt_step_imu_bk`,
+//! `gyrotherm export --target c` of inertial-unit models: the generated C (`gt_step_imu_bk`,
 //! and `gt_step_imu` beside it), built with gcc `-std=c99 -ffp-contract=off -Wall -Wextra
 //! -Werror -pedantic`, gives every axis the same status, rate, bias and scale factor as
 //! `compensate --stream` with the unit model (in process: `compensate_imu_lines`), to the last

@@ -36,7 +36,7 @@ fn hostile_model(dir: &Path) -> PathBuf {
 
 fn export(model: &Path, lang: &str, out: &Path) -> std::process::Output {
     gyrotherm()
-        .args(["export", "--lang", lang, "--model"])
+        .args(["export", "--target", lang, "--model"])
         .arg(model)
         .arg("--out")
         .arg(out)
@@ -179,7 +179,7 @@ fn a_model_with_a_key_named_twice_is_refused_by_every_command() {
     let comp = dir.path().join("comp.csv");
     for args in [
         vec!["model", "check", m],
-        vec!["export", "--model", m, "--lang", "c", "--out", o],
+        vec!["export", "--model", m, "--target", "c", "--out", o],
         vec![
             "compensate",
             "--model",

@@ -180,9 +180,9 @@ fn sensor_limits_are_set_at_train_and_old_files_load() {
                 "train",
                 "--method",
                 "linear",
-                "--temp-max",
+                "--temp-max-c",
                 "80",
-                "--temp-max-rate",
+                "--temp-max-rate-c-per-s",
                 "0.5",
                 "--input",
             ])
@@ -223,9 +223,9 @@ fn sensor_limits_are_set_at_train_and_old_files_load() {
             "train",
             "--method",
             "linear",
-            "--temp-min",
+            "--temp-min-c",
             "90",
-            "--temp-max",
+            "--temp-max-c",
             "80",
             "--input",
         ])
@@ -237,7 +237,7 @@ fn sensor_limits_are_set_at_train_and_old_files_load() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("--temp-min") && err.contains("min < max"),
+        err.contains("--temp-min-c") && err.contains("min < max"),
         "{err}"
     );
 }

@@ -1,6 +1,5 @@
-//! Messages name the flags `--help` shows. A hidden alias (`--tau` for `--tau-s`,
-//! `--fill-gaps` for `--fill-gaps-max-s`) still parses, but a user reading a message looks
-//! it up in `--help` and does not find it.
+//! Messages name the flags `--help` shows: a user reading a message looks the flag up in
+//! `--help`, so a message naming a flag that is hidden (or gone) leaves them stuck.
 //!
 //! The flags are those the real binary's `--help` lists, for every command and subcommand;
 //! the messages are the string text of the library and the CLI (code lines outside comments
@@ -96,11 +95,9 @@ fn messages_name_the_flags_help_shows() {
     let mut named = Vec::new();
     named_flags(&root.join("src"), &mut named);
     named_flags(&root.join("../gyrotherm/src"), &mut named);
-    // `--recipe` and `--lang` are hidden on purpose: they are named only to say they are
-    // deprecated.
     let hidden: Vec<String> = named
         .iter()
-        .filter(|(_, _, f)| !shown.contains(f) && f != "--recipe" && f != "--lang")
+        .filter(|(_, _, f)| !shown.contains(f))
         .map(|(file, line, f)| format!("{file}:{line}: {f}"))
         .collect();
     assert!(

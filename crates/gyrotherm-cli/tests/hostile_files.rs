@@ -318,7 +318,7 @@ fn small_input_files_are_read_with_a_size_limit() {
                 "export",
                 "--model",
                 p(&model),
-                "--lang",
+                "--target",
                 "c",
                 "--out",
                 p(dir.path()),

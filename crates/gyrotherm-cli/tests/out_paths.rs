@@ -223,7 +223,7 @@ fn sigterm_mid_write_removes_the_temporary_file() {
     let out = d.join("out.csv");
     std::fs::write(&out, "old").unwrap();
     let mut child = gyrotherm()
-        .args(["compensate", "--sample-period", "1", "--model"])
+        .args(["compensate", "--sample-period-s", "1", "--model"])
         .arg(&model)
         .arg("--input")
         .arg(&fifo)

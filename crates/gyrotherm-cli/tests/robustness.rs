@@ -80,15 +80,15 @@ fn numeric_options_are_checked_in_their_own_terms() {
             "is not a scale factor",
         ),
         (
-            &["evaluate", "--settle", "nan"],
+            &["evaluate", "--settle-s", "nan"],
             "is not zero or a positive number of seconds",
         ),
         (
-            &["evaluate", "--tau", "0"],
+            &["evaluate", "--tau-s", "0"],
             "is not a positive number of seconds",
         ),
         (
-            &["evaluate", "--tau", "1e308"],
+            &["evaluate", "--tau-s", "1e308"],
             "tau_s = 1e308 s is longer than half the log",
         ),
         (
@@ -238,7 +238,7 @@ fn a_closed_output_pipe_ends_quietly_with_0() {
         .args([
             "compensate",
             "--stream",
-            "--sample-period",
+            "--sample-period-s",
             "1",
             "--model",
             p(&model),
@@ -280,9 +280,9 @@ fn a_wrong_sample_period_cannot_make_runaway_output() {
             "evaluate",
             "--input",
             p(&log),
-            "--sample-period",
+            "--sample-period-s",
             period,
-            "--fill-gaps",
+            "--fill-gaps-max-s",
             fill,
         ]);
         assert_eq!(code, 2, "{err}");

@@ -121,7 +121,7 @@ fn compensate_and_export_warn_on_an_unsealed_unit_model() {
     let export = |model: &Path| {
         let out = run_ok(
             gyrotherm()
-                .args(["export", "--lang", "c", "--model"])
+                .args(["export", "--target", "c", "--model"])
                 .arg(model)
                 .arg("--out")
                 .arg(dir.path().join("c")),

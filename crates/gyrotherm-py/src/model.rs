@@ -7,9 +7,9 @@ use std::sync::Mutex;
 use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
 use gyrotherm::compensate_lines::compensate_file;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, Target};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, Target};
 use gyrotherm::model::{ColumnsDef, GivenColumns, ModelFile};
-use gyrotherm::settings::FitSettings;
+use gyrotherm::settings::{FitSettings, Method, SettingError, METHODS, METHOD_NAMES};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -376,7 +376,6 @@ pub fn status_names() -> Vec<(u8, &'static str)> {
 #[pyo3(from_item_all)]
 pub struct FitArgs {
     method: String,
-    recipe: Option<String>,
     epochs: Option<usize>,
     seed: u64,
     hidden: usize,
@@ -389,7 +388,7 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
-    /// The library's fit configuration and what a deprecated spelling now means.
+    /// The library's fit configuration, and a note the library has on the settings.
     pub(crate) fn config(&self) -> PyResult<(FitConfig, Option<String>)> {
         let (cfg, note) = self.settings()?.fit_config().map_err(py_err::<FitError>)?;
         Ok((cfg, note.map(|n| n.to_string())))
@@ -398,13 +397,9 @@ impl FitArgs {
     /// The library's fit settings these arguments name.
     pub(crate) fn settings(&self) -> PyResult<FitSettings> {
         Ok(FitSettings {
-            method: self.method.parse().map_err(py_err::<FitError>)?,
-            recipe: self
-                .recipe
-                .as_deref()
-                .map(str::parse::<RecipeKind>)
-                .transpose()
-                .map_err(py_err::<FitError>)?,
+            method: parse_method(&self.method)?,
+            // A method names its recipe; the library's deprecated recipe setting is not taken.
+            recipe: None,
             epochs: self.epochs,
             seed: self.seed,
             hidden: self.hidden,
@@ -418,12 +413,25 @@ impl FitArgs {
     }
 }
 
+/// A method a fit can use, by name ([`METHOD_NAMES`]). The library also parses `lstm`, the
+/// method older model files record; as a setting that spelling is gone.
+pub(crate) fn parse_method(name: &str) -> PyResult<Method> {
+    let method: Method = name.parse().map_err(py_err::<FitError>)?;
+    if !METHODS.contains(&method) {
+        return Err(py_err::<FitError>(SettingError::Unknown {
+            setting: "method",
+            value: name.to_owned(),
+            expected: &METHOD_NAMES,
+        }));
+    }
+    Ok(method)
+}
+
 /// The library's fit defaults, keyed as `fit()`'s keywords.
 pub fn fit_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = FitSettings::default();
     let out = PyDict::new(py);
     out.set_item("method", d.method.as_str())?;
-    out.set_item("recipe", d.recipe.map(|r| r.as_str()))?;
     out.set_item("epochs", d.epochs)?;
     out.set_item("seed", d.seed)?;
     out.set_item("hidden", d.hidden)?;

@@ -462,9 +462,12 @@ fn compare_unit(
         .transpose()
         .map_err(py_err::<MetricsError>)?;
     let methods: Option<Vec<gyrotherm::model::Method>> = methods
-        .map(|m| m.iter().map(|n| n.parse()).collect::<Result<_, _>>())
-        .transpose()
-        .map_err(py_err::<FitError>)?;
+        .map(|m| {
+            m.iter()
+                .map(|n| crate::model::parse_method(n))
+                .collect::<PyResult<_>>()
+        })
+        .transpose()?;
     let fit = settings.settings()?;
     py.detach(|| {
         let read_all = |paths: &[PathBuf]| -> PyResult<Vec<(String, ImuLog)>> {

@@ -81,8 +81,6 @@ def test_model_file_with_a_key_named_twice_raises_the_cli_message(cli, logs, tmp
 
 
 def test_fit_refuses_bad_settings_and_misfiled_logs(logs):
-    with pytest.raises(gt.FitError, match="recipe: unknown value \"fancy\""):
-        gt.fit(static=logs["static"], recipe="fancy")
     with pytest.raises(gt.FitError, match="method: unknown value \"spline\""):
         gt.fit(static=logs["static"], method="spline")
     with pytest.raises(gt.FitError, match="epochs must be a whole number from 1 to 1000000, not 0"):

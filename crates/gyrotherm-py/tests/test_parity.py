@@ -9,7 +9,6 @@ here restates a default."""
 import inspect
 import json
 import re
-import warnings
 
 import pytest
 
@@ -151,19 +150,19 @@ def test_fit_with_defaults_writes_the_bytes_train_writes(cli, logs, tmp_path):
         assert a.read_bytes() == b.read_bytes(), extra
 
 
-def test_the_deprecated_recipe_names_the_method_in_both(cli, logs, tmp_path):
+def test_the_removed_spellings_are_refused_in_both(cli, logs, tmp_path):
     s = str(logs["static"])
-    a, b = tmp_path / "cli.json", tmp_path / "py.json"
-    p = cli("train", "--input", s, "--method", "lstm", "--recipe", "generic", "--epochs", "2",
-            "--out", a)
-    assert "deprecated" in p.stderr and "--method generic" in p.stderr, p.stderr
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        m = gt.fit(static=s, method="lstm", recipe="generic", epochs=2)
-    assert any("deprecated" in str(w.message) for w in caught)
-    assert m.method == "generic" == json.loads(a.read_text())["method"]
-    m.save(b)
-    assert a.read_bytes() == b.read_bytes()
+    a = tmp_path / "cli.json"
+    p = cli("train", "--input", s, "--method", "lstm", "--out", a, check=False)
+    assert p.returncode == 2 and "invalid value 'lstm'" in p.stderr, p.stderr
+    p = cli("train", "--input", s, "--recipe", "generic", "--out", a, check=False)
+    assert p.returncode == 2 and "unexpected argument '--recipe'" in p.stderr, p.stderr
+    assert not a.exists()
+    with pytest.raises(gt.FitError, match='method: unknown value "lstm"'):
+        gt.fit(static=s, method="lstm")
+    for old in ("recipe", "bias_window", "settle", "fill_gaps", "sample_period"):
+        with pytest.raises(TypeError, match=old):
+            gt.fit(static=s, **{old: 1})
 
 
 def test_unit_evaluate_and_compare_take_the_library_defaults(described):

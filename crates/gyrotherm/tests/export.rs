@@ -1,6 +1,6 @@
 //! `gyrotherm::export`: the static (flight) form of a model builds a compensator that equals
 //! the one built from the model file, bit for bit and status for status, on a faulted run; the
-//! Rust module of the flight-loop example is what `export --lang rust` writes today.
+//! Rust module of the flight-loop example is what `export --target rust` writes today.
 
 use gyrotherm::export::static_model;
 use gyrotherm::model::ModelFile;
@@ -51,7 +51,7 @@ fn static_model_compensates_like_the_model_file() {
 }
 
 /// The example's generated module is current: regenerate it with
-/// `gyrotherm export --model model.json --lang rust --out .` in its directory.
+/// `gyrotherm export --model model.json --target rust --out .` in its directory.
 #[test]
 fn flight_loop_example_module_is_current() {
     let dir = example_dir();

@@ -1,4 +1,4 @@
-//! `gyrotherm export --lang rust` of an inertial-unit model: the generated module of the
+//! `gyrotherm export --target rust` of an inertial-unit model: the generated module of the
 //! `imu_flight` example (a `thermal` model of three gyros and four sensors, the default
 //! multi-sensor fit: every axis reads several sensors, first sensors on three different ones),
 //! compiled into this test, builds a core `Unit` whose every axis equals
@@ -23,7 +23,7 @@ fn example_dir() -> std::path::PathBuf {
 }
 
 /// The example's generated module is current: regenerate it with
-/// `gyrotherm export --model model.json --lang rust --out .` in its directory.
+/// `gyrotherm export --model model.json --target rust --out .` in its directory.
 #[test]
 fn imu_flight_example_module_is_current() {
     let model = ImuModel::load(&example_dir().join("model.json")).unwrap();

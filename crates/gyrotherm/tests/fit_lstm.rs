@@ -401,7 +401,7 @@ fn residual_lstm_can_read_the_base_prediction() {
     assert!(diff > 0.0, "the LSTM reading the base changed nothing");
 }
 
-/// `--recipe published` is the paper's recipe: T and dT in, a plain LSTM, full BPTT.
+/// Method `published` is the paper's recipe: T and dT in, a plain LSTM, full BPTT.
 #[test]
 fn published_recipe_is_kept() {
     let r = RecipeSettings::of_kind(RecipeKind::parse("published").unwrap());

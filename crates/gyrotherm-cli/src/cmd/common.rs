@@ -39,11 +39,11 @@ pub struct LogArgs {
     pub gyro_unit: GyroUnit,
     /// Interpolate gaps (steps over 1.5 sample periods) up to MAX_S seconds long, instead of
     /// stopping with an error.
-    #[arg(long, alias = "fill-gaps", value_name = "MAX_S",
+    #[arg(long, value_name = "MAX_S",
           value_parser = seconds("fill_gaps_max_s", Rule::PositiveSeconds))]
     pub fill_gaps_max_s: Option<f64>,
     /// Nominal sample period in seconds (default: median of the first 100 time steps).
-    #[arg(long, alias = "sample-period", value_name = "SECONDS",
+    #[arg(long, value_name = "SECONDS",
           value_parser = seconds("sample_period_s", Rule::PositiveSeconds))]
     pub sample_period_s: Option<f64>,
     /// Field separator of the log: `,` (default), `;` or `tab`. With `;` or `tab`, numbers
@@ -254,9 +254,9 @@ mod tests {
             "rt",
             "--gyro-unit",
             "rad/s",
-            "--fill-gaps",
+            "--fill-gaps-max-s",
             "5",
-            "--sample-period",
+            "--sample-period-s",
             "0.01",
         ])
         .unwrap();
@@ -281,7 +281,7 @@ mod tests {
         let path = dir.path().join("gap.csv");
         // 1 Hz, one sample missing at t = 2.
         std::fs::write(&path, "time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n").unwrap();
-        let cli = Cli::try_parse_from(["t", "--fill-gaps", "2"]).unwrap();
+        let cli = Cli::try_parse_from(["t", "--fill-gaps-max-s", "2"]).unwrap();
         let log = read_log_reporting(&path, &cli.log).unwrap();
         assert_eq!(log.time_s, [0.0, 1.0, 2.0, 3.0]);
         let cli = Cli::try_parse_from(["t"]).unwrap();
@@ -295,7 +295,7 @@ mod tests {
     #[test]
     fn bad_values_are_refused() {
         assert!(Cli::try_parse_from(["t", "--gyro-unit", "mrad"]).is_err());
-        assert!(Cli::try_parse_from(["t", "--fill-gaps", "-1"]).is_err());
-        assert!(Cli::try_parse_from(["t", "--fill-gaps", "nan"]).is_err());
+        assert!(Cli::try_parse_from(["t", "--fill-gaps-max-s", "-1"]).is_err());
+        assert!(Cli::try_parse_from(["t", "--fill-gaps-max-s", "nan"]).is_err());
     }
 }

@@ -3,90 +3,16 @@
 //! paper's results table, for the user's own data, one column per model.
 
 use std::io::Write;
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
 use gyrotherm::compare::{compare_with_stages, Candidate, CompareConfig, Comparison, Stage};
 use gyrotherm::fit::NamedLog;
-use gyrotherm::settings::{Method, DEFAULT_METHOD};
 
-use super::common::LogArgs;
+use super::args::{resolve_tau, CompareArgs};
 use super::common::{named, read_logs};
+use super::print::print_table;
 use super::progress::TrainingBars;
-use super::train::{deprecation_text, method_parser, FitArgs};
-
-#[derive(Debug, clap::Args)]
-pub struct CompareArgs {
-    /// Training log (CSV); repeat for several (static → bias, rate-table → scale factor).
-    #[arg(long, required = true)]
-    pub train: Vec<PathBuf>,
-    /// Held-out log to judge on (CSV); repeat for several.
-    #[arg(long, required = true)]
-    pub test: Vec<PathBuf>,
-    /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
-    /// sample period nearest to it when 100 s is not one; said on stderr).
-    #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
-    pub tau_s: Option<f64>,
-    /// Print JSON instead of the table.
-    #[arg(long)]
-    pub json: bool,
-    #[doc = "Spec sheet (TOML) to judge every model column against; exit 1 when a column misses a limit."]
-    #[arg(long, value_name = "SPEC.toml", long_help = super::verdict::SPEC_HELP)]
-    pub spec: Option<PathBuf>,
-    #[command(flatten)]
-    pub columns: ColumnArgs,
-    #[command(flatten)]
-    pub fit: FitArgs,
-    #[command(flatten)]
-    pub log: LogArgs,
-}
-
-/// Which models the comparison fits, one column each (`compare`, `demo`, `report`).
-#[derive(Debug, clap::Args)]
-pub struct ColumnArgs {
-    /// Methods to compare, comma-separated, in table order (the names of `train --method`;
-    /// a recipe method's column is named by what its model holds, `published` is "LSTM, He
-    /// et al."; `--epochs` applies to every LSTM). Default: linear, poly, thermal, published.
-    #[arg(long, value_delimiter = ',', value_name = "LIST", value_parser = method_parser())]
-    pub methods: Option<Vec<Method>>,
-}
-
-impl ColumnArgs {
-    /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`;
-    /// a deprecated spelling is said on stderr.
-    pub fn compare_config(&self, fit: &FitArgs, tau_s: f64) -> anyhow::Result<CompareConfig> {
-        let (cfg, note) = fit
-            .settings(DEFAULT_METHOD)
-            .compare_config(self.methods.as_deref(), tau_s)?;
-        if let Some(n) = note {
-            eprintln!("gyrotherm: warning: {}", deprecation_text(n));
-        }
-        Ok(cfg)
-    }
-}
-
-/// `--tau-s` if given, else the default for the held-out logs
-/// ([`gyrotherm::compare::default_tau_s`]), said on stderr when it is not 100 s.
-pub fn resolve_tau(tau: Option<f64>, test: &[NamedLog]) -> f64 {
-    tau_or_default(tau, || gyrotherm::compare::default_tau_s(test))
-}
-
-/// `tau`, or the library's default (`(τ, the sample period it was adjusted to)`), saying
-/// on stderr when 100 s was not a multiple of the sample period.
-pub fn tau_or_default(tau: Option<f64>, default: impl FnOnce() -> (f64, Option<f64>)) -> f64 {
-    if let Some(t) = tau {
-        return t;
-    }
-    let (t, adjusted_to) = default();
-    if let Some(period) = adjusted_to {
-        eprintln!(
-            "gyrotherm: τ = {t} s, the multiple of the {period} s sample period nearest 100 s \
-             (100 s is not one; give --tau-s to choose)"
-        );
-    }
-    t
-}
 
 /// Run the comparison with progress bars for every column that trains an LSTM.
 pub fn run_comparison(
@@ -213,20 +139,4 @@ fn coverage_lines(test: &[NamedLog], cmp: &Comparison) -> anyhow::Result<Vec<Str
         }
     }
     Ok(out)
-}
-
-/// The human table: the models fitted, then one block per held-out log.
-pub fn print_table(
-    w: &mut dyn Write,
-    cmp: &Comparison,
-    cfg: &CompareConfig,
-) -> std::io::Result<()> {
-    for line in cmp.headline(cfg) {
-        writeln!(w, "NOTE: {line}")?;
-    }
-    for line in cmp.model_lines() {
-        writeln!(w, "{line}")?;
-    }
-    writeln!(w)?;
-    cmp.table(cfg).write_text(w)
 }

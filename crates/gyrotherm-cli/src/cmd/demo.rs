@@ -10,9 +10,10 @@ use anyhow::Context as _;
 use gyrotherm::csvlog::{write_log, TestLog};
 use gyrotherm::sim::{simulate, SimConfig};
 
+use super::args::{ColumnArgs, FitArgs};
 use super::common::{builtin_profile, named};
-use super::compare::{print_table, run_comparison, ColumnArgs};
-use super::train::FitArgs;
+use super::compare::run_comparison;
+use super::print::print_table;
 
 #[derive(Debug, clap::Args)]
 pub struct DemoArgs {

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context as _};
 use gyrotherm::export::autopilot::{self, ModelRef};
 use gyrotherm::export::unit::{column_map, export_imu};
-use gyrotherm::export::{export, ExportTarget, Lang, EXPORT_TARGETS};
+use gyrotherm::export::{export, ExportTarget, EXPORT_TARGETS};
 use gyrotherm::imu_model::ImuModel;
 use gyrotherm::model::ModelFile;
 use gyrotherm::settings::autopilot::{self as ap, AutopilotSettings, GyroAxis, GYRO_AXES};
@@ -22,13 +22,9 @@ pub struct ExportArgs {
     #[arg(long)]
     pub model: PathBuf,
     /// What to write.
-    #[arg(long, required_unless_present = "lang", conflicts_with = "lang",
+    #[arg(long,
           value_parser = choice::<ExportTarget>(EXPORT_TARGETS.map(|t| (t.as_str(), t.help()))))]
-    pub target: Option<ExportTarget>,
-    /// Deprecated spelling of `--target c|rust`, kept for one release.
-    #[arg(long, hide = true,
-          value_parser = choice::<Lang>([Lang::C, Lang::Rust].map(|l| (l.as_str(), l.help()))))]
-    pub lang: Option<Lang>,
+    pub target: ExportTarget,
     /// Output directory (created if missing).
     #[arg(long)]
     pub out: PathBuf,
@@ -59,16 +55,7 @@ impl ExportArgs {
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
-    let target = match (args.target, args.lang) {
-        (Some(t), _) => t,
-        (None, Some(l)) => {
-            eprintln!(
-                "gyrotherm: warning: --lang is deprecated and will be removed: use --target {l}"
-            );
-            ExportTarget::from(l)
-        }
-        (None, None) => bail!("give --target"),
-    };
+    let target = args.target;
     let is_imu = super::imu::is_imu_model(&args.model)?;
     let Some(lang) = target.lang() else {
         return run_autopilot(&args, target, is_imu);

@@ -10,9 +10,9 @@ use gyrotherm::compensate_lines::Mode;
 use gyrotherm::csvlog::{self, ImuLog};
 use gyrotherm::imu_model::{self, ImuFitEvent, ImuModel};
 
+use super::args::{CompensateArgs, TrainArgs};
 use super::common::{error_message, LogArgs};
-use super::compensate::CompensateArgs;
-use super::train::TrainArgs;
+use super::stream::stdio_stream;
 
 /// Whether `path` holds an inertial-unit model (an unreadable file is left to the
 /// single-axis path, which names the problem).
@@ -157,7 +157,7 @@ pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
              gaps themselves and write one output line per input line"
         );
         let opts = args.log.read_options();
-        let summary = super::compensate::stdio_stream(|input, output| {
+        let summary = stdio_stream(|input, output| {
             compensate_imu_lines(
                 &model,
                 input,

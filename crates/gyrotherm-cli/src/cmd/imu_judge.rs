@@ -12,11 +12,11 @@ use gyrotherm::imu_model::ImuModel;
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::EvaluateSettings;
 
-use super::compare::{print_table, CompareArgs};
-use super::evaluate::{print_evaluation, EvaluateArgs};
+use super::args::{tau_or_default, ColumnArgs, CompareArgs, EvaluateArgs, FitArgs, ReportArgs};
+use super::common::LogArgs;
 use super::imu::{fit_event_printer, read_imu_logs};
+use super::print::{print_evaluation, print_table};
 use super::progress::TrainingBars;
-use super::report::ReportArgs;
 
 /// `evaluate` on a unit log: each gyro column's figures; with `--model`, also each axis's
 /// compensated output.
@@ -120,13 +120,13 @@ fn run_unit_comparison(
     train: &[std::path::PathBuf],
     test: &[std::path::PathBuf],
     tau: Option<f64>,
-    columns: &super::compare::ColumnArgs,
-    fit: &super::train::FitArgs,
-    log: &super::common::LogArgs,
+    columns: &ColumnArgs,
+    fit: &FitArgs,
+    log: &LogArgs,
 ) -> anyhow::Result<(ImuComparison, gyrotherm::compare::CompareConfig)> {
     let train = read_imu_logs(train, log)?;
     let test = read_imu_logs(test, log)?;
-    let tau_s = super::compare::tau_or_default(tau, || imu_judge::default_tau_s(&test));
+    let tau_s = tau_or_default(tau, || imu_judge::default_tau_s(&test));
     let cfg = columns.compare_config(fit, tau_s)?;
     let started = std::time::Instant::now();
     let sensors = train.first().map_or(0, |(_, l)| l.temp.len());

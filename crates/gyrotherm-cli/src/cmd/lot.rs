@@ -64,10 +64,10 @@ pub struct AddArgs {
     #[arg(long)]
     pub station: Option<String>,
     /// Bias-stability smoothing time, s (default as `compare`).
-    #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
+    #[arg(long, value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
     pub tau_s: Option<f64>,
     /// Time dropped at the start of each rate-table segment, s.
-    #[arg(long, alias = "settle", default_value_t = gyrotherm::settings::EvaluateSettings::default().settle_s,
+    #[arg(long, default_value_t = gyrotherm::settings::EvaluateSettings::default().settle_s,
           value_parser = super::common::seconds("settle_s", gyrotherm::settings::Rule::NonNegativeSeconds))]
     pub settle_s: f64,
     /// Print the recorded run as JSON.

@@ -1,7 +1,13 @@
-//! One file per subcommand: a clap `Args` struct and `run(args) -> anyhow::Result<ExitCode>`.
-//! `common` holds the options shared by every command that reads a log.
+//! One file per subcommand with its `run(args) -> anyhow::Result<ExitCode>`, and its clap
+//! `Args` struct unless the struct is shared. Below the command files: `args` holds the
+//! arguments of the commands with a single-gyro and an inertial-unit path (`train`,
+//! `compensate`, `evaluate`, `compare`, `report`), which the unit paths `imu` and `imu_judge`
+//! take too; `print` the text of a comparison and an evaluation; `stream` stdin and stdout as
+//! a live stream; `common` the options shared by every command that reads a log. A command
+//! file imports only these lower modules and the unit paths, never a file that imports it.
 
 pub mod allan;
+pub mod args;
 pub mod common;
 pub mod compare;
 pub mod compensate;
@@ -13,9 +19,11 @@ pub mod imu_judge;
 pub mod lot;
 pub mod model;
 pub mod plan;
+pub mod print;
 pub mod progress;
 pub mod report;
 pub mod settings;
 pub mod simulate;
+pub mod stream;
 pub mod train;
 pub mod verdict;

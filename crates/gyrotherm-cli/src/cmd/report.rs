@@ -2,7 +2,6 @@
 //! HTML report with the figures a gyro engineer looks at (`DIR/index.html`, one PNG and SVG
 //! per figure; see `gyrotherm::report::job`).
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use std::io::Write as _;
@@ -10,35 +9,10 @@ use std::io::Write as _;
 use anyhow::Context as _;
 use gyrotherm::report::write_full_report_with;
 
-use super::common::{named, read_logs, LogArgs};
-use super::compare::{print_table, resolve_tau, run_comparison, ColumnArgs};
-use super::train::FitArgs;
-
-#[derive(Debug, clap::Args)]
-pub struct ReportArgs {
-    /// Training log (CSV); repeat for several (static → bias, rate-table → scale factor).
-    #[arg(long, required = true)]
-    pub train: Vec<PathBuf>,
-    /// Held-out log to judge on (CSV); repeat for several.
-    #[arg(long, required = true)]
-    pub test: Vec<PathBuf>,
-    /// Report folder (created if missing): index.html and a PNG and SVG per figure.
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
-    /// Bias-stability smoothing time, s (default 100 s, or the multiple of the held-out logs'
-    /// sample period nearest to it when 100 s is not one; said on stderr).
-    #[arg(long, alias = "tau", value_parser = super::common::seconds("tau_s", gyrotherm::settings::Rule::PositiveSeconds))]
-    pub tau_s: Option<f64>,
-    #[doc = "Spec sheet (TOML) to judge every model column against; exit 1 when a column misses a limit."]
-    #[arg(long, value_name = "SPEC.toml", long_help = super::verdict::SPEC_HELP)]
-    pub spec: Option<PathBuf>,
-    #[command(flatten)]
-    pub columns: ColumnArgs,
-    #[command(flatten)]
-    pub fit: FitArgs,
-    #[command(flatten)]
-    pub log: LogArgs,
-}
+use super::args::{resolve_tau, ReportArgs};
+use super::common::{named, read_logs};
+use super::compare::run_comparison;
+use super::print::print_table;
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     if args.log.read_options().is_multi_column() {

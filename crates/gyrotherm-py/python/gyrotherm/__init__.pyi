@@ -162,7 +162,6 @@ def fit(
     # Defaults: the library's (gyrotherm.FIT_DEFAULTS), not restated here.
     method: str = ...,
     *,
-    recipe: Optional[str] = ...,  # deprecated: the recipes are methods
     epochs: Optional[int] = ...,
     seed: int = ...,
     hidden: int = ...,
@@ -196,7 +195,6 @@ def compare(
     tau_s: Optional[float] = None,
     spec: Optional[PathLike] = None,
     method: str = ...,
-    recipe: Optional[str] = ...,
     epochs: Optional[int] = ...,
     seed: int = ...,
     hidden: int = ...,

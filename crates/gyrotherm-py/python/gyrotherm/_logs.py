@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import warnings
 from typing import Any, Dict, Optional, Union
 
 import numpy as np
@@ -15,19 +14,10 @@ PathLike = Union[str, "os.PathLike[str]"]
 #: The library's defaults for reading a log (the CLI's ``--time-col`` … ``--delimiter``).
 READ_DEFAULTS: Dict[str, Any] = dict(_g.READ_DEFAULTS)
 
-#: Deprecated spellings of log options (one release), and the names they now have.
-_RENAMED = {"fill_gaps": "fill_gaps_max_s", "sample_period": "sample_period_s"}
-
 
 def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
     """The full option dict for the Rust side; unknown keys are an error."""
     options = dict(options)
-    for old, new in _RENAMED.items():
-        if old in options:
-            warnings.warn(
-                f"log option {old} is deprecated; use {new}", DeprecationWarning, stacklevel=3
-            )
-            options[new] = options.pop(old)
     unknown = sorted(set(options) - set(READ_DEFAULTS))
     if unknown:
         raise TypeError(

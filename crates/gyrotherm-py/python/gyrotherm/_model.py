@@ -152,7 +152,7 @@ class Model:
         ``sigma_dph``. Returns
         the rows written, the count per status and the extrapolation warnings (also issued as
         warnings)."""
-        if options.get("fill_gaps_max_s", options.get("fill_gaps")) is not None:
+        if options.get("fill_gaps_max_s") is not None:
             raise _g.CompensationError(
                 "fill_gaps_max_s does not apply to compensate: the compensator bridges time gaps "
                 "itself and writes one output line per input line"
@@ -327,16 +327,12 @@ def _paths(logs, what: str):
 
 _FIT = _g.FIT_DEFAULTS
 
-#: Deprecated keyword spellings of :func:`fit` (one release), and the names they now have.
-_FIT_RENAMED = {"bias_window": "bias_window_s", "settle": "settle_s"}
-
 
 def fit(
     static: Union[PathLike, Iterable[PathLike], None] = (),
     table: Union[PathLike, Iterable[PathLike], None] = (),
     method: str = _FIT["method"],
     *,
-    recipe: Optional[str] = _FIT["recipe"],
     epochs: Optional[int] = _FIT["epochs"],
     seed: int = _FIT["seed"],
     hidden: int = _FIT["hidden"],
@@ -355,9 +351,8 @@ def fit(
     ``static``: static logs (bias model); ``table``: rate-table logs (scale-factor model).
     ``method``: one of ``gyrotherm.METHOD_NAMES``: ``"thermal"`` (the default),
     ``"residual"``, ``"generic"``, ``"direct"``, ``"published"`` (He et al. 2024 as
-    published), ``"linear"`` or ``"poly"``. ``recipe`` is deprecated (``method="lstm",
-    recipe="residual"`` is ``method="residual"``; warns). ``bias_window_s``/``settle_s`` in
-    seconds (``bias_window``/``settle`` are deprecated spellings). ``progress``: True prints
+    published), ``"linear"`` or ``"poly"``. ``bias_window_s``/``settle_s`` in
+    seconds. ``progress``: True prints
     epochs and loss to stderr; a callable gets ``(target, epoch, loss)``. Log options
     (``time_col``, ``gyro_unit``, ``fill_gaps_max_s``, ``delimiter`` …) apply to every log.
     The GIL is released while reading and training.
@@ -370,20 +365,12 @@ def fit(
     ``"axis_start"`` (``temp`` None), ``"start"``, ``"done"`` (with the sensor's
     cross-validated RMS) or ``"axis"`` (the axis is done and reads ``temp``).
     """
-    for old, new in _FIT_RENAMED.items():
-        if old in log_options:
-            warnings.warn(f"{old} is deprecated; use {new}", DeprecationWarning, stacklevel=2)
-            value = log_options.pop(old)
-            if new == "bias_window_s":
-                bias_window_s = value
-            else:
-                settle_s = value
     static_paths = _paths(static, "static")
     table_paths = _paths(table, "table")
     if not static_paths and not table_paths:
         raise _g.FitError("no training logs given; pass static=[...] and/or table=[...]")
     settings = _fit_settings(
-        method, recipe, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
+        method, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
         poly_rate_degree, cross, validate_on_runs,
     )
     options = read_options(log_options)
@@ -486,13 +473,12 @@ def evaluate(
 
 
 def _fit_settings(
-    method, recipe, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
+    method, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
     poly_rate_degree, cross, validate_on_runs,
 ) -> Dict[str, Any]:
     """The fit keywords of :func:`fit` and :func:`compare` as the binding's settings."""
     return {
         "method": str(method),
-        "recipe": None if recipe is None else str(recipe),
         "epochs": None if epochs is None else int(epochs),
         "seed": int(seed),
         "hidden": int(hidden),
@@ -513,7 +499,6 @@ def compare(
     tau_s: Optional[float] = None,
     spec: Optional[PathLike] = None,
     method: str = _FIT["method"],
-    recipe: Optional[str] = _FIT["recipe"],
     epochs: Optional[int] = _FIT["epochs"],
     seed: int = _FIT["seed"],
     hidden: int = _FIT["hidden"],
@@ -549,7 +534,7 @@ def compare(
     if not train_paths or not test_paths:
         raise _g.FitError("give training logs (train=[...]) and held-out logs (test=[...])")
     settings = _fit_settings(
-        method, recipe, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
+        method, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
         poly_rate_degree, cross, validate_on_runs,
     )
     text, notes = _g.compare_unit(
