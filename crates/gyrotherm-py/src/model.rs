@@ -7,7 +7,7 @@ use std::sync::Mutex;
 use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
 use gyrotherm::compensate_lines::compensate_file;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, Target};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, Target};
 use gyrotherm::model::{ColumnsDef, GivenColumns, ModelFile};
 use gyrotherm::settings::FitSettings;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -402,7 +402,7 @@ impl FitArgs {
             recipe: self
                 .recipe
                 .as_deref()
-                .map(str::parse::<RecipeKind>)
+                .map(gyrotherm::Method::parse_recipe)
                 .transpose()
                 .map_err(py_err::<FitError>)?,
             epochs: self.epochs,

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, FitConfig, RecipeKind, Target};
+use gyrotherm::fit::{fit_model, FitConfig, Target};
 use gyrotherm::model::ColumnsDef;
 use gyrotherm::settings::fit::{self, RECIPE_NAMES};
 use gyrotherm::settings::{Deprecation, FitSettings, Method, Rule, DEFAULT_METHOD, METHODS};
@@ -31,8 +31,8 @@ use super::progress::TrainingBars;
 pub struct FitArgs {
     /// Deprecated (one release): the recipe of the former `lstm` method, now a method of its
     /// own (`--method lstm --recipe residual` is `--method residual`).
-    #[arg(long, hide = true, value_parser = choice::<RecipeKind>(RECIPE_NAMES.map(|n| (n, ""))))]
-    pub recipe: Option<RecipeKind>,
+    #[arg(long, hide = true, value_parser = choice::<Method>(RECIPE_NAMES.map(|n| (n, ""))))]
+    pub recipe: Option<Method>,
     /// Training epochs of the method's LSTM (default: the method's own).
     #[arg(long)]
     pub epochs: Option<usize>,

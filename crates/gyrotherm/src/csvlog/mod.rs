@@ -23,7 +23,7 @@ mod gaps;
 mod imu;
 mod number;
 mod reader;
-mod writer;
+pub(crate) mod writer;
 
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};

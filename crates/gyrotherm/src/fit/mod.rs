@@ -31,12 +31,15 @@ pub mod thermal;
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
 use crate::features::{FeatureSpec, FeatureTable};
-use crate::model::{self, FeatureDef, Method, ModelFile, SubModel, TrainingInfo};
+use crate::model::{self, FeatureDef, ModelFile, SubModel, TrainingInfo};
+use crate::settings::fit::{Deprecation, FitSettings};
+use crate::settings::method::Method;
+use crate::settings::rule::SettingError;
 use crate::targets::{self, TargetSet};
 
 pub use crate::model::Target;
 pub use error::FitError;
-pub use recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary, UnknownRecipe};
+pub use recipe::{LstmVerdict, RecipeSettings, TrainSummary};
 pub use select::TermSelection;
 pub use terms::BaseTerms;
 
@@ -72,9 +75,7 @@ impl FitConfig {
     pub fn new(method: Method) -> Self {
         FitConfig {
             method,
-            recipe: method
-                .recipe_kind()
-                .map_or_else(RecipeSettings::default, RecipeSettings::of_kind),
+            recipe: RecipeSettings::of_kind(method),
             poly: PolyDegrees::default(),
             bias_window_s: targets::BIAS_WINDOW_S,
             settle_s: targets::SETTLE_S,
@@ -85,12 +86,47 @@ impl FitConfig {
     }
 }
 
+/// The fit's side of the user's settings: the settings sit below the fit and know nothing of
+/// it, so the fit builds its configuration from them here.
+impl FitSettings {
+    /// The recipe settings a recipe method trains with here (`epochs` and
+    /// `validate_on_runs` applied to the method's own).
+    pub fn recipe_for(&self, kind: Method) -> RecipeSettings {
+        let mut r = RecipeSettings::of_kind(kind);
+        if let Some(e) = self.epochs {
+            r.epochs = e;
+        }
+        r.validate_on_runs = self.validate_on_runs;
+        r.hidden = self.hidden;
+        r
+    }
+
+    /// The library's fit configuration: checked, deprecated spellings resolved (what was
+    /// resolved is returned, to be said).
+    pub fn fit_config(&self) -> Result<(FitConfig, Option<Deprecation>), SettingError> {
+        self.validate()?;
+        let (method, note) = self.resolve()?;
+        let mut cfg = FitConfig::new(method);
+        // linear and poly fit no recipe; theirs stays the default, unused.
+        cfg.recipe = self.recipe_for(method);
+        cfg.seed = self.seed;
+        cfg.bias_window_s = self.bias_window_s;
+        cfg.settle_s = self.settle_s;
+        cfg.poly = PolyDegrees {
+            temp: self.poly_temp_degree,
+            rate: self.poly_rate_degree,
+            cross: self.cross,
+        };
+        Ok((cfg, note))
+    }
+}
+
 impl FitConfig {
     /// The method a fit with this configuration writes: for a recipe method, its recipe's
     /// (the recipe may be swapped in whole, as a comparison column does).
     pub fn model_method(&self) -> Method {
         if self.method.is_recipe() {
-            self.recipe.kind.method()
+            self.recipe.kind
         } else {
             self.method
         }
@@ -334,7 +370,7 @@ pub fn fit_model(
 
 /// Whether the method identifies lags from the data (the `thermal` recipe).
 pub fn uses_identification(cfg: &FitConfig) -> bool {
-    cfg.method.is_recipe() && cfg.recipe.kind == RecipeKind::Thermal
+    cfg.method.is_recipe() && cfg.recipe.kind == Method::Thermal
 }
 
 /// Widest span a static run's gyro output may have, °/s, from its 1st to its 99th
@@ -607,15 +643,17 @@ pub(crate) fn fit_model_with(
 }
 
 impl RecipeSettings {
-    /// The recipe of a kind with its default knobs.
-    pub fn of_kind(kind: RecipeKind) -> Self {
+    /// The recipe of a recipe method with its default knobs; the default recipe
+    /// ([`Method::Thermal`]'s) for a method that trains none of its own (`linear` and `poly`
+    /// fit no recipe, the read-only `lstm` names none), as a [`FitConfig`] of theirs holds.
+    pub fn of_kind(kind: Method) -> Self {
         match kind {
-            RecipeKind::Published => Self::published(),
-            RecipeKind::Residual => Self::residual(),
-            RecipeKind::Generic => Self::generic(),
-            RecipeKind::Direct => Self::direct(),
-            RecipeKind::Thermal => RecipeSettings {
-                kind: RecipeKind::Thermal,
+            Method::Published => Self::published(),
+            Method::Residual => Self::residual(),
+            Method::Generic => Self::generic(),
+            Method::Direct => Self::direct(),
+            Method::Thermal | Method::Linear | Method::Poly | Method::Lstm => RecipeSettings {
+                kind: Method::Thermal,
                 ..Self::residual()
             },
         }
@@ -641,11 +679,15 @@ pub fn fit_target(
         });
     }
     match recipe.kind {
-        RecipeKind::Published => published::fit(train, recipe, n_in, seed, progress),
-        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct => {
+        Method::Published => published::fit(train, recipe, n_in, seed, progress),
+        Method::Residual | Method::Generic | Method::Direct => {
             residual::fit(train, recipe, target, n_in, seed, progress)
         }
         // Its features come from the logs: `fit_model` identifies them and fits it.
-        RecipeKind::Thermal => Err(FitError::NeedsLogs),
+        Method::Thermal => Err(FitError::NeedsLogs),
+        // Least squares on all runs at once (`fit_model`); `lstm` is read only.
+        Method::Linear | Method::Poly | Method::Lstm => Err(FitError::NotARecipe {
+            method: recipe.kind,
+        }),
     }
 }

@@ -5,16 +5,17 @@
 //! (`docs/experiments/lstm-recipes.md`).
 
 use super::error::FitError;
-use super::recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary};
+use super::recipe::{LstmVerdict, RecipeSettings, TrainSummary};
 use crate::model::SubModel;
 use crate::nn::{train_normalised, Bptt, Sequence, TrainConfig};
+use crate::settings::method::Method;
 use crate::targets::TargetSet;
 
 impl RecipeSettings {
     /// The published recipe.
     pub fn published() -> Self {
         RecipeSettings {
-            kind: RecipeKind::Published,
+            kind: Method::Published,
             epochs: 1000,
             lr: 0.01,
             ..Self::residual()
