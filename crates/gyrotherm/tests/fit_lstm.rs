@@ -406,10 +406,7 @@ fn published_recipe_is_kept() {
     let r = RecipeSettings::of_kind(Method::Published);
     assert_eq!(r, RecipeSettings::published());
     assert_eq!((r.epochs, r.lr), (1000, 0.01));
-    assert_eq!(
-        gyrotherm::fit::recipe::feature_spec(&r),
-        FeatureSpec::PUBLISHED
-    );
+    assert_eq!(r.feature_spec(), FeatureSpec::PUBLISHED);
     assert_eq!(RecipeSettings::default().kind, Method::Thermal);
     assert!(Method::parse_recipe("fancy")
         .unwrap_err()

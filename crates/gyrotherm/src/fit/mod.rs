@@ -8,6 +8,9 @@
 //!
 //! Modules, each one concept, imports running one way (down this list):
 //! - [`recipe`]: which LSTM recipe, its knobs, and what training reports ([`TrainSummary`]).
+//! - `methods`: how each method is fitted, one row per method (its recipe's default knobs,
+//!   its features, the function that fits one target); the methods' names are
+//!   [`crate::settings::method`]'s registry.
 //! - [`published`], [`residual`], [`generic`], [`direct`]: one recipe each.
 //! - [`thermal`]: the thermal-state recipe (lags identified from the data, ridge by
 //!   cross-validation; no LSTM).
@@ -21,6 +24,7 @@
 pub mod direct;
 pub mod error;
 pub mod generic;
+mod methods;
 pub mod published;
 pub mod recipe;
 pub mod residual;
@@ -39,6 +43,7 @@ use crate::targets::{self, TargetSet};
 
 pub use crate::model::Target;
 pub use error::FitError;
+use methods::TargetFit;
 pub use recipe::{LstmVerdict, RecipeSettings, TrainSummary};
 pub use select::TermSelection;
 pub use terms::BaseTerms;
@@ -220,9 +225,10 @@ impl FitOutcome {
 
 /// The feature specification a method reads.
 pub fn feature_spec(cfg: &FitConfig) -> FeatureSpec {
-    match cfg.method {
-        Method::Linear | Method::Poly => FeatureSpec::PUBLISHED,
-        _ => recipe::feature_spec(&cfg.recipe),
+    if cfg.method.is_recipe() {
+        cfg.recipe.feature_spec()
+    } else {
+        methods::fitting(cfg.method).features
     }
 }
 
@@ -370,7 +376,7 @@ pub fn fit_model(
 
 /// Whether the method identifies lags from the data (the `thermal` recipe).
 pub fn uses_identification(cfg: &FitConfig) -> bool {
-    cfg.method.is_recipe() && cfg.recipe.kind == Method::Thermal
+    cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Identified)
 }
 
 /// Widest span a static run's gyro output may have, °/s, from its 1st to its 99th
@@ -642,24 +648,6 @@ pub(crate) fn fit_model_with(
     })
 }
 
-impl RecipeSettings {
-    /// The recipe of a recipe method with its default knobs; the default recipe
-    /// ([`Method::Thermal`]'s) for a method that trains none of its own (`linear` and `poly`
-    /// fit no recipe, the read-only `lstm` names none), as a [`FitConfig`] of theirs holds.
-    pub fn of_kind(kind: Method) -> Self {
-        match kind {
-            Method::Published => Self::published(),
-            Method::Residual => Self::residual(),
-            Method::Generic => Self::generic(),
-            Method::Direct => Self::direct(),
-            Method::Thermal | Method::Linear | Method::Poly | Method::Lstm => RecipeSettings {
-                kind: Method::Thermal,
-                ..Self::residual()
-            },
-        }
-    }
-}
-
 /// Fit one target (bias or scale factor) on the training runs with an LSTM recipe.
 pub fn fit_target(
     train: &[TargetSet],
@@ -678,15 +666,12 @@ pub fn fit_target(
             other: t.table.n_features,
         });
     }
-    match recipe.kind {
-        Method::Published => published::fit(train, recipe, n_in, seed, progress),
-        Method::Residual | Method::Generic | Method::Direct => {
-            residual::fit(train, recipe, target, n_in, seed, progress)
-        }
+    match methods::fitting(recipe.kind).fit {
+        TargetFit::Recipe(fit) => fit(train, recipe, target, n_in, seed, progress),
         // Its features come from the logs: `fit_model` identifies them and fits it.
-        Method::Thermal => Err(FitError::NeedsLogs),
+        TargetFit::Identified => Err(FitError::NeedsLogs),
         // Least squares on all runs at once (`fit_model`); `lstm` is read only.
-        Method::Linear | Method::Poly | Method::Lstm => Err(FitError::NotARecipe {
+        TargetFit::LeastSquares | TargetFit::None => Err(FitError::NotARecipe {
             method: recipe.kind,
         }),
     }

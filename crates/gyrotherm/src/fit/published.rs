@@ -6,7 +6,7 @@
 
 use super::error::FitError;
 use super::recipe::{LstmVerdict, RecipeSettings, TrainSummary};
-use crate::model::SubModel;
+use crate::model::{SubModel, Target};
 use crate::nn::{train_normalised, Bptt, Sequence, TrainConfig};
 use crate::settings::method::Method;
 use crate::targets::TargetSet;
@@ -26,6 +26,7 @@ impl RecipeSettings {
 pub(crate) fn fit(
     train: &[TargetSet],
     recipe: &RecipeSettings,
+    _target: Target,
     n_in: usize,
     seed: u64,
     progress: &mut dyn FnMut(usize, f64),

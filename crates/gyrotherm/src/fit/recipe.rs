@@ -5,7 +5,6 @@
 
 use super::select::TermSelection;
 use super::terms::BaseTerms;
-use crate::features::FeatureSpec;
 use crate::settings::method::Method;
 
 /// A recipe and its knobs: how a recipe method fits (not called an LSTM recipe: the
@@ -137,18 +136,6 @@ impl LstmVerdict {
                 validation_blocks: false,
                 left_out_runs: false,
             } => "left out: its correction fitted none of the validation residual",
-        }
-    }
-}
-
-/// The feature specification a recipe's models read.
-pub fn feature_spec(recipe: &RecipeSettings) -> FeatureSpec {
-    match recipe.kind {
-        Method::Published | Method::Linear | Method::Poly => FeatureSpec::PUBLISHED,
-        // Thermal: the lags are identified from the logs (`thermal::identify`); this is the
-        // shape before identification. The read-only `lstm` trains no recipe of its own.
-        Method::Residual | Method::Generic | Method::Direct | Method::Thermal | Method::Lstm => {
-            FeatureSpec::THERMAL_STATE
         }
     }
 }

@@ -2,12 +2,11 @@
 //! `"method"` says, what `gyrotherm train --method` and Python's `fit(method=…)` take), its
 //! kind of fit, the label of its comparison column and its `--help` line.
 //!
-//! A new method is its fitting module plus one entry of the registry below (each variant's
-//! documentation names the module that fits it); the fit dispatches
-//! on [`Method`] with exhaustive matches ([`crate::fit::fit_target`],
-//! [`crate::fit::RecipeSettings::of_kind`]), so the compiler names each place a new method
-//! must be fitted. The registry sits below the fit (it imports only [`super::rule`]): model
-//! files, settings and the fit all name a method by this one enum.
+//! A new method is its fitting module, one entry of the registry below and one row of the
+//! fit's table of how each method is fitted (`fit/methods.rs`, an exhaustive match: the
+//! compiler refuses a method without its row). The two halves cannot be one table: model
+//! files and settings name a method, and they sit below the fit, so the registry imports
+//! only [`super::rule`] and the fit imports it.
 
 use serde::{Deserialize, Serialize};
 
