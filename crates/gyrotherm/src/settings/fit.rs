@@ -1,6 +1,5 @@
 //! Fitting settings: one struct for `gyrotherm train` (and the fit part of `compare`,
 //! `report`, `demo`) and Python's `fit()`.
-
 //!
 //! The settings sit below what they configure: this file imports only the rules, the methods
 //! and the library's target constants. The fit and the comparison build their configurations
