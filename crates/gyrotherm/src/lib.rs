@@ -106,7 +106,7 @@ pub use compensate::{compensate_log, compensator, CompensateError};
 pub use compensate_lines::{compensate_lines, LinesError, LinesSummary};
 pub use csvlog::{read_log, write_log, LogError, ReadOptions, TestLog};
 pub use features::{FeatureSpec, FeatureTable};
-pub use fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog, RecipeKind, RecipeSettings};
+pub use fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog, RecipeSettings};
 pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
 pub(crate) use settings::Rule;
 pub use settings::{FitSettings, SettingError};

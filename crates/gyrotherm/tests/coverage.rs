@@ -9,7 +9,7 @@
 use gyrotherm::compensate::compensator;
 use gyrotherm::coverage::missing_note;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, RecipeSettings};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeSettings};
 use gyrotherm::model::{Method, ModelFile, Seal, CHECKSUM_KEY};
 use gyrotherm::sim::{simulate_series, SimConfig};
 
@@ -41,7 +41,7 @@ fn thermal_model() -> ModelFile {
         },
     ];
     let mut cfg = FitConfig::new(Method::Lstm);
-    cfg.recipe = RecipeSettings::of_kind(RecipeKind::Thermal);
+    cfg.recipe = RecipeSettings::of_kind(Method::Thermal);
     let fit = fit_model(&named, &cfg, &|_, _, _| {}).unwrap();
     assert!(fit.coverage_note.is_none(), "{:?}", fit.coverage_note);
     fit.model

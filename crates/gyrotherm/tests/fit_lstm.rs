@@ -7,8 +7,7 @@ use gyrotherm::csvlog::TestLog;
 use gyrotherm::features::FeatureSpec;
 use gyrotherm::fit::terms::{bias_terms, generic_linear_terms, ladder, BaseTerms};
 use gyrotherm::fit::{
-    fit_model, fit_target, select, terms, FitConfig, FitOutcome, NamedLog, RecipeKind,
-    RecipeSettings, Target,
+    fit_model, fit_target, select, terms, FitConfig, FitOutcome, NamedLog, RecipeSettings, Target,
 };
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
@@ -404,25 +403,22 @@ fn residual_lstm_can_read_the_base_prediction() {
 /// Method `published` is the paper's recipe: T and dT in, a plain LSTM, full BPTT.
 #[test]
 fn published_recipe_is_kept() {
-    let r = RecipeSettings::of_kind(RecipeKind::parse("published").unwrap());
+    let r = RecipeSettings::of_kind(Method::Published);
     assert_eq!(r, RecipeSettings::published());
     assert_eq!((r.epochs, r.lr), (1000, 0.01));
-    assert_eq!(
-        gyrotherm::fit::recipe::feature_spec(&r),
-        FeatureSpec::PUBLISHED
-    );
-    assert_eq!(RecipeSettings::default().kind, RecipeKind::Thermal);
-    assert!(RecipeKind::parse("fancy")
+    assert_eq!(r.feature_spec(), FeatureSpec::PUBLISHED);
+    assert_eq!(RecipeSettings::default().kind, Method::Thermal);
+    assert!(Method::parse_recipe("fancy")
         .unwrap_err()
         .to_string()
         .contains("published"));
     for kind in [
-        RecipeKind::Published,
-        RecipeKind::Residual,
-        RecipeKind::Generic,
-        RecipeKind::Direct,
+        Method::Published,
+        Method::Residual,
+        Method::Generic,
+        Method::Direct,
     ] {
-        assert_eq!(RecipeKind::parse(kind.as_str()), Ok(kind));
+        assert_eq!(Method::parse_recipe(kind.as_str()), Ok(kind));
         assert_eq!(RecipeSettings::of_kind(kind).kind, kind);
     }
     assert_eq!(RecipeSettings::generic().base, BaseTerms::LinearT2);

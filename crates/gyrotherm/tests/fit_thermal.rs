@@ -3,16 +3,14 @@
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{
-    fit_model, FitConfig, FitOutcome, LstmVerdict, NamedLog, RecipeKind, RecipeSettings,
-};
+use gyrotherm::fit::{fit_model, FitConfig, FitOutcome, LstmVerdict, NamedLog, RecipeSettings};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::model::{Method, SubModel};
 use gyrotherm::sim::{random_unit, simulate, FogUnit, Profile, SensorNode, SimConfig};
 
 fn thermal() -> FitConfig {
     let mut c = FitConfig::new(Method::Thermal);
-    c.recipe = RecipeSettings::of_kind(RecipeKind::Thermal);
+    c.recipe = RecipeSettings::of_kind(Method::Thermal);
     c
 }
 

@@ -87,7 +87,6 @@ fn method_names_parse_back_and_lstm_is_not_listed() {
 /// that contradicts the method is refused naming both settings.
 #[test]
 fn deprecated_recipe_and_lstm_resolve_to_a_method() {
-    use gyrotherm::fit::RecipeKind;
     use gyrotherm::settings::{Deprecation, FitSettings};
     let with = |method, recipe| FitSettings {
         method,
@@ -96,18 +95,9 @@ fn deprecated_recipe_and_lstm_resolve_to_a_method() {
     };
     let cases = [
         (with(Method::Lstm, None), Method::Thermal),
-        (
-            with(Method::Lstm, Some(RecipeKind::Residual)),
-            Method::Residual,
-        ),
-        (
-            with(Method::Thermal, Some(RecipeKind::Direct)),
-            Method::Direct,
-        ),
-        (
-            with(Method::Linear, Some(RecipeKind::Direct)),
-            Method::Linear,
-        ),
+        (with(Method::Lstm, Some(Method::Residual)), Method::Residual),
+        (with(Method::Thermal, Some(Method::Direct)), Method::Direct),
+        (with(Method::Linear, Some(Method::Direct)), Method::Linear),
         (with(Method::Generic, None), Method::Generic),
     ];
     for (s, want) in cases {
@@ -124,7 +114,7 @@ fn deprecated_recipe_and_lstm_resolve_to_a_method() {
             now: Method::Thermal
         })
     ));
-    let err = with(Method::Generic, Some(RecipeKind::Direct))
+    let err = with(Method::Generic, Some(Method::Direct))
         .validate()
         .unwrap_err()
         .to_string();

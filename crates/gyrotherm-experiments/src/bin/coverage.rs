@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use gyrotherm::compensate::compensator;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, RecipeSettings};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeSettings};
 use gyrotherm::model::Method;
 use gyrotherm::sim::{random_unit, simulate_series, FogUnit, SimConfig, SimSeries};
 use gyrotherm_core::coverage::Coverage;
@@ -96,7 +96,7 @@ fn run_unit(unit_seed: u64) -> Result<Vec<Window>, String> {
         .map(|(name, log)| NamedLog { name, log })
         .collect();
     let mut cfg = FitConfig::new(Method::Lstm);
-    cfg.recipe = RecipeSettings::of_kind(RecipeKind::Thermal);
+    cfg.recipe = RecipeSettings::of_kind(Method::Thermal);
     cfg.seed = 1;
     let fit =
         fit_model(&named, &cfg, &|_, _, _| {}).map_err(|e| format!("unit {unit_seed}: {e}"))?;

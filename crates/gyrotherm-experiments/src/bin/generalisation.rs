@@ -29,7 +29,7 @@ use std::time::Instant;
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::thermal::Basis;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, RecipeSettings};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeSettings};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::Method;
@@ -65,13 +65,13 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         }
         "generic" => lstm(RecipeSettings::generic()),
         "published" => lstm(RecipeSettings::published()),
-        "direct" => lstm(RecipeSettings::of_kind(RecipeKind::Direct)),
-        "thermal" => lstm(RecipeSettings::of_kind(RecipeKind::Thermal)),
+        "direct" => lstm(RecipeSettings::of_kind(Method::Direct)),
+        "thermal" => lstm(RecipeSettings::of_kind(Method::Thermal)),
         v if v.starts_with("thermal-lstm") => {
             // thermal-lstm[:<base input 0|1>[:<runs gate 0|1>[:<epochs>[:<min improvement>
             // [:<residual smoothing steps>]]]]]: the thermal model with a residual LSTM on
             // top, for the design-family sweep.
-            let mut c = lstm(RecipeSettings::of_kind(RecipeKind::Thermal));
+            let mut c = lstm(RecipeSettings::of_kind(Method::Thermal));
             c.thermal.residual_lstm = true;
             let parts: Vec<&str> = v.split(':').collect();
             c.recipe.base_input = parts.get(1) == Some(&"1");
@@ -89,7 +89,7 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         }
         v if v.starts_with("thermal:") => {
             // thermal:<lags>:<basis>[:<folds>] for the design-family sweep.
-            let mut c = lstm(RecipeSettings::of_kind(RecipeKind::Thermal));
+            let mut c = lstm(RecipeSettings::of_kind(Method::Thermal));
             let parts: Vec<&str> = v.split(':').collect();
             if let Some(n) = parts.get(1) {
                 c.thermal.n_lags = n.parse().map_err(|e| format!("{v}: {e}"))?;

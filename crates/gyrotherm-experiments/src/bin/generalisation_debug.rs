@@ -5,7 +5,7 @@
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeKind, RecipeSettings};
+use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeSettings};
 use gyrotherm::model::Method;
 use gyrotherm::sim::{random_unit, simulate_series, SimConfig, SimSeries};
 
@@ -56,7 +56,7 @@ fn main() {
             "poly" => FitConfig::new(Method::Poly),
             _ => FitConfig::new(Method::Lstm),
         };
-        if let Ok(k) = RecipeKind::parse(m) {
+        if let Ok(k) = Method::parse_recipe(m) {
             cfg.recipe = RecipeSettings::of_kind(k);
             cfg.thermal.basis = gyrotherm::fit::thermal::Basis::Lean;
             cfg.thermal.min_lag_ratio = 3.0;

@@ -25,7 +25,7 @@ use std::time::Instant;
 
 use gyrotherm::compensate::compensate_log;
 use gyrotherm::csvlog::TestLog;
-use gyrotherm::fit::{fit_model, BaseTerms, FitConfig, NamedLog, RecipeKind, RecipeSettings};
+use gyrotherm::fit::{fit_model, BaseTerms, FitConfig, NamedLog, RecipeSettings};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
 use gyrotherm::model::Method;
@@ -109,7 +109,7 @@ fn main() {
     let train_seed: u64 = get("--train-seed").map_or(7, |v| v.parse().unwrap());
     let test_seed: u64 = get("--test-seed").map_or(11, |v| v.parse().unwrap());
     let mut recipe = RecipeSettings::of_kind(
-        RecipeKind::parse(&get("--recipe").unwrap_or_else(|| "residual".into())).unwrap(),
+        Method::parse_recipe(&get("--recipe").unwrap_or_else(|| "residual".into())).unwrap(),
     );
     if let Some(e) = get("--epochs") {
         recipe.epochs = e.parse().unwrap();
@@ -213,7 +213,7 @@ fn main() {
         ("linear".into(), Method::Linear, None),
         ("poly".into(), Method::Poly, None),
     ];
-    if recipe.kind != RecipeKind::Published {
+    if recipe.kind != Method::Published {
         for b in &bases {
             let label = b.map_or("base".to_string(), |b| format!("b:{}", b.name()));
             runs.push((label, Method::Lstm, Some(*b)));

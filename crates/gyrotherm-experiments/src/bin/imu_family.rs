@@ -60,7 +60,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use gyrotherm::csvlog::{ImuLog, NamedSeries};
-use gyrotherm::fit::{FitConfig, RecipeKind, RecipeSettings};
+use gyrotherm::fit::{FitConfig, RecipeSettings};
 use gyrotherm::imu_model::{
     compensate_imu, fit_imu_with, imu_axis_compensators, ImuFitSettings, ImuModel, ImuSensors,
 };
@@ -663,7 +663,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         tests.push((*profile, st, tabs, floors));
     }
     let mut cfg = FitConfig::new(Method::Lstm);
-    cfg.recipe = RecipeSettings::of_kind(RecipeKind::Thermal);
+    cfg.recipe = RecipeSettings::of_kind(Method::Thermal);
     cfg.seed = 1;
     if let Some(t) = job.tau_max_s {
         cfg.thermal.tau_range_s.1 = t;

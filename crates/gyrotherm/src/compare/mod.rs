@@ -25,16 +25,22 @@ use serde::Serialize;
 
 use crate::compensate::{compensate_log, extrapolation_warnings, Compensated};
 use crate::csvlog::{TestLog, NOISE_COL};
-use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, RecipeKind, RecipeSettings, Target};
+use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, RecipeSettings, Target};
 use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
-use crate::model::Method;
+use crate::settings::fit::{Deprecation, FitSettings};
+use crate::settings::method::{Method, DEFAULT_METHOD};
+use crate::settings::rule::{check, Rule, SettingError};
 use crate::targets;
 
 /// Bias-stability smoothing time of the comparison, s (100 s: docs/method.md, He et al. 2024).
 pub const BIAS_STABILITY_TAU_S: f64 = 100.0;
 
-/// The column name of the published recipe: the seed's method, named after its authors.
-pub const PUBLISHED_LABEL: &str = "LSTM, He et al.";
+/// The column name of the published recipe: the seed's method, named after its authors
+/// (its [`Method::column_label`]).
+pub const PUBLISHED_LABEL: &str = match Method::Published.column_label() {
+    Some(label) => label,
+    None => Method::Published.as_str(),
+};
 
 /// One column of the comparison: a method and, for a recipe method, the recipe it trains.
 #[derive(Debug, Clone, PartialEq)]
@@ -79,10 +85,12 @@ impl Candidate {
 
     /// The fit settings of this column: `base` with its method and recipe.
     pub fn fit_config(&self, base: &FitConfig) -> FitConfig {
-        let recipe = match (&self.recipe, self.method.recipe_kind()) {
-            (Some(r), _) => r.clone(),
-            (None, Some(kind)) if kind != base.recipe.kind => RecipeSettings::of_kind(kind),
-            _ => base.recipe.clone(),
+        let recipe = match &self.recipe {
+            Some(r) => r.clone(),
+            None if self.method.is_own_recipe() && self.method != base.recipe.kind => {
+                RecipeSettings::of_kind(self.method)
+            }
+            None => base.recipe.clone(),
         };
         FitConfig {
             method: self.method,
@@ -96,6 +104,12 @@ impl Candidate {
         self.fit_config(base).model_method() == Method::Published
     }
 
+    /// The column's own label, if its method has one ([`Method::column_label`]: the
+    /// published recipe's [`PUBLISHED_LABEL`]); otherwise the column is labelled by its model.
+    pub fn column_label(&self, base: &FitConfig) -> Option<&'static str> {
+        self.fit_config(base).model_method().column_label()
+    }
+
     /// The column's key in `gyrotherm compare --json` and `--methods`: the method's name.
     pub fn key(&self, base: &FitConfig) -> &'static str {
         self.fit_config(base).model_method().as_str()
@@ -106,7 +120,54 @@ impl Candidate {
         let c = self.fit_config(base);
         c.method.is_recipe()
             && c.recipe.epochs > 0
-            && (c.recipe.kind != RecipeKind::Thermal || c.thermal.residual_lstm)
+            && (c.recipe.kind != Method::Thermal || c.thermal.residual_lstm)
+    }
+}
+
+/// The comparison's side of the user's settings: the settings sit below the comparison and
+/// know nothing of it, so the comparison builds its configuration from them here.
+impl FitSettings {
+    /// The comparison of `methods` (None: `linear`, `poly`, this settings' method, which is
+    /// `thermal` unless the deprecated `recipe` names another, and `published`, once) with
+    /// these settings, bias stability over `tau_s`. The deprecated `lstm` in `methods` is
+    /// this settings' method.
+    pub fn compare_config(
+        &self,
+        methods: Option<&[Method]>,
+        tau_s: f64,
+    ) -> Result<(CompareConfig, Option<Deprecation>), SettingError> {
+        check("tau_s", tau_s, Rule::PositiveSeconds)?;
+        let (fit, note) = self.fit_config()?;
+        let main = fit.model_method();
+        let wanted: Vec<Method> = match methods {
+            Some(m) => m
+                .iter()
+                .map(|m| if *m == Method::Lstm { main } else { *m })
+                .collect(),
+            None => {
+                let mut all = vec![Method::Linear, Method::Poly, main];
+                if main != Method::Published {
+                    all.push(Method::Published);
+                }
+                all
+            }
+        };
+        let candidates = wanted
+            .into_iter()
+            .map(|m| Candidate {
+                method: m,
+                recipe: m.is_own_recipe().then(|| self.recipe_for(m)),
+            })
+            .collect();
+        Ok((
+            CompareConfig {
+                candidates,
+                fit,
+                tau_s,
+                settle_s: self.settle_s,
+            },
+            note,
+        ))
     }
 }
 
@@ -155,7 +216,7 @@ impl Default for CompareConfig {
                 Candidate::of(Method::Thermal),
                 Candidate::published(None),
             ],
-            fit: FitConfig::new(crate::settings::DEFAULT_METHOD),
+            fit: FitConfig::new(DEFAULT_METHOD),
             tau_s: BIAS_STABILITY_TAU_S,
             settle_s: targets::SETTLE_S,
         }
@@ -476,11 +537,7 @@ pub fn compare_with_stages(
         let fit = match fit {
             Ok(f) => f,
             Err(e) => {
-                let label = if c.is_published(&cfg.fit) {
-                    PUBLISHED_LABEL
-                } else {
-                    key
-                };
+                let label = c.column_label(&cfg.fit).unwrap_or(key);
                 failed.push(FailedColumn {
                     key,
                     label,
@@ -490,11 +547,9 @@ pub fn compare_with_stages(
                 continue;
             }
         };
-        let label = if c.is_published(&cfg.fit) {
-            PUBLISHED_LABEL
-        } else {
-            fit.model.label()
-        };
+        let label = c
+            .column_label(&cfg.fit)
+            .unwrap_or_else(|| fit.model.label());
         columns.push(Column { key, label });
         fits.push(fit);
     }

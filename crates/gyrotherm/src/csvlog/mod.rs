@@ -24,7 +24,7 @@ mod gaps;
 mod imu;
 mod number;
 mod reader;
-mod writer;
+pub(crate) mod writer;
 
 pub use column_list::{
     parse_table_axis, split_columns, COLUMN_LIST_SEPARATOR, TABLE_AXIS_SLOPE_RANGE,

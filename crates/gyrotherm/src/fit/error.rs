@@ -3,6 +3,7 @@
 use crate::baseline::LsqError;
 use crate::model::{ModelFileError, Target};
 use crate::nn::TrainError;
+use crate::settings::method::Method;
 
 /// Why [`fit_model`](super::fit_model) (or one recipe) could not fit a model. Each variant
 /// names the run, the target or the value at fault.
@@ -42,6 +43,9 @@ pub enum FitError {
     Thermal(super::thermal::ThermalError),
     /// The thermal recipe identifies its features from the logs: fit it through `fit_model`.
     NeedsLogs,
+    /// [`fit_target`](super::fit_target) was given a method that is no recipe (`linear` and
+    /// `poly` fit by least squares through `fit_model`; `lstm` is read only).
+    NotARecipe { method: Method },
     /// The fitted model did not pass the model file's checks.
     Model(ModelFileError),
     /// The fit of one target (bias or scale factor) failed.
@@ -114,6 +118,9 @@ impl std::fmt::Display for FitError {
                 f,
                 "the thermal recipe identifies its features from the logs: fit it with fit_model"
             ),
+            FitError::NotARecipe { method } => {
+                write!(f, "method `{method}` is no recipe: fit it with fit_model")
+            }
             FitError::Model(e) => e.fmt(f),
             FitError::Target { target, .. } => match target {
                 Target::Bias => f.write_str("bias model"),

@@ -4,14 +4,15 @@
 //! linear + `T²` scale terms left 23–92 ppm held out, against a 10 ppm target
 //! (`docs/experiments/lstm-recipes.md`).
 
-use super::recipe::{RecipeKind, RecipeSettings};
+use super::recipe::RecipeSettings;
 use super::terms::BaseTerms;
+use crate::settings::method::Method;
 
 impl RecipeSettings {
     /// The residual recipe on the generic base [`BaseTerms::LinearT2`].
     pub fn generic() -> Self {
         RecipeSettings {
-            kind: RecipeKind::Generic,
+            kind: Method::Generic,
             base: BaseTerms::LinearT2,
             scale_base: BaseTerms::Tailored,
             ..Self::residual()

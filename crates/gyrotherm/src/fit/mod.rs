@@ -8,6 +8,9 @@
 //!
 //! Modules, each one concept, imports running one way (down this list):
 //! - [`recipe`]: which LSTM recipe, its knobs, and what training reports ([`TrainSummary`]).
+//! - `methods`: how each method is fitted, one row per method (its recipe's default knobs,
+//!   its features, the function that fits one target); the methods' names are
+//!   [`crate::settings::method`]'s registry.
 //! - [`published`], [`residual`], [`generic`], [`direct`]: one recipe each.
 //! - [`thermal`]: the thermal-state recipe (lags identified from the data, ridge by
 //!   cross-validation; no LSTM).
@@ -21,6 +24,7 @@
 pub mod direct;
 pub mod error;
 pub mod generic;
+mod methods;
 pub mod published;
 pub mod recipe;
 pub mod residual;
@@ -31,12 +35,16 @@ pub mod thermal;
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
 use crate::features::{FeatureSpec, FeatureTable};
-use crate::model::{self, FeatureDef, Method, ModelFile, SubModel, TrainingInfo};
+use crate::model::{self, FeatureDef, ModelFile, SubModel, TrainingInfo};
+use crate::settings::fit::{Deprecation, FitSettings};
+use crate::settings::method::Method;
+use crate::settings::rule::SettingError;
 use crate::targets::{self, TargetSet};
 
 pub use crate::model::Target;
 pub use error::FitError;
-pub use recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary, UnknownRecipe};
+use methods::TargetFit;
+pub use recipe::{LstmVerdict, RecipeSettings, TrainSummary};
 pub use select::TermSelection;
 pub use terms::BaseTerms;
 
@@ -72,9 +80,7 @@ impl FitConfig {
     pub fn new(method: Method) -> Self {
         FitConfig {
             method,
-            recipe: method
-                .recipe_kind()
-                .map_or_else(RecipeSettings::default, RecipeSettings::of_kind),
+            recipe: RecipeSettings::of_kind(method),
             poly: PolyDegrees::default(),
             bias_window_s: targets::BIAS_WINDOW_S,
             settle_s: targets::SETTLE_S,
@@ -85,12 +91,47 @@ impl FitConfig {
     }
 }
 
+/// The fit's side of the user's settings: the settings sit below the fit and know nothing of
+/// it, so the fit builds its configuration from them here.
+impl FitSettings {
+    /// The recipe settings a recipe method trains with here (`epochs` and
+    /// `validate_on_runs` applied to the method's own).
+    pub fn recipe_for(&self, kind: Method) -> RecipeSettings {
+        let mut r = RecipeSettings::of_kind(kind);
+        if let Some(e) = self.epochs {
+            r.epochs = e;
+        }
+        r.validate_on_runs = self.validate_on_runs;
+        r.hidden = self.hidden;
+        r
+    }
+
+    /// The library's fit configuration: checked, deprecated spellings resolved (what was
+    /// resolved is returned, to be said).
+    pub fn fit_config(&self) -> Result<(FitConfig, Option<Deprecation>), SettingError> {
+        self.validate()?;
+        let (method, note) = self.resolve()?;
+        let mut cfg = FitConfig::new(method);
+        // linear and poly fit no recipe; theirs stays the default, unused.
+        cfg.recipe = self.recipe_for(method);
+        cfg.seed = self.seed;
+        cfg.bias_window_s = self.bias_window_s;
+        cfg.settle_s = self.settle_s;
+        cfg.poly = PolyDegrees {
+            temp: self.poly_temp_degree,
+            rate: self.poly_rate_degree,
+            cross: self.cross,
+        };
+        Ok((cfg, note))
+    }
+}
+
 impl FitConfig {
     /// The method a fit with this configuration writes: for a recipe method, its recipe's
     /// (the recipe may be swapped in whole, as a comparison column does).
     pub fn model_method(&self) -> Method {
         if self.method.is_recipe() {
-            self.recipe.kind.method()
+            self.recipe.kind
         } else {
             self.method
         }
@@ -184,9 +225,10 @@ impl FitOutcome {
 
 /// The feature specification a method reads.
 pub fn feature_spec(cfg: &FitConfig) -> FeatureSpec {
-    match cfg.method {
-        Method::Linear | Method::Poly => FeatureSpec::PUBLISHED,
-        _ => recipe::feature_spec(&cfg.recipe),
+    if cfg.method.is_recipe() {
+        cfg.recipe.feature_spec()
+    } else {
+        methods::fitting(cfg.method).features
     }
 }
 
@@ -334,7 +376,7 @@ pub fn fit_model(
 
 /// Whether the method identifies lags from the data (the `thermal` recipe).
 pub fn uses_identification(cfg: &FitConfig) -> bool {
-    cfg.method.is_recipe() && cfg.recipe.kind == RecipeKind::Thermal
+    cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Identified)
 }
 
 /// Widest span a static run's gyro output may have, °/s, from its 1st to its 99th
@@ -606,22 +648,6 @@ pub(crate) fn fit_model_with(
     })
 }
 
-impl RecipeSettings {
-    /// The recipe of a kind with its default knobs.
-    pub fn of_kind(kind: RecipeKind) -> Self {
-        match kind {
-            RecipeKind::Published => Self::published(),
-            RecipeKind::Residual => Self::residual(),
-            RecipeKind::Generic => Self::generic(),
-            RecipeKind::Direct => Self::direct(),
-            RecipeKind::Thermal => RecipeSettings {
-                kind: RecipeKind::Thermal,
-                ..Self::residual()
-            },
-        }
-    }
-}
-
 /// Fit one target (bias or scale factor) on the training runs with an LSTM recipe.
 pub fn fit_target(
     train: &[TargetSet],
@@ -640,12 +666,13 @@ pub fn fit_target(
             other: t.table.n_features,
         });
     }
-    match recipe.kind {
-        RecipeKind::Published => published::fit(train, recipe, n_in, seed, progress),
-        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct => {
-            residual::fit(train, recipe, target, n_in, seed, progress)
-        }
+    match methods::fitting(recipe.kind).fit {
+        TargetFit::Recipe(fit) => fit(train, recipe, target, n_in, seed, progress),
         // Its features come from the logs: `fit_model` identifies them and fits it.
-        RecipeKind::Thermal => Err(FitError::NeedsLogs),
+        TargetFit::Identified => Err(FitError::NeedsLogs),
+        // Least squares on all runs at once (`fit_model`); `lstm` is read only.
+        TargetFit::LeastSquares | TargetFit::None => Err(FitError::NotARecipe {
+            method: recipe.kind,
+        }),
     }
 }

@@ -5,16 +5,17 @@
 //! (`docs/experiments/lstm-recipes.md`).
 
 use super::error::FitError;
-use super::recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary};
-use crate::model::SubModel;
+use super::recipe::{LstmVerdict, RecipeSettings, TrainSummary};
+use crate::model::{SubModel, Target};
 use crate::nn::{train_normalised, Bptt, Sequence, TrainConfig};
+use crate::settings::method::Method;
 use crate::targets::TargetSet;
 
 impl RecipeSettings {
     /// The published recipe.
     pub fn published() -> Self {
         RecipeSettings {
-            kind: RecipeKind::Published,
+            kind: Method::Published,
             epochs: 1000,
             lr: 0.01,
             ..Self::residual()
@@ -25,6 +26,7 @@ impl RecipeSettings {
 pub(crate) fn fit(
     train: &[TargetSet],
     recipe: &RecipeSettings,
+    _target: Target,
     n_in: usize,
     seed: u64,
     progress: &mut dyn FnMut(usize, f64),

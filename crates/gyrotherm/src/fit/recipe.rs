@@ -5,80 +5,14 @@
 
 use super::select::TermSelection;
 use super::terms::BaseTerms;
-use crate::features::FeatureSpec;
-
-/// Which recipe (each is a [`Method`](crate::settings::Method) of its own:
-/// [`RecipeKind::method`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum RecipeKind {
-    /// As published ([`super::published`]).
-    Published,
-    /// Least-squares fit on thermal-state inputs plus an LSTM on its residual, with truncated
-    /// BPTT and early stopping ([`super::residual`]). Base: [`BaseTerms::Selected`].
-    Residual,
-    /// As `Residual`, on the generic base [`BaseTerms::LinearT2`] (no term chosen from the
-    /// bias equation).
-    Generic,
-    /// As `Residual` with a constant base only ([`BaseTerms::Constant`]): the LSTM models the
-    /// whole bias from the thermal-state inputs (windowed truncated BPTT, early stopping).
-    Direct,
-    /// Thermal time constants identified from the training data and a ridge fit on them, no
-    /// LSTM ([`super::thermal`]). The default.
-    #[default]
-    Thermal,
-}
-
-impl RecipeKind {
-    /// The name used on the command line (`--recipe`).
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            RecipeKind::Published => "published",
-            RecipeKind::Residual => "residual",
-            RecipeKind::Generic => "generic",
-            RecipeKind::Direct => "direct",
-            RecipeKind::Thermal => "thermal",
-        }
-    }
-
-    /// Parse a `--recipe` value.
-    pub fn parse(name: &str) -> Result<RecipeKind, UnknownRecipe> {
-        match name {
-            "published" => Ok(RecipeKind::Published),
-            "residual" => Ok(RecipeKind::Residual),
-            "generic" => Ok(RecipeKind::Generic),
-            "direct" => Ok(RecipeKind::Direct),
-            "thermal" => Ok(RecipeKind::Thermal),
-            _ => Err(UnknownRecipe {
-                name: name.to_owned(),
-            }),
-        }
-    }
-}
-
-/// A `--recipe` value [`RecipeKind::parse`] does not know.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct UnknownRecipe {
-    pub name: String,
-}
-
-impl std::fmt::Display for UnknownRecipe {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "unknown LSTM recipe {:?}: use `thermal` (default), `residual`, `generic`, `direct` or \
-             `published`",
-            self.name
-        )
-    }
-}
-
-impl std::error::Error for UnknownRecipe {}
+use crate::settings::method::Method;
 
 /// A recipe and its knobs: how a recipe method fits (not called an LSTM recipe: the
 /// thermal recipe, the default, holds no LSTM) (knobs marked `Residual` apply to `Generic` and `Direct` too).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecipeSettings {
-    pub kind: RecipeKind,
+    /// The recipe method these knobs train ([`Method::is_own_recipe`]).
+    pub kind: Method,
     /// Maximum epochs: Adam steps for `Published` (1000 as published); passes over all
     /// training windows for `Residual`.
     pub epochs: usize,
@@ -178,16 +112,6 @@ pub enum LstmVerdict {
     },
 }
 
-impl std::str::FromStr for RecipeKind {
-    type Err = crate::settings::SettingError;
-    /// The deprecated `recipe` setting: a recipe method's name.
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        RecipeKind::parse(s).map_err(|_| {
-            crate::settings::SettingError::unknown("recipe", s, &crate::settings::fit::RECIPE_NAMES)
-        })
-    }
-}
-
 impl LstmVerdict {
     /// What became of the LSTM, as a sentence fragment (`kept`, `left out: …`).
     pub fn text(&self) -> &'static str {
@@ -212,18 +136,6 @@ impl LstmVerdict {
                 validation_blocks: false,
                 left_out_runs: false,
             } => "left out: its correction fitted none of the validation residual",
-        }
-    }
-}
-
-/// The feature specification a recipe's models read.
-pub fn feature_spec(recipe: &RecipeSettings) -> FeatureSpec {
-    match recipe.kind {
-        RecipeKind::Published => FeatureSpec::PUBLISHED,
-        // Thermal: the lags are identified from the logs (`thermal::identify`); this is the
-        // shape before identification.
-        RecipeKind::Residual | RecipeKind::Generic | RecipeKind::Direct | RecipeKind::Thermal => {
-            FeatureSpec::THERMAL_STATE
         }
     }
 }

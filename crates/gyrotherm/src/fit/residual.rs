@@ -18,7 +18,7 @@
 //! (`docs/experiments/lstm-recipes.md`, `docs/experiments/lstm-residual.md`).
 
 use super::error::FitError;
-use super::recipe::{LstmVerdict, RecipeKind, RecipeSettings, TrainSummary, MIN_GAIN};
+use super::recipe::{LstmVerdict, RecipeSettings, TrainSummary, MIN_GAIN};
 use super::select::{select_terms, FOLDS, GAP_STEPS};
 use super::terms::{candidates, ladder, BaseTerms};
 use crate::baseline::{fit_fixed_effects, FixedEffectsFit, Terms};
@@ -27,16 +27,18 @@ use crate::model::{SubModel, Target};
 use crate::nn::{
     predict, train_normalised, Bptt, NormalisedFit, Sequence, TrainConfig, WindowStart,
 };
+use crate::settings::fit::DEFAULT_HIDDEN;
+use crate::settings::method::Method;
 use crate::targets::TargetSet;
 
 impl RecipeSettings {
     /// The residual recipe with its default knobs.
     pub fn residual() -> Self {
         RecipeSettings {
-            kind: RecipeKind::Residual,
+            kind: Method::Residual,
             epochs: 300,
             lr: 0.003,
-            hidden: crate::settings::fit::DEFAULT_HIDDEN,
+            hidden: DEFAULT_HIDDEN,
             window: 1000,
             burn_in: 200,
             batch: 4,
@@ -58,7 +60,7 @@ impl Default for RecipeSettings {
     /// The thermal recipe ([`super::thermal`]): chosen on a family of simulated units
     /// (docs/experiments/generalisation.md).
     fn default() -> Self {
-        Self::of_kind(super::RecipeKind::Thermal)
+        Self::of_kind(Method::Thermal)
     }
 }
 

@@ -1,7 +1,7 @@
 //! Allan deviation of a log column: the settings, and the policy of which curve the noise
 //! terms are read from.
 
-use super::{Rule, SettingError};
+use super::rule::{Rule, SettingError};
 use crate::allan::{self, AllanError, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
 use crate::csvlog::{rate_column_to_dph, GYRO_COL};
 

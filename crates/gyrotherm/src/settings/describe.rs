@@ -9,8 +9,8 @@ use super::allan::{AllanSettings, KIND_NAMES, TAU_SET_NAMES};
 use super::compensate::temp_sensor_defaults;
 use super::evaluate::EvaluateSettings;
 use super::fit::{FitSettings, RECIPE_NAMES};
+use super::method::METHOD_NAMES;
 use super::read::{delimiter_name, DELIMITER_NAMES, GYRO_UNIT_NAMES};
-use super::METHOD_NAMES;
 use crate::csvlog::ReadOptions;
 
 /// One setting: its name (the Python keyword; the flag is `--` plus the name with `-` for

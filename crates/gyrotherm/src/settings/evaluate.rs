@@ -1,7 +1,7 @@
 //! The standard figures of a log column (`gyrotherm evaluate`): the settings, and the policy
 //! for the bias-stability smoothing time τ.
 
-use super::{Rule, SettingError};
+use super::rule::{Rule, SettingError};
 use crate::csvlog::{rate_column_to_dph, TestLog, GYRO_COL};
 use crate::metrics::{self, Evaluation, EvaluationError, EvaluationOptions};
 

@@ -1,11 +1,15 @@
 //! Fitting settings: one struct for `gyrotherm train` (and the fit part of `compare`,
 //! `report`, `demo`) and Python's `fit()`.
+//!
+//! The settings sit below what they configure: this file imports only the rules, the methods
+//! and the library's target constants. The fit and the comparison build their configurations
+//! from it ([`FitSettings::fit_config`] in [`crate::fit`], [`FitSettings::compare_config`] in
+//! [`crate::compare`]).
 
-use super::{check, Method, Rule, SettingError, DEFAULT_METHOD};
-use crate::baseline::PolyDegrees;
-use crate::compare::{Candidate, CompareConfig};
-use crate::fit::thermal::multi::{ExtraTerms, FirstBy};
-use crate::fit::{FitConfig, RecipeKind, RecipeSettings};
+pub use super::method::RECIPE_NAMES;
+use super::method::{Method, DEFAULT_METHOD};
+pub use super::rule::MAX_EPOCHS;
+use super::rule::{check, Rule, SettingError};
 use crate::targets;
 
 /// Default random seed of the LSTM initialisation and window order.
@@ -16,10 +20,6 @@ pub const DEFAULT_BIAS_WINDOW_S: f64 = targets::BIAS_WINDOW_S;
 pub const DEFAULT_SETTLE_S: f64 = targets::SETTLE_S;
 /// Default highest power of T in the `poly` bias model.
 pub const DEFAULT_POLY_TEMP_DEGREE: u8 = 3;
-/// Most training epochs one may ask for: a thousand times the published method's 1000
-/// (Adam steps), far beyond any loss that still falls, while the loss history of that many
-/// epochs stays a few megabytes.
-pub const MAX_EPOCHS: usize = 1_000_000;
 /// Default highest power of dT in the `poly` bias model.
 pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 /// Default hidden units of the LSTM recipes: 8, as published (He et al. 2024, §2).
@@ -27,9 +27,6 @@ pub const DEFAULT_HIDDEN: usize = 8;
 /// Most hidden units the LSTM recipes take (a 128-unit network has 70,000 parameters; the
 /// flight crate's fixed-size network then needs 290 KB).
 pub const MAX_HIDDEN: usize = 128;
-
-/// Names of the deprecated `recipe` setting (the recipe methods' names).
-pub const RECIPE_NAMES: [&str; 5] = ["thermal", "residual", "generic", "direct", "published"];
 
 /// Default least relative drop of an inertial-unit axis's cross-validated RMS for a further
 /// temperature sensor to join its model: −1, a sensor joins unless it doubles the
@@ -58,6 +55,34 @@ pub const DEFAULT_IMU_FIRST: FirstBy = FirstBy::Single;
 /// and every tenth step (a higher worst case): docs/experiments/imu.md. The one-axis fit
 /// searches on every step.
 pub const IMU_IDENTIFY_EVERY: usize = 5;
+
+/// The terms a further sensor adds ([`extra_terms`](crate::fit::thermal::multi::extra_terms); the default
+/// is [`DEFAULT_IMU_EXTRA_TERMS`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExtraTerms {
+    /// `T` and each lag difference, linearly.
+    Linear,
+    /// `T` alone.
+    Temp,
+    /// `T` and the fastest lag difference.
+    TempFast,
+    /// `T, T², T³` and each lag difference.
+    Cubic,
+    /// The first sensor's basis less its constant (`T, T², T³, Dj, T·D1` with `lean`).
+    Same,
+}
+
+/// Which sensor comes first (gets the full basis; the default is [`DEFAULT_IMU_FIRST`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FirstBy {
+    /// The lowest one-sensor cross-validated RMS.
+    Single,
+    /// The lowest cross-validated RMS of the model on every sensor with it first.
+    Combined,
+    /// The bias model is the average of the fits with each chosen sensor first
+    /// ([`fit_multi_averaged`](crate::fit::thermal::multi::fit_multi_averaged)); the order (and the scale factor) as `Single`.
+    Average,
+}
 
 /// Which temperature sensors each axis of an inertial unit may read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -111,9 +136,10 @@ impl Default for ImuFitSettings {
 pub struct FitSettings {
     /// Fitting method ([`DEFAULT_METHOD`]).
     pub method: Method,
-    /// Deprecated for one release: the recipe of the former `lstm` method. Given with
-    /// `thermal` (the default) or `lstm`, it names the method ([`FitSettings::resolve`]).
-    pub recipe: Option<RecipeKind>,
+    /// Deprecated for one release: the recipe of the former `lstm` method, a recipe method
+    /// ([`RECIPE_NAMES`]). Given with `thermal` (the default) or `lstm`, it names the method
+    /// ([`FitSettings::resolve`]).
+    pub recipe: Option<Method>,
     /// Training epochs of the method's LSTM (None: the method's own).
     pub epochs: Option<usize>,
     /// Random seed of the LSTM initialisation and window order.
@@ -219,7 +245,10 @@ impl FitSettings {
                 m => (m, None),
             });
         };
-        let now = r.method();
+        if !r.is_own_recipe() {
+            return Err(SettingError::unknown("recipe", r.as_str(), &RECIPE_NAMES));
+        }
+        let now = r;
         match self.method {
             Method::Lstm => Ok((now, Some(Deprecation::LstmMethod { now }))),
             Method::Linear | Method::Poly => Ok((
@@ -239,80 +268,6 @@ impl FitSettings {
             }),
         }
     }
-
-    /// The recipe settings a recipe method trains with here (`epochs` and
-    /// `validate_on_runs` applied to the method's own).
-    pub fn recipe_for(&self, kind: RecipeKind) -> RecipeSettings {
-        let mut r = RecipeSettings::of_kind(kind);
-        if let Some(e) = self.epochs {
-            r.epochs = e;
-        }
-        r.validate_on_runs = self.validate_on_runs;
-        r.hidden = self.hidden;
-        r
-    }
-
-    /// The library's fit configuration: checked, deprecated spellings resolved (what was
-    /// resolved is returned, to be said).
-    pub fn fit_config(&self) -> Result<(FitConfig, Option<Deprecation>), SettingError> {
-        self.validate()?;
-        let (method, note) = self.resolve()?;
-        let mut cfg = FitConfig::new(method);
-        // linear and poly fit no recipe; theirs stays the default, unused.
-        cfg.recipe = self.recipe_for(method.recipe_kind().unwrap_or_default());
-        cfg.seed = self.seed;
-        cfg.bias_window_s = self.bias_window_s;
-        cfg.settle_s = self.settle_s;
-        cfg.poly = PolyDegrees {
-            temp: self.poly_temp_degree,
-            rate: self.poly_rate_degree,
-            cross: self.cross,
-        };
-        Ok((cfg, note))
-    }
-
-    /// The comparison of `methods` (None: `linear`, `poly`, this settings' method, which is
-    /// `thermal` unless the deprecated `recipe` names another, and `published`, once) with
-    /// these settings, bias stability over `tau_s`. The deprecated `lstm` in `methods` is
-    /// this settings' method.
-    pub fn compare_config(
-        &self,
-        methods: Option<&[Method]>,
-        tau_s: f64,
-    ) -> Result<(CompareConfig, Option<Deprecation>), SettingError> {
-        check("tau_s", tau_s, Rule::PositiveSeconds)?;
-        let (fit, note) = self.fit_config()?;
-        let main = fit.model_method();
-        let wanted: Vec<Method> = match methods {
-            Some(m) => m
-                .iter()
-                .map(|m| if *m == Method::Lstm { main } else { *m })
-                .collect(),
-            None => {
-                let mut all = vec![Method::Linear, Method::Poly, main];
-                if main != Method::Published {
-                    all.push(Method::Published);
-                }
-                all
-            }
-        };
-        let candidates = wanted
-            .into_iter()
-            .map(|m| Candidate {
-                method: m,
-                recipe: m.recipe_kind().map(|k| self.recipe_for(k)),
-            })
-            .collect();
-        Ok((
-            CompareConfig {
-                candidates,
-                fit,
-                tau_s,
-                settle_s: self.settle_s,
-            },
-            note,
-        ))
-    }
 }
 
 #[cfg(test)]
@@ -329,7 +284,7 @@ mod tests {
                 epochs: Some(e),
                 ..FitSettings::default()
             };
-            let err = s.fit_config().unwrap_err();
+            let err = s.validate().unwrap_err();
             assert_eq!(err.setting(), "epochs");
             let msg = err.to_string();
             assert_eq!(

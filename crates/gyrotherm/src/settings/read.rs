@@ -1,7 +1,7 @@
 //! Reading a log: [`ReadOptions`] (defined in `csvlog`, where the reader uses it) checked
 //! here, and the lists of values its settings take.
 
-use super::{check_opt, Rule, SettingError};
+use super::rule::{check_opt, Rule, SettingError};
 use crate::csvlog::{GyroUnit, ReadOptions};
 
 /// Names of the gyro units, default first.

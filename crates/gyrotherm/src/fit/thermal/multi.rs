@@ -25,6 +25,7 @@
 //! the selection; docs/experiments/imu-worst-model.md has what each gave.
 
 use super::*;
+use crate::settings::fit::{DEFAULT_IMU_EXTRA_TERMS, DEFAULT_IMU_FIRST, DEFAULT_IMU_MIN_GAIN};
 use crate::targets::TargetSet;
 
 /// Settings of the multi-sensor selection.
@@ -43,42 +44,15 @@ pub struct MultiConfig {
 impl Default for MultiConfig {
     fn default() -> Self {
         MultiConfig {
-            min_gain: crate::settings::fit::DEFAULT_IMU_MIN_GAIN,
-            extra: crate::settings::fit::DEFAULT_IMU_EXTRA_TERMS,
-            first: crate::settings::fit::DEFAULT_IMU_FIRST,
+            min_gain: DEFAULT_IMU_MIN_GAIN,
+            extra: DEFAULT_IMU_EXTRA_TERMS,
+            first: DEFAULT_IMU_FIRST,
             select_folds: 0,
         }
     }
 }
 
-/// The terms a further sensor adds ([`extra_terms`]; the default is
-/// [`DEFAULT_IMU_EXTRA_TERMS`](crate::settings::fit::DEFAULT_IMU_EXTRA_TERMS)).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExtraTerms {
-    /// `T` and each lag difference, linearly.
-    Linear,
-    /// `T` alone.
-    Temp,
-    /// `T` and the fastest lag difference.
-    TempFast,
-    /// `T, T², T³` and each lag difference.
-    Cubic,
-    /// The first sensor's basis less its constant (`T, T², T³, Dj, T·D1` with `lean`).
-    Same,
-}
-
-/// Which sensor comes first (gets the full basis; the default is
-/// [`DEFAULT_IMU_FIRST`](crate::settings::fit::DEFAULT_IMU_FIRST)).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FirstBy {
-    /// The lowest one-sensor cross-validated RMS.
-    Single,
-    /// The lowest cross-validated RMS of the model on every sensor with it first.
-    Combined,
-    /// The bias model is the average of the fits with each chosen sensor first
-    /// ([`fit_multi_averaged`]); the order (and the scale factor) as `Single`.
-    Average,
-}
+pub use crate::settings::fit::{ExtraTerms, FirstBy};
 
 /// One sensor's data for one axis: its identification and its training sets (features of
 /// this sensor's spec; targets and rows are the same for every sensor of the axis).
