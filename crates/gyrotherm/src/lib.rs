@@ -9,10 +9,14 @@
 //!                                  └ nn (LSTM training)
 //! ```
 //!
-//! The modules, from the ground up: each imports only modules listed before it (the one
-//! exception is [`settings`], see its line). The fit fills the model file and checks it as
-//! flight code runs it, so the file type and the compensator sit below the fit.
+//! The modules, from the ground up: each imports only modules listed before it. The fit
+//! fills the model file and checks it as flight code runs it, so the file type and the
+//! compensator sit below the fit. Settings sit below what they configure: the rules and the
+//! error of a setting at the bottom, each job's settings right above the figures they name.
 //!
+//! - `error_chain`: an error and its causes as one line ([`error_chain()`]).
+//! - `number_text`: how a number is written in a CSV field and in a message.
+//! - [`setting_rule`]: the rules a setting's value may break, and [`SettingError`].
 //! - [`atomic_file`]: writing an output so that nothing is lost (temporary file, then rename).
 //! - [`input_file`]: reading the small input files (models, spec sheets, profiles).
 //! - [`json_keys`]: a JSON object that names a key twice.
@@ -29,6 +33,8 @@
 //! - [`targets`]: what the models learn: bias from static runs, scale factor from rate-table
 //!   runs ([`TargetSet`]).
 //! - [`baseline`]: least-squares fits over monomials of the features.
+//! - [`settings`]: what a user can choose for each job, with every default, list of values
+//!   and check defined once (the command line and Python only translate).
 //! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]), with the coverage
 //!   map it carries.
 //! - [`compensate`]: the flight compensator (`gyrotherm-core`) run over a log
@@ -40,11 +46,6 @@
 //!   [`RecipeSettings`]).
 //! - [`compare`]: held-out comparison of methods: the numbers of the results table.
 //! - [`spec`]: spec sheets: limits on the standard figures, and a run's verdict.
-//! - [`settings`]: what a user can choose for each job, with every default, list of values
-//!   and check defined once (the command line and Python only translate). `csvlog`, `model`,
-//!   `coverage`, `fit` and `compare` take names from it (its error type, the method names,
-//!   defaults) while it imports some of them: the one place where imports still run both
-//!   ways.
 //! - [`imu_error`]: why an inertial-unit model cannot be fitted, read, written or applied.
 //! - [`compensate_lines`](mod@compensate_lines): a CSV stream compensated line by line, with a
 //!   status per line.
@@ -80,6 +81,8 @@ pub mod compensate_lines;
 pub mod coverage;
 pub mod coverage_track;
 pub mod csvlog;
+mod error_chain;
+pub use error_chain::error_chain;
 pub mod export;
 pub mod features;
 pub mod fit;
@@ -93,8 +96,10 @@ pub mod metrics;
 pub mod model;
 pub mod moving_average;
 pub mod nn;
+mod number_text;
 pub mod plan;
 pub mod report;
+pub mod setting_rule;
 pub mod settings;
 pub mod sim;
 pub mod spec;
@@ -108,21 +113,6 @@ pub use csvlog::{read_log, write_log, LogError, ReadOptions, TestLog};
 pub use features::{FeatureSpec, FeatureTable};
 pub use fit::{fit_model, FitConfig, FitError, FitOutcome, NamedLog, RecipeSettings};
 pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
-pub(crate) use settings::Rule;
 pub use settings::{FitSettings, SettingError};
 pub use sim::{simulate, SimConfig};
 pub use targets::TargetSet;
-
-/// An error and its causes on one line, `: `-separated, outermost first: what a front end
-/// prints. Every error of this library states only its own level's fact and returns its cause
-/// from `source()`, so each cause appears once.
-pub fn error_chain(err: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = err.to_string();
-    let mut cause = err.source();
-    while let Some(c) = cause {
-        text.push_str(": ");
-        text.push_str(&c.to_string());
-        cause = c.source();
-    }
-    text
-}

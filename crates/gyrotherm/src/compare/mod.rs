@@ -32,8 +32,7 @@ use crate::settings::method::{Method, DEFAULT_METHOD};
 use crate::settings::rule::{check, Rule, SettingError};
 use crate::targets;
 
-/// Bias-stability smoothing time of the comparison, s (100 s: docs/method.md, He et al. 2024).
-pub const BIAS_STABILITY_TAU_S: f64 = 100.0;
+pub use crate::metrics::BIAS_STABILITY_TAU_S;
 
 /// The column name of the published recipe: the seed's method, named after its authors
 /// (its [`Method::column_label`]).
@@ -541,7 +540,7 @@ pub fn compare_with_stages(
                 failed.push(FailedColumn {
                     key,
                     label,
-                    reason: crate::error_chain(&e),
+                    reason: crate::error_chain::error_chain(&e),
                 });
                 first_error.get_or_insert((key, e));
                 continue;
@@ -583,12 +582,15 @@ pub fn compare_with_stages(
         let mut warnings = Vec::new();
         for (fit, col) in fits.iter().zip(&columns) {
             let judged = compensate_log(&fit.model, t.log)
-                .map_err(|e| crate::error_chain(&e))
+                .map_err(|e| crate::error_chain::error_chain(&e))
                 .and_then(|comp| {
                     performance(t.log, &comp.gyro_comp_dps, cfg.tau_s, cfg.settle_s)
                         .map(|p| (comp, p))
                         .map_err(|e| {
-                            format!("its output cannot be judged: {}", crate::error_chain(&e))
+                            format!(
+                                "its output cannot be judged: {}",
+                                crate::error_chain::error_chain(&e)
+                            )
                         })
                 });
             let (comp, performance) = match judged {

@@ -12,7 +12,7 @@
 use super::{ReadOptions, DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
 // Named at the crate root, not in `settings`, whose modules read `ReadOptions`: the log
 // format takes the settings' error type only, not the modules that describe the options.
-use crate::{Rule, SettingError};
+use crate::setting_rule::{Rule, SettingError};
 
 /// Separator of the names in a column list.
 pub const COLUMN_LIST_SEPARATOR: char = ',';

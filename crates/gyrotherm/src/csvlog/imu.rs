@@ -140,8 +140,9 @@ pub fn read_imu_log(
     opts: &ReadOptions,
     table_axis: Option<&str>,
 ) -> Result<(ImuLog, ReadReport), LogError> {
-    let options =
-        |e: crate::SettingError| LogError::new(Kind::BadOptions, path, None, None, e.to_string());
+    let options = |e: crate::setting_rule::SettingError| {
+        LogError::new(Kind::BadOptions, path, None, None, e.to_string())
+    };
     let gyro_cols = opts.gyro_cols().map_err(options)?;
     let temp_cols = opts.temp_cols().map_err(options)?;
     opts.validate_columns().map_err(options)?;

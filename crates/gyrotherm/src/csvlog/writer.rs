@@ -7,6 +7,9 @@
 
 use std::io::{self, Write};
 
+pub use crate::number_text::format_f64;
+pub(crate) use crate::number_text::short_f64;
+
 /// Rows are handed to the inner writer once this many bytes are buffered (unless flushing
 /// every row).
 const CHUNK_BYTES: usize = 64 * 1024;
@@ -179,23 +182,4 @@ impl<W: Write> Drop for LogWriter<W> {
     fn drop(&mut self) {
         let _ = self.flush();
     }
-}
-
-/// Shortest round-trip decimal text of `v` (see the module doc).
-#[inline]
-pub fn format_f64(buf: &mut Vec<u8>, v: f64) {
-    let a = v.abs();
-    // Writing into a Vec cannot fail.
-    let _ = if a != 0.0 && !(1e-5..1e16).contains(&a) {
-        write!(buf, "{v:e}")
-    } else {
-        write!(buf, "{v}")
-    };
-}
-
-/// `v` as [`format_f64`] writes it, as text for a message: 1e300, not 301 digits.
-pub(crate) fn short_f64(v: f64) -> String {
-    let mut buf = Vec::new();
-    format_f64(&mut buf, v);
-    String::from_utf8_lossy(&buf).into_owned()
 }

@@ -629,7 +629,7 @@ pub(crate) fn fit_model_with(
     });
     let (coverage, coverage_note) = match coverage {
         Some(Ok(c)) => (Some(c), None),
-        Some(Err(e)) => (None, Some(crate::error_chain(&e))),
+        Some(Err(e)) => (None, Some(crate::error_chain::error_chain(&e))),
         None => (None, Some("no bias model: no coverage map".to_owned())),
     };
     let model = ModelFile {

@@ -28,6 +28,9 @@ use std::fmt;
 /// °/s → °/h.
 pub const DPS_TO_DPH: f64 = 3600.0;
 
+/// Bias-stability smoothing time of the comparison, s (100 s: docs/method.md, He et al. 2024).
+pub const BIAS_STABILITY_TAU_S: f64 = 100.0;
+
 /// Why a figure could not be computed.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]

@@ -1,9 +1,9 @@
 //! Allan deviation of a log column: the settings, and the policy of which curve the noise
 //! terms are read from.
 
-use super::rule::{Rule, SettingError};
 use crate::allan::{self, AllanError, AllanPoint, DevKind, NoiseModel, NoiseTerms, TauSet};
 use crate::csvlog::{rate_column_to_dph, GYRO_COL};
+use crate::setting_rule::{Rule, SettingError};
 
 /// Names of the deviations, default first.
 pub const KIND_NAMES: [&str; 5] = ["oadev", "adev", "mdev", "hdev", "ohdev"];

@@ -3,7 +3,7 @@
 //! parameters are for, which of its gyro axes a single-gyro model fills, and (PX4) the
 //! device id the firmware matches them to.
 
-use super::rule::{Rule, SettingError};
+use crate::setting_rule::{Rule, SettingError};
 
 /// A gyro axis of the autopilot's IMU.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

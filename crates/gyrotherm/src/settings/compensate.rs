@@ -1,12 +1,12 @@
 //! Compensation settings: which temperature readings the flight compensator believes. They
-//! are [`TempSensorDef`] (stored in the model file by `train`, used by `compensate`); the
-//! defaults are the core's [`TempLimits::DEFAULT`](gyrotherm_core::compensator::TempLimits).
+//! are [`TempSensorDef`](crate::model::TempSensorDef) (stored in the model file by `train`,
+//! used by `compensate`); the defaults are the core's [`TempLimits::DEFAULT`].
 
-pub use crate::model::TempSensorDef;
+use gyrotherm_core::compensator::TempLimits;
 
 /// `(setting name, default)` of each temperature-sensor limit, in `--help` order.
 pub fn temp_sensor_defaults() -> [(&'static str, f64); 5] {
-    let d = TempSensorDef::default();
+    let d = TempLimits::DEFAULT;
     [
         ("temp_min_c", d.min_c),
         ("temp_max_c", d.max_c),

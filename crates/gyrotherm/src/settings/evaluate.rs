@@ -1,12 +1,12 @@
 //! The standard figures of a log column (`gyrotherm evaluate`): the settings, and the policy
 //! for the bias-stability smoothing time τ.
 
-use super::rule::{Rule, SettingError};
 use crate::csvlog::{rate_column_to_dph, TestLog, GYRO_COL};
 use crate::metrics::{self, Evaluation, EvaluationError, EvaluationOptions};
+use crate::setting_rule::{Rule, SettingError};
 
 /// The preferred bias-stability smoothing time, s (100 s, He et al. 2024 and docs/method.md §4).
-pub const PREFERRED_TAU_S: f64 = crate::compare::BIAS_STABILITY_TAU_S;
+pub const PREFERRED_TAU_S: f64 = crate::metrics::BIAS_STABILITY_TAU_S;
 /// Default time dropped at the start of each rate-table segment, s.
 pub const DEFAULT_SETTLE_S: f64 = crate::targets::SETTLE_S;
 

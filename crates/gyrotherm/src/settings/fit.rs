@@ -8,8 +8,8 @@
 
 pub use super::method::RECIPE_NAMES;
 use super::method::{Method, DEFAULT_METHOD};
-pub use super::rule::MAX_EPOCHS;
-use super::rule::{check, Rule, SettingError};
+pub use crate::setting_rule::MAX_EPOCHS;
+use crate::setting_rule::{check, Rule, SettingError};
 use crate::targets;
 
 /// Default random seed of the LSTM initialisation and window order.

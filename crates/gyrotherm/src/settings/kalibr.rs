@@ -1,7 +1,7 @@
 //! The Kalibr noise file of `gyrotherm allan --kalibr` ([`crate::allan::kalibr`]): the ROS
 //! topic it names.
 
-use super::rule::{Rule, SettingError};
+use crate::setting_rule::{Rule, SettingError};
 
 /// The topic written when none is given: Kalibr's own examples name their IMU `/imu0`.
 pub const DEFAULT_ROSTOPIC: &str = "/imu0";

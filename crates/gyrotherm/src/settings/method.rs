@@ -6,11 +6,11 @@
 //! fit's table of how each method is fitted (`fit/methods.rs`, an exhaustive match: the
 //! compiler refuses a method without its row). The two halves cannot be one table: model
 //! files and settings name a method, and they sit below the fit, so the registry imports
-//! only [`super::rule`] and the fit imports it.
+//! only [`crate::setting_rule`] and the fit imports it.
 
 use serde::{Deserialize, Serialize};
 
-use super::rule::SettingError;
+use crate::setting_rule::SettingError;
 
 /// The kind of fit a method is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -41,7 +41,7 @@ pub mod kalibr;
 pub mod method;
 pub mod plan;
 pub mod read;
-pub mod rule;
+pub use crate::setting_rule as rule;
 
 pub use allan::{AllanAnalysis, AllanSettings};
 pub use describe::{describe, OptionSpec};

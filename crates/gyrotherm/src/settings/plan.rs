@@ -1,7 +1,7 @@
 //! Settings of `gyrotherm plan`: the flight envelope (when no flight log gives it) and the
 //! chamber's limits, and the fixed rules of the proposed profile (see [`crate::plan`]).
 
-use super::rule::{check, check_opt, Rule, SettingError};
+use crate::setting_rule::{check, check_opt, Rule, SettingError};
 
 /// The chamber's default coldest set point, °C (the usual qualification chamber's range,
 /// −55…+85 °C, the MIL-STD-810 extremes an airborne unit is tested to).
@@ -35,7 +35,7 @@ pub const ROOM_C: f64 = 22.0;
 /// temperature cell of a ramp gets at least this many seconds at 1 Hz, by repeating it.
 pub const MIN_CELL_S: f64 = super::coverage::MIN_CELL_STEPS as f64;
 
-pub use super::rule::{ABSOLUTE_ZERO_C, MAX_ENVELOPE_C};
+pub use crate::setting_rule::{ABSOLUTE_ZERO_C, MAX_ENVELOPE_C};
 
 /// The settings of one plan.
 #[derive(Debug, Clone, Copy, PartialEq)]

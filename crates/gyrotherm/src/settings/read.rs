@@ -1,8 +1,8 @@
 //! Reading a log: [`ReadOptions`] (defined in `csvlog`, where the reader uses it) checked
 //! here, and the lists of values its settings take.
 
-use super::rule::{check_opt, Rule, SettingError};
 use crate::csvlog::{GyroUnit, ReadOptions};
+use crate::setting_rule::{check_opt, Rule, SettingError};
 
 /// Names of the gyro units, default first.
 pub const GYRO_UNIT_NAMES: [&str; 3] = ["dps", "dph", "rad/s"];

@@ -1,7 +1,7 @@
 //! The rules a setting's value may break, and the error that names the setting
-//! ([`SettingError`]): the bottom of the settings, imported by every settings file and by
+//! ([`SettingError`]): the bottom of the settings (kept below the log format, which checks column lists by them), imported by every settings file and by
 //! the modules they configure. The bounds the rules state are defined here, where they are
-//! checked, and re-exported where they are documented ([`super::fit`], [`super::plan`]).
+//! checked, and re-exported where they are documented ([`crate::settings::fit`], [`crate::settings::plan`]).
 
 use std::fmt;
 
@@ -40,7 +40,7 @@ pub enum Rule {
     Finite,
     /// A list of column names (one, or several separated by commas).
     ColumnList,
-    /// Hidden units of an LSTM: a whole number from 1 to [`MAX_HIDDEN`](super::fit::MAX_HIDDEN).
+    /// Hidden units of an LSTM: a whole number from 1 to [`MAX_HIDDEN`](crate::settings::fit::MAX_HIDDEN).
     HiddenUnits,
     /// A temperature a flight reaches, °C: from absolute zero to
     /// [`MAX_ENVELOPE_C`].
@@ -227,7 +227,7 @@ pub fn check(setting: &'static str, v: f64, rule: Rule) -> Result<f64, SettingEr
         Err(SettingError::Invalid {
             setting,
             // 1e308, not 309 digits.
-            value: crate::csvlog::writer::short_f64(v),
+            value: crate::number_text::short_f64(v),
             rule,
         })
     }
