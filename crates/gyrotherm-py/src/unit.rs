@@ -107,7 +107,7 @@ fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
     let load_warnings: Vec<String> = model.load_warning(&path).into_iter().collect();
     // Python keeps a class per form.
     Ok(match model.into_form() {
-        Form::Single(file) => Py::new(py, RawModel::loaded(file, load_warnings))?.into_any(),
+        Form::Single(file) => Py::new(py, RawModel::loaded(*file, load_warnings))?.into_any(),
         Form::Unit(file) => Py::new(py, RawUnitModel::loaded(file, load_warnings))?.into_any(),
     })
 }

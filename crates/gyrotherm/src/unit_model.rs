@@ -35,7 +35,7 @@ pub struct Model {
 /// a class per form ([`Model::into_form`]); everything else goes through [`Model`].
 #[derive(Debug, Clone)]
 pub enum Form {
-    Single(ModelFile),
+    Single(Box<ModelFile>),
     Unit(ImuModel),
 }
 
@@ -131,7 +131,7 @@ impl Model {
         }
         let (m, seal) = ModelFile::from_json_sealed(text).map_err(TextError::Single)?;
         Ok(Model {
-            form: Form::Single(m),
+            form: Form::Single(Box::new(m)),
             seal,
         })
     }
@@ -139,7 +139,7 @@ impl Model {
     /// A single-gyro model as a one-axis unit (sealed: it was made, not read).
     pub fn from_single(m: ModelFile) -> Model {
         Model {
-            form: Form::Single(m),
+            form: Form::Single(Box::new(m)),
             seal: Seal::Verified,
         }
     }
@@ -268,7 +268,7 @@ impl Model {
                         gyro,
                         temps: vec![temp.clone()],
                         scores: vec![SensorScore { temp, cv_rms: None }],
-                        model: m.clone(),
+                        model: ModelFile::clone(m),
                         more: Vec::new(),
                         multi_cv_rms: None,
                         fallback: None,
