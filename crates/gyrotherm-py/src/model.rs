@@ -34,6 +34,17 @@ pub struct RawModel {
     load_warnings: Vec<String>,
 }
 
+impl RawModel {
+    /// A model read from a file, with what to tell about it.
+    pub(crate) fn loaded(file: ModelFile, load_warnings: Vec<String>) -> RawModel {
+        RawModel {
+            file,
+            training_notes: Vec::new(),
+            load_warnings,
+        }
+    }
+}
+
 /// The time, gyro and temperature arrays of one log, checked to hold one value per sample.
 fn samples<'a>(
     time_s: &'a PyReadonlyArray1<'_, f64>,

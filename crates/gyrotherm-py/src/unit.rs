@@ -8,20 +8,21 @@ use std::sync::Mutex;
 use gyrotherm::csvlog::{self, ImuLog, NamedSeries};
 use gyrotherm::imu_model::{self, ImuFitEvent, ImuModel};
 use gyrotherm::model::TempSensorDef;
+use gyrotherm::unit_model::{Form, Model};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::allan::slice;
 use crate::logs::LogOptions;
-use crate::model::FitArgs;
+use crate::model::{FitArgs, RawModel};
 use crate::{py_err, CompensationError, FitError, LogError, MetricsError, ModelError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RawUnitModel>()?;
     m.add_function(wrap_pyfunction!(read_imu_log, m)?)?;
     m.add_function(wrap_pyfunction!(fit_unit, m)?)?;
-    m.add_function(wrap_pyfunction!(is_unit_model_file, m)?)?;
+    m.add_function(wrap_pyfunction!(load_model, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_unit, m)?)?;
     m.add_function(wrap_pyfunction!(compare_unit, m)?)?;
     Ok(())
@@ -97,11 +98,18 @@ fn imu_judge_period(log: &ImuLog) -> f64 {
     gyrotherm::imu_judge::axis_test_log(log, 0, 0).sample_period_s()
 }
 
-/// Whether the file holds an inertial unit's model.
+/// Read and check a model file of either form (`gyrotherm::unit_model::Model::load`): a
+/// `RawModel` for a single-gyro file, a `RawUnitModel` for an inertial unit's, each with
+/// `load_warnings` saying when the file has no content checksum.
 #[pyfunction]
-fn is_unit_model_file(path: PathBuf) -> bool {
-    gyrotherm::input_file::read_capped_to_string(&path, gyrotherm::input_file::InputKind::Model)
-        .is_ok_and(|t| imu_model::is_imu_model_text(&t))
+fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
+    let model = py.detach(|| Model::load(&path)).map_err(model_err)?;
+    let load_warnings: Vec<String> = model.load_warning(&path).into_iter().collect();
+    // Python keeps a class per form.
+    Ok(match model.into_form() {
+        Form::Single(file) => Py::new(py, RawModel::loaded(*file, load_warnings))?.into_any(),
+        Form::Unit(file) => Py::new(py, RawUnitModel::loaded(file, load_warnings))?.into_any(),
+    })
 }
 
 /// A unit model file in memory.
@@ -122,6 +130,16 @@ type AxisColumns<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<u8>>,
 );
+
+impl RawUnitModel {
+    /// A unit model read from a file, with what to tell about it.
+    pub(crate) fn loaded(file: ImuModel, load_warnings: Vec<String>) -> RawUnitModel {
+        RawUnitModel {
+            file,
+            load_warnings,
+        }
+    }
+}
 
 #[pymethods]
 impl RawUnitModel {

@@ -124,8 +124,9 @@ pub struct ImuModel {
     pub axes: Vec<ImuAxis>,
 }
 
-/// Whether model-file text is an inertial unit's (it has [`IMU_VERSION_KEY`]).
-pub fn is_imu_model_text(text: &str) -> bool {
+/// Whether model-file text is an inertial unit's (it has [`IMU_VERSION_KEY`]): the one place
+/// the two file forms are told apart (by `unit_model::Model::load`).
+pub(crate) fn is_imu_model_text(text: &str) -> bool {
     serde_json::from_str::<serde_json::Value>(text.strip_prefix('\u{feff}').unwrap_or(text))
         .ok()
         .and_then(|v| v.get(IMU_VERSION_KEY).cloned())

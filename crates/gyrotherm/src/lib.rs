@@ -55,6 +55,8 @@
 //! - [`plan`]: what the training logs cover of a flight's envelope, and the runs still needed.
 //! - [`report`]: the figures and the HTML report.
 //! - [`export`]: a model as flight code (C, Rust) or autopilot parameters.
+//! - [`unit_model`]: the model of a unit of N axes, read from either file form through one
+//!   entry point ([`unit_model::Model::load`]).
 //! - [`lot`]: the test station's record of units judged against their spec sheet.
 //!
 //! ```no_run
@@ -106,6 +108,7 @@ pub mod spec;
 pub mod string_table;
 pub mod table_segments;
 pub mod targets;
+pub mod unit_model;
 
 pub use compensate::{compensate_log, compensator, CompensateError};
 pub use compensate_lines::{compensate_lines, LinesError, LinesSummary};

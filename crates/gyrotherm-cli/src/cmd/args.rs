@@ -208,8 +208,9 @@ pub struct EvaluateArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Inertial-unit model (JSON from `train` with column lists): judge each axis's raw and
-    /// compensated output (the log is read with the model's gyro and temperature columns).
+    /// Model file from `train` (an inertial unit's, or a single gyro's as a unit of one axis):
+    /// judge each axis's raw and compensated output (the log is read with the model's gyro and
+    /// temperature columns).
     #[arg(long, value_name = "UNIT.json")]
     pub model: Option<PathBuf>,
     #[doc = "Spec sheet (TOML) to judge the figures against; exit 1 when a limit is missed."]

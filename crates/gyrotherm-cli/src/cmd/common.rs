@@ -219,6 +219,17 @@ pub fn builtin_profile() -> clap::builder::PossibleValuesParser {
 /// An error and its causes on one line, `: `-separated, outermost first. Each error of the
 /// library states only its own level's fact and returns its cause from `source()`, so the
 /// chain printed as it is says each cause once.
+/// Print a line the library tells about a model and what was done with it.
+pub fn tell(t: &gyrotherm::unit_model::Told) {
+    use gyrotherm::unit_model::Told;
+    match t {
+        Told::Line(l) => eprintln!("gyrotherm: {l}"),
+        Told::Note(n) => eprintln!("gyrotherm: note: {n}"),
+        Told::Warning(w) => eprintln!("gyrotherm: warning: {w}"),
+        Told::Item(i) => eprintln!("  {i}"),
+    }
+}
+
 pub fn error_message(err: &anyhow::Error) -> String {
     format!("{err:#}")
 }

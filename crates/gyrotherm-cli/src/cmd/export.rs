@@ -7,14 +7,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context as _};
-use gyrotherm::export::autopilot::{self, ModelRef};
-use gyrotherm::export::unit::{column_map, export_imu};
-use gyrotherm::export::{export, ExportTarget, EXPORT_TARGETS};
-use gyrotherm::imu_model::ImuModel;
-use gyrotherm::model::ModelFile;
+use gyrotherm::export::autopilot;
+use gyrotherm::export::{ExportTarget, EXPORT_TARGETS};
 use gyrotherm::settings::autopilot::{self as ap, AutopilotSettings, GyroAxis, GYRO_AXES};
+use gyrotherm::unit_model::Model;
 
-use super::common::choice;
+use super::common::{choice, tell};
 
 #[derive(Debug, clap::Args)]
 pub struct ExportArgs {
@@ -56,9 +54,8 @@ impl ExportArgs {
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
     let target = args.target;
-    let is_imu = super::imu::is_imu_model(&args.model)?;
     let Some(lang) = target.lang() else {
-        return run_autopilot(&args, target, is_imu);
+        return run_autopilot(&args, target);
     };
     for (given, flag) in [
         (args.instance.is_some(), "--instance"),
@@ -69,71 +66,30 @@ pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
             bail!("{flag} is for --target ardupilot or px4, not {target}");
         }
     }
-    if is_imu {
-        let (model, seal) = ImuModel::load_sealed(&args.model)
-            .map_err(anyhow::Error::new)
-            .with_context(|| format!("cannot use model {}", args.model.display()))?;
-        if let Some(w) = seal.warning(&args.model) {
-            eprintln!("gyrotherm: warning: {w}");
-        }
-        let files = export_imu(&model, lang, &args.out)?;
-        for f in files {
-            eprintln!("gyrotherm: wrote {}", f.display());
-        }
-        // The names stay out of the generated source (they come from the model file): the
-        // files list the order by index, and this is the map.
-        eprintln!("gyrotherm: column order of the exported unit (names from the model file):");
-        for line in column_map(&model) {
-            eprintln!("  {line}");
-        }
-        return Ok(ExitCode::SUCCESS);
-    }
-    let (model, seal) = ModelFile::load_sealed(&args.model).map_err(anyhow::Error::new)?;
-    if let Some(w) = seal.warning(&args.model) {
+    let model = load(&args)?;
+    model.export(lang, &args.out)?.iter().for_each(tell);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The model, its warning told when the file is not sealed.
+fn load(args: &ExportArgs) -> anyhow::Result<Model> {
+    let model = Model::load(&args.model)?;
+    if let Some(w) = model.load_warning(&args.model) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    let files = export(&model, lang, &args.out)?;
-    for f in files {
-        eprintln!("gyrotherm: wrote {}", f.display());
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(model)
 }
 
 /// `--target ardupilot|px4`: the polynomial fitted to the model's steady-state bias, its fit
 /// and what it leaves out on stderr, the parameter file in `--out`.
-fn run_autopilot(
-    args: &ExportArgs,
-    target: ExportTarget,
-    is_imu: bool,
-) -> anyhow::Result<ExitCode> {
+fn run_autopilot(args: &ExportArgs, target: ExportTarget) -> anyhow::Result<ExitCode> {
     let settings = args.autopilot_settings();
-    let cannot = || format!("cannot use model {}", args.model.display());
-    let export = if is_imu {
-        let (model, seal) = ImuModel::load_sealed(&args.model)
-            .map_err(anyhow::Error::new)
-            .with_context(cannot)?;
-        if let Some(w) = seal.warning(&args.model) {
-            eprintln!("gyrotherm: warning: {w}");
-        }
-        if args.axis.is_some() {
-            eprintln!(
-                "gyrotherm: warning: --axis is for a single-gyro model; the unit's axes are X, \
-                 Y, Z in its column order:"
-            );
-            for (axis, gyro) in ["X", "Y", "Z"].iter().zip(&model.gyro_cols) {
-                eprintln!("  {axis} = {gyro}");
-            }
-        }
-        autopilot::generate(ModelRef::Unit(&model), target, &settings)
-    } else {
-        let (model, seal) = ModelFile::load_sealed(&args.model).map_err(anyhow::Error::new)?;
-        if let Some(w) = seal.warning(&args.model) {
-            eprintln!("gyrotherm: warning: {w}");
-        }
-        autopilot::generate(ModelRef::Single(&model), target, &settings)
-    }
-    .map_err(anyhow::Error::new)
-    .with_context(cannot)?;
+    let model = load(args)?;
+    let (told, export) = model.export_autopilot(target, &settings, args.axis.is_some());
+    told.iter().for_each(tell);
+    let export = export
+        .map_err(anyhow::Error::new)
+        .with_context(|| format!("cannot use model {}", args.model.display()))?;
     for line in export.summary() {
         match line.strip_prefix("warning: ") {
             Some(w) => eprintln!("gyrotherm: warning: {w}"),

@@ -1,27 +1,15 @@
-//! `train` and `compensate` for an inertial unit: several gyro and temperature columns
-//! (`--gyro-col`/`--temp-col` lists), one model file for the unit (`gyrotherm::imu_model`).
+//! `train` for an inertial unit: several gyro and temperature columns (`--gyro-col`/`--temp-col`
+//! lists), one model file for the unit (`gyrotherm::imu_model`), and the reading of such logs.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::compensate_imu_lines::{compensate_imu_file, compensate_imu_lines};
-use gyrotherm::compensate_lines::Mode;
 use gyrotherm::csvlog::{self, ImuLog};
-use gyrotherm::imu_model::{self, ImuFitEvent, ImuModel};
+use gyrotherm::imu_model::{self, ImuFitEvent};
 
-use super::args::{CompensateArgs, TrainArgs};
+use super::args::TrainArgs;
 use super::common::{error_message, LogArgs};
-use super::stream::stdio_stream;
-
-/// Whether `path` holds an inertial-unit model (an unreadable file is left to the
-/// single-axis path, which names the problem).
-pub fn is_imu_model(path: &Path) -> anyhow::Result<bool> {
-    Ok(
-        gyrotherm::input_file::read_capped_to_string(path, gyrotherm::input_file::InputKind::Model)
-            .is_ok_and(|t| imu_model::is_imu_model_text(&t)),
-    )
-}
 
 /// Read every log with the column lists, reporting each failure, then stop if any failed.
 pub fn read_imu_logs(paths: &[PathBuf], args: &LogArgs) -> anyhow::Result<Vec<(String, ImuLog)>> {
@@ -141,72 +129,6 @@ pub fn train(args: TrainArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `compensate` with an inertial-unit model: for each gyro column G the output adds
-/// `G_bias`, `G_scale`, `G_comp` and `G_status`.
-pub fn compensate(args: CompensateArgs) -> anyhow::Result<ExitCode> {
-    let (model, seal) = ImuModel::load_sealed(&args.model)
-        .map_err(anyhow::Error::new)
-        .with_context(|| format!("cannot use model {}", args.model.display()))?;
-    if let Some(w) = seal.warning(&args.model) {
-        eprintln!("gyrotherm: warning: {w}");
-    }
-    if args.stream {
-        anyhow::ensure!(
-            args.log.fill_gaps_max_s.is_none(),
-            "--fill-gaps-max-s does not apply to compensate --stream: the compensators bridge time \
-             gaps themselves and write one output line per input line"
-        );
-        let opts = args.log.read_options();
-        let summary = stdio_stream(|input, output| {
-            compensate_imu_lines(
-                &model,
-                input,
-                "<stdin>".as_ref(),
-                &opts,
-                output,
-                Mode::Stream,
-                true,
-            )
-        })?;
-        eprintln!("gyrotherm: {}", summary.describe(&model));
-        for w in &summary.warnings {
-            eprintln!("gyrotherm: warning: {w}");
-        }
-        return Ok(ExitCode::SUCCESS);
-    }
-    let (Some(input), Some(out)) = (&args.input, &args.out) else {
-        anyhow::bail!("give --input FILE and --out FILE");
-    };
-    anyhow::ensure!(
-        args.log.fill_gaps_max_s.is_none(),
-        "--fill-gaps-max-s does not apply to compensate: the compensators bridge time gaps themselves \
-         and write one output line per input line"
-    );
-    let summary = compensate_imu_file(&model, input, out, &args.log.read_options())?;
-    let counts: Vec<String> = model
-        .gyro_cols
-        .iter()
-        .zip(&summary.per_axis)
-        .map(|(g, n)| {
-            let fallback = if n[4] > 0 {
-                format!(", {} fallback", n[4])
-            } else {
-                String::new()
-            };
-            format!(
-                "{g}: {} ok, {} held, {} degraded, {} invalid{fallback}",
-                n[0], n[1], n[2], n[3]
-            )
-        })
-        .collect();
-    eprintln!(
-        "gyrotherm: wrote {} ({} lines; {})",
-        out.display(),
-        summary.rows,
-        counts.join("; ")
-    );
-    Ok(ExitCode::SUCCESS)
-}
 /// Live lines on stderr for each step of a unit fit ([`ImuFitEvent`]): the axis and sensor
 /// with the seconds since `started` (the axes run on threads, so lines of several axes
 /// interleave; each line names its axis).

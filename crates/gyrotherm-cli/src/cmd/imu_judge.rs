@@ -8,9 +8,9 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 use gyrotherm::csvlog;
 use gyrotherm::imu_judge::{self, ImuComparison};
-use gyrotherm::imu_model::ImuModel;
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::EvaluateSettings;
+use gyrotherm::unit_model::Model;
 
 use super::args::{tau_or_default, ColumnArgs, CompareArgs, EvaluateArgs, FitArgs, ReportArgs};
 use super::common::LogArgs;
@@ -23,25 +23,10 @@ use super::progress::TrainingBars;
 pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
     // The sheet first: a bad sheet fails before the log is read.
     let spec = super::verdict::load(args.spec.as_deref())?;
-    let model = args
-        .model
-        .as_ref()
-        .map(|p| {
-            // A readable file that is not a unit's model: say what to do instead.
-            if p.is_file() && !super::imu::is_imu_model(p)? {
-                anyhow::bail!(
-                    "{}: evaluate --model takes an inertial unit's model (train with column \
-                     lists); for a single-axis model run compensate, then evaluate --column \
-                     gyro_comp_dps",
-                    p.display()
-                );
-            }
-            ImuModel::load(p)
-                .map_err(anyhow::Error::new)
-                .with_context(|| format!("cannot use model {}", p.display()))
-        })
-        .transpose()?;
+    // A single-gyro model is the unit of its one axis.
+    let model = args.model.as_deref().map(Model::load).transpose()?;
     let base = args.log.read_options();
+    let model = model.as_ref().map(|m| m.to_unit(&base));
     let opts = match &model {
         Some(m) => m.read_options(&base),
         None => base,
@@ -63,9 +48,10 @@ pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
         reference_scale: args.reference_scale,
     };
     let input = args.input.display().to_string();
-    let unit = imu_judge::evaluate_imu_spec(&log, model.as_ref(), &settings, spec.as_ref(), &input)
-        .map_err(anyhow::Error::new)
-        .with_context(|| input.clone())?;
+    let unit =
+        imu_judge::evaluate_imu_spec(&log, model.as_deref(), &settings, spec.as_ref(), &input)
+            .map_err(anyhow::Error::new)
+            .with_context(|| input.clone())?;
     let (axes, tau) = (&unit.axes, &unit.tau);
     if let Some(note) = tau.note(axes[0].raw.sample_period_s) {
         eprintln!("gyrotherm: {note}");

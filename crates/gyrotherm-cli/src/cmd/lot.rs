@@ -7,8 +7,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::lot::{self, judge_unit, open_store, UnitInputs};
+use gyrotherm::csvlog::{ImuLog, ReadOptions};
+use gyrotherm::lot::{self, open_store, UnitInputs};
 use gyrotherm::model::GivenColumns;
+use gyrotherm::unit_model::Model;
 
 use super::common::{read_logs_with, LogArgs};
 
@@ -109,85 +111,79 @@ pub fn run(args: LotArgs, given: GivenColumns) -> anyhow::Result<ExitCode> {
 
 fn add(a: AddArgs, given: GivenColumns) -> anyhow::Result<ExitCode> {
     let spec = super::verdict::load(a.spec.as_deref())?;
-    if super::imu::is_imu_model(&a.model)? {
-        return add_unit(a, spec);
-    }
-    anyhow::ensure!(
-        !a.log.read_options().is_multi_column(),
-        "{}: a single-axis model; --gyro-col/--temp-col lists need an inertial unit's model \
-         (`gyrotherm train` with the same lists), whose columns lot add then reads",
-        a.model.display()
-    );
+    let cannot = || format!("cannot use model {}", a.model.display());
+    let model = Model::load(&a.model)?;
     // The columns the model was trained with, unless the command line names others.
-    let model = gyrotherm::ModelFile::load(&a.model)
-        .with_context(|| format!("cannot use model {}", a.model.display()))?;
     let opts = model
         .read_options(&a.log.read_options(), given)
-        .with_context(|| format!("cannot use model {}", a.model.display()))?;
-    let mut warnings = Vec::new();
-    let logs = read_logs_with(&a.test, &opts, &mut warnings)?;
-    for w in &warnings {
-        eprintln!("gyrotherm: warning: {w}");
-    }
-    let tests: Vec<(PathBuf, gyrotherm::TestLog)> = logs
-        .into_iter()
-        .map(|(name, log)| (PathBuf::from(name), log))
-        .collect();
+        .with_context(cannot)?;
     let station = a.station.clone().unwrap_or_else(lot::default_station);
-    // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
-    let (run, verdict) = judge_unit(&inputs(&a, &station, spec.as_ref(), &tests))
-        .with_context(|| format!("unit {}", a.unit))?;
-    record(&a, run, |w| match &verdict {
-        Some(v) => super::verdict::print(w, v),
-        None => Ok(()),
-    })
-}
-
-/// What `lot add` judges a unit on besides its logs `tests`, from its arguments.
-fn inputs<'a, L>(
-    a: &'a AddArgs,
-    station: &'a str,
-    spec: Option<&'a gyrotherm::spec::Spec>,
-    tests: &'a [L],
-) -> UnitInputs<'a, L> {
-    UnitInputs {
+    let inputs = UnitInputs {
         unit: &a.unit,
-        station,
+        station: &station,
         model_path: &a.model,
-        tests,
-        spec,
+        tests: &[],
+        spec: spec.as_ref(),
         tau_s: a.tau_s,
         settle_s: a.settle_s,
-    }
-}
-
-/// `lot add` with an inertial unit's model: the logs read with the model's columns, each axis
-/// judged and the unit's verdict (`gyrotherm::lot::judge_imu_unit`).
-fn add_unit(a: AddArgs, spec: Option<gyrotherm::spec::Spec>) -> anyhow::Result<ExitCode> {
-    let model = gyrotherm::imu_model::ImuModel::load(&a.model)
-        .map_err(anyhow::Error::new)
-        .with_context(|| format!("cannot use model {}", a.model.display()))?;
-    let opts = model.read_options(&a.log.read_options());
-    let tests = super::imu::read_imu_logs_with(&a.test, &a.log, &opts)?;
-    let station = a.station.clone().unwrap_or_else(lot::default_station);
+    };
     // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
-    let (run, verdict) = lot::judge_imu_unit(&inputs(&a, &station, spec.as_ref(), &tests))
-        .with_context(|| format!("unit {}", a.unit))?;
+    let (run, verdict) = lot::judge_model(&model, &inputs, &opts, &mut HeldOut(&a))?;
     record(&a, run, |w| {
         let Some(v) = &verdict else {
             return Ok(());
         };
         // As `evaluate --model UNIT.json --spec` prints it: each axis, then the unit.
-        for (k, (gyro, axis)) in v.axes.iter().enumerate() {
+        let (axes, unit) = v.parts();
+        for (k, (heading, axis)) in axes.iter().enumerate() {
             if k > 0 {
                 writeln!(w)?;
             }
-            writeln!(w, "axis {} ({gyro}) against the spec:", k + 1)?;
+            if let Some(h) = heading {
+                writeln!(w, "{h}")?;
+            }
             super::verdict::print(w, axis)?;
         }
-        writeln!(w)?;
-        writeln!(w, "{}", v.unit.line(v.axes.len()))
+        if let Some(line) = unit {
+            writeln!(w)?;
+            writeln!(w, "{line}")?;
+        }
+        Ok(())
     })
+}
+
+/// `lot add`'s held-out logs, read as the command line says.
+struct HeldOut<'a>(&'a AddArgs);
+
+impl lot::HeldOutReader for HeldOut<'_> {
+    type Error = anyhow::Error;
+
+    fn not_judged(&self, e: lot::LotError) -> anyhow::Error {
+        anyhow::Error::new(e).context(format!("unit {}", self.0.unit))
+    }
+
+    fn single(&mut self, opts: &ReadOptions) -> anyhow::Result<Vec<(PathBuf, gyrotherm::TestLog)>> {
+        let a = self.0;
+        anyhow::ensure!(
+            !a.log.read_options().is_multi_column(),
+            "{}: a single-axis model; --gyro-col/--temp-col lists need an inertial unit's model \
+             (`gyrotherm train` with the same lists), whose columns lot add then reads",
+            a.model.display()
+        );
+        let mut warnings = Vec::new();
+        let logs = read_logs_with(&a.test, opts, &mut warnings)?;
+        for w in &warnings {
+            eprintln!("gyrotherm: warning: {w}");
+        }
+        Ok(logs
+            .into_iter()
+            .map(|(name, log)| (PathBuf::from(name), log))
+            .collect())
+    }
+
+    fn unit(&mut self, opts: &ReadOptions) -> anyhow::Result<Vec<(String, ImuLog)>> {
+        super::imu::read_imu_logs_with(&self.0.test, &self.0.log, opts)
+    }
 }
 
 /// The judged run into the lot (judged first: a unit that cannot be judged leaves the lot as

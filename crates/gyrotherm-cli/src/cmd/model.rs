@@ -6,9 +6,7 @@ use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context as _;
-use gyrotherm::imu_model::ImuModel;
-use gyrotherm::model::{ModelFile, Seal};
+use gyrotherm::unit_model::Model;
 
 #[derive(Debug, clap::Args)]
 pub struct ModelArgs {
@@ -32,73 +30,21 @@ pub enum ModelAction {
 }
 
 pub fn run(args: ModelArgs) -> anyhow::Result<ExitCode> {
-    let file = match &args.action {
-        ModelAction::Seal { file } | ModelAction::Check { file } => file,
-    };
-    if super::imu::is_imu_model(file)? {
-        return run_unit(args.action);
-    }
     match args.action {
         ModelAction::Seal { file } => {
-            let (_, digest) = ModelFile::seal(&file)?;
+            let digest = Model::seal_file(&file)?;
             eprintln!(
                 "gyrotherm: sealed {} (content_sha256 {digest})",
                 file.display()
             );
         }
         ModelAction::Check { file } => {
-            let (m, seal) = ModelFile::load_sealed(&file)?;
-            if let Some(w) = seal.warning(&file) {
+            let m = Model::load(&file)?;
+            if let Some(w) = m.load_warning(&file) {
                 eprintln!("gyrotherm: warning: {w}");
             }
             // Errors returned, not `println!`: a closed pipe ends the command quietly.
-            writeln!(
-                std::io::stdout(),
-                "{}: {}, content_sha256 {}",
-                file.display(),
-                state(seal),
-                m.content_digest()?
-            )?;
-        }
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
-fn state(seal: Seal) -> &'static str {
-    match seal {
-        Seal::Verified => "ok, sealed",
-        Seal::Absent => "ok but not sealed",
-    }
-}
-
-/// [`run`] with an inertial unit's model file: the same checks as `compensate` applies.
-fn run_unit(action: ModelAction) -> anyhow::Result<ExitCode> {
-    let context = |file: &PathBuf| format!("cannot use model {}", file.display());
-    match action {
-        ModelAction::Seal { file } => {
-            let (_, digest) = ImuModel::seal(&file)
-                .map_err(anyhow::Error::new)
-                .with_context(|| context(&file))?;
-            eprintln!(
-                "gyrotherm: sealed {} (content_sha256 {digest})",
-                file.display()
-            );
-        }
-        ModelAction::Check { file } => {
-            let (m, seal) = ImuModel::load_sealed(&file)
-                .map_err(anyhow::Error::new)
-                .with_context(|| context(&file))?;
-            if let Some(w) = seal.warning(&file) {
-                eprintln!("gyrotherm: warning: {w}");
-            }
-            writeln!(
-                std::io::stdout(),
-                "{}: {} (inertial unit, {} axes), content_sha256 {}",
-                file.display(),
-                state(seal),
-                m.axes.len(),
-                m.content_digest()?
-            )?;
+            writeln!(std::io::stdout(), "{}", m.check_line(&file)?)?;
         }
     }
     Ok(ExitCode::SUCCESS)

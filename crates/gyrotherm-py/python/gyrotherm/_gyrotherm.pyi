@@ -1,6 +1,6 @@
 """Type stubs of the compiled module (internal; use the names in ``gyrotherm``)."""
 
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -47,7 +47,7 @@ def scale_factor(
 def read_log(path: str, options: Dict[str, Any]) -> Tuple[Dict[str, Any], Dict[str, Any]]: ...
 def read_lot(db: str) -> Dict[str, Any]: ...
 def read_imu_log(path: str, options: Dict[str, Any]) -> Tuple[Dict[str, Any], Dict[str, Any]]: ...
-def is_unit_model_file(path: str) -> bool: ...
+def load_model(path: str) -> Union[RawModel, RawUnitModel]: ...
 def fit_unit(
     static_logs: List[str],
     table_logs: List[str],

@@ -77,10 +77,10 @@ class Model:
         """Read and check a model file (raises ``gyrotherm.ModelError``; warns,
         ``GyrothermWarning``, when the file has no content checksum). An inertial unit's file
         (``train`` with column lists) comes back as a :class:`UnitModel`."""
-        if _g.is_unit_model_file(os.fspath(path)):
-            return UnitModel.load(path)
-        raw = _g.RawModel.load(os.fspath(path))
+        raw = _g.load_model(os.fspath(path))
         _warn(raw.load_warnings)
+        if isinstance(raw, _g.RawUnitModel):
+            return UnitModel(raw)
         return cls(raw)
 
     @classmethod

@@ -29,13 +29,14 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::compensate::compensate_log;
-use crate::csvlog::{ImuLog, TestLog};
+use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::NamedLog;
 use crate::imu_judge::{ImuJudgeError, UnitVerdict};
 use crate::imu_model::ImuModel;
 use crate::metrics::EvaluationOptions;
 use crate::model::ModelFile;
 use crate::spec::{self, MeasureOptions, Spec};
+use crate::unit_model::Model;
 
 /// One input file of a run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -955,4 +956,79 @@ pub fn default_station() -> String {
         .filter(|s| !s.is_empty())
         .or_else(|| std::env::var("HOSTNAME").ok().filter(|s| !s.is_empty()))
         .unwrap_or_else(|| "unknown".into())
+}
+
+/// The verdict of a run judged through [`judge_model`], in the shape its model gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ModelRunVerdict {
+    /// A single-gyro model's one verdict.
+    Axis(spec::Verdict),
+    /// An inertial unit's verdicts, per axis and the unit's.
+    Unit(ImuRunVerdict),
+}
+
+impl ModelRunVerdict {
+    /// The verdicts to print, each under its heading when the run has axes of its own
+    /// (`axis K (GYRO) against the spec:`), then the unit's line when it has one.
+    pub fn parts(&self) -> (Vec<(Option<String>, &spec::Verdict)>, Option<String>) {
+        match self {
+            ModelRunVerdict::Axis(v) => (vec![(None, v)], None),
+            ModelRunVerdict::Unit(v) => (
+                v.axes
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (gyro, axis))| {
+                        (
+                            Some(format!("axis {} ({gyro}) against the spec:", k + 1)),
+                            axis,
+                        )
+                    })
+                    .collect(),
+                Some(v.unit.line(v.axes.len())),
+            ),
+        }
+    }
+}
+
+/// How a front end reads a unit's held-out logs for [`judge_model`], with the read options
+/// the model gives ([`Model::read_options`]): one gyro's logs, or an inertial unit's.
+pub trait HeldOutReader {
+    /// The front end's error.
+    type Error;
+    /// The front end's error for a unit that could not be judged.
+    fn not_judged(&self, e: LotError) -> Self::Error;
+    /// One gyro's logs, with the paths they were read from.
+    fn single(&mut self, opts: &ReadOptions) -> Result<Vec<(PathBuf, TestLog)>, Self::Error>;
+    /// An inertial unit's logs, with the paths they were read from.
+    fn unit(&mut self, opts: &ReadOptions) -> Result<Vec<(String, ImuLog)>, Self::Error>;
+}
+
+/// Judge one unit with its model of either form ([`judge_unit`] for a single-gyro model,
+/// [`judge_imu_unit`] for an inertial unit's): its held-out logs read by `read` with `opts`
+/// (from [`Model::read_options`]); `u` says the rest (its `tests` are not read).
+pub fn judge_model<R: HeldOutReader>(
+    model: &Model,
+    u: &UnitInputs<'_, ()>,
+    opts: &ReadOptions,
+    read: &mut R,
+) -> Result<(Run, Option<ModelRunVerdict>), R::Error> {
+    fn with<'a, L>(u: &UnitInputs<'a, ()>, tests: &'a [L]) -> UnitInputs<'a, L> {
+        UnitInputs {
+            unit: u.unit,
+            station: u.station,
+            model_path: u.model_path,
+            tests,
+            spec: u.spec,
+            tau_s: u.tau_s,
+            settle_s: u.settle_s,
+        }
+    }
+    if model.is_unit() {
+        let tests = read.unit(opts)?;
+        let (run, v) = judge_imu_unit(&with(u, &tests)).map_err(|e| read.not_judged(e))?;
+        return Ok((run, v.map(ModelRunVerdict::Unit)));
+    }
+    let tests = read.single(opts)?;
+    let (run, v) = judge_unit(&with(u, &tests)).map_err(|e| read.not_judged(e))?;
+    Ok((run, v.map(ModelRunVerdict::Axis)))
 }
