@@ -72,7 +72,11 @@ pub struct FitConfig {
     /// Random seed (LSTM initialisation and window order).
     pub seed: u64,
     /// Settings of the thermal recipe ([`thermal`]).
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub thermal: thermal::ThermalConfig,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) thermal: thermal::ThermalConfig,
 }
 
 impl FitConfig {

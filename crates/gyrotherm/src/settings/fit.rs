@@ -104,17 +104,33 @@ pub struct ImuFitSettings {
     pub min_gain: f64,
     /// Experiment (0: off): the weight of the first sensor's one-sensor bias model in an
     /// average with the several-sensor bias model.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub blend: f64,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) blend: f64,
     /// Experiment (None: the recipe's grid): the decades (lowest, highest power of ten) of
     /// the ridge strengths the several-sensor fits and the sensor selection try.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub multi_ridge_decades: Option<(i32, i32)>,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) multi_ridge_decades: Option<(i32, i32)>,
     /// The further sensors' terms ([`DEFAULT_IMU_EXTRA_TERMS`]; the others are experiments).
     pub multi_extra: ExtraTerms,
     /// How the first sensor is chosen ([`DEFAULT_IMU_FIRST`]; the others are experiments).
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub multi_first: FirstBy,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) multi_first: FirstBy,
     /// Experiment (0: the identification's): folds of the sensor selection's
     /// cross-validation.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub multi_select_folds: usize,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) multi_select_folds: usize,
 }
 
 impl Default for ImuFitSettings {
