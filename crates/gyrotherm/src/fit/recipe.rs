@@ -110,7 +110,7 @@ pub enum LstmVerdict {
     /// Kept in the model (scaled by [`TrainSummary::lstm_gain`]).
     Kept,
     /// Left out; the flags say which check it failed (neither: its validation gain fell
-    /// below [`MIN_GAIN`]).
+    /// below `MIN_GAIN`).
     LeftOut {
         /// It did not beat the base by [`RecipeSettings::min_val_improvement`] on the validation
         /// blocks.
@@ -150,4 +150,4 @@ impl LstmVerdict {
 
 /// Below this validation gain the residual LSTM is dropped and the sub-model is the physical
 /// fit alone (a gain this small changes the output by less than 0.1 % of the LSTM's swing).
-pub const MIN_GAIN: f64 = 1e-3;
+pub(crate) const MIN_GAIN: f64 = 1e-3;
