@@ -399,18 +399,15 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
-    /// The library's fit configuration, and a note the library has on the settings.
-    pub(crate) fn config(&self) -> PyResult<(FitConfig, Option<String>)> {
-        let (cfg, note) = self.settings()?.fit_config().map_err(py_err::<FitError>)?;
-        Ok((cfg, note.map(|n| n.to_string())))
+    /// The library's fit configuration.
+    pub(crate) fn config(&self) -> PyResult<FitConfig> {
+        self.settings()?.fit_config().map_err(py_err::<FitError>)
     }
 
     /// The library's fit settings these arguments name.
     pub(crate) fn settings(&self) -> PyResult<FitSettings> {
         Ok(FitSettings {
             method: parse_method(&self.method)?,
-            // A method names its recipe; the library's deprecated recipe setting is not taken.
-            recipe: None,
             epochs: self.epochs,
             seed: self.seed,
             hidden: self.hidden,
@@ -468,7 +465,7 @@ fn fit(
     options: LogOptions,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<RawModel> {
-    let (cfg, deprecation) = settings.config()?;
+    let cfg = settings.config()?;
     let opts = options.read_options()?;
     let failed: Mutex<Option<PyErr>> = Mutex::new(None);
     let result = py.detach(|| -> Result<_, PyErr> {
@@ -527,6 +524,6 @@ fn fit(
     Ok(RawModel {
         file: result.model,
         training_notes: notes,
-        load_warnings: deprecation.into_iter().collect(),
+        load_warnings: Vec::new(),
     })
 }

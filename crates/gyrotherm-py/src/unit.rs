@@ -324,8 +324,8 @@ fn fit_unit(
     settings: FitArgs,
     options: LogOptions,
     progress: Option<Py<PyAny>>,
-) -> PyResult<(RawUnitModel, Option<String>)> {
-    let (cfg, deprecation) = settings.config()?;
+) -> PyResult<RawUnitModel> {
+    let cfg = settings.config()?;
     let table_col = options.table_col.clone();
     let failed: Mutex<Option<PyErr>> = Mutex::new(None);
     let file = py.detach(|| -> PyResult<ImuModel> {
@@ -391,13 +391,10 @@ fn fit_unit(
     if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
         return Err(e);
     }
-    Ok((
-        RawUnitModel {
-            file,
-            load_warnings: Vec::new(),
-        },
-        deprecation,
-    ))
+    Ok(RawUnitModel {
+        file,
+        load_warnings: Vec::new(),
+    })
 }
 
 /// The figures of each axis of a unit log, as `gyrotherm evaluate --json` prints them with
@@ -460,8 +457,8 @@ fn evaluate_unit(
 /// `--gyro-col`/`--temp-col` lists prints it (`gyrotherm::imu_judge::compare_imu`): per axis
 /// the one-sensor methods on the sensor the one-sensor choice picks and, with several
 /// sensors, the unit's own fit on every sensor it keeps. `methods`: names as in
-/// `compare --methods` (None: the library's default list). Returns the JSON text and
-/// deprecation notes.
+/// `compare --methods` (None: the library's default list). Returns the JSON text and the
+/// notes (on τ when it is not the one asked for).
 #[pyfunction]
 #[pyo3(signature = (train, test, settings, options, methods=None, tau_s=None, spec=None))]
 #[allow(clippy::too_many_arguments)]
@@ -509,10 +506,9 @@ fn compare_unit(
                 t
             }
         };
-        let (cfg, note) = fit
+        let cfg = fit
             .compare_config(methods.as_deref(), tau_s)
             .map_err(py_err::<FitError>)?;
-        notes.extend(note.map(|n| n.to_string()));
         let cmp = gyrotherm::imu_judge::compare_imu(
             &train,
             &test,

@@ -132,7 +132,7 @@ fn under_dev_or_proc(path: &Path) -> bool {
 /// (see [`destination`]) the writer is on a temporary file in the same folder, which is
 /// synced and renamed over the file; on error (or a panic) the temporary file is removed
 /// and the file is left as it was. FIFOs, devices and standard output are written straight.
-pub fn write_atomically<T, E>(
+pub(crate) fn write_atomically<T, E>(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> Result<T, E>,
 ) -> Result<T, E>
@@ -265,7 +265,7 @@ fn clone_stderr() -> io::Result<File> {
     }
 }
 
-/// Write bytes safely (see [`write_atomically`]).
+/// Write bytes safely (see `write_atomically`).
 pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomically(path, |w| w.write_all(bytes))
 }

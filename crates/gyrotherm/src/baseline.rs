@@ -7,7 +7,7 @@
 //!
 //! The fit solves `min ‖X c - y‖` by SVD (nalgebra) on the column-scaled design matrix
 //! (each column divided by its RMS), with a rank check: a fit whose smallest/largest singular
-//! value ratio is below [`RANK_TOL`] is refused with the terms that are dependent, and a term
+//! value ratio is below `RANK_TOL` is refused with the terms that are dependent, and a term
 //! over a feature that does not vary in the training data is refused first with the feature's
 //! value (e.g. a run at constant temperature). The coefficients are for the raw (unscaled)
 //! monomials, so `gyrotherm_core::baseline::BaselineModel` evaluates them directly.
@@ -27,7 +27,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 /// Smallest accepted ratio of smallest to largest singular value of the scaled design matrix.
-pub const RANK_TOL: f64 = 1e-10;
+pub(crate) const RANK_TOL: f64 = 1e-10;
 
 /// The monomials of a baseline model: `powers[j][i]` is the power of feature `i` in term `j`.
 /// JSON: `{"n_features": 2, "powers": [[0,0],[1,0],[0,1]]}`.

@@ -7,9 +7,9 @@
 //! of a base with a residual LSTM, only the base is cross-validated). Per cell the file keeps
 //! the count of held-out steps and the RMS of their residual (prediction − the 100 s smoothed
 //! output, °/h), and σ: the RMS shrunk towards the pooled RMS by
-//! [`SHRINK_STEPS`](crate::settings::coverage::SHRINK_STEPS) steps, times
+//! `SHRINK_STEPS` steps, times
 //! [`SIGMA_SCALE`](crate::settings::coverage::SIGMA_SCALE), where the cell holds at least
-//! [`MIN_CELL_STEPS`](crate::settings::coverage::MIN_CELL_STEPS) steps (0, not covered,
+//! `MIN_CELL_STEPS` steps (0, not covered,
 //! otherwise). The flight crate's [`CoverageMap`](gyrotherm_core::coverage::CoverageMap)
 //! turns it into a per-sample verdict. The file's form of the map, [`CoverageDef`], is
 //! defined with the model file it sits in.
@@ -27,7 +27,7 @@ use crate::targets::TargetSet;
 /// Why no coverage map was made.
 #[derive(Debug)]
 #[non_exhaustive]
-pub enum CoverageFitError {
+pub(crate) enum CoverageFitError {
     /// The bias model has no least-squares part to fit again per fold.
     NotLeastSquares,
     /// No labelled step of a static log.
@@ -92,7 +92,7 @@ fn cell(x: f64, lo: f64, w: f64, n: usize) -> usize {
 
 /// The coverage map of a bias model fitted on `sets` (static logs' bias targets on the
 /// model's features): see the module doc.
-pub fn cross_validated(
+pub(crate) fn cross_validated(
     bias: &SubModel,
     sets: &[TargetSet],
     s: &CoverageSettings,

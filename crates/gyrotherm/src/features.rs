@@ -16,7 +16,7 @@ pub use gyrotherm_core::features::{
 /// (`rate_lag_s`, 20 s published), and at least its step period. The model steps on the time
 /// axis and reads dT as the temperature difference over the window; a log sampled more
 /// sparsely has no sample inside a window, so every step bridges a gap.
-pub fn max_sample_period_s(spec: &FeatureSpec) -> f64 {
+pub(crate) fn max_sample_period_s(spec: &FeatureSpec) -> f64 {
     spec.rate_lag_s.max(spec.step_period_s)
 }
 
@@ -138,7 +138,7 @@ impl From<SpecError> for FeatureError {
 }
 
 /// Name and unit of each feature of `spec`.
-pub fn feature_names(spec: &FeatureSpec) -> (Vec<String>, Vec<&'static str>) {
+pub(crate) fn feature_names(spec: &FeatureSpec) -> (Vec<String>, Vec<&'static str>) {
     let mut names = Vec::new();
     let mut units = Vec::new();
     for i in 0..spec.n_features() {

@@ -156,7 +156,7 @@ impl UnitVerdict {
     /// The one rule of a unit's verdict: it passes only when every axis passes. `axes`: each
     /// axis's gyro column and whether it passed, in column order; `judged`: which output
     /// (`compensated` or `raw`).
-    pub fn from_axes<'a>(
+    pub(crate) fn from_axes<'a>(
         spec: &str,
         spec_sha256: &str,
         judged: &'static str,
@@ -245,18 +245,8 @@ pub fn default_tau_s(test: &[(String, ImuLog)]) -> (f64, Option<f64>) {
 
 /// `evaluate` on a unit log: the figures of each gyro column (raw, in °/s as read), and with
 /// `model` of each axis's compensated output (`G_comp`, the flight compensator's output as
-/// `compensate` writes it). `settings.column` must be the default (the gyro columns are
-/// named by the log's column list). Returns the axes in column order and the τ used.
-pub fn evaluate_imu(
-    log: &ImuLog,
-    model: Option<&ImuModel>,
-    settings: &EvaluateSettings,
-) -> Result<(Vec<AxisEvaluation>, ResolvedTau), ImuJudgeError> {
-    let e = evaluate_imu_spec(log, model, settings, None, "")?;
-    Ok((e.axes, e.tau))
-}
-
-/// [`evaluate_imu`], and with `spec` each axis judged against the spec sheet as the
+/// `compensate` writes it); `settings.column` must be the default (the gyro columns are
+/// named by the log's column list). With `spec`, each axis judged against the spec sheet as the
 /// single-axis `evaluate --spec` judges one column (the same figures, measured on the axis's
 /// single-axis log, [`axis_test_log`]): the compensated output when `model` is given (the
 /// unit as it is flown), else the raw gyro column. `log_name` names the log in the
@@ -369,7 +359,7 @@ pub fn evaluate_imu_spec(
 
 /// Every figure of one axis of a unit's compensated output on each held-out log.
 #[derive(Debug, Clone, PartialEq)]
-pub struct AxisFigures {
+pub(crate) struct AxisFigures {
     /// The gyro column.
     pub gyro: String,
     /// The temperature columns the axis's model reads, the first sensor first.
@@ -383,7 +373,7 @@ pub struct AxisFigures {
 /// single-axis view of the log ([`axis_test_log`]) as `evaluate --model` measures it. The
 /// logs must be read with the model's columns ([`ImuModel::read_options`]). Axes in the
 /// model's order.
-pub fn measure_unit(
+pub(crate) fn measure_unit(
     model: &ImuModel,
     tests: &[(String, ImuLog)],
     opts: &MeasureOptions,
@@ -432,7 +422,7 @@ pub fn measure_unit(
 /// Each axis of [`measure_unit`] judged against `spec` on all its held-out logs (as the
 /// single-axis [`spec::judge`] judges one column), and the unit's verdict
 /// ([`UnitVerdict::from_axes`]: compensated output).
-pub fn judge_unit_figures(
+pub(crate) fn judge_unit_figures(
     spec: &Spec,
     axes: &[AxisFigures],
 ) -> Result<(Vec<Verdict>, UnitVerdict), ImuJudgeError> {
@@ -609,7 +599,8 @@ pub struct ImuComparison {
 
 /// Progress of a unit comparison: axis index, then the comparison's own (column key,
 /// target, epoch, loss).
-pub type ImuCompareProgress<'a> = dyn Fn(usize, &'static str, Target, usize, f64) + Sync + 'a;
+pub(crate) type ImuCompareProgress<'a> =
+    dyn Fn(usize, &'static str, Target, usize, f64) + Sync + 'a;
 
 /// `compare` on unit logs: the sensor per axis from the unit fit with `cfg.fit` (skipped
 /// with one temperature column; `events` tells its steps), then every column of `cfg`
@@ -753,12 +744,12 @@ impl AxisVerdicts {
 }
 
 /// The name of the unit fit's column in [`unit_verdicts`] and [`verdicts_across_axes`].
-pub const UNIT_FIT_COLUMN: &str = "unit fit";
+pub(crate) const UNIT_FIT_COLUMN: &str = "unit fit";
 
 /// The unit's verdict of each judged column across the axes ([`UnitVerdict::from_axes`]: a
 /// column passes for the unit only when it passes on every axis), the columns in the order
 /// of the tables, the unit's own fit ([`UNIT_FIT_COLUMN`]) last.
-pub fn unit_verdicts(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<(String, UnitVerdict)> {
+pub(crate) fn unit_verdicts(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<(String, UnitVerdict)> {
     let mut names: Vec<String> = Vec::new();
     let mut per: Vec<Vec<(&str, bool)>> = Vec::new();
     for a in axes {
@@ -792,7 +783,7 @@ pub fn unit_verdicts(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<(String, UnitVer
         .collect()
 }
 
-/// One line per judged column across the axes ([`unit_verdicts`]): `linear: FAIL on
+/// One line per judged column across the axes (`unit_verdicts`): `linear: FAIL on
 /// gyro_x_dps, gyro_z_dps`, `unit fit: PASS on every axis`.
 pub fn verdicts_across_axes(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<String> {
     unit_verdicts(spec, axes)
@@ -862,7 +853,7 @@ pub fn judge_unit_comparison(
 }
 
 /// The header of the unit fit's column in the table across axes.
-pub const UNIT_FIT_HEADER: &str = "unit fit (axis's sensors)";
+pub(crate) const UNIT_FIT_HEADER: &str = "unit fit (axis's sensors)";
 
 /// One axis in `gyrotherm compare --json` for a unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -932,7 +923,7 @@ impl ImuComparison {
     /// The table across axes (axis × figure): per held-out log and figure (bias stability,
     /// × noise floor, scale-factor error, SF thermal error) one row per axis, with the raw
     /// output, each method (columns named by method, the same for every axis), the unit's own
-    /// fit when there is one ([`UNIT_FIT_HEADER`]: each axis's row reads that axis's sensors)
+    /// fit when there is one (`UNIT_FIT_HEADER`: each axis's row reads that axis's sensors)
     /// and the noise floor. The per-rate output ranges stay in the axes' own tables.
     pub fn across_axes(&self, cfg: &CompareConfig) -> Table {
         let mut headers = vec![
@@ -1131,7 +1122,9 @@ mod tests {
             column: "other_dps".into(),
             ..Default::default()
         };
-        let e = evaluate_imu(&log, None, &s).unwrap_err().to_string();
+        let e = evaluate_imu_spec(&log, None, &s, None, "")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("judged per gyro column"), "{e}");
     }
 }

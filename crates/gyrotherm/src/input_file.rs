@@ -60,7 +60,7 @@ impl InputKind {
     }
 }
 
-/// A file larger than its kind may be (the source of the `io::Error` [`read_capped`]
+/// A file larger than its kind may be (the source of the `io::Error` `read_capped`
 /// returns).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TooLarge {
@@ -85,7 +85,7 @@ impl std::error::Error for TooLarge {}
 /// [`io::ErrorKind::FileTooLarge`] (source [`TooLarge`], naming the limit and what to do)
 /// when it holds more than [`InputKind::limit_bytes`]. A device or pipe is read up to one
 /// byte past the limit, never further. The caller's error names the file.
-pub fn read_capped(path: &Path, kind: InputKind) -> io::Result<Vec<u8>> {
+pub(crate) fn read_capped(path: &Path, kind: InputKind) -> io::Result<Vec<u8>> {
     let limit = kind.limit_bytes();
     let file = std::fs::File::open(path)?;
     let too_large = || io::Error::new(io::ErrorKind::FileTooLarge, TooLarge { kind });
@@ -104,7 +104,7 @@ pub fn read_capped(path: &Path, kind: InputKind) -> io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// [`read_capped`] as UTF-8 text (an error of kind [`io::ErrorKind::InvalidData`] when it is
+/// `read_capped` as UTF-8 text (an error of kind [`io::ErrorKind::InvalidData`] when it is
 /// not, as [`std::fs::read_to_string`] says).
 pub fn read_capped_to_string(path: &Path, kind: InputKind) -> io::Result<String> {
     String::from_utf8(read_capped(path, kind)?).map_err(|_| {

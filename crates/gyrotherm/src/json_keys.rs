@@ -2,7 +2,7 @@
 //! or refuses (into a struct), and other readers may keep the first, so one file can mean
 //! two models: a sealed model file with a decoy array before the real one would check out
 //! against its content hash while a reader that keeps the first value uses the decoy.
-//! [`check_unique_keys`] reads the text once, keeping nothing, and refuses the first
+//! `check_unique_keys` reads the text once, keeping nothing, and refuses the first
 //! repeated key with its place (`bias.baseline.coefficients`).
 
 use std::cell::RefCell;
@@ -37,7 +37,7 @@ impl fmt::Display for DuplicateKey {
 
 /// Why [`check_unique_keys`] refused a text.
 #[derive(Debug)]
-pub enum KeyCheckError {
+pub(crate) enum KeyCheckError {
     /// An object names a key twice.
     Duplicate(DuplicateKey),
     /// The text is not JSON.
@@ -46,7 +46,7 @@ pub enum KeyCheckError {
 
 /// Refuse `text` if any object in it, at any depth, names a key twice; also refuses text
 /// that is not one JSON value.
-pub fn check_unique_keys(text: &str) -> Result<(), KeyCheckError> {
+pub(crate) fn check_unique_keys(text: &str) -> Result<(), KeyCheckError> {
     let found = RefCell::new(None);
     let mut de = serde_json::Deserializer::from_str(text);
     let result = Walk {

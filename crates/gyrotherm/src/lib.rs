@@ -20,7 +20,7 @@
 //! - [`atomic_file`]: writing an output so that nothing is lost (temporary file, then rename).
 //! - [`input_file`]: reading the small input files (models, spec sheets, profiles).
 //! - [`json_keys`]: a JSON object that names a key twice.
-//! - [`string_table`]: a table of strings, as results are printed.
+//! - `string_table`: a table of strings, as results are printed.
 //! - [`moving_average`]: the one centred moving average on a time axis.
 //! - [`table_segments`]: the one segmentation of a rate-table log by commanded rate.
 //! - [`allan`]: Allan-family deviations of rate data, with confidence intervals.
@@ -46,7 +46,7 @@
 //!   [`RecipeSettings`]).
 //! - [`compare`]: held-out comparison of methods: the numbers of the results table.
 //! - [`spec`]: spec sheets: limits on the standard figures, and a run's verdict.
-//! - [`imu_error`]: why an inertial-unit model cannot be fitted, read, written or applied.
+//! - `imu_error`: why an inertial-unit model cannot be fitted, read, written or applied.
 //! - [`compensate_lines`](mod@compensate_lines): a CSV stream compensated line by line, with a
 //!   status per line.
 //! - [`imu_model`]: one model file for an inertial unit: a model per gyro axis.
@@ -88,7 +88,7 @@ pub use error_chain::error_chain;
 pub mod export;
 pub mod features;
 pub mod fit;
-pub mod imu_error;
+pub(crate) mod imu_error;
 pub mod imu_judge;
 pub mod imu_model;
 pub mod input_file;
@@ -105,7 +105,7 @@ pub mod setting_rule;
 pub mod settings;
 pub mod sim;
 pub mod spec;
-pub mod string_table;
+pub(crate) mod string_table;
 pub mod table_segments;
 pub mod targets;
 pub mod unit_model;

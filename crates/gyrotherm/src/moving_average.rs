@@ -1,18 +1,18 @@
 //! The centred moving average on a time axis, the one smoothing every part of the library
 //! uses: the bias and scale-factor targets, the report's figures and its temperature rate.
 //!
-//! [`centred_mean`] is the one implementation: for each sample the mean of the included,
+//! `centred_mean` is the one implementation: for each sample the mean of the included,
 //! finite values within `±W/2` on the time axis, with a policy at the ends of the run
-//! ([`Edges`]). [`centred_moving_average`] is its strict form for training targets (every
+//! (`Edges`). [`centred_moving_average`] is its strict form for training targets (every
 //! value must be finite, time strictly increasing; the window shrinks symmetrically at the
-//! ends); [`windowed_mean`] its lenient form for figures (non-finite values skipped, the
+//! ends); `windowed_mean` its lenient form for figures (non-finite values skipped, the
 //! window cut off at the ends).
 
 use std::fmt;
 
 /// What the window does near the ends of the run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Edges {
+pub(crate) enum Edges {
     /// Shrinks symmetrically (`h = min(W/2, t − t_first, t_last − t)`) so it stays centred:
     /// a linear trend passes through unbiased; the first and last values are the raw samples.
     Shrink,
@@ -79,7 +79,7 @@ impl std::error::Error for MovingAverageError {}
 /// (non-decreasing), over the samples `j` with `include(j)` and a finite `x[j]` only; a
 /// 1e-9·W tolerance absorbs time-stamp round-off. O(N): two pointers over prefix sums of
 /// `x − x_0` (the offset keeps the sums small). The inputs are cut to the shorter length.
-pub fn centred_mean(
+pub(crate) fn centred_mean(
     time_s: &[f64],
     x: &[f64],
     window_s: f64,
@@ -146,7 +146,7 @@ pub fn centred_mean(
 
 /// The strict centred moving average of training targets: `y_i` = mean of the `x_j` with
 /// `|t_j − t_i| ≤ h_i` (inclusive, with a 1e-9·W tolerance for time-stamp round-off), where
-/// `h_i = min(W/2, t_i − t_0, t_end − t_i)` ([`Edges::Shrink`]). [`Smoothed::full_window`]
+/// `h_i = min(W/2, t_i − t_0, t_end − t_i)` (`Edges::Shrink`). [`Smoothed::full_window`]
 /// marks the samples with the whole window, for callers that mask the edges out of a loss.
 ///
 /// At 1 Hz, `W = 100 s` averages 101 samples (t-50 … t+50).
@@ -185,7 +185,7 @@ pub fn centred_moving_average(
 /// The lenient centred moving average of figures: each output is the mean of the finite
 /// `y[j]` with `|t[j] − t[i]| <= window_s / 2` (NaN where there are none), the window cut
 /// off at the ends ([`Edges::Truncate`]). `time_s` must be non-decreasing.
-pub fn windowed_mean(time_s: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
+pub(crate) fn windowed_mean(time_s: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
     centred_mean(time_s, y, window_s, Edges::Truncate, |_| true).values
 }
 

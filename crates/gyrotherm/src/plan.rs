@@ -9,12 +9,12 @@
 //!
 //! **Profile.** A deliberately simple design (constants in [`crate::settings::plan`]):
 //! from room temperature, ramp to the envelope's hot end and soak; then at each of
-//! [`crate::settings::plan::RATE_LEVELS`] rates `R·k/levels` (slowest first, R
+//! `crate::settings::plan::RATE_LEVELS` rates `R·k/levels` (slowest first, R
 //! the flight's largest |dT| with a margin, at most the chamber's), ramp cold, soak, ramp
 //! hot, soak, repeated until every temperature cell of the coverage grid holds
-//! [`crate::settings::plan::MIN_CELL_S`] seconds of each ramp direction; back to
+//! `crate::settings::plan::MIN_CELL_S` seconds of each ramp direction; back to
 //! room. The envelope is the flight's temperature extremes widened by
-//! [`crate::settings::plan::TEMP_MARGIN_C`], clipped to the chamber's range.
+//! `crate::settings::plan::TEMP_MARGIN_C`, clipped to the chamber's range.
 //! Down- and up-ramps give −r and +r, the soaks 0: the rate rows of the grid between levels
 //! are at most one cell from a covered one.
 

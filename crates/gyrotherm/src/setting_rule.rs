@@ -13,7 +13,7 @@ pub const MAX_EPOCHS: usize = 1_000_000;
 /// Absolute zero, °C: no envelope temperature below it.
 pub const ABSOLUTE_ZERO_C: f64 = -273.15;
 /// Hottest envelope temperature accepted, °C: far above any flight (and any chamber's
-/// [`crate::sim::profile::TARGET_RANGE_C`]); beyond it a value is a typo, not a flight.
+/// `crate::sim::profile::TARGET_RANGE_C`); beyond it a value is a typo, not a flight.
 pub const MAX_ENVELOPE_C: f64 = 1000.0;
 
 /// The rule a value broke.
@@ -40,7 +40,8 @@ pub enum Rule {
     Finite,
     /// A list of column names (one, or several separated by commas).
     ColumnList,
-    /// Hidden units of an LSTM: a whole number from 1 to [`MAX_HIDDEN`](crate::settings::fit::MAX_HIDDEN).
+    /// Hidden units of an LSTM: the number the flight compensator's network is built for
+    /// ([`gyrotherm_core::compensator::HIDDEN`]).
     HiddenUnits,
     /// A temperature a flight reaches, °C: from absolute zero to
     /// [`MAX_ENVELOPE_C`].

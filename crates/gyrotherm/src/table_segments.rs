@@ -1,17 +1,17 @@
 //! Rate-table segments: runs of samples with one commanded table rate. The one segmentation
 //! that the scale-factor figures ([`crate::metrics::scale_factor()`]) and the scale-factor
-//! training targets ([`crate::targets::scale_targets`]) share, so the two always agree on
+//! training targets (`crate::targets::scale_targets`) share, so the two always agree on
 //! where a segment starts and ends.
 //!
 //! Tolerance: a reading belongs to the current segment when it lies within `tol_dps` of the
 //! segment's **first** reading (comparing with the first, not the previous, reading keeps a
-//! slow drift from chaining into one segment). [`RATE_TOLERANCE_DPS`] (1e-9 °/s) absorbs the
+//! slow drift from chaining into one segment). `RATE_TOLERANCE_DPS` (1e-9 °/s) absorbs the
 //! decimal round-off of a logged command column (`19.999999999999996`); a measured table
 //! rate with encoder noise is not a command column and must be turned into one first. A
-//! segment whose rate is within the tolerance of zero is a stop segment ([`Segment::is_stop`]).
+//! segment whose rate is within the tolerance of zero is a stop segment (`Segment::is_stop`).
 
 /// Default tolerance, °/s: two readings this close are the same commanded rate.
-pub const RATE_TOLERANCE_DPS: f64 = 1e-9;
+pub(crate) const RATE_TOLERANCE_DPS: f64 = 1e-9;
 
 /// A run of samples with one commanded table rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,7 +26,7 @@ pub struct Segment {
 
 impl Segment {
     /// True when the rate is zero within `tol_dps` (a stop segment).
-    pub fn is_stop(&self, tol_dps: f64) -> bool {
+    pub(crate) fn is_stop(&self, tol_dps: f64) -> bool {
         self.rate_dps.abs() <= tol_dps
     }
 }

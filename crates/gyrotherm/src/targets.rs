@@ -76,7 +76,7 @@ pub const BIAS_WINDOW_S: f64 = 100.0;
 /// Default settle time excluded at the start of each table segment, s.
 pub const SETTLE_S: f64 = 10.0;
 /// Default smoothing window of the output inside a rate segment, s.
-pub const SCALE_WINDOW_S: f64 = 60.0;
+pub(crate) const SCALE_WINDOW_S: f64 = 60.0;
 
 /// True when a log is a static test ([`TestLog::is_static`]: no table column, or a table
 /// column that is zero throughout).
@@ -164,7 +164,7 @@ fn settled_start(log: &TestLog, seg: &Segment, settle_s: f64) -> usize {
 }
 
 /// Scale-factor target of a rate-table log (see the module doc).
-pub fn scale_targets(
+pub(crate) fn scale_targets(
     log: &TestLog,
     spec: &FeatureSpec,
     settle_s: f64,

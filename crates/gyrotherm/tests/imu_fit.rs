@@ -48,7 +48,6 @@ fn thermal() -> gyrotherm::fit::FitConfig {
     }
     .fit_config()
     .unwrap()
-    .0
 }
 
 #[test]

@@ -83,42 +83,29 @@ fn method_names_parse_back_and_lstm_is_not_listed() {
     assert!(err.contains("method: unknown value \"fancy\""), "{err}");
 }
 
-/// The deprecated spellings resolve as documented on `FitSettings::resolve`, and a recipe
-/// that contradicts the method is refused naming both settings.
+/// Method `lstm`, which older model files record (they load above), is no method a fit or a
+/// comparison takes: it is refused by name, with the methods that are.
 #[test]
-fn deprecated_recipe_and_lstm_resolve_to_a_method() {
-    use gyrotherm::settings::{Deprecation, FitSettings};
-    let with = |method, recipe| FitSettings {
+fn the_read_only_lstm_method_is_refused_as_a_setting() {
+    use gyrotherm::settings::FitSettings;
+    let with = |method| FitSettings {
         method,
-        recipe,
         ..FitSettings::default()
     };
-    let cases = [
-        (with(Method::Lstm, None), Method::Thermal),
-        (with(Method::Lstm, Some(Method::Residual)), Method::Residual),
-        (with(Method::Thermal, Some(Method::Direct)), Method::Direct),
-        (with(Method::Linear, Some(Method::Direct)), Method::Linear),
-        (with(Method::Generic, None), Method::Generic),
-    ];
-    for (s, want) in cases {
-        let (cfg, note) = s.fit_config().unwrap();
-        assert_eq!(cfg.model_method(), want, "{s:?}");
-        assert_eq!(
-            note.is_some(),
-            s.recipe.is_some() || s.method == Method::Lstm
-        );
-    }
-    assert!(matches!(
-        with(Method::Lstm, None).resolve().unwrap().1,
-        Some(Deprecation::LstmMethod {
-            now: Method::Thermal
-        })
-    ));
-    let err = with(Method::Generic, Some(Method::Direct))
-        .validate()
+    let err = with(Method::Lstm).fit_config().unwrap_err().to_string();
+    assert!(
+        err.contains("method") && err.contains("lstm") && err.contains("thermal"),
+        "{err}"
+    );
+    assert_eq!(
+        with(Method::Generic).fit_config().unwrap().model_method(),
+        Method::Generic
+    );
+    let err = FitSettings::default()
+        .compare_config(Some(&[Method::Linear, Method::Lstm]), 100.0)
         .unwrap_err()
         .to_string();
-    assert!(err.contains("recipe and method conflict"), "{err}");
+    assert!(err.contains("methods") && err.contains("lstm"), "{err}");
     let err = FitSettings {
         settle_s: -1.0,
         ..FitSettings::default()

@@ -67,9 +67,6 @@ impl FitArgs {
     pub fn settings(&self, method: Method) -> FitSettings {
         FitSettings {
             method,
-            // The command line names the method itself; the library's deprecated recipe
-            // setting is never given.
-            recipe: None,
             epochs: self.epochs,
             seed: self.seed,
             hidden: self.hidden,
@@ -84,18 +81,7 @@ impl FitArgs {
 
     /// The library's fit configuration for `method`.
     pub fn fit_config(&self, method: Method) -> anyhow::Result<FitConfig> {
-        let (cfg, note) = self.settings(method).fit_config()?;
-        warn_deprecated(note);
-        Ok(cfg)
-    }
-}
-
-/// A deprecated spelling the library resolved, said on stderr. The command line passes none
-/// (`--method` lists only the current names and no recipe is given); the library's note is
-/// still said rather than dropped should it report one.
-pub fn warn_deprecated(note: Option<gyrotherm::settings::Deprecation>) {
-    if let Some(n) = note {
-        eprintln!("gyrotherm: warning: {n}");
+        Ok(self.settings(method).fit_config()?)
     }
 }
 
@@ -257,11 +243,9 @@ pub struct ColumnArgs {
 impl ColumnArgs {
     /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`.
     pub fn compare_config(&self, fit: &FitArgs, tau_s: f64) -> anyhow::Result<CompareConfig> {
-        let (cfg, note) = fit
+        Ok(fit
             .settings(DEFAULT_METHOD)
-            .compare_config(self.methods.as_deref(), tau_s)?;
-        warn_deprecated(note);
-        Ok(cfg)
+            .compare_config(self.methods.as_deref(), tau_s)?)
     }
 }
 

@@ -54,7 +54,7 @@ def fit_unit(
     settings: Dict[str, Any],
     options: Dict[str, Any],
     progress: Optional[Any] = None,
-) -> Tuple[RawUnitModel, Optional[str]]: ...
+) -> RawUnitModel: ...
 
 def evaluate_log(
     path: str,

@@ -383,9 +383,7 @@ def fit(
             unit_callback = progress
         else:
             raise TypeError("progress: give True, False or a callable(event, gyro, temp, cv_rms)")
-        raw_unit, note = _g.fit_unit(static_paths, table_paths, settings, options, unit_callback)
-        if note is not None:
-            _warn([note])
+        raw_unit = _g.fit_unit(static_paths, table_paths, settings, options, unit_callback)
         return UnitModel(raw_unit)
     if progress is True:
         callback = _PrintProgress(epochs)

@@ -177,7 +177,7 @@ pub fn kalibr_noise(
 /// A number as a YAML float every YAML reader takes as one: the shortest round-trip digits,
 /// with a `.` in the mantissa and a signed exponent (YAML 1.1, which PyYAML and so Kalibr
 /// follow, reads `1e-5` as a string).
-pub fn yaml_float(v: f64) -> String {
+pub(crate) fn yaml_float(v: f64) -> String {
     let s = format!("{v:e}");
     let (mant, exp) = s.split_once('e').unwrap_or((&s, "0"));
     let mant = if mant.contains('.') {

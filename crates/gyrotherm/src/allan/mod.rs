@@ -93,7 +93,7 @@ impl DevKind {
     /// Largest m used by the automatic τ sets (`octave`, `decade`, `all`): ⌊N/5⌋ for the
     /// non-overlapping estimators, ⌊N/4⌋ otherwise — the limits Stable32 uses (they reproduce
     /// the τ lists of the reference files in docs/method.md).
-    pub fn auto_max_m(self, n_samples: usize) -> usize {
+    pub(crate) fn auto_max_m(self, n_samples: usize) -> usize {
         match self {
             DevKind::Adev | DevKind::Hdev => n_samples / 5,
             _ => n_samples / 4,
@@ -126,11 +126,11 @@ impl std::str::FromStr for DevKind {
 /// Which τ values to evaluate.
 #[derive(Debug, Clone, PartialEq)]
 pub enum TauSet {
-    /// m = 1, 2, 4, 8, … up to [`DevKind::auto_max_m`].
+    /// m = 1, 2, 4, 8, … up to `DevKind::auto_max_m`.
     Octave,
-    /// m = 1, 2, 5, 10, 20, 50, … up to [`DevKind::auto_max_m`].
+    /// m = 1, 2, 5, 10, 20, 50, … up to `DevKind::auto_max_m`.
     Decade,
-    /// Every m from 1 to [`DevKind::auto_max_m`] (O(N) work per τ: for short logs).
+    /// Every m from 1 to `DevKind::auto_max_m` (O(N) work per τ: for short logs).
     All,
     /// Explicit τ values in seconds; each must be an integer multiple of τ0.
     Seconds(Vec<f64>),

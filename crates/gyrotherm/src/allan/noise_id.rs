@@ -25,7 +25,7 @@ pub const MIN_AVERAGES: usize = 30;
 /// At most this many averages (the first ones) are used, to bound time and memory on long
 /// logs (the lag-1 autocorrelation of 1e5 points has a standard error of about 0.003, far
 /// below the 0.25 steps between noise types).
-pub const MAX_AVERAGES: usize = 100_000;
+pub(crate) const MAX_AVERAGES: usize = 100_000;
 
 fn lag1_acf(x: &[f64]) -> f64 {
     let mu = x.iter().sum::<f64>() / x.len() as f64;
@@ -128,7 +128,7 @@ fn b1_theory(n: f64, mu: i32) -> f64 {
 }
 
 /// Fewest averages for the B1 method.
-pub const B1_MIN_AVERAGES: usize = 4;
+pub(crate) const B1_MIN_AVERAGES: usize = 4;
 
 /// Noise identification for τ with too few averages for the lag-1 method (Stable32's
 /// fallback): the B1 ratio picks α ∈ {−2, −1, 0, ≥1} by the geometric-mean boundaries of

@@ -19,7 +19,7 @@
 use super::AllanPoint;
 
 /// How far the local log-log slope may be from a term's slope for a point to be used.
-pub const SLOPE_TOL: f64 = 0.2;
+pub(crate) const SLOPE_TOL: f64 = 0.2;
 
 /// One noise term.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]

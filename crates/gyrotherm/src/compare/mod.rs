@@ -27,19 +27,12 @@ use crate::compensate::{compensate_log, extrapolation_warnings, Compensated};
 use crate::csvlog::{TestLog, NOISE_COL};
 use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, RecipeSettings, Target};
 use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
-use crate::settings::fit::{Deprecation, FitSettings};
-use crate::settings::method::{Method, DEFAULT_METHOD};
+use crate::settings::fit::FitSettings;
+use crate::settings::method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
 use crate::settings::rule::{check, Rule, SettingError};
 use crate::targets;
 
 pub use crate::metrics::BIAS_STABILITY_TAU_S;
-
-/// The column name of the published recipe: the seed's method, named after its authors
-/// (its [`Method::column_label`]).
-pub const PUBLISHED_LABEL: &str = match Method::Published.column_label() {
-    Some(label) => label,
-    None => Method::Published.as_str(),
-};
 
 /// One column of the comparison: a method and, for a recipe method, the recipe it trains.
 #[derive(Debug, Clone, PartialEq)]
@@ -98,14 +91,9 @@ impl Candidate {
         }
     }
 
-    /// Whether this column trains the published recipe.
-    pub fn is_published(&self, base: &FitConfig) -> bool {
-        self.fit_config(base).model_method() == Method::Published
-    }
-
     /// The column's own label, if its method has one ([`Method::column_label`]: the
-    /// published recipe's [`PUBLISHED_LABEL`]); otherwise the column is labelled by its model.
-    pub fn column_label(&self, base: &FitConfig) -> Option<&'static str> {
+    /// published recipe's names its authors); otherwise the column is labelled by its model.
+    pub(crate) fn column_label(&self, base: &FitConfig) -> Option<&'static str> {
         self.fit_config(base).model_method().column_label()
     }
 
@@ -126,23 +114,28 @@ impl Candidate {
 /// The comparison's side of the user's settings: the settings sit below the comparison and
 /// know nothing of it, so the comparison builds its configuration from them here.
 impl FitSettings {
-    /// The comparison of `methods` (None: `linear`, `poly`, this settings' method, which is
-    /// `thermal` unless the deprecated `recipe` names another, and `published`, once) with
-    /// these settings, bias stability over `tau_s`. The deprecated `lstm` in `methods` is
-    /// this settings' method.
+    /// The comparison of `methods` (None: `linear`, `poly`, this settings' method and
+    /// `published`, once) with these settings, bias stability over `tau_s`.
     pub fn compare_config(
         &self,
         methods: Option<&[Method]>,
         tau_s: f64,
-    ) -> Result<(CompareConfig, Option<Deprecation>), SettingError> {
+    ) -> Result<CompareConfig, SettingError> {
         check("tau_s", tau_s, Rule::PositiveSeconds)?;
-        let (fit, note) = self.fit_config()?;
+        let fit = self.fit_config()?;
         let main = fit.model_method();
         let wanted: Vec<Method> = match methods {
-            Some(m) => m
-                .iter()
-                .map(|m| if *m == Method::Lstm { main } else { *m })
-                .collect(),
+            Some(m) => {
+                // `lstm`, which older model files record, is no method a fit can use.
+                if let Some(old) = m.iter().find(|m| !METHODS.contains(m)) {
+                    return Err(SettingError::unknown(
+                        "methods",
+                        old.as_str(),
+                        &METHOD_NAMES,
+                    ));
+                }
+                m.to_vec()
+            }
             None => {
                 let mut all = vec![Method::Linear, Method::Poly, main];
                 if main != Method::Published {
@@ -158,15 +151,12 @@ impl FitSettings {
                 recipe: m.is_own_recipe().then(|| self.recipe_for(m)),
             })
             .collect();
-        Ok((
-            CompareConfig {
-                candidates,
-                fit,
-                tau_s,
-                settle_s: self.settle_s,
-            },
-            note,
-        ))
+        Ok(CompareConfig {
+            candidates,
+            fit,
+            tau_s,
+            settle_s: self.settle_s,
+        })
     }
 }
 
@@ -252,7 +242,7 @@ pub struct MethodResult {
     /// The column's key ([`Candidate::key`]).
     pub key: &'static str,
     /// The column's name: what the model holds ([`ModelFile::label`](crate::model::ModelFile::label)),
-    /// or [`PUBLISHED_LABEL`].
+    /// or the published recipe's label ([`Method::column_label`]).
     pub label: &'static str,
     pub performance: Performance,
     pub compensated: Compensated,
@@ -280,8 +270,8 @@ pub struct TestResult {
 pub struct FailedColumn {
     /// [`Candidate::key`].
     pub key: &'static str,
-    /// Its name in the table: [`PUBLISHED_LABEL`] or the method's name (a model that was
-    /// never fitted holds nothing to name it by).
+    /// Its name in the table: the published recipe's label ([`Method::column_label`]) or the
+    /// method's name (a model that was never fitted holds nothing to name it by).
     pub label: &'static str,
     /// The error and its causes, as one line.
     pub reason: String,
@@ -305,7 +295,7 @@ pub struct Comparison {
 pub struct Column {
     /// [`Candidate::key`]: `linear`, `poly`, `lstm` or `published`.
     pub key: &'static str,
-    /// What the model holds, or [`PUBLISHED_LABEL`].
+    /// What the model holds, or the published recipe's label ([`Method::column_label`]).
     pub label: &'static str,
 }
 

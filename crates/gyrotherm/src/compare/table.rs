@@ -275,7 +275,12 @@ impl ComparisonTable {
     /// Adds a column named `header` after the others: `per_log[i]` holds its figures on the
     /// log of block `i`, `floors[i]` that log's noise floor, °/h (the `× noise floor` row).
     /// A figure the column lacks is `-`.
-    pub fn push_column(&mut self, header: &str, per_log: &[Performance], floors: &[Option<f64>]) {
+    pub(crate) fn push_column(
+        &mut self,
+        header: &str,
+        per_log: &[Performance],
+        floors: &[Option<f64>],
+    ) {
         self.columns.push(header.to_owned());
         let empty = Performance::default();
         for (i, b) in self.blocks.iter_mut().enumerate() {

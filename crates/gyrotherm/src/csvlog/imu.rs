@@ -49,7 +49,7 @@ impl ImuLog {
     }
 
     /// Index of the gyro column the table turns.
-    pub fn table_axis_index(&self) -> Option<usize> {
+    pub(crate) fn table_axis_index(&self) -> Option<usize> {
         let a = self.table_axis.as_deref()?;
         self.gyro.iter().position(|g| g.name == a)
     }
@@ -106,7 +106,7 @@ impl ImuLog {
 /// The gyro the table turns: the one whose output has a slope on the table rate within
 /// [`TABLE_AXIS_SLOPE_RANGE`] (least squares over the samples, table rate and output
 /// centred); None when none or several do.
-pub fn detect_table_axis(gyro: &[NamedSeries], table_dps: &[f64]) -> Option<usize> {
+pub(crate) fn detect_table_axis(gyro: &[NamedSeries], table_dps: &[f64]) -> Option<usize> {
     let n = table_dps.len() as f64;
     let mt = table_dps.iter().sum::<f64>() / n;
     let stt: f64 = table_dps.iter().map(|t| (t - mt) * (t - mt)).sum();

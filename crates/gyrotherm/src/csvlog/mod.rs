@@ -137,7 +137,7 @@ impl TestLog {
         }
     }
     /// Names of the columns held: the standard ones present, then the pass-through ones.
-    pub fn column_names(&self) -> Vec<String> {
+    pub(crate) fn column_names(&self) -> Vec<String> {
         [GYRO_COL, TEMP_COL]
             .into_iter()
             .chain(self.table_dps.as_ref().map(|_| DEFAULT_TABLE_COL))
@@ -204,7 +204,7 @@ pub enum GyroUnit {
 
 impl GyroUnit {
     /// °/s per unit of the file: the factor a gyro field is multiplied by on reading.
-    pub fn dps_per_unit(self) -> f64 {
+    pub(crate) fn dps_per_unit(self) -> f64 {
         match self {
             GyroUnit::Dps => 1.0,
             // 1 °/h = 1/3600 °/s.
@@ -297,10 +297,10 @@ pub struct ReadReport {
 impl ReadReport {
     /// Jitter above which a log is reported as irregularly sampled (the figures assume
     /// even sampling).
-    pub const JITTER_WARNING: f64 = 0.05;
+    pub(crate) const JITTER_WARNING: f64 = 0.05;
 
     /// A warning about irregular steps, with the measured jitter, if above
-    /// [`JITTER_WARNING`](Self::JITTER_WARNING).
+    /// `JITTER_WARNING`.
     pub fn jitter_warning(&self, source: &Path) -> Option<String> {
         let period = self.sample_period_s?;
         (self.max_step_jitter > Self::JITTER_WARNING).then(|| {

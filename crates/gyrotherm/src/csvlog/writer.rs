@@ -55,7 +55,7 @@ impl<W: Write> LogWriter<W> {
     /// [`ReadOptions::delimiter`](super::ReadOptions::delimiter)): a field holding it is quoted.
     /// Numbers are still written with a decimal point, which the reader accepts beside the
     /// decimal comma.
-    pub fn with_delimiter<I>(out: W, header: I, delimiter: u8) -> io::Result<Self>
+    pub(crate) fn with_delimiter<I>(out: W, header: I, delimiter: u8) -> io::Result<Self>
     where
         I: IntoIterator,
         I::Item: AsRef<str>,

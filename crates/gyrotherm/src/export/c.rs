@@ -1,4 +1,4 @@
-//! `--lang c`: `gyrotherm_model.h` and `gyrotherm_model.c`, C99, no heap, no global mutable
+//! `--target c`: `gyrotherm_model.h` and `gyrotherm_model.c`, C99, no heap, no global mutable
 //! state; weights, scalers and limits as `static const`. The API (the header's complete
 //! `gt_state` has a fixed size per model):
 //!

@@ -90,7 +90,7 @@ pub enum Lang {
 pub const LANG_NAMES: [&str; 2] = ["c", "rust"];
 
 impl Lang {
-    /// The name on the command line (`--lang`).
+    /// The name on the command line (`--target`).
     pub fn as_str(&self) -> &'static str {
         match self {
             Lang::C => "c",

@@ -1,4 +1,4 @@
-//! `--lang rust`: one module, `gyrotherm_model.rs`, holding the model as a `static`
+//! `--target rust`: one module, `gyrotherm_model.rs`, holding the model as a `static`
 //! [`StaticModel`] for `gyrotherm-core`. Flight code builds its compensator once with
 //! `Compensator::from_static(&gyrotherm_model::MODEL)`: no JSON, no heap. A model file's
 //! coverage map goes into `MODEL.coverage` (`MODEL.coverage_map()` builds the core's map).

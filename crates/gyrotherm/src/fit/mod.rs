@@ -36,7 +36,7 @@ use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
 use crate::features::{FeatureSpec, FeatureTable};
 use crate::model::{self, FeatureDef, ModelFile, SubModel, TrainingInfo};
-use crate::settings::fit::{Deprecation, FitSettings};
+use crate::settings::fit::FitSettings;
 use crate::settings::method::Method;
 use crate::settings::rule::SettingError;
 use crate::targets::{self, TargetSet};
@@ -72,7 +72,11 @@ pub struct FitConfig {
     /// Random seed (LSTM initialisation and window order).
     pub seed: u64,
     /// Settings of the thermal recipe ([`thermal`]).
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub thermal: thermal::ThermalConfig,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) thermal: thermal::ThermalConfig,
 }
 
 impl FitConfig {
@@ -96,7 +100,7 @@ impl FitConfig {
 impl FitSettings {
     /// The recipe settings a recipe method trains with here (`epochs` and
     /// `validate_on_runs` applied to the method's own).
-    pub fn recipe_for(&self, kind: Method) -> RecipeSettings {
+    pub(crate) fn recipe_for(&self, kind: Method) -> RecipeSettings {
         let mut r = RecipeSettings::of_kind(kind);
         if let Some(e) = self.epochs {
             r.epochs = e;
@@ -106,11 +110,10 @@ impl FitSettings {
         r
     }
 
-    /// The library's fit configuration: checked, deprecated spellings resolved (what was
-    /// resolved is returned, to be said).
-    pub fn fit_config(&self) -> Result<(FitConfig, Option<Deprecation>), SettingError> {
+    /// The library's fit configuration, the settings checked first.
+    pub fn fit_config(&self) -> Result<FitConfig, SettingError> {
         self.validate()?;
-        let (method, note) = self.resolve()?;
+        let method = self.method;
         let mut cfg = FitConfig::new(method);
         // linear and poly fit no recipe; theirs stays the default, unused.
         cfg.recipe = self.recipe_for(method);
@@ -122,7 +125,7 @@ impl FitSettings {
             rate: self.poly_rate_degree,
             cross: self.cross,
         };
-        Ok((cfg, note))
+        Ok(cfg)
     }
 }
 
@@ -375,7 +378,7 @@ pub fn fit_model(
 }
 
 /// Whether the method identifies lags from the data (the `thermal` recipe).
-pub fn uses_identification(cfg: &FitConfig) -> bool {
+pub(crate) fn uses_identification(cfg: &FitConfig) -> bool {
     cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Identified)
 }
 
@@ -384,7 +387,7 @@ pub fn uses_identification(cfg: &FitConfig) -> bool {
 /// FOG drifts below 1 °/h over −40…+85 °C, a consumer MEMS gyro about 1 °/s), while a rate
 /// table turns at ±1 to ±400 °/s: a wider span is a rate-table run read without its table
 /// column, whose rates a bias model would fit as bias.
-pub const MAX_STATIC_SPAN_DPS: f64 = 5.0;
+pub(crate) const MAX_STATIC_SPAN_DPS: f64 = 5.0;
 
 /// Refuses training logs the models cannot learn from: one sampled more sparsely than the
 /// models step ([`crate::features::max_sample_period_s`]), and a static one whose gyro output
@@ -462,7 +465,7 @@ pub(crate) fn identify_every(
 
 /// [`fit_model`] with the identification already made ([`identify`] on the same logs and
 /// settings; None for methods without one).
-pub fn fit_model_identified(
+pub(crate) fn fit_model_identified(
     logs: &[NamedLog],
     cfg: &FitConfig,
     identified: Option<thermal::Identified>,

@@ -35,7 +35,11 @@ pub struct RecipeSettings {
     /// `Residual`: stop after this many epochs without a better validation loss.
     pub patience: Option<usize>,
     /// `Residual`: also fit a residual LSTM to the scale factor (default: baseline only).
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub scale_lstm: bool,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) scale_lstm: bool,
     /// `Residual`: the least relative validation-loss reduction for which the residual LSTM is
     /// kept; below it the sub-model is the physical fit alone.
     pub min_val_improvement: f64,
@@ -45,7 +49,11 @@ pub struct RecipeSettings {
     pub scale_base: BaseTerms,
     /// `Residual`: centred moving average (steps) applied to the base's residual before the
     /// LSTM is trained on it (1: none), to take the sensor noise out of its target.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub residual_smooth_steps: usize,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) residual_smooth_steps: usize,
     /// `Residual`: the LSTM reads the base (least-squares) prediction as one more input after
     /// the features, so that its correction can depend on the predicted level
     /// ([`SubModel::Residual::lstm_reads_base`](crate::model::SubModel::Residual)). Off by
@@ -102,7 +110,7 @@ pub enum LstmVerdict {
     /// Kept in the model (scaled by [`TrainSummary::lstm_gain`]).
     Kept,
     /// Left out; the flags say which check it failed (neither: its validation gain fell
-    /// below [`MIN_GAIN`]).
+    /// below `MIN_GAIN`).
     LeftOut {
         /// It did not beat the base by [`RecipeSettings::min_val_improvement`] on the validation
         /// blocks.
@@ -142,4 +150,4 @@ impl LstmVerdict {
 
 /// Below this validation gain the residual LSTM is dropped and the sub-model is the physical
 /// fit alone (a gain this small changes the output by less than 0.1 % of the LSTM's swing).
-pub const MIN_GAIN: f64 = 1e-3;
+pub(crate) const MIN_GAIN: f64 = 1e-3;

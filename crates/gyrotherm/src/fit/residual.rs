@@ -10,7 +10,8 @@
 //! runs (never the test run): the runs are cut into blocks and every `validation_every`-th
 //! block is kept for validation. It is kept only if it beats "no correction" on those blocks
 //! by [`RecipeSettings::min_val_improvement`], scaled by the gain they support. The scale factor
-//! gets the base only, or a residual LSTM too with [`RecipeSettings::scale_lstm`].
+//! gets the base only, or a residual LSTM too with `RecipeSettings::scale_lstm` (an experiment
+//! knob).
 //!
 //! Why a least-squares base under the LSTM, and why the LSTM is gated: an 8-unit LSTM alone
 //! does not extrapolate to a profile with faster temperature swings, where a base of the

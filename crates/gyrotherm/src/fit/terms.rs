@@ -137,7 +137,7 @@ impl Candidate {
 }
 
 /// The ladder's rungs, in the order tried: (T degree, second-order part).
-pub const LADDER: [(u8, SecondOrder); 9] = [
+pub(crate) const LADDER: [(u8, SecondOrder); 9] = [
     (1, SecondOrder::None),
     (2, SecondOrder::None),
     (3, SecondOrder::None),
@@ -149,7 +149,7 @@ pub const LADDER: [(u8, SecondOrder); 9] = [
     (3, SecondOrder::FastMid),
 ];
 
-/// The ladder of term sets ([`LADDER`]): a polynomial in T of degree 1 to 3, the lag
+/// The ladder of term sets (`LADDER`): a polynomial in T of degree 1 to 3, the lag
 /// differences linear, and none, the fastest lag's or the two fastest lags' second-order
 /// terms; named `T<d>`, `T<d>+fast`, `T<d>+fast+mid`. 9 sets of 5 to 12 terms, all within the
 /// flight crate's 16. The 20 s rate dT is not a term: the lag differences carry the rate at

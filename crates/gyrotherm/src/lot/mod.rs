@@ -179,14 +179,14 @@ impl Run {
     }
 
     /// The gyro column of axis `axis` (None: a single-axis run, or no such axis).
-    pub fn gyro_of(&self, axis: Option<u32>) -> Option<&str> {
+    pub(crate) fn gyro_of(&self, axis: Option<u32>) -> Option<&str> {
         self.axis_of(axis).map(|a| a.gyro.as_str())
     }
 }
 
 /// The unit's verdict from its axes' verdicts: `none` when no axis was judged, else the rule
 /// of [`UnitVerdict::from_axes`] (a unit passes only when every axis passes).
-pub fn unit_verdict_of_axes(axes: &[AxisRecord]) -> RunVerdict {
+pub(crate) fn unit_verdict_of_axes(axes: &[AxisRecord]) -> RunVerdict {
     if axes.iter().all(|a| a.verdict == RunVerdict::None) {
         return RunVerdict::None;
     }
@@ -387,7 +387,7 @@ pub trait LotStore {
 /// shows), URL query parameters and `key=value` settings whose key ends in `password`
 /// (`password`, `sslpassword`; any case, percent-encoded or not), quoted values whole.
 /// The command line and Python show a lot's name only through this.
-pub fn redact_db(db: &str) -> String {
+pub(crate) fn redact_db(db: &str) -> String {
     let Some((scheme, rest)) = db.split_once("://") else {
         return redact_conninfo(db);
     };
@@ -523,7 +523,7 @@ pub fn open_store(
 }
 
 /// What [`judge_unit`] needs besides the logs; for an inertial unit (several gyro axes,
-/// [`judge_imu_unit`]) the same with its logs ([`ImuUnitInputs`]).
+/// [`judge_imu_unit`]) the same with its logs (`ImuUnitInputs`).
 #[derive(Debug, Clone)]
 pub struct UnitInputs<'a, L = (PathBuf, TestLog)> {
     pub unit: &'a str,
@@ -562,7 +562,7 @@ pub fn check_unit_name(name: &str) -> Result<&str, LotError> {
 }
 
 /// SHA-256 of a file's bytes, hex.
-pub fn file_sha256(path: &Path) -> Result<String, LotError> {
+pub(crate) fn file_sha256(path: &Path) -> Result<String, LotError> {
     let bytes = std::fs::read(path).map_err(|source| LotError::Read {
         path: path.to_path_buf(),
         source,
@@ -631,7 +631,7 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
 }
 
 /// What [`judge_imu_unit`] needs besides the logs: an inertial unit's [`UnitInputs`].
-pub type ImuUnitInputs<'a> = UnitInputs<'a, (String, ImuLog)>;
+pub(crate) type ImuUnitInputs<'a> = UnitInputs<'a, (String, ImuLog)>;
 
 impl<L> UnitInputs<'_, L> {
     /// A model error in [`UnitInputs::model_path`].
@@ -738,9 +738,9 @@ pub struct ImuRunVerdict {
 }
 
 /// Judge an inertial unit: compensate each held-out log with the unit's model, measure every
-/// figure of each axis ([`crate::imu_judge::measure_unit`], as `evaluate --model` measures
+/// figure of each axis (`crate::imu_judge::measure_unit`, as `evaluate --model` measures
 /// it), judge each axis and the unit against the spec
-/// ([`crate::imu_judge::judge_unit_figures`]); the [`Run`] to record (dated now, a row per
+/// (`crate::imu_judge::judge_unit_figures`); the [`Run`] to record (dated now, a row per
 /// axis in [`Run::axes`], each figure with its axis) and the verdicts when a spec is given.
 pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>), LotError> {
     check_unit_name(u.unit.trim())?;

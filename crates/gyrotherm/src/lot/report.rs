@@ -23,7 +23,7 @@ use crate::spec::FIGURES;
 use super::{FigureRow, Run, RunVerdict};
 
 /// How many units the "worst units" table lists.
-pub const WORST_UNITS: usize = 10;
+pub(crate) const WORST_UNITS: usize = 10;
 
 /// The lot's yield over each unit's newest run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -103,7 +103,7 @@ fn csv_text(s: &str) -> String {
 /// Every run as CSV: one row per figure and log (and axis, for an inertial unit: `axis` names
 /// its gyro column and `axis_verdict` gives the axis's verdict; both empty for a single-axis
 /// run).
-pub fn lot_csv(runs: &[Run]) -> Result<Vec<u8>, csv::Error> {
+pub(crate) fn lot_csv(runs: &[Run]) -> Result<Vec<u8>, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record([
         "run_id",

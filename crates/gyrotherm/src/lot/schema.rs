@@ -2,7 +2,7 @@
 //! keeps them in step) so a lab can create the tables in its own database.
 //!
 //! A store holds one row in `schema_version`. Opening a store with an older version runs the
-//! steps after it ([`SQLITE_MIGRATIONS`], [`PG_MIGRATIONS`], index i upgrades version i + 1
+//! steps after it (`SQLITE_MIGRATIONS`, `PG_MIGRATIONS`, index i upgrades version i + 1
 //! to i + 2) in the same transaction as the check; a newer version is refused and nothing is
 //! written. A new store is made the same way (version 1, then every step), so the steps run
 //! on every new lot, not only on the old ones.
@@ -12,10 +12,10 @@
 //! axis (`figures.axis`, 0 for a single-axis run, which has no `run_axes` row).
 
 /// The schema version this gyrotherm writes and reads.
-pub const SCHEMA_VERSION: i64 = 2;
+pub(crate) const SCHEMA_VERSION: i64 = 2;
 
 /// Version 1 in SQLite.
-pub const SQLITE_V1: &str = "\
+pub(crate) const SQLITE_V1: &str = "\
 CREATE TABLE schema_version (version INTEGER NOT NULL);
 CREATE TABLE runs (
     id                   INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -59,7 +59,7 @@ INSERT INTO schema_version (version) VALUES (1);
 ";
 
 /// Version 1 in PostgreSQL: the same tables; ids from an identity column.
-pub const PG_V1: &str = "\
+pub(crate) const PG_V1: &str = "\
 CREATE TABLE schema_version (version INTEGER NOT NULL);
 CREATE TABLE runs (
     id                   BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY,
@@ -105,7 +105,7 @@ INSERT INTO schema_version (version) VALUES (1);
 /// Version 1 to 2 in SQLite: the axes of a unit's run, and the axis of each figure.
 /// SQLite cannot change a primary key in place, so `figures` is copied into a new table with
 /// the axis in its key (every existing figure on axis 0) and renamed.
-pub const SQLITE_V1_TO_V2: &str = "\
+pub(crate) const SQLITE_V1_TO_V2: &str = "\
 CREATE TABLE run_axes (
     run_id  INTEGER NOT NULL REFERENCES runs (id),
     axis    INTEGER NOT NULL,
@@ -135,7 +135,7 @@ UPDATE schema_version SET version = 2;
 ";
 
 /// Version 1 to 2 in PostgreSQL: as [`SQLITE_V1_TO_V2`]; PostgreSQL changes the key in place.
-pub const PG_V1_TO_V2: &str = "\
+pub(crate) const PG_V1_TO_V2: &str = "\
 CREATE TABLE run_axes (
     run_id  BIGINT NOT NULL REFERENCES runs (id),
     axis    INTEGER NOT NULL,
@@ -151,10 +151,10 @@ UPDATE schema_version SET version = 2;
 ";
 
 /// Upgrades of an SQLite lot: index i takes version i + 1 to i + 2.
-pub const SQLITE_MIGRATIONS: &[&str] = &[SQLITE_V1_TO_V2];
+pub(crate) const SQLITE_MIGRATIONS: &[&str] = &[SQLITE_V1_TO_V2];
 
 /// Upgrades of a PostgreSQL lot, as [`SQLITE_MIGRATIONS`].
-pub const PG_MIGRATIONS: &[&str] = &[PG_V1_TO_V2];
+pub(crate) const PG_MIGRATIONS: &[&str] = &[PG_V1_TO_V2];
 
 /// The columns every reader selects, in this order (both stores).
 pub(crate) const RUN_COLUMNS: &str = "id, unit, tested_at, gyrotherm_version, station, \

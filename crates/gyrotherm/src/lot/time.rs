@@ -24,7 +24,7 @@ pub fn rfc3339_utc(unix_ms: i64) -> String {
 }
 
 /// The inverse of [`rfc3339_utc`] (exactly its format), None otherwise.
-pub fn parse_rfc3339_utc(s: &str) -> Option<i64> {
+pub(crate) fn parse_rfc3339_utc(s: &str) -> Option<i64> {
     let b = s.as_bytes();
     if b.len() != 24 || b[4] != b'-' || b[7] != b'-' || b[10] != b'T' || b[23] != b'Z' {
         return None;

@@ -44,7 +44,7 @@ impl ZScore {
     }
 
     /// x·std + mean for channel `c`.
-    pub fn invert(&self, c: usize, z: f64) -> f64 {
+    pub(crate) fn invert(&self, c: usize, z: f64) -> f64 {
         z * self.std[c] + self.mean[c]
     }
 }

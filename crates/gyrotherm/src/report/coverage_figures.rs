@@ -18,9 +18,9 @@ use super::ReportError;
 
 const CELL_GREY: (u8, u8, u8) = (150, 150, 150);
 /// Colour of the samples inside the training region.
-pub const INSIDE: (u8, u8, u8) = (0, 90, 170);
+pub(crate) const INSIDE: (u8, u8, u8) = (0, 90, 170);
 /// Colour of the samples at its edge.
-pub const EDGE: (u8, u8, u8) = (213, 140, 0);
+pub(crate) const EDGE: (u8, u8, u8) = (213, 140, 0);
 /// Colour of the samples outside it (and of the ±1σ band).
 pub const OUTSIDE: (u8, u8, u8) = (200, 30, 30);
 const RESIDUAL: (u8, u8, u8) = (60, 60, 60);
@@ -34,7 +34,7 @@ const VERDICTS: [(Coverage, &str, (u8, u8, u8)); 3] = [
 
 /// One covered cell, in the figure's units.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CellRect {
+pub(crate) struct CellRect {
     /// Temperature span, °C.
     pub temp_c: (f64, f64),
     /// Temperature-rate span, °C/min.
@@ -43,7 +43,7 @@ pub struct CellRect {
 
 /// Data of the coverage-map figure.
 #[derive(Debug, Clone, Copy)]
-pub struct CoverageMapData<'a> {
+pub(crate) struct CoverageMapData<'a> {
     /// The training region's covered cells.
     pub cells: &'a [CellRect],
     /// The held-out run: temperature (°C), its rate (°C/min) and verdict per sample.
@@ -57,7 +57,10 @@ pub struct CoverageMapData<'a> {
 /// The coverage map: the covered cells outlined in grey and the held-out run's path over
 /// them, one colour per verdict (a stretch of one verdict is one line; the path breaks where
 /// the verdict changes). Temperature (°C) across, its rate (°C/min) up. 1000 × 600 px.
-pub fn coverage_map_figure(path: &Path, d: &CoverageMapData) -> Result<FigureFiles, ReportError> {
+pub(crate) fn coverage_map_figure(
+    path: &Path,
+    d: &CoverageMapData,
+) -> Result<FigureFiles, ReportError> {
     let n = d.temp_c.len();
     if d.rate_c_per_min.len() != n || d.coverage.len() != n {
         return Err(ReportError::Data {
@@ -110,7 +113,7 @@ pub fn coverage_map_figure(path: &Path, d: &CoverageMapData) -> Result<FigureFil
 
 /// Data of the σ figure.
 #[derive(Debug, Clone, Copy)]
-pub struct SigmaData<'a> {
+pub(crate) struct SigmaData<'a> {
     pub time_s: &'a [f64],
     /// Compensated output minus the true rate, °/h, per sample.
     pub residual_dph: &'a [f64],
@@ -124,7 +127,7 @@ pub struct SigmaData<'a> {
 /// σ beside the residual: top, the residual's means over consecutive `window_s` windows
 /// with the band ±σ (σ averaged over the same windows, as docs/experiments/coverage.md
 /// judges it); bottom, σ per sample, one colour per verdict. 1000 × 800 px.
-pub fn sigma_figure(path: &Path, d: &SigmaData) -> Result<FigureFiles, ReportError> {
+pub(crate) fn sigma_figure(path: &Path, d: &SigmaData) -> Result<FigureFiles, ReportError> {
     let n = d.time_s.len();
     if d.residual_dph.len() != n || d.sigma_dph.len() != n || d.coverage.len() != n {
         return Err(ReportError::Data {

@@ -414,7 +414,7 @@ impl NoiseTerm {
 }
 
 /// √(2 ln 2 / π), IEEE Std 952-1997 eq. C.19: the flat floor of σ(τ) is 0.6643·B.
-pub const BIAS_INSTABILITY_FACTOR: f64 = 0.664_282_470_267_960_1;
+pub(crate) const BIAS_INSTABILITY_FACTOR: f64 = 0.664_282_470_267_960_1;
 
 /// A noise term drawn as a dashed slope line across the τ range of the curves.
 #[derive(Debug, Clone, PartialEq)]
@@ -485,7 +485,7 @@ pub fn allan_figure(
 /// Means of `y` over consecutive windows of `window_s` starting at `time_s[0]`: returns the
 /// window centres (s) and the means of the finite samples in each; empty windows are
 /// skipped. `time_s` must be non-decreasing.
-pub fn window_means(time_s: &[f64], y: &[f64], window_s: f64) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn window_means(time_s: &[f64], y: &[f64], window_s: f64) -> (Vec<f64>, Vec<f64>) {
     let n = time_s.len().min(y.len());
     let (mut centres, mut means) = (Vec::new(), Vec::new());
     let Some(&t0) = time_s.first() else {

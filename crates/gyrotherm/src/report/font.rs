@@ -14,7 +14,7 @@ use plotters_backend::{
 use super::ReportError;
 
 /// The family every figure draws its text with.
-pub const FONT_FAMILY: &str = "sans-serif";
+pub(crate) const FONT_FAMILY: &str = "sans-serif";
 
 /// DejaVu Sans, unmodified.
 static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
@@ -23,7 +23,7 @@ static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
 
 /// Register the embedded font with plotters, once per process; thread-safe. Every figure
 /// writer calls this before drawing, so callers need not.
-pub fn ensure_font() -> Result<(), ReportError> {
+pub(crate) fn ensure_font() -> Result<(), ReportError> {
     REGISTERED
         .get_or_init(|| {
             for style in [

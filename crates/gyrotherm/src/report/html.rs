@@ -117,7 +117,7 @@ pub fn write_report(dir: &Path, content: &ReportContent) -> Result<PathBuf, Repo
 }
 
 /// The page as a string (see [`write_report`]).
-pub fn render_html(c: &ReportContent) -> String {
+pub(crate) fn render_html(c: &ReportContent) -> String {
     let mut h = String::with_capacity(4096);
     let title = escape(&c.title);
     // `write!` into a String cannot fail.

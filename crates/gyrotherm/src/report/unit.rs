@@ -17,7 +17,7 @@ use crate::spec::{Spec, Verdict};
 
 /// The figures of each axis's page that the unit page shows in the axis's section, with
 /// their captions.
-pub const UNIT_PAGE_FIGURES: [(&str, &str); 2] = [
+pub(crate) const UNIT_PAGE_FIGURES: [(&str, &str); 2] = [
     (
         "fig7_compensation",
         "raw and compensated output of the main held-out log",
@@ -33,13 +33,13 @@ const UNIT_CSS: &str = "table.across-axes td:nth-child(-n+3){text-align:left}\
 table.axis-verdicts td:nth-child(-n+3){text-align:left}";
 
 /// The folder of axis `k` (0-based) inside the report folder.
-pub fn axis_folder(k: usize) -> String {
+pub(crate) fn axis_folder(k: usize) -> String {
     format!("axis{}", k + 1)
 }
 
 /// The unit's verdict of each judged column ([`unit_verdicts`]): a row per column, a cell per
 /// axis and the unit's cell (`PASS` only when every axis passes).
-pub fn unit_verdict_table(spec: &Spec, verdicts: &[AxisVerdicts]) -> Table {
+pub(crate) fn unit_verdict_table(spec: &Spec, verdicts: &[AxisVerdicts]) -> Table {
     let mut headers = vec!["column".to_owned()];
     headers.extend(verdicts.iter().map(|a| a.gyro.clone()));
     headers.push("unit".to_owned());
@@ -59,7 +59,7 @@ pub fn unit_verdict_table(spec: &Spec, verdicts: &[AxisVerdicts]) -> Table {
 }
 
 /// One axis's verdicts: a row per judged column, figure and held-out log.
-pub fn axis_verdict_table(a: &AxisVerdicts) -> Table {
+pub(crate) fn axis_verdict_table(a: &AxisVerdicts) -> Table {
     let headers = [
         "column",
         "figure",

@@ -6,12 +6,12 @@ use crate::csvlog::{rate_column_to_dph, GYRO_COL};
 use crate::setting_rule::{Rule, SettingError};
 
 /// Names of the deviations, default first.
-pub const KIND_NAMES: [&str; 5] = ["oadev", "adev", "mdev", "hdev", "ohdev"];
+pub(crate) const KIND_NAMES: [&str; 5] = ["oadev", "adev", "mdev", "hdev", "ohdev"];
 /// Default deviation.
 pub const DEFAULT_KIND: DevKind = DevKind::Oadev;
 /// Names of the automatic τ sets, default first (a comma-separated list of seconds is also
 /// a τ set).
-pub const TAU_SET_NAMES: [&str; 3] = ["octave", "decade", "all"];
+pub(crate) const TAU_SET_NAMES: [&str; 3] = ["octave", "decade", "all"];
 /// Default τ set.
 pub const DEFAULT_TAUS: TauSet = TauSet::Octave;
 
@@ -115,7 +115,7 @@ impl AllanSettings {
     }
 
     /// The noise model of the confidence intervals.
-    pub fn noise_model(&self) -> NoiseModel {
+    pub(crate) fn noise_model(&self) -> NoiseModel {
         self.alpha.map_or(NoiseModel::Identify, NoiseModel::Alpha)
     }
 

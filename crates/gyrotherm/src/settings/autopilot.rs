@@ -16,7 +16,7 @@ pub enum GyroAxis {
 /// The axes in order (the order of the autopilot's parameters).
 pub const GYRO_AXES: [GyroAxis; 3] = [GyroAxis::X, GyroAxis::Y, GyroAxis::Z];
 /// Names of [`GYRO_AXES`].
-pub const GYRO_AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
+pub(crate) const GYRO_AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
 
 impl GyroAxis {
     /// The name on the command line (`--axis`).
@@ -51,13 +51,13 @@ impl std::str::FromStr for GyroAxis {
 }
 
 /// Default IMU instance (the autopilot's first IMU: ArduPilot `INS_TCAL1_*`, PX4 `TC_G0_*`).
-pub const DEFAULT_INSTANCE: u8 = 0;
+pub(crate) const DEFAULT_INSTANCE: u8 = 0;
 /// Default axis a single-gyro model fills.
-pub const DEFAULT_AXIS: GyroAxis = GyroAxis::X;
+pub(crate) const DEFAULT_AXIS: GyroAxis = GyroAxis::X;
 /// IMUs ArduPilot calibrates (`INS_TCAL1` to `INS_TCAL3`).
-pub const ARDUPILOT_INSTANCES: u8 = 3;
+pub(crate) const ARDUPILOT_INSTANCES: u8 = 3;
 /// Gyros PX4 calibrates (`TC_G0` to `TC_G3`, `GYRO_COUNT_MAX`).
-pub const PX4_INSTANCES: u8 = 4;
+pub(crate) const PX4_INSTANCES: u8 = 4;
 
 /// What an autopilot export writes besides the polynomial.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

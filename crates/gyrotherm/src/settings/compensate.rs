@@ -5,7 +5,7 @@
 use gyrotherm_core::compensator::TempLimits;
 
 /// `(setting name, default)` of each temperature-sensor limit, in `--help` order.
-pub fn temp_sensor_defaults() -> [(&'static str, f64); 5] {
+pub(crate) fn temp_sensor_defaults() -> [(&'static str, f64); 5] {
     let d = TempLimits::DEFAULT;
     [
         ("temp_min_c", d.min_c),

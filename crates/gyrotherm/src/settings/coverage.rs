@@ -11,32 +11,32 @@
 //! held-out runs *with this grid, these folds, this cell minimum and this shrinkage*; a user
 //! changing any one of them would get a σ whose ±1σ share nobody has measured, and a map a
 //! flight reader cannot compare with another model's. The struct keeps them together for
-//! [`crate::coverage::cross_validated`] and its tests; the calibration harness
+//! `crate::coverage::cross_validated` and its tests; the calibration harness
 //! (`crates/gyrotherm-experiments/src/bin/coverage.rs`) varies scale and growth on the
 //! design family only, through [`crate::coverage::CoverageDef::rescaled`]. A change of any
 //! constant here needs that record re-run (`bench/coverage.sh design`, then `confirm` once).
 
 /// Temperature cells of the grid (the core's maximum).
-pub const TEMP_CELLS: usize = gyrotherm_core::coverage::MAX_TEMP_CELLS;
+pub(crate) const TEMP_CELLS: usize = gyrotherm_core::coverage::MAX_TEMP_CELLS;
 /// Temperature-rate cells of the grid (the core's maximum).
-pub const RATE_CELLS: usize = gyrotherm_core::coverage::MAX_RATE_CELLS;
+pub(crate) const RATE_CELLS: usize = gyrotherm_core::coverage::MAX_RATE_CELLS;
 /// Narrowest temperature cell, °C: twice the DS18B20's ±0.5 °C accuracy (He et al. 2024,
 /// DOI 10.19452/j.issn1007-5453.2024.02.004, §3), so a log that barely moved covers a cell
 /// or two, not sixteen slivers of noise.
-pub const MIN_TEMP_CELL_C: f64 = 1.0;
+pub(crate) const MIN_TEMP_CELL_C: f64 = 1.0;
 /// Narrowest rate cell, °C/s: 0.06 °C/min, about the rate noise of a 0.0625 °C sensor step
 /// over the 20 s rate window (0.0625 / 20 ≈ 0.003 °C/s) divided by thirty.
-pub const MIN_RATE_CELL_C_PER_S: f64 = 1e-3;
+pub(crate) const MIN_RATE_CELL_C_PER_S: f64 = 1e-3;
 /// Cross-validation folds: contiguous time blocks of each static log, as the `thermal`
 /// method's own cross-validation uses (README, "The method").
 pub const FOLDS: usize = 5;
 /// Held-out steps a cell needs to count as covered: one 100 s bias window (He et al. 2024,
 /// §3), so a cell's residual is at least one independent smoothed value.
-pub const MIN_CELL_STEPS: u64 = 100;
+pub(crate) const MIN_CELL_STEPS: u64 = 100;
 /// Steps of pooled residual mixed into each cell's RMS (shrinkage towards the pooled RMS):
 /// residuals of a 100 s smoothed target are correlated over about 100 steps, so a cell of a
 /// few hundred steps holds only a few independent values.
-pub const SHRINK_STEPS: f64 = 300.0;
+pub(crate) const SHRINK_STEPS: f64 = 300.0;
 /// σ = SIGMA_SCALE × the cell's shrunk cross-validated RMS (design family,
 /// docs/experiments/coverage.md).
 pub const SIGMA_SCALE: f64 = 0.9;

@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::allan::{AllanSettings, KIND_NAMES, TAU_SET_NAMES};
 use super::compensate::temp_sensor_defaults;
 use super::evaluate::EvaluateSettings;
-use super::fit::{FitSettings, RECIPE_NAMES};
+use super::fit::FitSettings;
 use super::method::METHOD_NAMES;
 use super::read::{delimiter_name, DELIMITER_NAMES, GYRO_UNIT_NAMES};
 use crate::csvlog::ReadOptions;
@@ -23,7 +23,7 @@ pub struct OptionSpec {
     pub values: Vec<&'static str>,
     /// Whether the setting is a switch (a flag without a value on the command line).
     pub switch: bool,
-    /// Deprecated spelling, kept one release.
+    /// A deprecated spelling, hidden from `--help` (none at present).
     pub deprecated: bool,
     /// Whether a value outside `values` is accepted too (`taus`: a list of seconds;
     /// `delimiter`: other spellings of the same separators).
@@ -78,15 +78,10 @@ pub fn log_options() -> Vec<OptionSpec> {
 }
 
 /// The settings of fitting (`train`; also `compare`, `report`, `demo`).
-pub fn fit_options() -> Vec<OptionSpec> {
+pub(crate) fn fit_options() -> Vec<OptionSpec> {
     let d = FitSettings::default();
     vec![
         choice("method", d.method.as_str(), &METHOD_NAMES),
-        OptionSpec {
-            deprecated: true,
-            values: RECIPE_NAMES.to_vec(),
-            ..opt("recipe", None)
-        },
         opt("epochs", d.epochs.map(|e| e.to_string())),
         opt("seed", Some(d.seed.to_string())),
         opt("hidden", Some(d.hidden.to_string())),
@@ -100,7 +95,7 @@ pub fn fit_options() -> Vec<OptionSpec> {
 }
 
 /// The temperature-sensor limits (`train` stores them in the model; `compensate` uses them).
-pub fn sensor_options() -> Vec<OptionSpec> {
+pub(crate) fn sensor_options() -> Vec<OptionSpec> {
     temp_sensor_defaults()
         .into_iter()
         .map(|(name, v)| opt(name, Some(v.to_string())))
@@ -108,7 +103,7 @@ pub fn sensor_options() -> Vec<OptionSpec> {
 }
 
 /// The settings of `allan`.
-pub fn allan_options() -> Vec<OptionSpec> {
+pub(crate) fn allan_options() -> Vec<OptionSpec> {
     let d = AllanSettings::default();
     vec![
         opt("column", Some(d.column)),
@@ -123,7 +118,7 @@ pub fn allan_options() -> Vec<OptionSpec> {
 }
 
 /// The settings of `evaluate`.
-pub fn evaluate_options() -> Vec<OptionSpec> {
+pub(crate) fn evaluate_options() -> Vec<OptionSpec> {
     let d = EvaluateSettings::default();
     vec![
         opt("column", Some(d.column)),
@@ -134,7 +129,7 @@ pub fn evaluate_options() -> Vec<OptionSpec> {
 }
 
 /// The settings of `plan` (the flight log is a setting: the envelope comes from it).
-pub fn plan_options() -> Vec<OptionSpec> {
+pub(crate) fn plan_options() -> Vec<OptionSpec> {
     let d = super::plan::PlanSettings::default();
     let num = |v: Option<f64>| v.map(|v| v.to_string());
     vec![

@@ -6,7 +6,7 @@ use crate::metrics::{self, Evaluation, EvaluationError, EvaluationOptions};
 use crate::setting_rule::{Rule, SettingError};
 
 /// The preferred bias-stability smoothing time, s (100 s, He et al. 2024 and docs/method.md §4).
-pub const PREFERRED_TAU_S: f64 = crate::metrics::BIAS_STABILITY_TAU_S;
+pub(crate) const PREFERRED_TAU_S: f64 = crate::metrics::BIAS_STABILITY_TAU_S;
 /// Default time dropped at the start of each rate-table segment, s.
 pub const DEFAULT_SETTLE_S: f64 = crate::targets::SETTLE_S;
 
@@ -16,7 +16,7 @@ pub struct EvaluateSettings {
     /// Rate column to judge: `gyro_dps` or a numeric extra column (`*_dps`, `*_dph`,
     /// `*_rad_s`).
     pub column: String,
-    /// Smoothing time of the bias stability, s (None: [`PREFERRED_TAU_S`], or the multiple
+    /// Smoothing time of the bias stability, s (None: `PREFERRED_TAU_S`, or the multiple
     /// of the sample period nearest to it when it is not one).
     pub tau_s: Option<f64>,
     /// Time dropped at the start of each rate-table segment, s.
@@ -95,7 +95,7 @@ impl std::error::Error for EvaluateError {
     }
 }
 
-/// The τ used, and whether it was moved off [`PREFERRED_TAU_S`] (then the caller should say
+/// The τ used, and whether it was moved off `PREFERRED_TAU_S` (then the caller should say
 /// so: a log at one sample per 15 s gets τ = 105 s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ResolvedTau {

@@ -6,8 +6,7 @@
 //! from it ([`FitSettings::fit_config`] in [`crate::fit`], [`FitSettings::compare_config`] in
 //! [`crate::compare`]).
 
-pub use super::method::RECIPE_NAMES;
-use super::method::{Method, DEFAULT_METHOD};
+use super::method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
 pub use crate::setting_rule::MAX_EPOCHS;
 use crate::setting_rule::{check, Rule, SettingError};
 use crate::targets;
@@ -24,9 +23,6 @@ pub const DEFAULT_POLY_TEMP_DEGREE: u8 = 3;
 pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 /// Default hidden units of the LSTM recipes: 8, as published (He et al. 2024, §2).
 pub const DEFAULT_HIDDEN: usize = 8;
-/// Most hidden units the LSTM recipes take (a 128-unit network has 70,000 parameters; the
-/// flight crate's fixed-size network then needs 290 KB).
-pub const MAX_HIDDEN: usize = 128;
 
 /// Default least relative drop of an inertial-unit axis's cross-validated RMS for a further
 /// temperature sensor to join its model: −1, a sensor joins unless it doubles the
@@ -56,7 +52,7 @@ pub const DEFAULT_IMU_FIRST: FirstBy = FirstBy::Single;
 /// searches on every step.
 pub const IMU_IDENTIFY_EVERY: usize = 5;
 
-/// The terms a further sensor adds ([`extra_terms`](crate::fit::thermal::multi::extra_terms); the default
+/// The terms a further sensor adds (`extra_terms`; the default
 /// is [`DEFAULT_IMU_EXTRA_TERMS`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ExtraTerms {
@@ -104,17 +100,33 @@ pub struct ImuFitSettings {
     pub min_gain: f64,
     /// Experiment (0: off): the weight of the first sensor's one-sensor bias model in an
     /// average with the several-sensor bias model.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub blend: f64,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) blend: f64,
     /// Experiment (None: the recipe's grid): the decades (lowest, highest power of ten) of
     /// the ridge strengths the several-sensor fits and the sensor selection try.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub multi_ridge_decades: Option<(i32, i32)>,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) multi_ridge_decades: Option<(i32, i32)>,
     /// The further sensors' terms ([`DEFAULT_IMU_EXTRA_TERMS`]; the others are experiments).
     pub multi_extra: ExtraTerms,
     /// How the first sensor is chosen ([`DEFAULT_IMU_FIRST`]; the others are experiments).
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub multi_first: FirstBy,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) multi_first: FirstBy,
     /// Experiment (0: the identification's): folds of the sensor selection's
     /// cross-validation.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
     pub multi_select_folds: usize,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) multi_select_folds: usize,
 }
 
 impl Default for ImuFitSettings {
@@ -136,16 +148,12 @@ impl Default for ImuFitSettings {
 pub struct FitSettings {
     /// Fitting method ([`DEFAULT_METHOD`]).
     pub method: Method,
-    /// Deprecated for one release: the recipe of the former `lstm` method, a recipe method
-    /// ([`RECIPE_NAMES`]). Given with `thermal` (the default) or `lstm`, it names the method
-    /// ([`FitSettings::resolve`]).
-    pub recipe: Option<Method>,
     /// Training epochs of the method's LSTM (None: the method's own).
     pub epochs: Option<usize>,
     /// Random seed of the LSTM initialisation and window order.
     pub seed: u64,
-    /// Hidden units of the method's LSTM ([`DEFAULT_HIDDEN`]). The trainer takes 1 to
-    /// [`MAX_HIDDEN`], but a model file must run in flight, whose network is built for
+    /// Hidden units of the method's LSTM ([`DEFAULT_HIDDEN`]). The trainer takes other
+    /// sizes, but a model file must run in flight, whose network is built for
     /// [`gyrotherm_core::compensator::HIDDEN`] units: until the flight crate and its exports
     /// take other sizes, [`FitSettings::validate`] accepts that size only.
     pub hidden: usize,
@@ -168,7 +176,6 @@ impl Default for FitSettings {
     fn default() -> Self {
         FitSettings {
             method: DEFAULT_METHOD,
-            recipe: None,
             epochs: None,
             seed: DEFAULT_SEED,
             hidden: DEFAULT_HIDDEN,
@@ -178,36 +185,6 @@ impl Default for FitSettings {
             poly_rate_degree: DEFAULT_POLY_RATE_DEGREE,
             cross: true,
             validate_on_runs: false,
-        }
-    }
-}
-
-/// A deprecated spelling that was accepted, and what it now means (to be said to the user).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Deprecation {
-    /// Method `lstm`: it is now the recipe's own method.
-    LstmMethod { now: Method },
-    /// `recipe` naming the method.
-    Recipe { now: Method },
-    /// `recipe` given with a method that has none (`linear`, `poly`): ignored, as before.
-    RecipeIgnored { method: Method },
-}
-
-impl std::fmt::Display for Deprecation {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Deprecation::LstmMethod { now } => write!(
-                f,
-                "method `lstm` is deprecated and now means method `{now}`; give that instead"
-            ),
-            Deprecation::Recipe { now } => write!(
-                f,
-                "recipe is deprecated: the recipes are methods now; give method `{now}`"
-            ),
-            Deprecation::RecipeIgnored { method } => write!(
-                f,
-                "recipe is deprecated, and method `{method}` has none: ignored"
-            ),
         }
     }
 }
@@ -225,48 +202,15 @@ impl FitSettings {
         check("hidden", self.hidden as f64, Rule::HiddenUnits)?;
         check("bias_window_s", self.bias_window_s, Rule::PositiveSeconds)?;
         check("settle_s", self.settle_s, Rule::NonNegativeSeconds)?;
-        self.resolve().map(|_| ())
-    }
-
-    /// The method these settings fit, with the deprecated spellings turned into it: `lstm`
-    /// becomes the recipe's method (`thermal` without one); a `recipe` given with `thermal`
-    /// (the default, so a script's `--recipe residual` keeps its meaning) names the method;
-    /// with `linear` or `poly` it is ignored, as it always was; with another recipe method it
-    /// must agree.
-    pub fn resolve(&self) -> Result<(Method, Option<Deprecation>), SettingError> {
-        let Some(r) = self.recipe else {
-            return Ok(match self.method {
-                Method::Lstm => (
-                    DEFAULT_METHOD,
-                    Some(Deprecation::LstmMethod {
-                        now: DEFAULT_METHOD,
-                    }),
-                ),
-                m => (m, None),
-            });
-        };
-        if !r.is_own_recipe() {
-            return Err(SettingError::unknown("recipe", r.as_str(), &RECIPE_NAMES));
+        // `lstm`, which older model files record, is no method a fit can use.
+        if !METHODS.contains(&self.method) {
+            return Err(SettingError::unknown(
+                "method",
+                self.method.as_str(),
+                &METHOD_NAMES,
+            ));
         }
-        let now = r;
-        match self.method {
-            Method::Lstm => Ok((now, Some(Deprecation::LstmMethod { now }))),
-            Method::Linear | Method::Poly => Ok((
-                self.method,
-                Some(Deprecation::RecipeIgnored {
-                    method: self.method,
-                }),
-            )),
-            m if m == now || m == DEFAULT_METHOD => Ok((now, Some(Deprecation::Recipe { now }))),
-            m => Err(SettingError::Conflict {
-                setting: "recipe",
-                other: "method",
-                why: format!(
-                    "recipe `{}` is method `{now}`, but method `{m}` was given",
-                    r.as_str()
-                ),
-            }),
-        }
+        Ok(())
     }
 }
 

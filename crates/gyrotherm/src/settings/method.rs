@@ -20,8 +20,7 @@ pub enum Family {
     Recipe,
     /// Classic least squares on T and dT ([`crate::baseline`]).
     LeastSquares,
-    /// Read only: files of earlier versions name it; no fit writes it, and the command line
-    /// and Python take it only as a deprecated spelling.
+    /// Read only: files of earlier versions name it; no fit writes it, and no fit takes it.
     ReadOnly,
 }
 
@@ -54,7 +53,7 @@ macro_rules! registry {
 
         /// Every method's entry, in the order of [`Method`]'s variants: the fitting methods
         /// default first, in the order `--help` lists them, then the read-only ones.
-        pub const REGISTRY: &[MethodInfo] = &[$(
+        pub(crate) const REGISTRY: &[MethodInfo] = &[$(
             MethodInfo {
                 method: Method::$variant,
                 name: $name,
@@ -95,10 +94,9 @@ registry! {
     Poly = "poly", LeastSquares, None, "polynomial in T and dT (industry standard)";
     /// Read from files written before the methods were one list: the `lstm` method with a
     /// recipe the file did not record. Such files load and compensate as before (the
-    /// sub-models say what they are); no fit writes it. On the command line and in Python,
-    /// `lstm` is a deprecated spelling resolved by [`super::FitSettings::resolve`].
+    /// sub-models say what they are); no fit writes it or takes it.
     Lstm = "lstm", ReadOnly, None,
-        "deprecated: the former LSTM method; use `thermal` or a recipe's name";
+        "the former LSTM method, read from older model files only";
 }
 
 /// How many entries of the registry are of a kind (`None`: every fitting method, that is
@@ -158,14 +156,14 @@ pub const METHODS: [Method; N_METHODS] = {
 /// The names of [`METHODS`].
 pub const METHOD_NAMES: [&str; N_METHODS] = names(None);
 
-/// The names of the recipe methods, the values of the deprecated `recipe` setting.
-pub const RECIPE_NAMES: [&str; N_RECIPES] = names(Some(Family::Recipe));
+/// The names of the recipe methods.
+pub(crate) const RECIPE_NAMES: [&str; N_RECIPES] = names(Some(Family::Recipe));
 
 /// The default method of `train` and `fit()`.
 pub const DEFAULT_METHOD: Method = Method::Thermal;
 
 impl Method {
-    /// The method's entry in [`REGISTRY`].
+    /// The method's entry in `REGISTRY`.
     pub const fn info(&self) -> &'static MethodInfo {
         // The variants are declared in registry order, one per entry.
         &REGISTRY[*self as usize]
@@ -204,7 +202,7 @@ impl Method {
         !matches!(self.family(), Family::LeastSquares)
     }
 
-    /// The deprecated `recipe` setting: a recipe method's name ([`RECIPE_NAMES`]).
+    /// A recipe method by name (`RECIPE_NAMES`).
     pub fn parse_recipe(s: &str) -> Result<Method, SettingError> {
         REGISTRY
             .iter()
@@ -222,7 +220,7 @@ impl std::fmt::Display for Method {
 
 impl std::str::FromStr for Method {
     type Err = SettingError;
-    /// A name of [`METHOD_NAMES`], or the deprecated `lstm`.
+    /// A name of [`METHOD_NAMES`], or `lstm`, which older model files record.
     fn from_str(s: &str) -> Result<Self, SettingError> {
         REGISTRY
             .iter()

@@ -46,6 +46,6 @@ pub use crate::setting_rule as rule;
 pub use allan::{AllanAnalysis, AllanSettings};
 pub use describe::{describe, OptionSpec};
 pub use evaluate::EvaluateSettings;
-pub use fit::{Deprecation, FitSettings};
+pub use fit::FitSettings;
 pub use method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
 pub use rule::{check, check_opt, parse_number, Rule, SettingError};

@@ -16,24 +16,24 @@ pub const CHAMBER_MAX_RATE_C_PER_MIN: f64 = 10.0;
 /// flight rate. With the coverage grid's 12 rate cells over −R…+R (cells R/6 wide), levels
 /// R/3 apart leave at most one cell between two levels (or a level and the soaks' 0), so no
 /// rate in between is further than the edge of the covered region.
-pub const RATE_LEVELS: usize = 3;
+pub(crate) const RATE_LEVELS: usize = 3;
 /// Margin added to the flight's temperature extremes, °C: one narrowest coverage cell
 /// ([`super::coverage::MIN_TEMP_CELL_C`]) beyond each, so the extremes lie inside a cell.
-pub const TEMP_MARGIN_C: f64 = super::coverage::MIN_TEMP_CELL_C;
+pub(crate) const TEMP_MARGIN_C: f64 = super::coverage::MIN_TEMP_CELL_C;
 /// Factor on the flight's largest rate: the gyro's temperature follows a chamber ramp with a
 /// lag, so its rate stays a little under the set point's (airborne: 9.2 °C/min on the sensor
 /// for a 9.5 °C/min ramp, 3 % under); 10 % more reaches the flight's rate.
-pub const RATE_MARGIN: f64 = 1.1;
+pub(crate) const RATE_MARGIN: f64 = 1.1;
 /// Soak at each extreme, s: three times the sum of the case and coil lags of the simulated
 /// unit (180 s + 300 s, `sim::FogUnit::default`), so the gyro is at rest again before the
 /// next ramp and every ramp starts the same way. The slower stress lag (2500 s) is left to
 /// the long soaks of the shock test the plan adds to, as are the temperatures in between.
-pub const SOAK_S: f64 = 1440.0;
+pub(crate) const SOAK_S: f64 = 1440.0;
 /// Room temperature the profile starts and ends at, °C.
-pub const ROOM_C: f64 = 22.0;
+pub(crate) const ROOM_C: f64 = 22.0;
 /// Held-out steps a coverage cell needs ([`super::coverage::MIN_CELL_STEPS`]): each
 /// temperature cell of a ramp gets at least this many seconds at 1 Hz, by repeating it.
-pub const MIN_CELL_S: f64 = super::coverage::MIN_CELL_STEPS as f64;
+pub(crate) const MIN_CELL_S: f64 = super::coverage::MIN_CELL_STEPS as f64;
 
 pub use crate::setting_rule::{ABSOLUTE_ZERO_C, MAX_ENVELOPE_C};
 
@@ -70,7 +70,7 @@ impl Default for PlanSettings {
 impl PlanSettings {
     /// Check the settings: finite temperatures, positive rates, each minimum below its
     /// maximum; the chamber's set points and ramp within what `simulate --profile-file`
-    /// accepts ([`crate::sim::profile::TARGET_RANGE_C`], [`crate::sim::profile::MAX_RAMP_C_PER_MIN`]), since
+    /// accepts (`crate::sim::profile::TARGET_RANGE_C`, `crate::sim::profile::MAX_RAMP_C_PER_MIN`), since
     /// the plan is written as such a profile; the envelope's temperatures physical (above
     /// absolute zero, below [`MAX_ENVELOPE_C`]).
     pub fn validate(&self) -> Result<(), SettingError> {

@@ -35,10 +35,10 @@ use super::fog::{FogUnit, SensorNode};
 use super::noise::Gauss;
 
 /// The ChaCha8 stream a unit is drawn from (apart from the run's noise streams, 1 to 31).
-pub const UNIT_STREAM: u64 = 40;
+pub(crate) const UNIT_STREAM: u64 = 40;
 
 /// A closed interval `(lo, hi)`.
-pub type Interval = (f64, f64);
+pub(crate) type Interval = (f64, f64);
 
 /// The ranges a unit is drawn from (see the module doc for the defaults and their reasons).
 /// Signed entries give the magnitude; the sign is drawn separately.
@@ -149,7 +149,7 @@ impl UnitRanges {
     /// [`UnitRanges::draw`] from another ChaCha8 stream of the same seed: the further gyros of
     /// an inertial unit ([`super::imu`]) are drawn from streams after [`UNIT_STREAM`], so the
     /// first gyro of unit N is single-axis unit N's gyro.
-    pub fn draw_on_stream(&self, unit_seed: u64, stream: u64) -> FogUnit {
+    pub(crate) fn draw_on_stream(&self, unit_seed: u64, stream: u64) -> FogUnit {
         let mut d = Draw(Gauss::new(unit_seed, stream));
         let has_mount = d.0.uniform() < self.mount_probability;
         let mount_tau_s = d.log_uniform(self.node_tau_s);

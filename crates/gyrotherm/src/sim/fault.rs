@@ -51,13 +51,13 @@ pub struct FaultParams {
 }
 
 /// The DS18B20's power-on register value, °C: what it returns after a failed conversion.
-pub const POWER_ON_VALUE_C: f64 = 85.0;
+pub(crate) const POWER_ON_VALUE_C: f64 = 85.0;
 /// The value a DS18B20 driver reports on a bus error, °C.
-pub const BUS_ERROR_VALUE_C: f64 = -127.0;
+pub(crate) const BUS_ERROR_VALUE_C: f64 = -127.0;
 
 impl FaultParams {
     /// True when no fault can occur.
-    pub fn is_off(&self) -> bool {
+    pub(crate) fn is_off(&self) -> bool {
         self.dropouts_per_hour == 0.0
             && self.stuck_temp_per_hour == 0.0
             && self.spikes_per_hour == 0.0

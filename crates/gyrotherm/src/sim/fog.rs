@@ -214,7 +214,7 @@ const QUANTA: [Quantum; 2] = [
 
 /// Largest temperature-sensor offset or noise (1σ) a unit may have, °C: beyond it the
 /// logged temperature no longer follows the unit's (chamber set points span −80 to 180 °C).
-pub const MAX_SENSOR_ERROR_C: f64 = 100.0;
+pub(crate) const MAX_SENSOR_ERROR_C: f64 = 100.0;
 
 impl FogUnit {
     /// Parse a JSON parameter file's text: the given fields override the default unit's.
@@ -242,7 +242,7 @@ impl FogUnit {
 
     /// Checks every field: finite; time constants > 0; noise terms and resolution ≥ 0; the
     /// quanta 0 or within a real part's range; the sensor's offset and noise at most
-    /// [`MAX_SENSOR_ERROR_C`].
+    /// `MAX_SENSOR_ERROR_C`.
     pub fn validate(&self) -> Result<(), SimError> {
         let bad = |field: &str, message: String| {
             Err(SimError::Unit {
@@ -354,7 +354,7 @@ impl FogUnit {
 
     /// Scale factor K of a thermal state: the coil polynomial plus the coil-rate and stress
     /// terms.
-    pub fn scale_of_state(&self, s: &ThermalState) -> f64 {
+    pub(crate) fn scale_of_state(&self, s: &ThermalState) -> f64 {
         self.scale_ppm_terms(s.coil_c, s.coil_rate_c_per_s(self), s.stress_c)
     }
 
@@ -372,7 +372,7 @@ impl FogUnit {
     /// The bias terms beyond [`FogUnit::thermal_bias_dph`], °/h: the radial-gradient Shupe
     /// term on d(T_case - T_coil)/dt and the saturating rate term A·tanh(dT_coil/dt / r_s),
     /// for the state `s` with chamber air at `air_c`.
-    pub fn gradient_and_saturation_bias_dph(&self, s: &ThermalState, air_c: f64) -> f64 {
+    pub(crate) fn gradient_and_saturation_bias_dph(&self, s: &ThermalState, air_c: f64) -> f64 {
         let coil_rate = s.coil_rate_c_per_s(self);
         let grad_rate = s.case_rate_c_per_s(self, air_c) - coil_rate;
         self.shupe_grad_dph_per_c_per_s * grad_rate
@@ -380,7 +380,7 @@ impl FogUnit {
     }
 
     /// Whether the unit has a mounting node between the chamber air and the case.
-    pub fn has_mount(&self) -> bool {
+    pub(crate) fn has_mount(&self) -> bool {
         self.mount_tau_s > 0.0
     }
 }
@@ -418,13 +418,13 @@ impl ThermalState {
     }
 
     /// Coil temperature rate, °C/s (= (T_case - T_coil)/τ_coil for the first-order node).
-    pub fn coil_rate_c_per_s(&self, unit: &FogUnit) -> f64 {
+    pub(crate) fn coil_rate_c_per_s(&self, unit: &FogUnit) -> f64 {
         (self.case_c - self.coil_c) / unit.coil_tau_s
     }
 
     /// Case temperature rate, °C/s, with chamber air at `air_c`: (drive - T_case)/τ_case, the
     /// drive being the mounting node, or the air when the unit has none.
-    pub fn case_rate_c_per_s(&self, unit: &FogUnit, air_c: f64) -> f64 {
+    pub(crate) fn case_rate_c_per_s(&self, unit: &FogUnit, air_c: f64) -> f64 {
         let drive = if unit.has_mount() {
             self.mount_c
         } else {

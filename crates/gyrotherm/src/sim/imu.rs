@@ -26,8 +26,8 @@
 //! sensor faults (inject them by editing the log).
 //!
 //! Determinism: the chamber uses the run's seed as a single-axis run does; gyro `k`'s noise
-//! and its coil sensor use the seed [`axis_seed`]`(seed, k)`, the case sensor stream
-//! [`CASE_SENSOR_STREAM`] of the run's seed.
+//! and its coil sensor use the seed `axis_seed``(seed, k)`, the case sensor stream
+//! `CASE_SENSOR_STREAM` of the run's seed.
 
 use super::fog::{lag_alpha, FogUnit, SensorNode, ThermalState, ThermalStep};
 use super::noise::{Gauss, NoiseParams, Quantizer, RateNoise};
@@ -45,10 +45,10 @@ pub const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
 /// The case (housing) sensor's column.
 pub const CASE_SENSOR_COL: &str = "temp_case_c";
 /// Gauss stream of the run's seed for the case sensor's noise (after the fault streams 30, 31).
-pub const CASE_SENSOR_STREAM: u64 = 32;
+pub(crate) const CASE_SENSOR_STREAM: u64 = 32;
 /// Stream of the unit seed the case sensor's lag, offset and noise are drawn from (after gyro
 /// z's unit stream).
-pub const CASE_SENSOR_UNIT_STREAM: u64 = UNIT_STREAM + 3;
+pub(crate) const CASE_SENSOR_UNIT_STREAM: u64 = UNIT_STREAM + 3;
 
 /// Gyro column of axis `a` (`gyro_x_dps`).
 pub fn gyro_col(axis: &str) -> String {
@@ -56,7 +56,7 @@ pub fn gyro_col(axis: &str) -> String {
 }
 
 /// Coil-sensor column of axis `a` (`temp_x_c`).
-pub fn coil_sensor_col(axis: &str) -> String {
+pub(crate) fn coil_sensor_col(axis: &str) -> String {
     format!("temp_{axis}_c")
 }
 
@@ -67,13 +67,13 @@ pub fn truth_col(base: &str, axis: &str) -> String {
 
 /// The axis a simulated gyro column names (`gyro_y_dps` → `y`), so a tool can find that
 /// axis's truth columns ([`truth_col`]); None for any other name.
-pub fn axis_of_gyro_col(col: &str) -> Option<&'static str> {
+pub(crate) fn axis_of_gyro_col(col: &str) -> Option<&'static str> {
     AXIS_NAMES.into_iter().find(|a| gyro_col(a) == col)
 }
 
 /// The seed of gyro `k`'s noise and coil sensor: the run's seed mixed with the axis
 /// (a golden-ratio multiple, so nearby seeds and axes never share a ChaCha8 key).
-pub fn axis_seed(seed: u64, k: usize) -> u64 {
+pub(crate) fn axis_seed(seed: u64, k: usize) -> u64 {
     seed ^ 0x9E37_79B9_7F4A_7C15u64.wrapping_mul(k as u64 + 1)
 }
 

@@ -12,7 +12,7 @@
 //! with B in °/h (He et al. 2024 eq. (1)-(3), DOI 10.19452/j.issn1007-5453.2024.02.004).
 //! `truth` adds [`TRUE_BIAS_COL`] (B, °/s), [`TRUE_SCALE_COL`] (K), [`NOISE_COL`]
 //! (gyro_dps - B - K·Ω, °/s, i.e. noise plus quantization) and the node temperatures
-//! [`CHAMBER_TEMP_COL`], [`CASE_TEMP_COL`], [`COIL_TEMP_COL`] (°C).
+//! `CHAMBER_TEMP_COL`, [`CASE_TEMP_COL`], [`COIL_TEMP_COL`] (°C).
 //!
 //! Determinism: every random number comes from ChaCha8 streams of `seed` and every
 //! transcendental function from `libm`, so the same config gives the same bytes on every
@@ -44,7 +44,7 @@ pub use profile::{Profile, Segment, BUILTIN_PROFILES};
 use crate::csvlog::{ExtraColumn, TestLog, NOISE_COL, TRUE_BIAS_COL, TRUE_SCALE_COL};
 
 /// Truth column: chamber air temperature, °C.
-pub const CHAMBER_TEMP_COL: &str = "chamber_temp_c";
+pub(crate) const CHAMBER_TEMP_COL: &str = "chamber_temp_c";
 /// Truth column: case temperature, °C.
 pub const CASE_TEMP_COL: &str = "case_temp_c";
 /// Truth column: coil temperature, °C.
@@ -57,7 +57,7 @@ pub const DEFAULT_TABLE_SEGMENT_S: f64 = 300.0;
 /// Most samples one run may make (memory bound: about 100 bytes per sample with truth).
 pub const MAX_SAMPLES: usize = 40_000_000;
 /// Sample-rate range, Hz (1 Hz as published, up to 1 kHz).
-pub const SAMPLE_RATE_RANGE_HZ: (f64, f64) = (0.01, 1000.0);
+pub(crate) const SAMPLE_RATE_RANGE_HZ: (f64, f64) = (0.01, 1000.0);
 /// Longest internal integration step of the chamber and thermal nodes, s.
 const MAX_SUBSTEP_S: f64 = 0.5;
 
@@ -116,7 +116,7 @@ impl SimConfig {
     }
 
     /// Number of samples the run will make: round(duration · rate).
-    pub fn sample_count(&self) -> usize {
+    pub(crate) fn sample_count(&self) -> usize {
         let n = (self.profile.duration_s() * self.sample_rate_hz).round();
         if n.is_finite() && n >= 0.0 {
             n as usize
@@ -354,7 +354,7 @@ pub fn simulate_series(cfg: &SimConfig) -> Result<SimSeries, SimError> {
 
 /// Simulate a run as a [`TestLog`]: `time_s, gyro_dps, temp_c[, table_dps]` and, with
 /// `cfg.truth`, the truth columns (in this order: [`TRUE_BIAS_COL`], [`TRUE_SCALE_COL`],
-/// [`NOISE_COL`], [`CHAMBER_TEMP_COL`], [`CASE_TEMP_COL`], [`COIL_TEMP_COL`]).
+/// [`NOISE_COL`], `CHAMBER_TEMP_COL`, [`CASE_TEMP_COL`], [`COIL_TEMP_COL`]).
 pub fn simulate(cfg: &SimConfig) -> Result<TestLog, SimError> {
     let s = simulate_series(cfg)?;
     let mut extra = Vec::new();

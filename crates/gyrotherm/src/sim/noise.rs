@@ -74,19 +74,19 @@ impl GaussMarkov {
 /// half-decade spacing from 10 s to 10^4 s, equal variances, so their summed spectrum is close
 /// to 1/f between about 1/(2π·10^4) and 1/(2π·10) Hz (the usual sum-of-GM approximation of
 /// flicker noise, e.g. Kasdin 1995, Proc. IEEE 83(5) sec. V).
-pub const FLICKER_TAUS_S: [f64; 7] = [
+pub(crate) const FLICKER_TAUS_S: [f64; 7] = [
     10.0, 31.6227766, 100.0, 316.227766, 1000.0, 3162.27766, 10000.0,
 ];
 
 /// Flicker floor of the Allan deviation for bias instability B: σ_min = 0.6643·B
 /// (IEEE Std 952-1997 C.1.3: σ = √(2 ln2 / π)·B).
-pub const FLICKER_FLOOR_FACTOR: f64 = 0.6643;
+pub(crate) const FLICKER_FLOOR_FACTOR: f64 = 0.6643;
 
 /// Allan variance of a continuous first-order Gauss-Markov process with variance σ² and
 /// correlation time T at averaging time τ (x = τ/T):
 /// AVAR = (2σ²T/τ)·[1 - (T/(2τ))·(3 - 4e^{-x} + e^{-2x})]
 /// (IEEE Std 952-1997 C.1.6, with q_c = 2σ²/T).
-pub fn gauss_markov_avar(sigma: f64, tau_c_s: f64, tau_s: f64) -> f64 {
+pub(crate) fn gauss_markov_avar(sigma: f64, tau_c_s: f64, tau_s: f64) -> f64 {
     let x = tau_s / tau_c_s;
     if x < 1e-4 {
         // Series of the bracket: 2σ²x/3·(1 - 3x/4), avoids cancellation.
@@ -101,7 +101,7 @@ pub fn gauss_markov_avar(sigma: f64, tau_c_s: f64, tau_s: f64) -> f64 {
 /// The summed curve rises below 30 s and falls above 10^4 s (where the slowest term turns
 /// white); its flat part is its maximum, flat within ±4 % from 60 s to 3000 s, so the
 /// maximum over a 401-point log grid of τ in [1 s, 10^5 s] is used.
-pub fn flicker_term_sigma(bias_instability: f64) -> f64 {
+pub(crate) fn flicker_term_sigma(bias_instability: f64) -> f64 {
     if bias_instability <= 0.0 {
         return 0.0;
     }

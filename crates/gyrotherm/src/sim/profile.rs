@@ -17,17 +17,17 @@
 //! 9000,-40    # soak
 //! ```
 //! Limits (a row outside them is an error naming the line): duration in (0, 10^7] s, target in
-//! [-80, 180] °C (thermal-chamber range), ramp rate at most [`MAX_RAMP_C_PER_MIN`].
+//! [-80, 180] °C (thermal-chamber range), ramp rate at most `MAX_RAMP_C_PER_MIN`.
 
 use super::SimError;
 
 /// Fastest set-point ramp a profile may ask for, °C/min (fast thermal-shock chambers reach
 /// about 15-25 °C/min; anything beyond is most likely a typo in the file).
-pub const MAX_RAMP_C_PER_MIN: f64 = 30.0;
+pub(crate) const MAX_RAMP_C_PER_MIN: f64 = 30.0;
 /// Coldest / hottest allowed set point, °C (typical thermal-chamber range).
-pub const TARGET_RANGE_C: (f64, f64) = (-80.0, 180.0);
+pub(crate) const TARGET_RANGE_C: (f64, f64) = (-80.0, 180.0);
 /// Longest allowed segment, s.
-pub const MAX_SEGMENT_S: f64 = 1e7;
+pub(crate) const MAX_SEGMENT_S: f64 = 1e7;
 
 /// One profile segment: ramp the set point linearly to `target_c` over `duration_s`.
 #[derive(Debug, Clone, Copy, PartialEq)]

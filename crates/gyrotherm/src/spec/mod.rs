@@ -281,7 +281,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 
 /// The known figure names nearest `key` (at most three, within a third of its length, or
 /// containing it / contained in it).
-pub fn nearest_figures(key: &str) -> Vec<&'static str> {
+pub(crate) fn nearest_figures(key: &str) -> Vec<&'static str> {
     let budget = (key.chars().count() / 3).max(2);
     let mut scored: Vec<(usize, &'static str)> = FIGURES
         .iter()

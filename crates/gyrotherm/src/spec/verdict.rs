@@ -23,7 +23,7 @@ pub struct FigureVerdict {
 
 impl FigureVerdict {
     /// The limit as text: `min ..= max`, `>= min`, `<= max`, or empty.
-    pub fn limit_text(&self) -> String {
+    pub(crate) fn limit_text(&self) -> String {
         match (self.min, self.max) {
             (Some(a), Some(b)) => format!("{a} ..= {b}"),
             (Some(a), None) => format!(">= {a}"),

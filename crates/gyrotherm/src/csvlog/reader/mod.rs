@@ -503,12 +503,12 @@ impl<R: Read> LogReader<R> {
     }
 
     /// Number of pass-through columns.
-    pub fn extra_count(&self) -> usize {
+    pub(crate) fn extra_count(&self) -> usize {
         self.src.cols.extra.len()
     }
 
     /// Whether the log has the table-rate column.
-    pub fn has_table(&self) -> bool {
+    pub(crate) fn has_table(&self) -> bool {
         self.src.cols.table.is_some()
     }
 
@@ -572,14 +572,14 @@ impl<R: Read> LogReader<R> {
 
     /// Bytes consumed by the parser so far, and the bytes per data row seen so far (for
     /// sizing buffers; None before any row).
-    pub fn bytes_per_row(&self) -> Option<f64> {
+    pub(crate) fn bytes_per_row(&self) -> Option<f64> {
         let rows = self.src.rows;
         (rows > 0).then(|| self.src.bytes_consumed() as f64 / rows as f64)
     }
 
     /// Convert the current sample's `k`-th pass-through field to text, with a located error
     /// if it is not UTF-8.
-    pub fn extra_text(&self, k: usize) -> Result<&str, LogError> {
+    pub(crate) fn extra_text(&self, k: usize) -> Result<&str, LogError> {
         if self.filled {
             return Ok("");
         }

@@ -64,7 +64,7 @@ pub struct SensorData<'a> {
 
 /// The further sensor's terms: `T` and each lag difference, linearly, no constant (other
 /// sets as `kind` says).
-pub fn extra_terms(lags: usize, kind: ExtraTerms) -> Terms {
+pub(crate) fn extra_terms(lags: usize, kind: ExtraTerms) -> Terms {
     let n = 2 + lags;
     let mut powers = vec![term(n, &[(0, 1)])];
     if kind == ExtraTerms::Cubic {
@@ -87,7 +87,12 @@ pub fn extra_terms(lags: usize, kind: ExtraTerms) -> Terms {
 
 /// The first sensor's terms for a target, degraded on few labelled steps exactly as
 /// [`fit_target`] does.
-pub fn first_terms(sets: &[TargetSet], cfg: &ThermalConfig, id: &Identified, scale: bool) -> Terms {
+pub(crate) fn first_terms(
+    sets: &[TargetSet],
+    cfg: &ThermalConfig,
+    id: &Identified,
+    scale: bool,
+) -> Terms {
     let lags = id.report.lags_s.len();
     let mut kind = if scale { cfg.scale_basis } else { id.basis };
     let labelled: usize = sets.iter().map(|s| s.labelled()).sum();
@@ -371,7 +376,7 @@ impl Shared {
 }
 
 /// [`cv_rms`], from `shared` when `order` is one of its trials.
-pub fn cv_rms_with<'a>(
+pub(crate) fn cv_rms_with<'a>(
     sensors: &[SensorData<'a>],
     order: &[usize],
     cfg: &ThermalConfig,
@@ -392,8 +397,8 @@ pub fn cv_rms_with<'a>(
 
 /// The sensors an axis keeps, first sensor first (see the module doc), and each one-sensor
 /// score; the trials' cross-validation comes from one [`Shared`] design over the best sensor
-/// and every other in ranked order, which it also returns (for [`fit_multi_with`] and
-/// [`cv_rms_with`]; None where there was nothing to try or it could not be made).
+/// and every other in ranked order, which it also returns (for `fit_multi_with` and
+/// `cv_rms_with`; None where there was nothing to try or it could not be made).
 pub fn select_shared(
     sensors: &[SensorData],
     cfg: &ThermalConfig,
@@ -453,7 +458,7 @@ pub fn select_shared(
 }
 
 /// A fitted target on several sensors: the first sensor's model (constant first, its
-/// terms) and each further sensor's coefficients over [`extra_terms`].
+/// terms) and each further sensor's coefficients over `extra_terms`.
 pub struct MultiFit {
     pub first: SubModel,
     pub extra: Vec<SubModel>,
@@ -463,7 +468,7 @@ pub struct MultiFit {
 
 /// Fit one target on the sensors `order` (ridge strength by cross-validation, or the
 /// fallback), per-run offsets averaged into the constant as [`fit_target`] does.
-pub fn fit_multi<'a>(
+pub(crate) fn fit_multi<'a>(
     sensors: &[SensorData<'a>],
     order: &[usize],
     cfg: &ThermalConfig,
@@ -474,7 +479,7 @@ pub fn fit_multi<'a>(
 }
 
 /// [`fit_multi`], from `shared` when `order` is one of its trials.
-pub fn fit_multi_with<'a>(
+pub(crate) fn fit_multi_with<'a>(
     sensors: &[SensorData<'a>],
     order: &[usize],
     cfg: &ThermalConfig,
@@ -541,7 +546,7 @@ pub fn fit_multi_with<'a>(
     })
 }
 
-/// The average of [`fit_multi`] over each sensor of `order` first (the others after it in
+/// The average of `fit_multi` over each sensor of `order` first (the others after it in
 /// their order): every sensor's terms are its first-sensor terms (the constant on the first
 /// sensor of `order`), each coefficient the mean of the fits'. A model averaged over which
 /// sensor gets the nonlinear terms, instead of one chosen by a cross-validation that cannot

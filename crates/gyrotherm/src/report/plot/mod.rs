@@ -127,7 +127,7 @@ impl Series {
     }
 
     /// The same series drawn in another style.
-    pub fn with_style(mut self, style: SeriesStyle) -> Self {
+    pub(crate) fn with_style(mut self, style: SeriesStyle) -> Self {
         self.style = style;
         self
     }
