@@ -92,14 +92,12 @@ pub struct ImuLinesSummary {
 impl ImuLinesSummary {
     /// `N lines (m malformed); gyro_x: ok a, held b, degraded c, invalid d; ...`, with
     /// `, fallback e` for an axis that ran on its fallback.
-    pub fn describe(&self, model: &ImuModel) -> String {
+    pub fn describe(&self, gyro_cols: &[String]) -> String {
         let mut s = format!("{} lines", self.rows);
         if self.malformed > 0 {
             s.push_str(&format!(" ({} malformed)", self.malformed));
         }
-        for (g, [ok, held, degraded, invalid, fallback]) in
-            model.gyro_cols.iter().zip(&self.per_axis)
-        {
+        for (g, [ok, held, degraded, invalid, fallback]) in gyro_cols.iter().zip(&self.per_axis) {
             s.push_str(&format!(
                 "; {g}: ok {ok}, held {held}, degraded {degraded}, invalid {invalid}"
             ));

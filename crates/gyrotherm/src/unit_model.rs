@@ -105,7 +105,8 @@ pub struct Compensation(Counts);
 #[derive(Debug, Clone, PartialEq)]
 enum Counts {
     Single(LinesSummary),
-    Unit(ImuLinesSummary),
+    /// A unit's counts, with the gyro columns they are per axis of.
+    Unit(ImuLinesSummary, Vec<String>),
 }
 
 impl Model {
@@ -321,7 +322,10 @@ impl Model {
     ) -> Result<Compensation, FileError> {
         Ok(Compensation(match &self.form {
             Form::Single(m) => Counts::Single(compensate_file(m, input, out, opts)?),
-            Form::Unit(m) => Counts::Unit(compensate_imu_file(m, input, out, opts)?),
+            Form::Unit(m) => Counts::Unit(
+                compensate_imu_file(m, input, out, opts)?,
+                m.gyro_cols.clone(),
+            ),
         }))
     }
 
@@ -344,15 +348,10 @@ impl Model {
                 Mode::Stream,
                 true,
             )?),
-            Form::Unit(m) => Counts::Unit(compensate_imu_lines(
-                m,
-                input,
-                source,
-                opts,
-                output,
-                Mode::Stream,
-                true,
-            )?),
+            Form::Unit(m) => Counts::Unit(
+                compensate_imu_lines(m, input, source, opts, output, Mode::Stream, true)?,
+                m.gyro_cols.clone(),
+            ),
         }))
     }
 
@@ -410,10 +409,10 @@ impl Model {
 impl Compensation {
     /// What to tell about the run: a file run writes `wrote OUT (...)`, a stream (`out` None)
     /// its counts; then temperature faults and warnings, as each form tells them.
-    pub fn told(&self, model: &Model, out: Option<&Path>) -> Vec<Told> {
+    pub fn told(&self, out: Option<&Path>) -> Vec<Told> {
         let mut told = Vec::new();
-        match (&self.0, &model.form) {
-            (Counts::Single(s), _) => {
+        match &self.0 {
+            Counts::Single(s) => {
                 told.push(Told::Line(match out {
                     Some(out) => format!("wrote {} ({})", out.display(), s.describe()),
                     None => s.describe(),
@@ -434,14 +433,13 @@ impl Compensation {
                 }
                 told.extend(s.warnings.iter().cloned().map(Told::Warning));
             }
-            (Counts::Unit(s), Form::Unit(m)) => match out {
+            Counts::Unit(s, gyro_cols) => match out {
                 None => {
-                    told.push(Told::Line(s.describe(m)));
+                    told.push(Told::Line(s.describe(gyro_cols)));
                     told.extend(s.warnings.iter().cloned().map(Told::Warning));
                 }
                 Some(out) => {
-                    let counts: Vec<String> = m
-                        .gyro_cols
+                    let counts: Vec<String> = gyro_cols
                         .iter()
                         .zip(&s.per_axis)
                         .map(|(g, n)| {
@@ -464,8 +462,6 @@ impl Compensation {
                     )));
                 }
             },
-            // A unit's counts come only from a unit's model.
-            (Counts::Unit(_), Form::Single(_)) => {}
         }
         told
     }

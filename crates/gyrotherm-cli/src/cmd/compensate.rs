@@ -43,14 +43,12 @@ pub fn run(args: CompensateArgs, given: GivenColumns) -> anyhow::Result<ExitCode
         let summary = stdio_stream(|input, output| {
             model.compensate_stream(input, "<stdin>".as_ref(), &opts, output)
         })?;
-        summary.told(&model, None)
+        summary.told(None)
     } else {
         let (Some(input), Some(out)) = (&args.input, &args.out) else {
             anyhow::bail!("give --input FILE and --out FILE, or --stream");
         };
-        model
-            .compensate_file(input, out, &opts)?
-            .told(&model, Some(out))
+        model.compensate_file(input, out, &opts)?.told(Some(out))
     };
     told.iter().for_each(tell);
     Ok(ExitCode::SUCCESS)
