@@ -502,4 +502,10 @@ fn plan_and_compensate_name_the_rate_they_print() {
     let (code, plan, err) = outcome(&["plan", "--flight", p(&flight)]);
     assert_eq!(code, 0, "{err}");
     assert!(plan.contains("rate of its 100 s moving average"), "{plan}");
+    // Without training logs no lag is identified: every soak keeps the fixed length, and the
+    // plan says so.
+    assert!(
+        plan.contains("soaks: first at each extreme 1440 s (0.4 h): no lag identified"),
+        "{plan}"
+    );
 }

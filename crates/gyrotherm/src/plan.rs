@@ -17,6 +17,12 @@
 //! `crate::settings::plan::TEMP_MARGIN_C`, clipped to the chamber's range.
 //! Down- and up-ramps give −r and +r, the soaks 0: the rate rows of the grid between levels
 //! are at most one cell from a covered one.
+//!
+//! **Soaks.** With training logs, the first soak at each extreme is long enough to separate
+//! the slowest thermal lag their fit identified: `LONG_SOAK_PER_LAG` times that lag
+//! ([`crate::settings::plan`]), so that its state settles at a constant temperature, where it
+//! can be told from the faster ones. The other soaks, and every soak without training logs,
+//! last `SOAK_S`. [`Plan::soak`] says which length was chosen and why.
 
 use std::fmt;
 
@@ -25,7 +31,8 @@ use crate::csvlog::TestLog;
 use crate::fit::{fit_model, FitConfig, FitError, NamedLog};
 use crate::settings::coverage::TEMP_CELLS;
 use crate::settings::plan::{
-    PlanSettings, MIN_CELL_S, RATE_LEVELS, RATE_MARGIN, ROOM_C, SOAK_S, TEMP_MARGIN_C,
+    PlanSettings, LONG_SOAK_PER_LAG, MIN_CELL_S, RATE_LEVELS, RATE_MARGIN, ROOM_C, SOAK_S,
+    TEMP_MARGIN_C,
 };
 use crate::settings::SettingError;
 use crate::sim::{Profile, Segment};
@@ -180,6 +187,10 @@ pub struct CoverageSummary {
     pub flight_shares: Option<[f64; 3]>,
     /// Share of the envelope's rectangle (41 × 41 lattice) outside.
     pub envelope_outside: f64,
+    /// The slowest thermal lag the fit identified, s (None: the fit holds no lag), and
+    /// whether it sits at the lag search's upper bound (the true lag may then be longer).
+    pub slowest_lag_s: Option<f64>,
+    pub lag_at_bound: bool,
 }
 
 /// The coverage of `train` against the flight and the envelope; None when the fit carries no
@@ -216,6 +227,19 @@ pub fn training_coverage(
             .and_then(|t| t.shares()),
         None => None,
     };
+    let slowest_lag_s = fit
+        .model
+        .features
+        .lag_tau_s
+        .iter()
+        .copied()
+        .filter(|t| t.is_finite())
+        .reduce(f64::max);
+    let bound_s = FitConfig::new(crate::settings::DEFAULT_METHOD)
+        .thermal
+        .tau_range_s
+        .1;
+    let lag_at_bound = slowest_lag_s.is_some_and(|t| t >= 0.99 * bound_s);
     let map = def.to_core().map_err(PlanError::Coverage)?;
     const N: usize = 41;
     let mut outside = 0usize;
@@ -235,6 +259,8 @@ pub fn training_coverage(
         rate_span_c_per_min: (60.0 * r0, 60.0 * r1),
         flight_shares,
         envelope_outside: outside as f64 / (N * N) as f64,
+        slowest_lag_s,
+        lag_at_bound,
     }))
 }
 
@@ -269,6 +295,49 @@ pub struct Plan {
     pub segments: Vec<PlannedSegment>,
     /// What the chamber's limits cut from the envelope.
     pub notes: Vec<String>,
+    /// The soaks' lengths and why.
+    pub soak: SoakLength,
+}
+
+/// How long the proposed profile soaks (see the module doc).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SoakLength {
+    /// The first soak at each extreme, s.
+    pub long_s: f64,
+    /// Every other soak, s.
+    pub other_s: f64,
+    /// Why `long_s`, in words.
+    pub why: String,
+}
+
+impl SoakLength {
+    fn for_lag(slowest_lag_s: Option<f64>) -> SoakLength {
+        match slowest_lag_s {
+            Some(tau) if LONG_SOAK_PER_LAG * tau > SOAK_S => SoakLength {
+                long_s: LONG_SOAK_PER_LAG * tau,
+                other_s: SOAK_S,
+                why: format!(
+                    "{LONG_SOAK_PER_LAG} × the slowest lag the training logs' fit identified \
+                     ({tau:.0} s), so that its state settles at each extreme"
+                ),
+            },
+            Some(tau) => SoakLength {
+                long_s: SOAK_S,
+                other_s: SOAK_S,
+                why: format!(
+                    "the slowest lag the training logs' fit identified ({tau:.0} s) settles \
+                     within the fixed soak"
+                ),
+            },
+            None => SoakLength {
+                long_s: SOAK_S,
+                other_s: SOAK_S,
+                why: "no lag identified (give training logs to size the first soak at each \
+                      extreme to their slowest lag)"
+                    .to_owned(),
+            },
+        }
+    }
 }
 
 impl Plan {
@@ -343,6 +412,9 @@ pub fn propose(env: &Envelope, s: &PlanSettings) -> Result<Plan, PlanError> {
     }
     let (lo, hi) = if lo < hi { (lo, hi) } else { (hi - 1.0, hi) };
     let span = hi - lo;
+    let soak = SoakLength::for_lag(s.slowest_lag_s);
+    // The first soak at each extreme is the long one.
+    let mut long_left = [true, true];
     let mut segments = vec![PlannedSegment {
         step: Step::Hold,
         from_c: ROOM_C,
@@ -352,6 +424,8 @@ pub fn propose(env: &Envelope, s: &PlanSettings) -> Result<Plan, PlanError> {
     }];
     let mut at = ROOM_C;
     let mut go = |to: f64, r: f64, segments: &mut Vec<PlannedSegment>| {
+        let extreme = [lo, hi].iter().position(|&e| e == to);
+        let long = extreme.is_some_and(|k| std::mem::take(&mut long_left[k]));
         if (to - at).abs() > 0.0 {
             segments.push(PlannedSegment {
                 step: Step::Ramp,
@@ -366,7 +440,7 @@ pub fn propose(env: &Envelope, s: &PlanSettings) -> Result<Plan, PlanError> {
             from_c: to,
             to_c: to,
             rate_c_per_min: 0.0,
-            duration_s: SOAK_S,
+            duration_s: if long { soak.long_s } else { soak.other_s },
         });
         at = to;
     };
@@ -392,6 +466,7 @@ pub fn propose(env: &Envelope, s: &PlanSettings) -> Result<Plan, PlanError> {
         rates_c_per_min: rates,
         segments,
         notes,
+        soak,
     };
     // What `plan --out` writes must be a profile `simulate --profile-file` reads: checked by
     // its own parser, so the two sets of limits cannot drift apart.

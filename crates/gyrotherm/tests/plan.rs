@@ -89,3 +89,53 @@ fn the_chamber_limits_bound_the_profile_and_are_said() {
     };
     assert!(resolve_envelope(None, &partial).is_err());
 }
+
+/// The first soak at each extreme is sized to the slowest lag the training fit identified
+/// (the rule's factor comes from docs/experiments/imu-soak.md: a lag at the search's 12,000 s
+/// bound gives the confirmed 6 h soaks); every other soak keeps the fixed length, and without
+/// an identified lag every soak does.
+#[test]
+fn the_first_soak_at_each_extreme_separates_the_slowest_identified_lag() {
+    let shock = sim(Profile::builtin("seed-shock").unwrap(), 1);
+    let flight = sim(Profile::builtin("airborne").unwrap(), 3);
+    let mut s = PlanSettings::default();
+    let fixed = propose(&resolve_envelope(Some(&flight), &s).unwrap(), &s).unwrap();
+    let c = coverage(&[("shock", &shock)], &flight, &s);
+    let tau = c.slowest_lag_s.expect("a thermal fit identifies lags");
+    s.slowest_lag_s = Some(tau);
+    let env = resolve_envelope(Some(&flight), &s).unwrap();
+    let plan = propose(&env, &s).unwrap();
+    let soaks = |p: &gyrotherm::plan::Plan| -> Vec<(f64, f64)> {
+        p.segments
+            .iter()
+            .filter(|g| g.step == gyrotherm::plan::Step::Soak)
+            .map(|g| (g.to_c, g.duration_s))
+            .collect()
+    };
+    let fixed_s = fixed.soak.other_s;
+    assert!(soaks(&fixed).iter().all(|&(_, d)| d == fixed_s));
+    assert_eq!(fixed.soak.long_s, fixed_s);
+    assert!(
+        fixed.soak.why.contains("no lag identified"),
+        "{}",
+        fixed.soak.why
+    );
+    // 1.8 × τ at each extreme, once; the same segments otherwise.
+    let long = 1.8 * tau;
+    assert!(long > fixed_s, "τ = {tau} s");
+    assert_eq!(plan.soak.long_s, long);
+    let got = soaks(&plan);
+    assert_eq!(got.len(), soaks(&fixed).len());
+    for extreme in [plan.temp_lo_c, plan.temp_hi_c] {
+        let at: Vec<f64> = got.iter().filter(|g| g.0 == extreme).map(|g| g.1).collect();
+        assert_eq!(at[0], long, "first soak at {extreme} °C");
+        assert!(at[1..].iter().all(|&d| d == fixed_s), "{at:?}");
+    }
+    assert!(
+        plan.soak.why.contains(&format!("({tau:.0} s)")),
+        "{}",
+        plan.soak.why
+    );
+    // Still a profile `simulate --profile-file` reads.
+    Profile::parse(&plan.profile_text(), "plan.txt").unwrap();
+}

@@ -55,13 +55,14 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
     // Written with errors returned, not `println!`: a closed pipe (`| head -1`) ends the
     // command quietly instead of a panic.
     let mut w = std::io::stdout().lock();
-    let s = PlanSettings {
+    let mut s = PlanSettings {
         temp_min_c: args.temp_min_c,
         temp_max_c: args.temp_max_c,
         max_rate_c_per_min: args.max_rate_c_per_min,
         chamber_min_c: args.chamber_min_c,
         chamber_max_c: args.chamber_max_c,
         chamber_max_rate_c_per_min: args.chamber_max_rate_c_per_min,
+        slowest_lag_s: None,
     };
     let flight = args
         .flight
@@ -122,6 +123,18 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
                     "envelope (temperature × ±rate): {:.1} % outside",
                     100.0 * c.envelope_outside
                 )?;
+                if let Some(tau) = c.slowest_lag_s {
+                    writeln!(
+                        w,
+                        "slowest thermal lag identified: {tau:.0} s{}",
+                        if c.lag_at_bound {
+                            " (at the lag search's upper bound: the true lag may be longer)"
+                        } else {
+                            ""
+                        }
+                    )?;
+                }
+                s.slowest_lag_s = c.slowest_lag_s;
             }
         }
     }
@@ -141,6 +154,14 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
             .join(", "),
         plan.duration_s(),
         plan.duration_s() / 3600.0
+    )?;
+    writeln!(
+        w,
+        "soaks: first at each extreme {:.0} s ({:.1} h): {}; the others {:.0} s",
+        plan.soak.long_s,
+        plan.soak.long_s / 3600.0,
+        plan.soak.why,
+        plan.soak.other_s
     )?;
     writeln!(
         w,

@@ -29,6 +29,13 @@ pub(crate) const RATE_MARGIN: f64 = 1.1;
 /// next ramp and every ramp starts the same way. The slower stress lag (2500 s) is left to
 /// the long soaks of the shock test the plan adds to, as are the temperatures in between.
 pub(crate) const SOAK_S: f64 = 1440.0;
+/// Long soaks per slowest identified lag: the first soak at each extreme lasts this many times
+/// the slowest thermal lag the training logs' fit identified (at least [`SOAK_S`]), so that the
+/// lag's state settles and can be told apart from the faster ones. 1.8 makes a lag at the lag
+/// search's default bound (12,000 s) a 6 h soak, the length chosen on the design family and
+/// confirmed on the confirmation family (the unit worst case 5.25× → 3.24× the noise floor;
+/// docs/experiments/imu-soak.md).
+pub(crate) const LONG_SOAK_PER_LAG: f64 = 1.8;
 /// Room temperature the profile starts and ends at, °C.
 pub(crate) const ROOM_C: f64 = 22.0;
 /// Held-out steps a coverage cell needs ([`super::coverage::MIN_CELL_STEPS`]): each
@@ -52,6 +59,10 @@ pub struct PlanSettings {
     pub chamber_max_c: f64,
     /// Chamber's fastest ramp, °C/min.
     pub chamber_max_rate_c_per_min: f64,
+    /// The slowest thermal lag identified in the training logs so far, s
+    /// ([`crate::plan::CoverageSummary::slowest_lag_s`]); None: none identified, and every
+    /// soak lasts the fixed soak.
+    pub slowest_lag_s: Option<f64>,
 }
 
 impl Default for PlanSettings {
@@ -63,6 +74,7 @@ impl Default for PlanSettings {
             chamber_min_c: CHAMBER_MIN_C,
             chamber_max_c: CHAMBER_MAX_C,
             chamber_max_rate_c_per_min: CHAMBER_MAX_RATE_C_PER_MIN,
+            slowest_lag_s: None,
         }
     }
 }
@@ -81,6 +93,7 @@ impl PlanSettings {
             self.max_rate_c_per_min,
             Rule::PositiveRate,
         )?;
+        check_opt("slowest_lag_s", self.slowest_lag_s, Rule::PositiveSeconds)?;
         check("chamber_min_c", self.chamber_min_c, Rule::Finite)?;
         check("chamber_max_c", self.chamber_max_c, Rule::Finite)?;
         check(
