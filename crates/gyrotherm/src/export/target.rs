@@ -25,12 +25,20 @@ pub const EXPORT_TARGETS: [ExportTarget; 4] = [
     ExportTarget::Px4,
 ];
 
-/// The names of [`EXPORT_TARGETS`].
-pub const EXPORT_TARGET_NAMES: [&str; 4] = ["c", "rust", "ardupilot", "px4"];
+/// The names of [`EXPORT_TARGETS`], in its order (made from it, so the two cannot differ).
+pub const EXPORT_TARGET_NAMES: [&str; EXPORT_TARGETS.len()] = {
+    let mut names = [""; EXPORT_TARGETS.len()];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = EXPORT_TARGETS[i].as_str();
+        i += 1;
+    }
+    names
+};
 
 impl ExportTarget {
     /// The name on the command line (`--target`).
-    pub fn as_str(self) -> &'static str {
+    pub const fn as_str(self) -> &'static str {
         match self {
             ExportTarget::C => "c",
             ExportTarget::Rust => "rust",
