@@ -14,6 +14,7 @@ use pyo3::import_exception;
 use pyo3::prelude::*;
 
 mod allan;
+mod export;
 mod figures;
 mod logs;
 mod lot;

@@ -282,6 +282,29 @@ impl RawUnitModel {
             .collect())
     }
 
+    /// Write the model for `target` (`c`, `rust`, `ardupilot`, `px4`) into the folder `out`:
+    /// the lines `gyrotherm export` prints, and its warnings.
+    #[pyo3(signature = (target, out, instance=None, axis=None, device_id=None))]
+    fn export(
+        &self,
+        py: Python<'_>,
+        target: &str,
+        out: PathBuf,
+        instance: Option<u8>,
+        axis: Option<&str>,
+        device_id: Option<u32>,
+    ) -> PyResult<crate::export::Written> {
+        crate::export::write(
+            py,
+            gyrotherm::unit_model::Model::from_unit(self.file.clone()),
+            target,
+            out,
+            instance,
+            axis,
+            device_id,
+        )
+    }
+
     /// A human-readable description.
     fn summary(&self) -> String {
         let m = &self.file;

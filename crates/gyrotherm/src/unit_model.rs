@@ -377,6 +377,43 @@ impl Model {
         Ok(told)
     }
 
+    /// Write the model for `target` into `dir`: flight code (C, Rust; [`Model::export`]) or
+    /// an autopilot's parameter file ([`Model::export_autopilot`]), with the polynomial's fit
+    /// and what it does not carry. What to tell comes with the outcome, also when it failed
+    /// (`axis_given` as for [`Model::export_autopilot`]).
+    pub fn write_export(
+        &self,
+        target: ExportTarget,
+        settings: &AutopilotSettings,
+        axis_given: bool,
+        dir: &Path,
+    ) -> (Vec<Told>, Result<(), ExportError>) {
+        if let Some(lang) = target.lang() {
+            return match self.export(lang, dir) {
+                Ok(told) => (told, Ok(())),
+                Err(e) => (Vec::new(), Err(e)),
+            };
+        }
+        let (mut told, export) = self.export_autopilot(target, settings, axis_given);
+        let export = match export {
+            Ok(e) => e,
+            Err(e) => return (told, Err(e)),
+        };
+        for line in export.summary() {
+            told.push(match line.strip_prefix("warning: ") {
+                Some(w) => Told::Warning(w.to_owned()),
+                None => Told::Line(line),
+            });
+        }
+        match autopilot::write(&export, dir) {
+            Ok(path) => {
+                told.push(Told::Line(format!("wrote {}", path.display())));
+                (told, Ok(()))
+            }
+            Err(e) => (told, Err(e)),
+        }
+    }
+
     /// The autopilot's parameters for the model (see [`autopilot::generate`]), with what to
     /// tell first when the command line named an axis (`axis_given`) that a unit's columns fix.
     pub fn export_autopilot(

@@ -7,8 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context as _};
-use gyrotherm::export::autopilot;
-use gyrotherm::export::{ExportTarget, EXPORT_TARGETS};
+use gyrotherm::export::{ExportError, ExportTarget, EXPORT_TARGETS};
 use gyrotherm::settings::autopilot::{self as ap, AutopilotSettings, GyroAxis, GYRO_AXES};
 use gyrotherm::unit_model::Model;
 
@@ -54,49 +53,34 @@ impl ExportArgs {
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
     let target = args.target;
-    let Some(lang) = target.lang() else {
-        return run_autopilot(&args, target);
-    };
-    for (given, flag) in [
-        (args.instance.is_some(), "--instance"),
-        (args.axis.is_some(), "--axis"),
-        (args.device_id.is_some(), "--device-id"),
-    ] {
-        if given {
-            bail!("{flag} is for --target ardupilot or px4, not {target}");
+    if target.lang().is_some() {
+        for (given, flag) in [
+            (args.instance.is_some(), "--instance"),
+            (args.axis.is_some(), "--axis"),
+            (args.device_id.is_some(), "--device-id"),
+        ] {
+            if given {
+                bail!("{flag} is for --target ardupilot or px4, not {target}");
+            }
         }
     }
-    let model = load(&args)?;
-    model.export(lang, &args.out)?.iter().for_each(tell);
-    Ok(ExitCode::SUCCESS)
-}
-
-/// The model, its warning told when the file is not sealed.
-fn load(args: &ExportArgs) -> anyhow::Result<Model> {
     let model = Model::load(&args.model)?;
     if let Some(w) = model.load_warning(&args.model) {
         eprintln!("gyrotherm: warning: {w}");
     }
-    Ok(model)
-}
-
-/// `--target ardupilot|px4`: the polynomial fitted to the model's steady-state bias, its fit
-/// and what it leaves out on stderr, the parameter file in `--out`.
-fn run_autopilot(args: &ExportArgs, target: ExportTarget) -> anyhow::Result<ExitCode> {
-    let settings = args.autopilot_settings();
-    let model = load(args)?;
-    let (told, export) = model.export_autopilot(target, &settings, args.axis.is_some());
+    let (told, written) = model.write_export(
+        target,
+        &args.autopilot_settings(),
+        args.axis.is_some(),
+        &args.out,
+    );
     told.iter().for_each(tell);
-    let export = export
-        .map_err(anyhow::Error::new)
-        .with_context(|| format!("cannot use model {}", args.model.display()))?;
-    for line in export.summary() {
-        match line.strip_prefix("warning: ") {
-            Some(w) => eprintln!("gyrotherm: warning: {w}"),
-            None => eprintln!("gyrotherm: {line}"),
-        }
+    match written {
+        Ok(()) => Ok(ExitCode::SUCCESS),
+        // A file that cannot be written names itself; anything else is the model's fault.
+        Err(e @ ExportError::Io { .. }) => Err(e.into()),
+        Err(e) if target.lang().is_some() => Err(e.into()),
+        Err(e) => Err(anyhow::Error::new(e))
+            .with_context(|| format!("cannot use model {}", args.model.display())),
     }
-    let path = autopilot::write(&export, &args.out)?;
-    eprintln!("gyrotherm: wrote {}", path.display());
-    Ok(ExitCode::SUCCESS)
 }

@@ -6,7 +6,8 @@
   confidence bounds; ``edf_greenhall`` and ``confidence_interval`` as in allantools.
 - Gyro figures: ``bias_stability``, ``noise_terms``, ``scale_factor``.
 - Logs and models: ``read_log``, ``read_lot`` (a lot database of ``gyrotherm lot``), ``fit`` → ``Model`` (``save``, ``Model.load``,
-  ``compensate``, ``summary``); model files are the CLI's JSON.
+  ``compensate``, ``summary``, ``export``: C, Rust, ArduPilot or PX4 parameters, as
+  ``gyrotherm export --target``); model files are the CLI's JSON.
 - Inertial units: ``gyro_col``/``temp_col`` lists in ``read_log`` and ``fit`` (→ ``UnitModel``:
   one file for the unit, ``compensate`` per axis), as the CLI's comma-separated lists;
   ``evaluate`` (figures and spec verdicts per axis) and ``compare`` (methods per axis, with
