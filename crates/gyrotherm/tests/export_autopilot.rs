@@ -175,9 +175,35 @@ fn check_both(
         );
     }
 
-    // PX4: the absolute offset against B(T), within the fit error.
+    // The correction the comparison evaluates (`AutopilotExport::correction`, f64) is the
+    // firmware's formula on the written text (f32 here), over and beyond the range.
     let slot = settings.instance;
     let q = px4_params(&px.text);
+    let wide: Vec<f32> = (0..=60)
+        .map(|i| lo - 20.0 + (hi - lo + 40.0) * i as f32 / 60.0)
+        .collect();
+    for a in 0..3 {
+        let ap0 = f64::from(ardupilot_poly(&p, n, a, 0.0));
+        let ap0_c = ap.correction.offset_dps(a, 0.0) * RAD;
+        for &t in &wide {
+            let pairs = [
+                (
+                    f64::from(ardupilot_poly(&p, n, a, t)) - ap0,
+                    ap.correction.offset_dps(a, f64::from(t)) * RAD - ap0_c,
+                ),
+                (
+                    f64::from(px4_offset(&q, slot, a, t)),
+                    px.correction.offset_dps(a, f64::from(t)) * RAD,
+                ),
+            ];
+            for (firmware, ours) in pairs {
+                let err_dph = (firmware - ours).abs() / RAD * 3600.0;
+                assert!(err_dph <= slack_dph, "axis {a}, T {t}: {err_dph} °/h");
+            }
+        }
+    }
+
+    // PX4: the absolute offset against B(T), within the fit error.
     assert_eq!(q["TC_G_ENABLE"], ("1".to_owned(), 6));
     assert_eq!(q[&format!("TC_G{slot}_ID")].1, 6);
     assert_eq!(

@@ -19,7 +19,9 @@
 //! Only the gyro coefficients are written; the accelerometer's (`INS_TCAL{n}_ACC*`) are left
 //! as they are on the vehicle.
 
-use super::steady_bias::{fit_cubic, AutopilotExport, FitError, SteadyBias, RAD_PER_DEG};
+use super::steady_bias::{
+    fit_cubic, AutopilotExport, Correction, FitError, SteadyBias, RAD_PER_DEG,
+};
 use super::ExportError;
 use crate::settings::autopilot::{AutopilotSettings, ARDUPILOT_INSTANCES};
 
@@ -68,6 +70,7 @@ pub fn generate(
     if gyr.iter().flatten().any(|v| !v.is_finite()) {
         return Err(AutopilotError::Fit.into());
     }
+    let (t_min_c, t_max_c) = (f64::from(steady.temp_min_c), f64::from(steady.temp_max_c));
     let mut export = AutopilotExport {
         file_name: FILE_NAME,
         text: String::new(),
@@ -76,6 +79,18 @@ pub fn generate(
         error_means: "error after the best constant, which the firmware's boot-time gyro \
                       calibration takes out: with the error at the boot temperature, up to twice \
                       this",
+        correction: Correction {
+            // No constant: the firmware's p(T_cal) and boot calibration stand in for it.
+            coef_rad: [0, 1, 2].map(|axis| {
+                [0.0, 1.0, 2.0, 3.0].map(|k: f64| match k as usize {
+                    0 => 0.0,
+                    k => f64::from(gyr[k - 1][axis]) / SCALE_FACTOR,
+                })
+            }),
+            t_min_c,
+            t_max_c,
+            t_ref_c: TEMP_REFERENCE_C,
+        },
     };
     let mut text = export.header(
         "ArduPilot gyro temperature calibration, written by gyrotherm export --target ardupilot",

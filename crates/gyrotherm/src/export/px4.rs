@@ -16,7 +16,8 @@
 //! training range.
 
 use super::steady_bias::{
-    cubic, fit_cubic, AutopilotError, AutopilotExport, FitError, SteadyBias, RAD_PER_DEG,
+    cubic, fit_cubic, AutopilotError, AutopilotExport, Correction, FitError, SteadyBias,
+    RAD_PER_DEG,
 };
 use super::ExportError;
 use crate::settings::autopilot::{AutopilotSettings, PX4_INSTANCES};
@@ -61,12 +62,19 @@ pub fn generate(
     if xk.iter().flatten().any(|v| !v.is_finite()) {
         return Err(AutopilotError::Fit.into());
     }
+    let (t_min_c, t_max_c) = (f64::from(steady.temp_min_c), f64::from(steady.temp_max_c));
     let mut export = AutopilotExport {
         file_name: FILE_NAME,
         text: String::new(),
         fit,
         steady,
         error_means: "error of the absolute offset, X0 included",
+        correction: Correction {
+            coef_rad: [0, 1, 2].map(|axis| [0, 1, 2, 3].map(|k| f64::from(xk[k][axis]))),
+            t_min_c,
+            t_max_c,
+            t_ref_c: f64::from(tref),
+        },
     };
     let mut text = export.header(
         "Sensor thermal compensation parameters, written by gyrotherm export --target px4",

@@ -400,6 +400,28 @@ pub fn cubic(c: &[f64; 4], x: f64) -> f64 {
     c[0] + (c[1] + (c[2] + c[3] * x) * x) * x
 }
 
+/// The correction the autopilot's firmware computes from the written parameters (as stored,
+/// f32): per axis X, Y, Z a cubic in `clamp(T, t_min_c, t_max_c) - t_ref_c`, rad/s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Correction {
+    /// Coefficients of x⁰ … x³ per axis, rad/s per °C^k.
+    pub coef_rad: [[f64; 4]; 3],
+    pub t_min_c: f64,
+    pub t_max_c: f64,
+    pub t_ref_c: f64,
+}
+
+impl Correction {
+    /// The offset the firmware subtracts from `axis` (0 X, 1 Y, 2 Z) at `temp_c`, °/s (a
+    /// temperature that is not finite gives NaN: the firmware's reading would be refused).
+    pub fn offset_dps(&self, axis: usize, temp_c: f64) -> f64 {
+        let x = temp_c.clamp(self.t_min_c, self.t_max_c) - self.t_ref_c;
+        self.coef_rad
+            .get(axis)
+            .map_or(0.0, |c| cubic(c, x) / RAD_PER_DEG)
+    }
+}
+
 /// How well the written polynomial holds over the grid, °/h.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitError {
@@ -437,6 +459,8 @@ pub struct AutopilotExport {
     pub steady: SteadyBias,
     /// A line on what the fit error includes (the constant's handling differs by target).
     pub error_means: &'static str,
+    /// What the firmware computes from the written parameters.
+    pub correction: Correction,
 }
 
 impl AutopilotExport {
