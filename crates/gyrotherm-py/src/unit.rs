@@ -499,10 +499,11 @@ fn compare_unit(
         .map(|p| gyrotherm::spec::Spec::load(&p))
         .transpose()
         .map_err(py_err::<MetricsError>)?;
-    let methods: Option<Vec<gyrotherm::model::Method>> = methods
+    // A unit's comparison has method columns only (the autopilot columns are single-gyro).
+    let methods: Option<Vec<gyrotherm::compare::ColumnName>> = methods
         .map(|m| {
             m.iter()
-                .map(|n| crate::model::parse_method(n))
+                .map(|n| crate::model::parse_method(n).map(gyrotherm::compare::ColumnName::Method))
                 .collect::<PyResult<_>>()
         })
         .transpose()?;

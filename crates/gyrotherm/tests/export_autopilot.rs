@@ -421,3 +421,80 @@ fn anyhow_chain(e: &dyn std::error::Error) -> String {
     }
     s
 }
+
+/// `compare --methods thermal,ardupilot`: the ArduPilot column is the held-out gyro output
+/// minus the firmware's correction from the parameter file `export --target ardupilot` writes
+/// for the comparison's `thermal` model (evaluated here from the file's text, in f32, as the
+/// firmware does), judged by the same bias-stability figure.
+#[test]
+fn the_autopilot_column_is_the_firmware_correction_of_the_exported_file() {
+    use gyrotherm::compare::{compare, ColumnName};
+    use gyrotherm::fit::NamedLog;
+    use gyrotherm::settings::{FitSettings, Method};
+    use gyrotherm::sim::{simulate, Profile, SimConfig};
+
+    let sim = |p: &str, seed| {
+        let mut c = SimConfig::new(Profile::builtin(p).unwrap());
+        c.seed = seed;
+        simulate(&c).unwrap()
+    };
+    let (train, test) = (sim("seed-shock", 1), sim("slow-ramp", 5));
+    let train = [NamedLog {
+        name: "shock",
+        log: &train,
+    }];
+    let test = [NamedLog {
+        name: "ramp",
+        log: &test,
+    }];
+    let cfg = FitSettings::default()
+        .compare_config(
+            Some(&[
+                ColumnName::Method(Method::Thermal),
+                ColumnName::Autopilot(ExportTarget::Ardupilot),
+            ]),
+            100.0,
+        )
+        .unwrap();
+    let mut cmp = compare(&train, &test, &cfg, &|_, _, _, _| {}).unwrap();
+    autopilot::add_columns(&mut cmp, &train, &test, &cfg).unwrap();
+    let keys: Vec<&str> = cmp.columns.iter().map(|c| c.key).collect();
+    assert_eq!(keys, ["thermal", "ardupilot"]);
+    let got = cmp.tests[0]
+        .methods
+        .iter()
+        .find(|m| m.key == "ardupilot")
+        .unwrap()
+        .performance
+        .bias_stability_dph
+        .unwrap();
+
+    let settings = AutopilotSettings::default();
+    let export = autopilot::generate(
+        ModelRef::Single(&cmp.fits[0].model),
+        ExportTarget::Ardupilot,
+        &settings,
+    )
+    .unwrap();
+    let p = ardupilot_params(&export.text);
+    let log = test[0].log;
+    let out: Vec<f64> = log
+        .gyro_dps
+        .iter()
+        .zip(&log.temp_c)
+        .map(|(g, &t)| g - f64::from(ardupilot_poly(&p, 1, 0, t as f32)).to_degrees())
+        .collect();
+    let want = gyrotherm::metrics::bias_stability_dph(&out, log.sample_period_s(), 100.0)
+        .unwrap()
+        .bias_stability_dph;
+    assert!(
+        (got - want).abs() <= 1e-6 * want + 1e-9,
+        "column {got} °/h, firmware on the file {want} °/h"
+    );
+    // A cubic in T carries no rate or lag terms: it does not beat the model it came from.
+    let thermal = cmp.tests[0].methods[0]
+        .performance
+        .bias_stability_dph
+        .unwrap();
+    assert!(got > thermal, "ardupilot {got} against thermal {thermal}");
+}

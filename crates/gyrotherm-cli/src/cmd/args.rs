@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use gyrotherm::compare::CompareConfig;
+use gyrotherm::compare::{ColumnName, CompareConfig};
 use gyrotherm::fit::{FitConfig, NamedLog};
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::fit;
@@ -23,6 +23,17 @@ pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
             .map(|m| PossibleValue::new(m.as_str()).help(m.help())),
     )
     .try_map(|s| s.parse::<Method>())
+}
+
+/// The `--methods` parser: the library's column names with their help.
+fn column_parser() -> impl clap::builder::TypedValueParser<Value = ColumnName> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser as _};
+    PossibleValuesParser::new(
+        ColumnName::all()
+            .into_iter()
+            .map(|(name, help)| PossibleValue::new(name).help(help)),
+    )
+    .try_map(|s| s.parse::<ColumnName>())
 }
 
 /// Fitting options shared by `train`, `compare`, `report` and `demo`: the library's
@@ -235,9 +246,11 @@ pub struct CompareArgs {
 pub struct ColumnArgs {
     /// Methods to compare, comma-separated, in table order (the names of `train --method`;
     /// a recipe method's column is named by what its model holds, `published` is "LSTM, He
-    /// et al."; `--epochs` applies to every LSTM). Default: linear, poly, thermal, published.
-    #[arg(long, value_delimiter = ',', value_name = "LIST", value_parser = method_parser())]
-    pub methods: Option<Vec<Method>>,
+    /// et al."; `--epochs` applies to every LSTM), then any autopilot polynomials (`ardupilot`,
+    /// `px4`: fitted to --method's model, single gyro). Default: linear, poly, thermal,
+    /// published.
+    #[arg(long, value_delimiter = ',', value_name = "LIST", value_parser = column_parser())]
+    pub methods: Option<Vec<ColumnName>>,
 }
 
 impl ColumnArgs {

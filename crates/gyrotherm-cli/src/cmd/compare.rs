@@ -76,6 +76,26 @@ pub fn run_comparison(
     Ok(cmp)
 }
 
+/// The autopilot columns asked for (`--methods …,ardupilot,px4`), after the fitted ones;
+/// a polynomial that could not be fitted is said as a column that was not fitted.
+pub fn add_autopilot_columns(
+    cmp: &mut Comparison,
+    train: &[NamedLog],
+    test: &[NamedLog],
+    cfg: &CompareConfig,
+) -> anyhow::Result<()> {
+    let before = cmp.failed.len();
+    gyrotherm::export::autopilot::add_columns(cmp, train, test, cfg)
+        .context("the autopilot columns failed")?;
+    for f in &cmp.failed[before..] {
+        eprintln!(
+            "gyrotherm: warning: the {} column was not fitted: {}",
+            f.key, f.reason
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     if args.log.read_options().is_multi_column() {
         return super::imu_judge::compare(args);
@@ -88,7 +108,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let test_named = named(&test);
     let tau_s = resolve_tau(args.tau_s, &test_named);
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
-    let cmp = run_comparison(&train_named, &test_named, &cfg)?;
+    let mut cmp = run_comparison(&train_named, &test_named, &cfg)?;
+    add_autopilot_columns(&mut cmp, &train_named, &test_named, &cfg)?;
     let verdicts = spec
         .as_ref()
         .map(|s| gyrotherm::spec::judge_comparison(s, &cmp, &test_named, &cfg))

@@ -96,7 +96,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         "gyrotherm: fitting the {} models on the training runs ...",
         keys.join(", ")
     );
-    let cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
+    let mut cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
+    super::compare::add_autopilot_columns(&mut cmp, &named[..2], &named[2..], &cfg)?;
     for (fit, col) in cmp.fits.iter().zip(&cmp.columns) {
         let path = args.dir.join(format!("model_{}.json", col.key));
         fit.model.save(&path).map_err(anyhow::Error::new)?;

@@ -114,6 +114,12 @@ fn run_unit_comparison(
     let test = read_imu_logs(test, log)?;
     let tau_s = tau_or_default(tau, || imu_judge::default_tau_s(&test));
     let cfg = columns.compare_config(fit, tau_s)?;
+    if let Some(t) = cfg.autopilot.first() {
+        anyhow::bail!(
+            "--methods {t}: the autopilot columns are for single-gyro logs; for a unit, \
+             export --target {t} writes the unit's parameters"
+        );
+    }
     let started = std::time::Instant::now();
     let sensors = train.first().map_or(0, |(_, l)| l.temp.len());
     if sensors > 1 {

@@ -26,7 +26,8 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let test_named = named(&test);
     let tau_s = resolve_tau(args.tau_s, &test_named);
     let cfg = args.columns.compare_config(&args.fit, tau_s)?;
-    let cmp = run_comparison(&train_named, &test_named, &cfg)?;
+    let mut cmp = run_comparison(&train_named, &test_named, &cfg)?;
+    super::compare::add_autopilot_columns(&mut cmp, &train_named, &test_named, &cfg)?;
     let verdicts = spec
         .as_ref()
         .map(|s| gyrotherm::spec::judge_comparison(s, &cmp, &test_named, &cfg))

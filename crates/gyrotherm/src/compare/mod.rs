@@ -27,6 +27,7 @@ use crate::compensate::{compensate_log, extrapolation_warnings, Compensated};
 use crate::csvlog::{TestLog, NOISE_COL};
 use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, RecipeSettings, Target};
 use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
+use crate::settings::export::{ExportTarget, EXPORT_TARGETS};
 use crate::settings::fit::FitSettings;
 use crate::settings::method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
 use crate::settings::rule::{check, Rule, SettingError};
@@ -111,6 +112,73 @@ impl Candidate {
     }
 }
 
+/// A column asked for by name (`compare --methods`, Python's `methods=`): a method, fitted on
+/// the training logs, or an autopilot's polynomial ([`ExportTarget::is_autopilot`]) fitted to
+/// the steady-state bias of the comparison's own method's model, as `export --target` writes
+/// it and the firmware computes it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnName {
+    Method(Method),
+    Autopilot(ExportTarget),
+}
+
+impl ColumnName {
+    /// Every name a column may be asked for by, with its help line: the methods a fit can
+    /// use, then the autopilot targets.
+    pub fn all() -> Vec<(&'static str, &'static str)> {
+        METHODS
+            .iter()
+            .map(|m| (m.as_str(), m.help()))
+            .chain(
+                EXPORT_TARGETS
+                    .iter()
+                    .filter(|t| t.is_autopilot())
+                    .map(|t| (t.as_str(), autopilot_column_help(*t))),
+            )
+            .collect()
+    }
+}
+
+fn autopilot_column_help(t: ExportTarget) -> &'static str {
+    match t {
+        ExportTarget::Px4 => {
+            "PX4's TC_G cubic in temperature, fitted to the steady-state bias of --method's \
+             model (what `export --target px4` writes), as the firmware computes it"
+        }
+        _ => {
+            "ArduPilot's INS_TCAL cubic in temperature, fitted to the steady-state bias of \
+             --method's model (what `export --target ardupilot` writes), as the firmware \
+             computes it"
+        }
+    }
+}
+
+impl std::str::FromStr for ColumnName {
+    type Err = SettingError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if let Some(m) = METHODS.iter().find(|m| m.as_str() == s) {
+            return Ok(ColumnName::Method(*m));
+        }
+        match EXPORT_TARGETS
+            .iter()
+            .find(|t| t.is_autopilot() && t.as_str() == s)
+        {
+            Some(t) => Ok(ColumnName::Autopilot(*t)),
+            None => Err(SettingError::Unknown {
+                setting: "methods",
+                value: s.to_owned(),
+                expected: column_names(),
+            }),
+        }
+    }
+}
+
+/// The names [`ColumnName`] parses, for error messages.
+fn column_names() -> &'static [&'static str] {
+    static NAMES: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    NAMES.get_or_init(|| ColumnName::all().into_iter().map(|(n, _)| n).collect())
+}
+
 /// The comparison's side of the user's settings: the settings sit below the comparison and
 /// know nothing of it, so the comparison builds its configuration from them here.
 impl FitSettings {
@@ -118,13 +186,29 @@ impl FitSettings {
     /// `published`, once) with these settings, bias stability over `tau_s`.
     pub fn compare_config(
         &self,
-        methods: Option<&[Method]>,
+        columns: Option<&[ColumnName]>,
         tau_s: f64,
     ) -> Result<CompareConfig, SettingError> {
         check("tau_s", tau_s, Rule::PositiveSeconds)?;
         let fit = self.fit_config()?;
         let main = fit.model_method();
-        let wanted: Vec<Method> = match methods {
+        let methods: Option<Vec<Method>> = columns.map(|c| {
+            c.iter()
+                .filter_map(|c| match c {
+                    ColumnName::Method(m) => Some(*m),
+                    ColumnName::Autopilot(_) => None,
+                })
+                .collect()
+        });
+        let autopilot: Vec<ExportTarget> = columns
+            .into_iter()
+            .flatten()
+            .filter_map(|c| match c {
+                ColumnName::Autopilot(t) => Some(*t),
+                ColumnName::Method(_) => None,
+            })
+            .collect();
+        let wanted: Vec<Method> = match methods.as_deref() {
             Some(m) => {
                 // `lstm`, which older model files record, is no method a fit can use.
                 if let Some(old) = m.iter().find(|m| !METHODS.contains(m)) {
@@ -153,6 +237,7 @@ impl FitSettings {
             .collect();
         Ok(CompareConfig {
             candidates,
+            autopilot,
             fit,
             tau_s,
             settle_s: self.settle_s,
@@ -188,6 +273,11 @@ pub fn default_tau_s(test: &[NamedLog]) -> (f64, Option<f64>) {
 pub struct CompareConfig {
     /// The columns to fit, in table order; no two with the same [`Candidate::key`].
     pub candidates: Vec<Candidate>,
+    /// Autopilot polynomials to show after them, each fitted to the steady-state bias of the
+    /// model of [`CompareConfig::fit`]'s method: added to a finished comparison by
+    /// `export::autopilot::add_columns` (the polynomial is the export's), not by
+    /// [`compare`].
+    pub autopilot: Vec<ExportTarget>,
     /// Fit settings shared by all columns (method and recipe set per [`Candidate`]).
     pub fit: FitConfig,
     /// Bias-stability smoothing time, s (100 s as in He et al. 2024).
@@ -205,6 +295,7 @@ impl Default for CompareConfig {
                 Candidate::of(Method::Thermal),
                 Candidate::published(None),
             ],
+            autopilot: Vec::new(),
             fit: FitConfig::new(DEFAULT_METHOD),
             tau_s: BIAS_STABILITY_TAU_S,
             settle_s: targets::SETTLE_S,

@@ -3,6 +3,7 @@
 
 use super::{CompareConfig, Comparison, Performance};
 use crate::model::SubModel;
+use crate::settings::export::ExportTarget;
 
 impl Comparison {
     /// One line per fitted model: its sub-models, and why no residual LSTM was kept when
@@ -12,6 +13,19 @@ impl Comparison {
             .iter()
             .zip(&self.columns)
             .map(|(f, col)| {
+                let autopilot = col
+                    .key
+                    .parse::<ExportTarget>()
+                    .is_ok_and(|t| t.is_autopilot());
+                if autopilot {
+                    return format!(
+                        "{:>16}: a cubic in temperature fitted to the steady-state bias of the {} \
+                         model (its rate and lag terms, and its scale-factor model, are not \
+                         carried)",
+                        col.label,
+                        f.model.label()
+                    );
+                }
                 let part = |s: &Option<SubModel>| s.as_ref().map_or("none", |s| s.kind());
                 let mut line = format!(
                     "{:>16}: bias model {}, scale-factor model {}",

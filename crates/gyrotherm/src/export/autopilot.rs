@@ -10,6 +10,11 @@ pub use super::steady_bias::{
     GRID_POINTS, MIN_RANGE_C, RAD_PER_DEG,
 };
 use super::{ExportError, ExportTarget};
+use crate::compare::{
+    performance, Column, CompareConfig, CompareError, Comparison, FailedColumn, MethodResult,
+};
+use crate::compensate::Compensated;
+use crate::fit::{fit_model, NamedLog};
 use crate::settings::autopilot::AutopilotSettings;
 
 /// The parameter file of `model` for an autopilot `target` (ArduPilot or PX4), with its fit
@@ -50,4 +55,93 @@ pub fn write(export: &AutopilotExport, dir: &Path) -> Result<PathBuf, ExportErro
         path: dir.to_path_buf(),
         source: std::io::Error::other("nothing written"),
     })
+}
+
+/// Add the comparison's autopilot columns ([`CompareConfig::autopilot`]) to a finished
+/// comparison of single-gyro logs: each autopilot's polynomial, fitted to the steady-state
+/// bias of the model of the comparison's own method (the column of that method, or a fit of
+/// it on `train` when it has none), subtracted from each held-out log's gyro output at its
+/// temperature as the firmware does ([`Correction`](super::steady_bias::Correction)), and
+/// judged with the same figures. The scale factor is left as it is (the autopilots correct
+/// the offset only). A polynomial that cannot be fitted is a failed column, with why.
+pub fn add_columns(
+    cmp: &mut Comparison,
+    train: &[NamedLog],
+    test: &[NamedLog],
+    cfg: &CompareConfig,
+) -> Result<(), CompareError> {
+    if cfg.autopilot.is_empty() {
+        return Ok(());
+    }
+    let method = cfg.fit.model_method();
+    let source = match cmp.fits.iter().find(|f| f.model.method == method) {
+        Some(f) => f.clone(),
+        None => fit_model(train, &cfg.fit, &|_, _, _| {}).map_err(|e| CompareError::Fit {
+            key: method.as_str(),
+            source: e.into(),
+        })?,
+    };
+    // The id names the gyro in PX4's file; the comparison writes no file.
+    let settings = AutopilotSettings {
+        device_id: Some(0),
+        ..AutopilotSettings::default()
+    };
+    let axis = settings.axis.index();
+    for &target in &cfg.autopilot {
+        let key = target.as_str();
+        let label = target.column_label();
+        if cmp.columns.iter().any(|c| c.key == key) {
+            return Err(CompareError::DuplicateColumn { key });
+        }
+        let export = match generate(ModelRef::Single(&source.model), target, &settings) {
+            Ok(e) => e,
+            Err(e) => {
+                cmp.failed.push(FailedColumn {
+                    key,
+                    label,
+                    reason: crate::error_chain::error_chain(&e),
+                });
+                continue;
+            }
+        };
+        for (t, result) in test.iter().zip(&mut cmp.tests) {
+            let bias_dps: Vec<f64> = t
+                .log
+                .temp_c
+                .iter()
+                .map(|&c| export.correction.offset_dps(axis, c))
+                .collect();
+            let gyro_comp_dps: Vec<f64> = t
+                .log
+                .gyro_dps
+                .iter()
+                .zip(&bias_dps)
+                .map(|(g, b)| g - b)
+                .collect();
+            match performance(t.log, &gyro_comp_dps, cfg.tau_s, cfg.settle_s) {
+                Ok(performance) => result.methods.push(MethodResult {
+                    method,
+                    key,
+                    label,
+                    performance,
+                    compensated: Compensated {
+                        scale: vec![1.0; bias_dps.len()],
+                        bias_dps,
+                        gyro_comp_dps,
+                    },
+                }),
+                Err(e) => result.failed.push(FailedColumn {
+                    key,
+                    label,
+                    reason: format!(
+                        "its output cannot be judged: {}",
+                        crate::error_chain::error_chain(&e)
+                    ),
+                }),
+            }
+        }
+        cmp.columns.push(Column { key, label });
+        cmp.fits.push(source.clone());
+    }
+    Ok(())
 }

@@ -100,12 +100,7 @@ impl Lang {
 
     /// One line on what is written (the `--help` text of the value).
     pub fn help(&self) -> &'static str {
-        match self {
-            Lang::C => {
-                "C99: gyrotherm_model.h and gyrotherm_model.c (no heap, no global mutable state)"
-            }
-            Lang::Rust => "Rust: gyrotherm_model.rs, the model as a `static` for gyrotherm-core",
-        }
+        ExportTarget::from(*self).help()
     }
 }
 

@@ -23,6 +23,7 @@
 //!   ([`CoverageSettings`](coverage::CoverageSettings)).
 //! - [`autopilot`]: which IMU and axis an autopilot parameter file is for, and (PX4) its
 //!   device id ([`AutopilotSettings`](autopilot::AutopilotSettings)).
+//! - [`export`](mod@export): the export targets, one list ([`ExportTarget`](export::ExportTarget)).
 //! - [`kalibr`]: the ROS topic named in a Kalibr noise file.
 //! - [`plan`]: the flight envelope and the chamber's limits of `gyrotherm plan`
 //!   ([`PlanSettings`](plan::PlanSettings)).
@@ -36,6 +37,7 @@ pub mod compensate;
 pub mod coverage;
 pub mod describe;
 pub mod evaluate;
+pub mod export;
 pub mod fit;
 pub mod kalibr;
 pub mod method;
