@@ -102,7 +102,10 @@ fn the_read_only_lstm_method_is_refused_as_a_setting() {
         Method::Generic
     );
     let err = FitSettings::default()
-        .compare_config(Some(&[Method::Linear, Method::Lstm]), 100.0)
+        .compare_config(
+            Some(&[Method::Linear, Method::Lstm].map(gyrotherm::compare::ColumnName::Method)),
+            100.0,
+        )
         .unwrap_err()
         .to_string();
     assert!(err.contains("methods") && err.contains("lstm"), "{err}");
