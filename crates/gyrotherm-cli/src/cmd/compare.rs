@@ -77,7 +77,11 @@ pub fn run_comparison(
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
-    if args.log.read_options().is_multi_column() {
+    if args
+        .log
+        .read_options()
+        .reads_unit(&[&args.train[..], &args.test[..]].concat())
+    {
         return super::imu_judge::compare(args);
     }
     let spec = super::verdict::load(args.spec.as_deref())?;

@@ -38,6 +38,9 @@ def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
     for k in ("fill_gaps_max_s", "sample_period_s"):
         if out[k] is not None:
             out[k] = float(out[k])
+    if out["format"] is not None:
+        out["format"] = str(out["format"])
+    out["instance"] = int(out["instance"])
     return out
 
 
@@ -63,7 +66,11 @@ def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any)
     default ``time_s``, ``gyro_dps``, ``temp_c``, ``table_dps``); pass-through columns keep
     their names too (numeric ones as float arrays). Options: ``time_col``, ``gyro_col``, ``temp_col``, ``table_col``,
     ``gyro_unit`` (``"dps"``, ``"dph"``, ``"rad/s"``), ``fill_gaps_max_s`` (max gap in s to
-    interpolate), ``sample_period_s`` (s), ``delimiter`` (``","``, ``";"`` or ``"tab"``).
+    interpolate), ``sample_period_s`` (s), ``delimiter`` (``","``, ``";"`` or ``"tab"``),
+    ``format`` (``"csv"``, ``"ulog"``, ``"dataflash"``; default: by the file's extension) and
+    ``instance`` (which of an autopilot's gyros). A PX4 ULog or ArduPilot DataFlash log holds
+    a three-axis unit: name its gyro columns (``gyro_col=["gyro_x_dps", "gyro_y_dps",
+    "gyro_z_dps"]``) or one of them.
 
     An inertial unit's log: ``gyro_col`` and ``temp_col`` take several columns, as a list or
     the CLI's comma-separated text (``gyro_col=["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"]``);
