@@ -158,6 +158,29 @@ fn pick(
         .collect()
 }
 
+/// Read an autopilot's log (a format that [holds a unit](LogFormat::holds_unit)) from any
+/// byte source, `source` naming it in messages: as [`read_imu_log`](super::read_imu_log) reads
+/// such a file, every axis. A CSV source is read line by line by
+/// [`LogReader`](super::LogReader) instead, so it is refused here.
+pub fn read_unit_from<R: std::io::Read>(
+    src: R,
+    source: &Path,
+    format: LogFormat,
+    instance: u8,
+) -> Result<(ImuLog, ReadReport), LogError> {
+    match format {
+        LogFormat::Ulog => super::ulog::read_from(src, source, instance),
+        LogFormat::DataFlash => super::dataflash::read_from(src, source, instance),
+        LogFormat::Csv => Err(LogError::new(
+            Kind::BadOptions,
+            source,
+            None,
+            None,
+            "a CSV source is read line by line with LogReader",
+        )),
+    }
+}
+
 /// Read one gyro axis of a log whose format holds a unit: the gyro column the options name
 /// (one of the unit's), with its temperature.
 pub(crate) fn read_axis(

@@ -34,7 +34,7 @@ pub use column_list::{
     parse_table_axis, split_columns, COLUMN_LIST_SEPARATOR, TABLE_AXIS_SLOPE_RANGE,
 };
 pub use error::{LogError, LogErrorKind};
-pub use format::{LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
+pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
 pub(crate) use imu::write_imu_csv;
 pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
