@@ -68,7 +68,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bytes.clear();
         }
     }
-    let rest = ulog.map(|w| w.bytes).or(bin.map(|w| w.bytes)).unwrap_or_default();
+    let rest = ulog
+        .map(|w| w.bytes)
+        .or(bin.map(|w| w.bytes))
+        .unwrap_or_default();
     file.write_all(&rest)?;
     file.flush()?;
     eprintln!("wrote {out}: {n} samples over {seconds} s");
