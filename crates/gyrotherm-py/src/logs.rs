@@ -12,6 +12,7 @@ use crate::{py_err, LogError, MetricsError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
+    m.add_function(wrap_pyfunction!(reads_unit, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_log, m)?)?;
     Ok(())
 }
@@ -78,6 +79,13 @@ pub fn read_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("format", d.format.map(|f| f.as_str()))?;
     out.set_item("instance", d.instance)?;
     Ok(out)
+}
+
+/// Whether reading `paths` with `options` gives inertial units (several gyro or temperature
+/// columns named, or a format that holds a unit: an autopilot's log).
+#[pyfunction]
+fn reads_unit(paths: Vec<PathBuf>, options: LogOptions) -> PyResult<bool> {
+    Ok(options.read_options()?.reads_unit(&paths))
 }
 
 /// Read a whole log; the error is the library's message (file, line, column, the fix).

@@ -44,10 +44,11 @@ def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
     return out
 
 
-def is_unit(options: Dict[str, Any]) -> bool:
-    """Whether full options (:func:`read_options`) name several gyro or temperature columns:
+def is_unit(options: Dict[str, Any], paths=()) -> bool:
+    """Whether full options (:func:`read_options`) name several gyro or temperature columns,
+    or a log of ``paths`` is of a format that holds a unit (PX4 ULog, ArduPilot DataFlash):
     an inertial unit's log."""
-    return "," in options["gyro_col"] or "," in options["temp_col"]
+    return _g.reads_unit([os.fspath(p) for p in paths], options)
 
 
 def _pandas():
@@ -84,7 +85,7 @@ def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any)
     Raises ``gyrotherm.LogError`` naming file, line and column.
     """
     opts = read_options(options)
-    reader = _g.read_imu_log if is_unit(opts) else _g.read_log
+    reader = _g.read_imu_log if is_unit(opts, [path]) else _g.read_log
     cols, report = reader(os.fspath(path), opts)
     pd = _pandas()
     if as_frame is None:
