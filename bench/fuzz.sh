@@ -14,7 +14,7 @@ secs=${1:?usage: bench/fuzz.sh SECONDS [TARGET...]}
 shift
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(csvlog model_file compensator allan export)
+    targets=(csvlog model_file compensator allan export ulog dataflash)
 fi
 parallel=${FUZZ_PARALLEL:-1}
 logs=bench/out/fuzz

@@ -12,6 +12,7 @@ use crate::{py_err, LogError, MetricsError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
+    m.add_function(wrap_pyfunction!(reads_unit, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_log, m)?)?;
     Ok(())
 }
@@ -31,6 +32,8 @@ pub struct LogOptions {
     pub fill_gaps_max_s: Option<f64>,
     pub sample_period_s: Option<f64>,
     pub delimiter: String,
+    pub format: Option<String>,
+    pub instance: u8,
 }
 
 impl LogOptions {
@@ -46,6 +49,13 @@ impl LogOptions {
             fill_gaps_max_s: self.fill_gaps_max_s,
             sample_period_s: self.sample_period_s,
             delimiter: read::parse_delimiter(&self.delimiter).map_err(py_err::<LogError>)?,
+            format: self
+                .format
+                .as_deref()
+                .map(str::parse)
+                .transpose()
+                .map_err(py_err::<LogError>)?,
+            instance: self.instance,
         };
         opts.validate().map_err(py_err::<LogError>)?;
         Ok(opts)
@@ -66,7 +76,16 @@ pub fn read_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("fill_gaps_max_s", d.fill_gaps_max_s)?;
     out.set_item("sample_period_s", d.sample_period_s)?;
     out.set_item("delimiter", read::delimiter_name(d.delimiter))?;
+    out.set_item("format", d.format.map(|f| f.as_str()))?;
+    out.set_item("instance", d.instance)?;
     Ok(out)
+}
+
+/// Whether reading `paths` with `options` gives inertial units (several gyro or temperature
+/// columns named, or a format that holds a unit: an autopilot's log).
+#[pyfunction]
+fn reads_unit(paths: Vec<PathBuf>, options: LogOptions) -> PyResult<bool> {
+    Ok(options.read_options()?.reads_unit(&paths))
 }
 
 /// Read a whole log; the error is the library's message (file, line, column, the fix).

@@ -323,7 +323,7 @@ pub fn compensate_imu_file(
     out: &Path,
     opts: &ReadOptions,
 ) -> Result<ImuLinesSummary, FileError> {
-    lines_to_file(input, out, |r, w| {
+    lines_to_file(input, out, opts, |r, w, opts| {
         compensate_imu_lines(model, r, input, opts, w, Mode::Strict, false)
     })
 }

@@ -307,27 +307,55 @@ pub fn compensate_file(
     out: &Path,
     opts: &ReadOptions,
 ) -> Result<LinesSummary, FileError> {
-    lines_to_file(input, out, |r, w| {
+    lines_to_file(input, out, opts, |r, w, opts| {
         compensate_lines(model, r, input, opts, w, Mode::Strict, false)
     })
 }
 
 /// Run `lines` from the file `input` into the CSV file `out`, written to a temporary file
-/// and renamed into place (the batch form of a stream).
+/// and renamed into place (the batch form of a stream). A log whose format holds a unit (an
+/// autopilot's) is read first and handed to `lines` as the CSV of its unit, with the read
+/// options of that CSV.
 pub(crate) fn lines_to_file<S>(
     input: &Path,
     out: &Path,
+    opts: &ReadOptions,
     lines: impl FnOnce(
-        std::io::BufReader<&std::fs::File>,
+        &mut dyn std::io::BufRead,
         &mut std::io::BufWriter<std::fs::File>,
+        &ReadOptions,
     ) -> Result<S, LinesError>,
 ) -> Result<S, FileError> {
-    let file = std::fs::File::open(input).map_err(|source| FileError::Open {
-        path: input.to_path_buf(),
-        source,
-    })?;
+    let (mut source, opts): (Box<dyn std::io::BufRead>, ReadOptions) =
+        if opts.format_of(input).holds_unit() {
+            let (log, _) = crate::csvlog::read_imu_log(input, opts, None)
+                .map_err(|e| FileError::Lines(LinesError::Log(e)))?;
+            let mut text = Vec::new();
+            crate::csvlog::write_imu_csv(&mut text, &log).map_err(|source| FileError::Open {
+                path: input.to_path_buf(),
+                source,
+            })?;
+            let csv = ReadOptions {
+                format: Some(crate::csvlog::LogFormat::Csv),
+                ..ReadOptions::default()
+            };
+            (
+                Box::new(std::io::Cursor::new(text)),
+                ReadOptions {
+                    gyro_col: opts.gyro_col.clone(),
+                    temp_col: opts.temp_col.clone(),
+                    ..csv
+                },
+            )
+        } else {
+            let file = std::fs::File::open(input).map_err(|source| FileError::Open {
+                path: input.to_path_buf(),
+                source,
+            })?;
+            (Box::new(std::io::BufReader::new(file)), opts.clone())
+        };
     crate::atomic_file::write_atomically(out, |w: &mut std::io::BufWriter<std::fs::File>| {
-        let s = lines(std::io::BufReader::new(&file), w)?;
+        let s = lines(&mut source, w, &opts)?;
         w.flush()?;
         Ok::<_, LinesError>(s)
     })

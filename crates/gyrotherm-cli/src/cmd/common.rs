@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use clap::Args;
-use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
+use gyrotherm::csvlog::{self, GyroUnit, LogFormat, ReadOptions, TestLog, LOG_FORMATS};
 use gyrotherm::fit::NamedLog;
 use gyrotherm::model::GivenColumns;
 use gyrotherm::settings::{read, Rule};
@@ -51,6 +51,14 @@ pub struct LogArgs {
     #[arg(long, value_name = "SEP", default_value = read::delimiter_name(ReadOptions::default().delimiter),
           value_parser = |s: &str| read::parse_delimiter(s))]
     pub delimiter: u8,
+    /// Log file format (default: by extension: .ulg PX4 ULog, .bin ArduPilot DataFlash, any
+    /// other CSV). An autopilot log is read as a three-axis unit, averaged per model step.
+    #[arg(long, value_name = "FORMAT",
+          value_parser = choice::<LogFormat>(LOG_FORMATS.map(|f| (f.as_str(), f.help()))))]
+    pub format: Option<LogFormat>,
+    /// Which of an autopilot's gyros to read (PX4 multi-instance, ArduPilot IMU instance).
+    #[arg(long, value_name = "N", default_value_t = ReadOptions::default().instance)]
+    pub instance: u8,
 }
 
 /// A value parser for a library setting with a list of names: the names (with their help
@@ -95,6 +103,8 @@ impl LogArgs {
             fill_gaps_max_s: self.fill_gaps_max_s,
             sample_period_s: self.sample_period_s,
             delimiter: self.delimiter,
+            format: self.format,
+            instance: self.instance,
         }
     }
 }
@@ -143,6 +153,9 @@ pub fn read_log_with(path: &Path, opts: &ReadOptions) -> anyhow::Result<(TestLog
         eprintln!("gyrotherm: {w}");
     }
     if let Some(w) = report.jitter_warning(path) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
+    if let Some(w) = report.truncation_warning(path) {
         eprintln!("gyrotherm: warning: {w}");
     }
     Ok((log, warning))

@@ -97,7 +97,11 @@ pub fn add_autopilot_columns(
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
-    if args.log.read_options().is_multi_column() {
+    if args
+        .log
+        .read_options()
+        .reads_unit(&[&args.train[..], &args.test[..]].concat())
+    {
         return super::imu_judge::compare(args);
     }
     let spec = super::verdict::load(args.spec.as_deref())?;

@@ -11,7 +11,7 @@ use super::args::EvaluateArgs;
 use super::print::print_evaluation;
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
-    if args.model.is_some() || args.log.read_options().is_multi_column() {
+    if args.model.is_some() || args.log.read_options().reads_unit(&[&args.input]) {
         return super::imu_judge::evaluate(args);
     }
     let mut w = std::io::stdout().lock();

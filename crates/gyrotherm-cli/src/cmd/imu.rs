@@ -38,6 +38,9 @@ pub fn read_imu_logs_with(
                         report.filled_samples
                     );
                 }
+                if let Some(w) = report.truncation_warning(p) {
+                    eprintln!("gyrotherm: warning: {w}");
+                }
                 if report.zero_table {
                     eprintln!(
                         "gyrotherm: {}: the table-rate column {} is all zeros: read as a \

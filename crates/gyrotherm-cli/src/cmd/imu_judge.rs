@@ -41,6 +41,9 @@ pub fn evaluate(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
             report.filled_samples
         );
     }
+    if let Some(w) = report.truncation_warning(&args.input) {
+        eprintln!("gyrotherm: warning: {w}");
+    }
     let settings = EvaluateSettings {
         column: args.column.clone(),
         tau_s: args.tau_s,

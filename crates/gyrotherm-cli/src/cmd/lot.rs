@@ -165,7 +165,7 @@ impl lot::HeldOutReader for HeldOut<'_> {
     fn single(&mut self, opts: &ReadOptions) -> anyhow::Result<Vec<(PathBuf, gyrotherm::TestLog)>> {
         let a = self.0;
         anyhow::ensure!(
-            !a.log.read_options().is_multi_column(),
+            !a.log.read_options().reads_unit(&a.test),
             "{}: a single-axis model; --gyro-col/--temp-col lists need an inertial unit's model \
              (`gyrotherm train` with the same lists), whose columns lot add then reads",
             a.model.display()

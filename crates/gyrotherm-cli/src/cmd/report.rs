@@ -15,7 +15,11 @@ use super::compare::run_comparison;
 use super::print::print_table;
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
-    if args.log.read_options().is_multi_column() {
+    if args
+        .log
+        .read_options()
+        .reads_unit(&[&args.train[..], &args.test[..]].concat())
+    {
         return super::imu_judge::report(args);
     }
     let spec = super::verdict::load(args.spec.as_deref())?;

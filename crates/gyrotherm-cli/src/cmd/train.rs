@@ -16,7 +16,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         [args.out.as_path()],
         args.input.iter().map(PathBuf::as_path),
     )?;
-    if args.log.read_options().is_multi_column() {
+    if args.log.read_options().reads_unit(&args.input) {
         return super::imu::train(args);
     }
     let logs = read_logs(&args.input, &args.log, &mut Vec::new())?;

@@ -102,6 +102,8 @@ def read_log(
     fill_gaps_max_s: Optional[float] = ...,
     sample_period_s: Optional[float] = ...,
     delimiter: str = ...,
+    format: Optional[str] = ...,
+    instance: int = ...,
 ) -> Any: ...
 
 def read_lot(db: PathLike, *, as_frame: Optional[bool] = None) -> Any: ...

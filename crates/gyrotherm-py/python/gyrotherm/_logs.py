@@ -38,13 +38,17 @@ def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
     for k in ("fill_gaps_max_s", "sample_period_s"):
         if out[k] is not None:
             out[k] = float(out[k])
+    if out["format"] is not None:
+        out["format"] = str(out["format"])
+    out["instance"] = int(out["instance"])
     return out
 
 
-def is_unit(options: Dict[str, Any]) -> bool:
-    """Whether full options (:func:`read_options`) name several gyro or temperature columns:
+def is_unit(options: Dict[str, Any], paths=()) -> bool:
+    """Whether full options (:func:`read_options`) name several gyro or temperature columns,
+    or a log of ``paths`` is of a format that holds a unit (PX4 ULog, ArduPilot DataFlash):
     an inertial unit's log."""
-    return "," in options["gyro_col"] or "," in options["temp_col"]
+    return _g.reads_unit([os.fspath(p) for p in paths], options)
 
 
 def _pandas():
@@ -63,7 +67,11 @@ def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any)
     default ``time_s``, ``gyro_dps``, ``temp_c``, ``table_dps``); pass-through columns keep
     their names too (numeric ones as float arrays). Options: ``time_col``, ``gyro_col``, ``temp_col``, ``table_col``,
     ``gyro_unit`` (``"dps"``, ``"dph"``, ``"rad/s"``), ``fill_gaps_max_s`` (max gap in s to
-    interpolate), ``sample_period_s`` (s), ``delimiter`` (``","``, ``";"`` or ``"tab"``).
+    interpolate), ``sample_period_s`` (s), ``delimiter`` (``","``, ``";"`` or ``"tab"``),
+    ``format`` (``"csv"``, ``"ulog"``, ``"dataflash"``; default: by the file's extension) and
+    ``instance`` (which of an autopilot's gyros). A PX4 ULog or ArduPilot DataFlash log holds
+    a three-axis unit: name its gyro columns (``gyro_col=["gyro_x_dps", "gyro_y_dps",
+    "gyro_z_dps"]``) or one of them.
 
     An inertial unit's log: ``gyro_col`` and ``temp_col`` take several columns, as a list or
     the CLI's comma-separated text (``gyro_col=["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"]``);
@@ -77,7 +85,7 @@ def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any)
     Raises ``gyrotherm.LogError`` naming file, line and column.
     """
     opts = read_options(options)
-    reader = _g.read_imu_log if is_unit(opts) else _g.read_log
+    reader = _g.read_imu_log if is_unit(opts, [path]) else _g.read_log
     cols, report = reader(os.fspath(path), opts)
     pd = _pandas()
     if as_frame is None:

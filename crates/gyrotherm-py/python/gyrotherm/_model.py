@@ -424,7 +424,7 @@ def fit(
         poly_rate_degree, cross, validate_on_runs,
     )
     options = read_options(log_options)
-    if is_unit(options):
+    if is_unit(options, static_paths + table_paths):
         if progress is True:
             unit_callback = _PrintUnitProgress()
         elif progress is False or progress is None:
@@ -491,7 +491,7 @@ def evaluate(
     options = read_options(log_options)
     import json
 
-    if raw_model is None and not is_unit(options):
+    if raw_model is None and not is_unit(options, [log]):
         text, note = _g.evaluate_log(
             os.fspath(log),
             options,

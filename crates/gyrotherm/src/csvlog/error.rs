@@ -51,6 +51,9 @@ pub enum LogErrorKind {
     BadLog,
     /// The log is sampled more sparsely than the model steps (compensation).
     SampledTooSparsely,
+    /// A binary log's bytes do not decode: not the format read, or damaged (the message
+    /// names the byte offset).
+    Corrupt,
 }
 
 /// A log that cannot be read: file, line, column and what to do.

@@ -140,6 +140,9 @@ pub fn read_imu_log(
     opts: &ReadOptions,
     table_axis: Option<&str>,
 ) -> Result<(ImuLog, ReadReport), LogError> {
+    if opts.format_of(path).holds_unit() {
+        return super::format::read_unit(path, opts);
+    }
     let options = |e: crate::setting_rule::SettingError| {
         LogError::new(Kind::BadOptions, path, None, None, e.to_string())
     };
@@ -416,22 +419,27 @@ pub fn write_imu_log(path: &Path, log: &ImuLog) -> Result<(), LogError> {
             return Err(bad(&s.name, format!("row {} is not finite", i + 1)));
         }
     }
-    crate::atomic_file::write_atomically(path, |w| -> std::io::Result<()> {
-        let header = std::iter::once(TIME_COL)
-            .chain(numeric.clone().map(|s| s.name.as_str()))
-            .chain(log.extra.iter().map(|c| c.name.as_str()));
-        let mut out = LogWriter::new(w, header)?;
-        for i in 0..n {
-            out.push_f64(log.time_s[i]);
-            for s in numeric.clone() {
-                out.push_f64(s.values[i]);
-            }
-            for c in &log.extra {
-                out.push_raw(c.values[i].as_bytes());
-            }
-            out.end_row()?;
+    crate::atomic_file::write_atomically(path, |w| write_imu_csv(w, log))
+        .map_err(|e| LogError::new(Kind::Io, path, None, None, format!("cannot write: {e}")))
+}
+
+/// The CSV of a unit's log, as [`write_imu_log`] writes it, into `w` (the columns' lengths
+/// checked by the caller).
+pub(crate) fn write_imu_csv<W: std::io::Write>(w: W, log: &ImuLog) -> std::io::Result<()> {
+    let numeric = log.gyro.iter().chain(&log.temp).chain(&log.table);
+    let header = std::iter::once(TIME_COL)
+        .chain(numeric.clone().map(|s| s.name.as_str()))
+        .chain(log.extra.iter().map(|c| c.name.as_str()));
+    let mut out = LogWriter::new(w, header)?;
+    for i in 0..log.len() {
+        out.push_f64(log.time_s[i]);
+        for s in numeric.clone() {
+            out.push_f64(s.values[i]);
         }
-        out.flush()
-    })
-    .map_err(|e| LogError::new(Kind::Io, path, None, None, format!("cannot write: {e}")))
+        for c in &log.extra {
+            out.push_raw(c.values[i].as_bytes());
+        }
+        out.end_row()?;
+    }
+    out.flush()
 }

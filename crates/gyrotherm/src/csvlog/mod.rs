@@ -19,23 +19,30 @@
 mod chunk;
 mod column_list;
 mod columns;
+mod dataflash;
 mod error;
+mod format;
 mod gaps;
 mod imu;
 mod number;
 mod reader;
+mod step_means;
+mod ulog;
 pub(crate) mod writer;
 
 pub use column_list::{
     parse_table_axis, split_columns, COLUMN_LIST_SEPARATOR, TABLE_AXIS_SLOPE_RANGE,
 };
 pub use error::{LogError, LogErrorKind};
+pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
+pub(crate) use imu::write_imu_csv;
 pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
 pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
 };
+pub use step_means::{SAMPLES_COL, SENSOR_GYRO_COLS, STEP_S};
 pub(crate) use writer::short_f64;
 pub use writer::{format_f64, LogWriter};
 
@@ -254,6 +261,11 @@ pub struct ReadOptions {
     /// Field separator: `b','` (default), `b';'` or `b'\t'`. With any separator but the
     /// comma, numbers may use a decimal comma (`0,5`), as European loggers write them.
     pub delimiter: u8,
+    /// The file format (None: by the file's extension, [`LogFormat::of_path`]).
+    pub format: Option<LogFormat>,
+    /// Which of an autopilot's sensors of the same kind to read (PX4's multi-instance,
+    /// ArduPilot's `I`); CSV logs ignore it.
+    pub instance: u8,
 }
 
 impl Default for ReadOptions {
@@ -267,6 +279,8 @@ impl Default for ReadOptions {
             fill_gaps_max_s: None,
             sample_period_s: None,
             delimiter: b',',
+            format: None,
+            instance: 0,
         }
     }
 }
@@ -292,9 +306,23 @@ pub struct ReadReport {
     /// The table-rate column holds only zeros: an inertial unit's log read as a static run
     /// ([`read_imu_log`] leaves its `table` out).
     pub zero_table: bool,
+    /// A binary log cut off mid-message: the byte where its last whole message ends (what
+    /// follows was not read).
+    pub truncated_at_byte: Option<u64>,
 }
 
 impl ReadReport {
+    /// A warning about a log cut off mid-message, if it was.
+    pub fn truncation_warning(&self, source: &Path) -> Option<String> {
+        self.truncated_at_byte.map(|at| {
+            format!(
+                "{}: the log is cut off in a message at byte {at}; read up to there (a log \
+                 copied before the autopilot closed it ends so)",
+                source.display()
+            )
+        })
+    }
+
     /// Jitter above which a log is reported as irregularly sampled (the figures assume
     /// even sampling).
     pub(crate) const JITTER_WARNING: f64 = 0.05;
@@ -319,7 +347,10 @@ impl ReadReport {
 /// Read and validate a whole log. The file is read once, streaming; the columns are sized
 /// from the file length and the bytes per row of the first rows.
 pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport), LogError> {
-    read_log_numbers(path, opts, &[]).map(|(log, report, _)| (log, report))
+    match opts.format_of(path) {
+        LogFormat::Csv => read_log_numbers(path, opts, &[]).map(|(log, report, _)| (log, report)),
+        _ => format::read_axis(path, opts),
+    }
 }
 
 /// [`read_log`], the pass-through columns named in `numbers` (the first of each name) parsed

@@ -11,7 +11,7 @@ use super::evaluate::EvaluateSettings;
 use super::fit::FitSettings;
 use super::method::METHOD_NAMES;
 use super::read::{delimiter_name, DELIMITER_NAMES, GYRO_UNIT_NAMES};
-use crate::csvlog::ReadOptions;
+use crate::csvlog::{ReadOptions, LOG_FORMAT_NAMES};
 
 /// One setting: its name (the Python keyword; the flag is `--` plus the name with `-` for
 /// `_`, except `cross`, whose flag is `--no-cross`), its default as text (None: no default,
@@ -74,6 +74,12 @@ pub fn log_options() -> Vec<OptionSpec> {
             open: true,
             ..choice("delimiter", delimiter_name(d.delimiter), &DELIMITER_NAMES)
         },
+        // No default: the file's extension picks the format.
+        OptionSpec {
+            values: LOG_FORMAT_NAMES.to_vec(),
+            ..opt("format", None)
+        },
+        opt("instance", Some(d.instance.to_string())),
     ]
 }
 
