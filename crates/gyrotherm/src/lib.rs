@@ -87,6 +87,7 @@ mod error_chain;
 pub use error_chain::error_chain;
 pub mod export;
 pub mod features;
+pub mod flight_size;
 pub mod fit;
 pub(crate) mod imu_error;
 pub mod imu_judge;
