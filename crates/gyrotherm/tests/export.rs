@@ -123,7 +123,7 @@ fn a_32_unit_static_model_compensates_like_the_model_file() {
         assert_eq!(x.bias_dps.to_bits(), y.bias_dps.to_bits(), "sample {i}");
     }
     // The 8-unit form refuses it, naming the size; the Rust text carries the size.
-    let e = static_model(&model).unwrap_err().to_string();
+    let e = gyrotherm::error_chain(&static_model(&model).unwrap_err());
     assert!(e.contains("32"), "{e}");
     let files = gyrotherm::export::generate(&model, gyrotherm::export::Lang::Rust).unwrap();
     assert!(files[0].1.contains("pub static MODEL: StaticModel<32> = "));
