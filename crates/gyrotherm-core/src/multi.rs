@@ -35,8 +35,7 @@
 
 use crate::baseline::BaselineModel;
 use crate::compensator::{
-    plausible_reading, Compensator, Corrected, ModelError, MoreSensors, Status, TempLimits,
-    HIDDEN,
+    plausible_reading, Compensator, Corrected, ModelError, MoreSensors, Status, TempLimits, HIDDEN,
 };
 use crate::features::{FeaturePipeline, FeatureSpec};
 

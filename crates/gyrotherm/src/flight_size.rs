@@ -12,9 +12,7 @@
 //! state stays 0 and their read-out weight is 0, so every gate sum of the real units adds
 //! exact zeros and the output is the same bits.
 
-use gyrotherm_core::compensator::{
-    Compensator, Corrected, TempLimits, HIDDEN_SIZES,
-};
+use gyrotherm_core::compensator::{Compensator, Corrected, TempLimits, HIDDEN_SIZES};
 use gyrotherm_core::features::{FeatureSpec, Features};
 use gyrotherm_core::multi::AxisCompensator;
 use gyrotherm_core::unit::UnitError;

@@ -33,10 +33,10 @@ use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 
 use crate::build_sized;
 use crate::compensate::{boxed_compensator, hidden_size, sized_compensator};
-use crate::flight_size::{FlightAxis, FlightCompensator, HiddenSize};
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
+use crate::flight_size::{FlightAxis, FlightCompensator, HiddenSize};
 pub use crate::imu_error::ImuError;
 use crate::model::{
     content_digest_of, parse_sealed, ModelFile, Seal, SealedTextError, SubModel, Target,
@@ -717,7 +717,11 @@ fn axis_checks(temp_cols: &[String], a: &ImuAxis) -> Result<(), ImuError> {
         // model must.
         let size = axes_hidden_size(std::slice::from_ref(a))?;
         let comp = build_sized!(FlightAxis, size, H => boxed_axis::<H>(temp_cols, a)?);
-        let further: Vec<_> = comp.further().into_iter().map(|(_, s, b, k)| (s, b, k)).collect();
+        let further: Vec<_> = comp
+            .further()
+            .into_iter()
+            .map(|(_, s, b, k)| (s, b, k))
+            .collect();
         a.model
             .check_outputs_with_further(comp.first().spec(), &further)
             .map_err(|source| ImuError::Axis {

@@ -81,7 +81,9 @@ fn model_32() -> ModelFile {
     let mut vec = |n: usize| -> Vec<f64> {
         (0..n)
             .map(|_| {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.6
             })
             .collect()
@@ -151,5 +153,8 @@ fn an_unsupported_lstm_size_is_refused_naming_it() {
             Ok(_) => panic!("a 12-unit LSTM was accepted"),
         },
     };
-    assert!(e.contains("12 hidden units") && e.contains("8, 16, 32 or 64"), "{e}");
+    assert!(
+        e.contains("12 hidden units") && e.contains("8, 16, 32 or 64"),
+        "{e}"
+    );
 }

@@ -297,9 +297,7 @@ fn flight_network_matches_pytorch_at_32_units() {
     for case in r["cases"].as_array().unwrap() {
         let name = case["name"].as_str().unwrap();
         let mut net = gyrotherm_core::lstm::Lstm::<5, 32>::new(&w);
-        let f32s = |v: Vec<f64>| -> [f32; 32] {
-            std::array::from_fn(|j| v[j] as f32)
-        };
+        let f32s = |v: Vec<f64>| -> [f32; 32] { std::array::from_fn(|j| v[j] as f32) };
         net.set_state(&f32s(flat(&case["h0"])), &f32s(flat(&case["c0"])))
             .unwrap();
         let x = flat(&case["x"]);

@@ -3,8 +3,8 @@
 
 use super::*;
 
-use gyrotherm_core::compensator::ModelError as FlightModelError;
 use crate::flight_size::HiddenSize;
+use gyrotherm_core::compensator::ModelError as FlightModelError;
 use gyrotherm_core::compensator::{NormalisedLstm, TargetModel, HIDDEN_SIZES, LSTM_INPUTS};
 
 /// Widen an LSTM to the flight input count and `H` hidden units: input columns beyond
