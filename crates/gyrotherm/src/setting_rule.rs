@@ -40,8 +40,8 @@ pub enum Rule {
     Finite,
     /// A list of column names (one, or several separated by commas).
     ColumnList,
-    /// Hidden units of an LSTM: the number the flight compensator's network is built for
-    /// ([`gyrotherm_core::compensator::HIDDEN`]).
+    /// Hidden units of an LSTM: a size the flight compensator's network is built for
+    /// ([`gyrotherm_core::compensator::HIDDEN_SIZES`]).
     HiddenUnits,
     /// A temperature a flight reaches, °C: from absolute zero to
     /// [`MAX_ENVELOPE_C`].
