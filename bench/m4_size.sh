@@ -76,6 +76,24 @@ done
 echo "state: sizeof(gt_state) = $state bytes per axis (RAM includes it); stack: sum of the"
 echo "frames of every function in gyrotherm_model.c (-fstack-usage), an upper bound for gt_step"
 
+# Instructions per gt_step of the LSTM models (QEMU mps2-an386 with -icount shift=0; the
+# Cortex-M4 takes about one cycle an instruction, more for loads, divisions and branches).
+if command -v qemu-system-arm >/dev/null; then
+    arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os \
+        -c bench/m4/startup.c -o "$work/startup.o"
+    for m in published lstm32 lstm64; do
+        dir="$work/$m"
+        arm-none-eabi-gcc "${CFLAGS[@]}" -I "$dir" bench/m4/step_count.c "$dir/gyrotherm_model.c" \
+            "$work/startup.o" -T bench/m4/mps2.ld --specs=rdimon.specs -Wl,--gc-sections \
+            -o "$dir/count.elf" -lm
+        n=$(timeout 600 qemu-system-arm -M mps2-an386 -nographic -icount shift=0 \
+            -semihosting-config enable=on,target=native -kernel "$dir/count.elf")
+        echo "$m: $n instructions per gt_step (QEMU $(qemu-system-arm --version | head -1 | awk '{print $4}'), -icount)"
+    done
+else
+    echo "instructions per step: needs qemu-system-arm (apt-get install qemu-system-arm)"
+fi
+
 # The inertial unit.
 unit=(--imu --unit random --unit-seed 1000 --profile fast-cycle)
 $bin simulate "${unit[@]}" --seed 1 --out "$work/us.csv" 2>/dev/null

@@ -370,3 +370,21 @@ impl StreamUnit {
         self.axes.iter_mut().for_each(FlightAxis::reset)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::setting_rule::Rule;
+
+    #[test]
+    fn the_sizes_are_the_cores_and_the_settings_rule_takes_them_alone() {
+        for h in HIDDEN_SIZES {
+            assert_eq!(HiddenSize::of_units(h).map(HiddenSize::units), Some(h));
+            assert!(Rule::HiddenUnits.holds(h as f64));
+        }
+        for h in [0usize, 1, 4, 12, 24, 48, 128] {
+            assert_eq!(HiddenSize::of_units(h), None);
+            assert!(!Rule::HiddenUnits.holds(h as f64));
+        }
+    }
+}
