@@ -189,7 +189,7 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
     // The axes share one time axis; the first axis's compensator steps as they all do.
     let mut cadence = unit
         .axis(0)
-        .map(|a| Cadence::new(a.spec(), a.limits().degraded_after_s));
+        .map(|a| Cadence::new(a.first().spec(), a.first().limits().degraded_after_s));
     let mut gyro = vec![0.0; n_axes];
     let mut temps = vec![0.0; ci.len()];
     // A line with no usable output: its fields (or empty ones), every axis invalid.

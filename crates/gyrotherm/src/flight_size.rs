@@ -186,21 +186,29 @@ impl FlightCompensator {
     }
 }
 
-/// What an axis's first sensor runs on: its features, limits and channel.
+/// One compensator of an axis (its first sensor's, or its fallback): its feature
+/// definition, limits, channel and latest features.
 #[derive(Debug, Clone, Copy)]
-pub struct FirstSensor<'a> {
+pub struct SensorView<'a> {
     spec: &'a FeatureSpec,
     limits: &'a TempLimits,
     channel: usize,
+    features: Option<&'a Features>,
 }
 
-impl<'a> FirstSensor<'a> {
+impl<'a> SensorView<'a> {
     fn of<const H: usize>(c: &'a Compensator<H>) -> Self {
-        FirstSensor {
+        SensorView {
             spec: c.spec(),
             limits: c.limits(),
             channel: c.channel(),
+            features: c.features(),
         }
+    }
+
+    /// The features of the latest step ([`Compensator::features`]).
+    pub fn features(&self) -> Option<&'a Features> {
+        self.features
     }
 
     /// The first sensor's features.
@@ -257,8 +265,8 @@ impl FlightAxis {
     }
 
     /// The first sensor (as [`AxisCompensator::first`]).
-    pub fn first(&self) -> FirstSensor<'_> {
-        each!(FlightAxis, self, c => FirstSensor::of(c.first()))
+    pub fn first(&self) -> SensorView<'_> {
+        each!(FlightAxis, self, c => SensorView::of(c.first()))
     }
 
     /// [`AxisCompensator::features`].
@@ -274,6 +282,11 @@ impl FlightAxis {
     /// [`AxisCompensator::sensors`].
     pub fn sensors(&self) -> Vec<usize> {
         each!(FlightAxis, self, c => c.sensors().collect())
+    }
+
+    /// The fallback's compensator ([`AxisCompensator::fallback`]).
+    pub fn fallback(&self) -> Option<SensorView<'_>> {
+        each!(FlightAxis, self, c => c.fallback().map(SensorView::of))
     }
 
     /// [`AxisCompensator::on_fallback`].
@@ -350,9 +363,9 @@ impl StreamUnit {
         out
     }
 
-    /// Axis `i`'s first sensor.
-    pub fn axis(&self, i: usize) -> Option<FirstSensor<'_>> {
-        self.axes.get(i).map(FlightAxis::first)
+    /// Axis `i`.
+    pub fn axis(&self, i: usize) -> Option<&FlightAxis> {
+        self.axes.get(i)
     }
 
     /// [`Unit::n_axes`](gyrotherm_core::unit::Unit::n_axes).
