@@ -15,7 +15,7 @@ use std::process::{Command, Stdio};
 mod cli;
 use cli::{gyrotherm, run_ok};
 mod export_gen;
-use export_gen::{generated_model, linear_terms, lstm_json, Lcg, HUGE};
+use export_gen::{generated_model, linear_terms, lstm_json_sized, Lcg, HUGE};
 
 fn have_gcc() -> bool {
     Command::new("gcc")
@@ -28,7 +28,8 @@ use cli::simulate_args as simulate;
 
 /// Models built here so that every part is certainly present: a residual LSTM on a baseline
 /// (thermal-state features) without and with the base value as input, and a spec with a moving
-/// average and lag levels and differences.
+/// average and lag levels and differences; and a residual LSTM of 32 hidden units beside an
+/// 8-unit scale-factor LSTM (the model runs at 32, the smaller network widened with zero units).
 fn constructed_models(dir: &Path, template: &Path) -> Vec<(String, PathBuf)> {
     let base: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(template).unwrap()).unwrap();
@@ -41,6 +42,15 @@ fn constructed_models(dir: &Path, template: &Path) -> Vec<(String, PathBuf)> {
                 "lag_tau_s": [300.0, 1000.0, 3000.0], "lag_outputs": "diff_from_t"}),
             5,
             false,
+            8,
+        ),
+        (
+            "residual-32-units",
+            serde_json::json!({"step_period_s": 1.0, "rate_lag_s": 20.0, "smoothing_window_s": 0.0,
+                "lag_tau_s": [300.0, 1000.0, 3000.0], "lag_outputs": "diff_from_t"}),
+            5,
+            false,
+            32,
         ),
         (
             "residual-reads-base-ma-both",
@@ -50,9 +60,10 @@ fn constructed_models(dir: &Path, template: &Path) -> Vec<(String, PathBuf)> {
                                 "step_allowance_c": 0.5, "degraded_after_s": 30.0}}),
             7,
             true,
+            8,
         ),
     ];
-    for (name, features, nf, reads_base) in specs {
+    for (name, features, nf, reads_base, hidden) in specs {
         let mut m = base.clone();
         // Made by hand from a trained file: unsealed (a stale checksum would be refused).
         m.as_object_mut().unwrap().remove("content_sha256");
@@ -68,12 +79,12 @@ fn constructed_models(dir: &Path, template: &Path) -> Vec<(String, PathBuf)> {
             mean[nf] = 2.7e-3;
             std[nf] = 5e-5;
         }
-        let mut bias = lstm_json(&mut rng, n_in, &mean, &std, (0.0, 2e-5));
+        let mut bias = lstm_json_sized(&mut rng, n_in, hidden, &mean, &std, (0.0, 2e-5));
         bias["terms"] = terms;
         bias["coefficients"] = coefficients.into();
         bias["lstm_reads_base"] = reads_base.into();
         m["bias"] = serde_json::json!({ "residual": bias });
-        let scale = lstm_json(&mut rng, nf, &mean[..nf], &std[..nf], (1.0, 3e-5));
+        let scale = lstm_json_sized(&mut rng, nf, 8, &mean[..nf], &std[..nf], (1.0, 3e-5));
         m["scale"] = serde_json::json!({ "lstm": scale });
         let path = dir.join(format!("m_{name}.json"));
         std::fs::write(&path, serde_json::to_string_pretty(&m).unwrap()).unwrap();

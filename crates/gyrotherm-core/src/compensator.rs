@@ -101,8 +101,15 @@ use core::fmt;
 /// ones never restart the pipeline, while a real clock reset costs two held samples.
 pub const REBASE_AFTER: u8 = 3;
 
-/// Hidden units of the flight LSTM: 8, as published (He et al. 2024, §2).
+/// Hidden units of the flight LSTM by default: 8, as published (He et al. 2024, §2). The
+/// types that hold an LSTM ([`NormalisedLstm`], [`TargetModel`], [`Compensator`], the axis and
+/// unit built on it, the static model) take the size as a const parameter defaulting to this,
+/// so an 8-unit model's storage does not grow for the larger networks.
 pub const HIDDEN: usize = 8;
+
+/// The LSTM sizes the ground tools train, check, compensate with and export: each a
+/// compile-time size of the flight types.
+pub const HIDDEN_SIZES: [usize; 4] = [8, 16, 32, 64];
 
 /// LSTM inputs in flight: every feature slot; slots beyond the spec's feature count are fed 0
 /// (their weights are 0 after export).
@@ -110,8 +117,8 @@ pub const LSTM_INPUTS: usize = MAX_FEATURES;
 
 /// An LSTM with its z-score normalisation: y = target_mean + target_std · lstm((x - mean)/std).
 #[derive(Debug, Clone)]
-pub struct NormalisedLstm {
-    lstm: Lstm<LSTM_INPUTS, HIDDEN>,
+pub struct NormalisedLstm<const H: usize = HIDDEN> {
+    lstm: Lstm<LSTM_INPUTS, H>,
     input_mean: [f64; MAX_FEATURES],
     input_std: [f64; MAX_FEATURES],
     n_inputs: usize,
@@ -183,10 +190,10 @@ impl core::error::Error for ModelError {
     }
 }
 
-impl NormalisedLstm {
+impl<const H: usize> NormalisedLstm<H> {
     /// Checked constructor: `input_mean`/`input_std` give the first `n_inputs` channels.
     pub fn new(
-        weights: &LstmWeights<LSTM_INPUTS, HIDDEN>,
+        weights: &LstmWeights<LSTM_INPUTS, H>,
         input_mean: &[f64],
         input_std: &[f64],
         target_mean: f64,
@@ -256,19 +263,19 @@ impl NormalisedLstm {
 /// [`lstm_reads_base`](Self::lstm_reads_base) the LSTM reads
 /// `(features..., baseline(features))` instead: the base prediction as one more input.
 #[derive(Debug, Clone)]
-pub struct TargetModel {
+pub struct TargetModel<const H: usize = HIDDEN> {
     /// Constant part (e.g. K = 1 when no scale-factor model was fitted).
     pub offset: f64,
     /// Fitted polynomial in the features.
     pub baseline: Option<BaselineModel>,
     /// LSTM (normalised), added to the rest.
-    pub lstm: Option<NormalisedLstm>,
+    pub lstm: Option<NormalisedLstm<H>>,
     /// When both a baseline and an LSTM are present: the LSTM's inputs are the features
     /// followed by the baseline's value (`n_features + 1` inputs). Ignored otherwise.
     pub lstm_reads_base: bool,
 }
 
-impl TargetModel {
+impl<const H: usize> TargetModel<H> {
     /// A model that always gives `value`.
     pub const fn constant(value: f64) -> Self {
         TargetModel {
@@ -560,10 +567,10 @@ pub(crate) fn plausible_reading(
 
 /// Bias and scale-factor models on one streaming feature pipeline (see the module doc).
 #[derive(Debug, Clone)]
-pub struct Compensator {
+pub struct Compensator<const H: usize = HIDDEN> {
     pipeline: FeaturePipeline,
-    bias: TargetModel,
-    scale: TargetModel,
+    bias: TargetModel<H>,
+    scale: TargetModel<H>,
     limits: TempLimits,
     /// B and K of the latest good step.
     held: Option<(f64, f64)>,
@@ -588,13 +595,13 @@ pub struct Compensator {
     channel: usize,
 }
 
-impl Compensator {
+impl<const H: usize> Compensator<H> {
     /// Checked constructor with the default [`TempLimits`]: both models must read the spec's
     /// feature count.
     pub fn new(
         spec: FeatureSpec,
-        bias: TargetModel,
-        scale: TargetModel,
+        bias: TargetModel<H>,
+        scale: TargetModel<H>,
     ) -> Result<Self, ModelError> {
         Self::with_limits(spec, bias, scale, TempLimits::DEFAULT)
     }
@@ -602,8 +609,8 @@ impl Compensator {
     /// Checked constructor with temperature-sensor limits.
     pub fn with_limits(
         spec: FeatureSpec,
-        bias: TargetModel,
-        scale: TargetModel,
+        bias: TargetModel<H>,
+        scale: TargetModel<H>,
         limits: TempLimits,
     ) -> Result<Self, ModelError> {
         let pipeline = FeaturePipeline::new(spec).map_err(ModelError::Spec)?;

@@ -35,7 +35,7 @@
 
 use crate::baseline::BaselineModel;
 use crate::compensator::{
-    plausible_reading, Compensator, Corrected, ModelError, MoreSensors, Status, TempLimits,
+    plausible_reading, Compensator, Corrected, ModelError, MoreSensors, Status, TempLimits, HIDDEN,
 };
 use crate::features::{FeaturePipeline, FeatureSpec};
 
@@ -117,30 +117,30 @@ impl MoreSensors for MoreParts {
 
 /// One gyro axis reading one or more of the unit's temperature sensors (see the module doc).
 #[derive(Debug, Clone)]
-pub struct AxisCompensator {
+pub struct AxisCompensator<const H: usize = HIDDEN> {
     /// The first sensor's compensator; its [`Compensator::channel`] is the first sensor's
     /// index among `temps`.
-    first: Compensator,
+    first: Compensator<H>,
     more: MoreParts,
     /// The fallback on the first sensor alone (see the module doc), stepped alongside.
-    fallback: Option<Compensator>,
+    fallback: Option<Compensator<H>>,
     /// Whether the latest sample that decided it ran on the fallback.
     on_fallback: bool,
 }
 
-impl From<Compensator> for AxisCompensator {
+impl<const H: usize> From<Compensator<H>> for AxisCompensator<H> {
     /// A one-sensor axis reading `temps[c.channel()]`: it steps exactly as
     /// [`Compensator::step_unit`].
-    fn from(c: Compensator) -> Self {
+    fn from(c: Compensator<H>) -> Self {
         let channel = c.channel();
         AxisCompensator::new(c, channel)
     }
 }
 
-impl AxisCompensator {
+impl<const H: usize> AxisCompensator<H> {
     /// An axis whose first (or only) sensor is `temps[first_index]`, with that sensor's
     /// compensator.
-    pub fn new(first: Compensator, first_index: usize) -> Self {
+    pub fn new(first: Compensator<H>, first_index: usize) -> Self {
         AxisCompensator {
             first: first.with_channel(first_index),
             more: MoreParts {
@@ -196,14 +196,14 @@ impl AxisCompensator {
     /// sensor's features alone, run on the first sensor (whatever its own channel) alongside
     /// the axis and used while the axis on all its sensors is degraded and the fallback is
     /// not (see the module doc). A later call replaces an earlier fallback.
-    pub fn with_fallback(mut self, fallback: Compensator) -> Self {
+    pub fn with_fallback(mut self, fallback: Compensator<H>) -> Self {
         self.fallback = Some(fallback.with_channel(self.first.channel()));
         self.on_fallback = false;
         self
     }
 
     /// The fallback compensator, if the axis has one.
-    pub fn fallback(&self) -> Option<&Compensator> {
+    pub fn fallback(&self) -> Option<&Compensator<H>> {
         self.fallback.as_ref()
     }
 
@@ -246,7 +246,7 @@ impl AxisCompensator {
     }
 
     /// The first sensor's compensator (its spec and limits).
-    pub fn first(&self) -> &Compensator {
+    pub fn first(&self) -> &Compensator<H> {
         &self.first
     }
 

@@ -50,15 +50,15 @@ use crate::lstm::LstmWeights;
 
 /// A whole model: feature definition, sensor limits, bias and scale-factor models.
 #[derive(Debug, Clone, PartialEq)]
-pub struct StaticModel {
+pub struct StaticModel<const H: usize = HIDDEN> {
     /// The model inputs.
     pub spec: FeatureSpec,
     /// Temperature-sensor fault limits.
     pub limits: TempLimits,
     /// Bias model, °/s.
-    pub bias: StaticTarget,
+    pub bias: StaticTarget<H>,
     /// Scale-factor model (dimensionless, ≈ 1).
-    pub scale: StaticTarget,
+    pub scale: StaticTarget<H>,
     /// The training region and its error (None: the model file has no coverage map).
     pub coverage: Option<StaticCoverage>,
 }
@@ -86,7 +86,7 @@ impl StaticCoverage {
     }
 }
 
-impl StaticModel {
+impl<const H: usize> StaticModel<H> {
     /// The model's coverage map, checked (None: the model has none).
     pub fn coverage_map(&self) -> Option<Result<CoverageMap, CoverageError>> {
         self.coverage.as_ref().map(StaticCoverage::to_map)
@@ -95,18 +95,18 @@ impl StaticModel {
 
 /// One target: `offset + baseline(features) + lstm(features)` (see [`TargetModel`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct StaticTarget {
+pub struct StaticTarget<const H: usize = HIDDEN> {
     /// Constant part.
     pub offset: f64,
     /// Polynomial part.
     pub baseline: Option<StaticBaseline>,
     /// LSTM part.
-    pub lstm: Option<StaticLstm>,
+    pub lstm: Option<StaticLstm<H>>,
     /// The LSTM reads the features followed by the baseline's value.
     pub lstm_reads_base: bool,
 }
 
-impl StaticTarget {
+impl<const H: usize> StaticTarget<H> {
     /// A target that is always `value`.
     pub const fn constant(value: f64) -> Self {
         StaticTarget {
@@ -129,14 +129,14 @@ pub struct StaticBaseline {
 }
 
 /// An LSTM (PyTorch layout, `LSTM_INPUTS` input slots of which the first `n_inputs` are used,
-/// the rest with zero weights) with its z-score normalisation.
+/// the rest with zero weights; `H` hidden units) with its z-score normalisation.
 #[derive(Debug, Clone, PartialEq)]
-pub struct StaticLstm {
-    pub w_ih: [[[f32; LSTM_INPUTS]; HIDDEN]; 4],
-    pub w_hh: [[[f32; HIDDEN]; HIDDEN]; 4],
-    pub b_ih: [[f32; HIDDEN]; 4],
-    pub b_hh: [[f32; HIDDEN]; 4],
-    pub w_out: [f32; HIDDEN],
+pub struct StaticLstm<const H: usize = HIDDEN> {
+    pub w_ih: [[[f32; LSTM_INPUTS]; H]; 4],
+    pub w_hh: [[[f32; H]; H]; 4],
+    pub b_ih: [[f32; H]; 4],
+    pub b_hh: [[f32; H]; 4],
+    pub w_out: [f32; H],
     pub b_out: f32,
     pub n_inputs: u8,
     pub input_mean: [f64; MAX_FEATURES],
@@ -173,8 +173,8 @@ pub struct StaticSensor {
     pub scale: Option<StaticBaseline>,
 }
 
-impl StaticTarget {
-    fn to_target(&self) -> Result<TargetModel, ModelError> {
+impl<const H: usize> StaticTarget<H> {
+    fn to_target(&self) -> Result<TargetModel<H>, ModelError> {
         let baseline = match &self.baseline {
             None => None,
             Some(b) => Some(b.to_model()?),
@@ -208,9 +208,9 @@ impl StaticTarget {
     }
 }
 
-impl Compensator {
+impl<const H: usize> Compensator<H> {
     /// The compensator of a static model, checked like [`Compensator::with_limits`].
-    pub fn from_static(m: &StaticModel) -> Result<Compensator, ModelError> {
+    pub fn from_static(m: &StaticModel<H>) -> Result<Compensator<H>, ModelError> {
         Compensator::with_limits(m.spec, m.bias.to_target()?, m.scale.to_target()?, m.limits)
     }
 }

@@ -40,7 +40,7 @@
 //! assert_eq!((out[0].status, out[1].status), (Status::Ok, Status::Held));
 //! ```
 
-use crate::compensator::{Compensator, Corrected, ModelError, Status};
+use crate::compensator::{Compensator, Corrected, ModelError, Status, HIDDEN};
 use crate::multi::AxisCompensator;
 use crate::static_model::{StaticModel, StaticSensor};
 use core::fmt;
@@ -107,13 +107,13 @@ impl core::error::Error for UnitError {
 
 /// An inertial unit's compensators (see the module doc).
 #[derive(Debug, Clone)]
-pub struct Unit<const N: usize = MAX_AXES> {
-    axes: [Option<AxisCompensator>; N],
+pub struct Unit<const N: usize = MAX_AXES, const H: usize = HIDDEN> {
+    axes: [Option<AxisCompensator<H>>; N],
     n_axes: usize,
     n_temps: usize,
 }
 
-impl<const N: usize> Unit<N> {
+impl<const N: usize, const H: usize> Unit<N, H> {
     /// An empty unit whose samples carry `n_temps` temperature channels.
     pub fn new(n_temps: usize) -> Self {
         Unit {
@@ -126,7 +126,7 @@ impl<const N: usize> Unit<N> {
     /// Add the next axis (gyro index = the number of axes so far): a [`Compensator`] (one
     /// sensor, its [`Compensator::channel`]) or an [`AxisCompensator`]; every sensor it reads
     /// must be below the unit's channel count.
-    pub fn push_axis(&mut self, axis: impl Into<AxisCompensator>) -> Result<(), UnitError> {
+    pub fn push_axis(&mut self, axis: impl Into<AxisCompensator<H>>) -> Result<(), UnitError> {
         let axis = axis.into();
         if let Some(channel) = axis.sensors().find(|&c| c >= self.n_temps) {
             return Err(UnitError::Channel {
@@ -148,7 +148,7 @@ impl<const N: usize> Unit<N> {
     /// whose axes read one sensor each): axis `i` runs `models[i]` on temperature channel
     /// `channels[i]` of `n_temps`.
     pub fn from_static(
-        models: &[StaticModel],
+        models: &[StaticModel<H>],
         channels: &[u8],
         n_temps: usize,
     ) -> Result<Self, UnitError> {
@@ -158,7 +158,7 @@ impl<const N: usize> Unit<N> {
     /// [`Unit::from_static`] with further sensors: axis `i` also reads `sensors[i]` (each
     /// further sensor's channel, features and parts; an axis beyond `sensors` reads none).
     pub fn from_static_sensors(
-        models: &[StaticModel],
+        models: &[StaticModel<H>],
         channels: &[u8],
         sensors: &[&[StaticSensor]],
         n_temps: usize,
@@ -171,10 +171,10 @@ impl<const N: usize> Unit<N> {
     /// sensor is given up on ([`AxisCompensator::with_fallback`]; an axis beyond `fallbacks`
     /// has none).
     pub fn from_static_fallbacks(
-        models: &[StaticModel],
+        models: &[StaticModel<H>],
         channels: &[u8],
         sensors: &[&[StaticSensor]],
-        fallbacks: &[Option<StaticModel>],
+        fallbacks: &[Option<StaticModel<H>>],
         n_temps: usize,
     ) -> Result<Self, UnitError> {
         if models.len() != channels.len()
@@ -222,7 +222,7 @@ impl<const N: usize> Unit<N> {
     }
 
     /// Axis `i`'s compensator (its first sensor's features, its sensors).
-    pub fn axis(&self, i: usize) -> Option<&AxisCompensator> {
+    pub fn axis(&self, i: usize) -> Option<&AxisCompensator<H>> {
         self.axes.get(i).and_then(Option::as_ref)
     }
 

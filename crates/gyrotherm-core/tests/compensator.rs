@@ -17,7 +17,7 @@ fn linear_compensator() -> Compensator {
     let mut k = BaselineModel::new(2).unwrap();
     k.push_term(&[0, 0], 1.0).unwrap();
     k.push_term(&[1, 0], 1e-5).unwrap();
-    let model = |m| TargetModel {
+    let model = |m| TargetModel::<8> {
         offset: 0.0,
         baseline: Some(m),
         lstm: None,
@@ -189,7 +189,7 @@ fn bad_limits_are_refused() {
         },
     ];
     for l in bad {
-        let r = Compensator::with_limits(
+        let r: Result<Compensator, _> = Compensator::with_limits(
             FeatureSpec::PUBLISHED,
             TargetModel::constant(0.0),
             TargetModel::constant(1.0),
@@ -557,7 +557,7 @@ fn step_index_never_saturates() {
         degraded_after_s: 1e7,
         ..TempLimits::DEFAULT
     };
-    let model = |m| TargetModel {
+    let model = |m| TargetModel::<8> {
         offset: 0.0,
         baseline: Some(m),
         lstm: None,

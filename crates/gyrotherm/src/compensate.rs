@@ -5,10 +5,13 @@
 
 use gyrotherm_core::compensator::Compensator;
 
+use crate::build_sized;
+use crate::flight_size::FlightCompensator;
+
 use crate::csvlog::TestLog;
 use crate::model::ModelFile;
 use crate::model::Target;
-pub use crate::model::{padded_core_lstm, target_model, CompensateError};
+pub use crate::model::{hidden_size, padded_core_lstm, target_model, CompensateError};
 
 /// Compensated series of one log, one value per sample.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -21,8 +24,25 @@ pub struct Compensated {
     pub gyro_comp_dps: Vec<f64>,
 }
 
-/// The flight compensator of a model file (bias 0 °/s and K = 1 where a target is absent).
-pub fn compensator(model: &ModelFile) -> Result<Compensator, CompensateError> {
+/// The flight compensator of a model file (bias 0 °/s and K = 1 where a target is absent), at
+/// the size of its LSTMs ([`hidden_size`]).
+pub fn compensator(model: &ModelFile) -> Result<FlightCompensator, CompensateError> {
+    let size = hidden_size([model.bias.as_ref(), model.scale.as_ref()])?;
+    Ok(build_sized!(FlightCompensator, size, H => boxed_compensator::<H>(model)?))
+}
+
+/// [`sized_compensator`], boxed in a frame of its own (see [`crate::flight_size`]).
+#[inline(never)]
+pub(crate) fn boxed_compensator<const H: usize>(
+    model: &ModelFile,
+) -> Result<Box<Compensator<H>>, CompensateError> {
+    sized_compensator::<H>(model).map(Box::new)
+}
+
+/// [`compensator`] at `H` hidden units (an LSTM of the model larger than `H` is refused).
+pub fn sized_compensator<const H: usize>(
+    model: &ModelFile,
+) -> Result<Compensator<H>, CompensateError> {
     let spec = model.feature_spec().map_err(CompensateError::Model)?;
     let in_target = |target| {
         move |e| CompensateError::InTarget {

@@ -11,7 +11,7 @@
 //! `compensate`: `G_bias` (°/s), `G_scale`, `G_comp` (°/s; empty when the axis is
 //! `invalid`) and `G_status`.
 //!
-//! The numbers are those of flight code: the flight [`Unit`] of
+//! The numbers are those of flight code: the flight [`Unit`](gyrotherm_core::unit::Unit) of
 //! [`gyrotherm_core::unit`] steps every axis with the line's time, gyro fields and all the
 //! model's temperature fields, and each axis reads its own sensors (one, or several with a
 //! model whose axes read further sensors), so a temperature field that is empty, not a number
@@ -29,7 +29,6 @@ use std::io::{BufRead, Write};
 use std::path::Path;
 
 use gyrotherm_core::compensator::{Corrected, Status};
-use gyrotherm_core::unit::Unit;
 
 use crate::compensate_lines::{
     check_added_columns, lines_to_file, parse_number, read_header, read_line_capped, record,
@@ -40,8 +39,7 @@ use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 pub use crate::imu_model::MAX_STREAM_AXES;
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
 
-/// The ground stream's unit: the core's, with room for [`MAX_STREAM_AXES`] axes.
-pub type StreamUnit = Unit<MAX_STREAM_AXES>;
+pub use crate::flight_size::StreamUnit;
 
 /// Suffixes of the columns added per gyro column, in order.
 pub const AXIS_SUFFIXES: [&str; 4] = ["bias", "scale", "comp", "status"];
@@ -61,18 +59,15 @@ pub fn output_columns(model: &ImuModel) -> Vec<String> {
 /// parts, [`imu_axis_compensators`]), the same axes as batch [`crate::imu_model::compensate_imu`].
 pub fn flight_unit(model: &ImuModel) -> Result<Box<StreamUnit>, ImuError> {
     let comps = imu_axis_compensators(model)?;
-    // Boxed: a unit of 16 axes, each with its fallback, is some 370 KB, more than a
-    // thread's stack holds in the copies a return by value can make.
-    let mut unit = Box::new(StreamUnit::new(model.temp_cols.len()));
-    for (c, a) in comps.into_iter().zip(&model.axes) {
-        unit.push_axis(c).map_err(|e| {
-            ImuError::Layout(format!(
-                "axis {}: {e} (a unit runs at most {MAX_STREAM_AXES} axes)",
-                a.gyro
-            ))
-        })?;
-    }
-    Ok(unit)
+    // Boxed: a unit of 16 axes, each with its fallback, is some 370 KB (more with larger
+    // LSTMs), more than a thread's stack holds in the copies a return by value can make.
+    let unit = StreamUnit::of_axes(model.temp_cols.len(), comps).map_err(|(i, e)| {
+        let gyro = model.axes.get(i).map_or("?", |a| a.gyro.as_str());
+        ImuError::Layout(format!(
+            "axis {gyro}: {e} (a unit runs at most {MAX_STREAM_AXES} axes)"
+        ))
+    })?;
+    Ok(Box::new(unit))
 }
 
 /// Counts of a run.

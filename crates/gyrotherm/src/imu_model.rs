@@ -27,14 +27,16 @@
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-use gyrotherm_core::compensator::{Compensator, Status};
+use gyrotherm_core::compensator::Status;
 use gyrotherm_core::features::LagOutputs;
 use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 
-use crate::compensate::compensator;
+use crate::build_sized;
+use crate::compensate::{boxed_compensator, hidden_size, sized_compensator};
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
+use crate::flight_size::{FlightAxis, FlightCompensator, HiddenSize};
 pub use crate::imu_error::ImuError;
 use crate::model::{
     content_digest_of, parse_sealed, ModelFile, Seal, SealedTextError, SubModel, Target,
@@ -713,8 +715,13 @@ fn axis_checks(temp_cols: &[String], a: &ImuAxis) -> Result<(), ImuError> {
         // The further sensors' parts must build a flight compensator, and with the first
         // sensor's model keep B and K plausible over the training range, as a single-axis
         // model must.
-        let comp = axis_compensator_in(temp_cols, a)?;
-        let further: Vec<_> = comp.further().map(|(_, s, b, k)| (s, b, k)).collect();
+        let size = axes_hidden_size(std::slice::from_ref(a))?;
+        let comp = build_sized!(FlightAxis, size, H => boxed_axis::<H>(temp_cols, a)?);
+        let further: Vec<_> = comp
+            .further()
+            .into_iter()
+            .map(|(_, s, b, k)| (s, b, k))
+            .collect();
         a.model
             .check_outputs_with_further(comp.first().spec(), &further)
             .map_err(|source| ImuError::Axis {
@@ -763,8 +770,39 @@ fn each_axis<T: Send>(axes: &[ImuAxis], check: impl Fn(&ImuAxis) -> T + Sync) ->
     })
 }
 
-/// [`ImuModel::axis_compensator`] with the model's temperature columns `temp_cols`.
-fn axis_compensator_in(temp_cols: &[String], a: &ImuAxis) -> Result<AxisCompensator, ImuError> {
+/// The LSTM size a unit of `axes` runs at: the largest LSTM of any axis's model or fallback
+/// (8 without one); see [`crate::flight_size`].
+fn axes_hidden_size(axes: &[ImuAxis]) -> Result<HiddenSize, ImuError> {
+    let mut size = HiddenSize::H8;
+    for a in axes {
+        for m in std::iter::once(&a.model).chain(a.fallback.as_ref()) {
+            let s = hidden_size([m.bias.as_ref(), m.scale.as_ref()]).map_err(|source| {
+                ImuError::Compensate {
+                    gyro: a.gyro.clone(),
+                    source: Box::new(source),
+                }
+            })?;
+            size = size.max(s);
+        }
+    }
+    Ok(size)
+}
+
+/// [`axis_compensator_in`], boxed in a frame of its own (see [`crate::flight_size`]).
+#[inline(never)]
+fn boxed_axis<const H: usize>(
+    temp_cols: &[String],
+    a: &ImuAxis,
+) -> Result<Box<AxisCompensator<H>>, ImuError> {
+    axis_compensator_in::<H>(temp_cols, a).map(Box::new)
+}
+
+/// [`ImuModel::axis_compensator`] with the model's temperature columns `temp_cols`, at `H`
+/// hidden units.
+fn axis_compensator_in<const H: usize>(
+    temp_cols: &[String],
+    a: &ImuAxis,
+) -> Result<AxisCompensator<H>, ImuError> {
     let index = |t: &String| {
         temp_cols
             .iter()
@@ -772,7 +810,7 @@ fn axis_compensator_in(temp_cols: &[String], a: &ImuAxis) -> Result<AxisCompensa
             .ok_or_else(|| ImuError::Layout(format!("axis {} reads unknown sensor {t}", a.gyro)))
     };
     let layout = |what: String| ImuError::Layout(format!("axis {}: {what}", a.gyro));
-    let first = compensator(&a.model).map_err(|source| ImuError::Compensate {
+    let first = sized_compensator::<H>(&a.model).map_err(|source| ImuError::Compensate {
         gyro: a.gyro.clone(),
         source: Box::new(source),
     })?;
@@ -818,7 +856,7 @@ fn axis_compensator_in(temp_cols: &[String], a: &ImuAxis) -> Result<AxisCompensa
             .map_err(|e| layout(format!("sensor {t}: {e}")))?;
     }
     if let Some(f) = &a.fallback {
-        let f = compensator(f).map_err(|source| ImuError::Compensate {
+        let f = sized_compensator::<H>(f).map_err(|source| ImuError::Compensate {
             gyro: a.gyro.clone(),
             source: Box::new(source),
         })?;
@@ -888,9 +926,17 @@ impl ImuModel {
 
     /// The flight compensator of one axis: its first sensor's [`Compensator`] and each
     /// further sensor's pipeline and parts, reading the indices of its sensors among
-    /// [`ImuModel::temp_cols`].
-    pub fn axis_compensator(&self, a: &ImuAxis) -> Result<AxisCompensator, ImuError> {
-        axis_compensator_in(&self.temp_cols, a)
+    /// [`ImuModel::temp_cols`], at the unit's LSTM size ([`ImuModel::hidden_size`]).
+    pub fn axis_compensator(&self, a: &ImuAxis) -> Result<FlightAxis, ImuError> {
+        let size = self.hidden_size()?;
+        Ok(build_sized!(FlightAxis, size, H => boxed_axis::<H>(&self.temp_cols, a)?))
+    }
+
+    /// The LSTM size every axis of the unit runs at: the largest LSTM of any axis's model or
+    /// fallback (8 without one). An LSTM of a size flight code is not built for is refused,
+    /// naming the axis and the size.
+    pub fn hidden_size(&self) -> Result<HiddenSize, ImuError> {
+        axes_hidden_size(&self.axes)
     }
 
     /// The sealed JSON text (pretty; `content_sha256` of the compact content last).
@@ -1028,7 +1074,8 @@ pub struct AxisCompensated {
 
 /// The one-sensor flight compensators of every axis, in axis order; refused for a model whose
 /// axes read several sensors (use [`imu_axis_compensators`]).
-pub fn imu_compensators(model: &ImuModel) -> Result<Vec<Compensator>, ImuError> {
+pub fn imu_compensators(model: &ImuModel) -> Result<Vec<FlightCompensator>, ImuError> {
+    let size = model.hidden_size()?;
     model
         .axes
         .iter()
@@ -1040,17 +1087,22 @@ pub fn imu_compensators(model: &ImuModel) -> Result<Vec<Compensator>, ImuError> 
                     a.temps.len()
                 )));
             }
-            compensator(&a.model).map_err(|source| ImuError::Compensate {
+            let one = |source| ImuError::Compensate {
                 gyro: a.gyro.clone(),
                 source: Box::new(source),
-            })
+            };
+            Ok(build_sized!(
+                FlightCompensator,
+                size,
+                H => boxed_compensator::<H>(&a.model).map_err(one)?
+            ))
         })
         .collect()
 }
 
 /// The flight compensators of every axis, in axis order, each reading its own sensors
 /// among `temps[]` in the order of [`ImuModel::temp_cols`].
-pub fn imu_axis_compensators(model: &ImuModel) -> Result<Vec<AxisCompensator>, ImuError> {
+pub fn imu_axis_compensators(model: &ImuModel) -> Result<Vec<FlightAxis>, ImuError> {
     model
         .axes
         .iter()

@@ -88,6 +88,7 @@ pub use error_chain::error_chain;
 pub mod export;
 pub mod features;
 pub mod fit;
+pub mod flight_size;
 pub(crate) mod imu_error;
 pub mod imu_judge;
 pub mod imu_model;

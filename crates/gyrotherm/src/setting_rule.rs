@@ -40,8 +40,8 @@ pub enum Rule {
     Finite,
     /// A list of column names (one, or several separated by commas).
     ColumnList,
-    /// Hidden units of an LSTM: the number the flight compensator's network is built for
-    /// ([`gyrotherm_core::compensator::HIDDEN`]).
+    /// Hidden units of an LSTM: a size the flight compensator's network is built for
+    /// ([`gyrotherm_core::compensator::HIDDEN_SIZES`]).
     HiddenUnits,
     /// A temperature a flight reaches, °C: from absolute zero to
     /// [`MAX_ENVELOPE_C`].
@@ -80,8 +80,7 @@ impl Rule {
             }
             Rule::HiddenUnits => {
                 "is not a number of hidden units the flight compensator runs: give 8 (as \
-                 published); the trainer (`nn`) takes up to 128, but flight code and its exports \
-                 are built for 8 today"
+                 published), 16, 32 or 64"
             }
             Rule::FlightTemperature => {
                 "°C is not a temperature a flight reaches: give -273.15 to 1000 °C"
@@ -116,7 +115,9 @@ impl Rule {
             | Rule::RosTopic => true,
             Rule::PositiveRate => v.is_finite() && v > 0.0,
             Rule::Finite => v.is_finite(),
-            Rule::HiddenUnits => v == gyrotherm_core::compensator::HIDDEN as f64,
+            Rule::HiddenUnits => gyrotherm_core::compensator::HIDDEN_SIZES
+                .iter()
+                .any(|&h| v == h as f64),
             Rule::FlightTemperature => (ABSOLUTE_ZERO_C..=MAX_ENVELOPE_C).contains(&v),
         }
     }

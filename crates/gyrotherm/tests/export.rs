@@ -67,3 +67,94 @@ fn flight_loop_example_module_is_current() {
         "examples/flight_loop/gyrotherm_model.rs is stale; regenerate it"
     );
 }
+
+/// The example model with its bias LSTM widened to 32 hidden units of fresh weights (the
+/// scale-factor LSTM stays at 8): the model runs at 32.
+fn model_32() -> ModelFile {
+    let path = example_dir().join("model.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    m.as_object_mut().unwrap().remove("content_sha256");
+    let p = &mut m["bias"]["lstm"]["params"];
+    let inputs = p["input_size"].as_u64().unwrap() as usize;
+    let mut state = 12345u64;
+    let mut vec = |n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.6
+            })
+            .collect()
+    };
+    let h = 32;
+    p["hidden_size"] = h.into();
+    p["w_ih"] = vec(4 * h * inputs).into();
+    p["w_hh"] = vec(4 * h * h).into();
+    p["b_ih"] = vec(4 * h).into();
+    p["b_hh"] = vec(4 * h).into();
+    p["w_out"] = vec(h).into();
+    ModelFile::from_json(&m.to_string()).unwrap()
+}
+
+#[test]
+fn a_32_unit_static_model_compensates_like_the_model_file() {
+    use gyrotherm::flight_size::{FlightCompensator, HiddenSize};
+    let model = model_32();
+    let cfg = SimConfig {
+        faults: FaultParams {
+            spikes_per_hour: 20.0,
+            dropouts_per_hour: 2.0,
+            dropout_s: 5.0,
+            ..Default::default()
+        },
+        ..SimConfig::new(Profile::builtin("seed-shock").unwrap())
+    };
+    let log = simulate(&cfg).unwrap();
+    let mut a = gyrotherm::compensate::compensator(&model).unwrap();
+    assert_eq!(a.hidden(), HiddenSize::H32);
+    assert!(matches!(a, FlightCompensator::H32(_)));
+    let s = gyrotherm::export::sized_static_model::<32>(&model).unwrap();
+    let mut b = Compensator::<32>::from_static(&s).unwrap();
+    for i in 0..log.len() {
+        let (t, g, c) = (log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
+        let (x, y) = (a.step(t, g, c), b.step(t, g, c));
+        assert_eq!(x.status, y.status, "sample {i}");
+        assert_eq!(x.rate_dps.to_bits(), y.rate_dps.to_bits(), "sample {i}");
+        assert_eq!(x.bias_dps.to_bits(), y.bias_dps.to_bits(), "sample {i}");
+    }
+    // The 8-unit form refuses it, naming the size; the Rust text carries the size.
+    let e = gyrotherm::error_chain(&static_model(&model).unwrap_err());
+    assert!(e.contains("32"), "{e}");
+    let files = gyrotherm::export::generate(&model, gyrotherm::export::Lang::Rust).unwrap();
+    assert!(files[0].1.contains("pub static MODEL: StaticModel<32> = "));
+}
+
+#[test]
+fn an_unsupported_lstm_size_is_refused_naming_it() {
+    let path = example_dir().join("model.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    m.as_object_mut().unwrap().remove("content_sha256");
+    let p = &mut m["bias"]["lstm"]["params"];
+    let inputs = p["input_size"].as_u64().unwrap() as usize;
+    let h = 12;
+    p["hidden_size"] = h.into();
+    p["w_ih"] = vec![0.01; 4 * h * inputs].into();
+    p["w_hh"] = vec![0.01; 4 * h * h].into();
+    p["b_ih"] = vec![0.0; 4 * h].into();
+    p["b_hh"] = vec![0.0; 4 * h].into();
+    p["w_out"] = vec![0.01; h].into();
+    let e = match ModelFile::from_json(&m.to_string()) {
+        Err(e) => gyrotherm::error_chain(&e),
+        Ok(model) => match gyrotherm::compensate::compensator(&model) {
+            Err(e) => gyrotherm::error_chain(&e),
+            Ok(_) => panic!("a 12-unit LSTM was accepted"),
+        },
+    };
+    assert!(
+        e.contains("12 hidden units") && e.contains("8, 16, 32 or 64"),
+        "{e}"
+    );
+}

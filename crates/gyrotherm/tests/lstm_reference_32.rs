@@ -272,3 +272,46 @@ fn clipped_cosine_adam_steps_match_pytorch_at_32_units() {
     let want = flatten(&params(&mb["params_after"], i, h));
     compare("params after the steps", &theta, &want, GRAD_REL_TOL);
 }
+
+/// The flight network (`gyrotherm_core::lstm::Lstm<5, 32>`, f32) on the same runs: each
+/// output and the final state within f32 rounding of PyTorch's f64 (1e-4 of the largest
+/// magnitude; a wrong term would be off by O(1)).
+#[test]
+fn flight_network_matches_pytorch_at_32_units() {
+    const F32_TOL: f64 = 1e-4;
+    let r = load();
+    let (i, h) = sizes(&r);
+    assert_eq!((i, h), (5, 32));
+    let p = params(&r["params"], i, h);
+    let w = p.to_core::<5, 32>().unwrap();
+    let close = |what: &str, got: &[f64], want: &[f64]| {
+        assert_eq!(got.len(), want.len(), "{what}: length");
+        let scale = want.iter().fold(1e-3f64, |a, v| a.max(v.abs()));
+        for (k, (g, w)) in got.iter().zip(want).enumerate() {
+            assert!(
+                (g - w).abs() <= F32_TOL * scale,
+                "{what}[{k}]: want {w}, got {g}"
+            );
+        }
+    };
+    for case in r["cases"].as_array().unwrap() {
+        let name = case["name"].as_str().unwrap();
+        let mut net = gyrotherm_core::lstm::Lstm::<5, 32>::new(&w);
+        let f32s = |v: Vec<f64>| -> [f32; 32] { std::array::from_fn(|j| v[j] as f32) };
+        net.set_state(&f32s(flat(&case["h0"])), &f32s(flat(&case["c0"])))
+            .unwrap();
+        let x = flat(&case["x"]);
+        let y: Vec<f64> = x
+            .chunks(5)
+            .map(|row| {
+                let xs: [f32; 5] = std::array::from_fn(|k| row[k] as f32);
+                f64::from(net.step(&xs).unwrap())
+            })
+            .collect();
+        close(&format!("{name} y"), &y, &flat(&case["y"]));
+        let hn: Vec<f64> = net.hidden().iter().map(|v| f64::from(*v)).collect();
+        let cn: Vec<f64> = net.cell().iter().map(|v| f64::from(*v)).collect();
+        close(&format!("{name} h_n"), &hn, &flat(&case["h_n"]));
+        close(&format!("{name} c_n"), &cn, &flat(&case["c_n"]));
+    }
+}

@@ -46,7 +46,8 @@ pub struct FitArgs {
     /// Random seed of the LSTM initialisation and window order.
     #[arg(long, default_value_t = fit::DEFAULT_SEED)]
     pub seed: u64,
-    /// Hidden units of the method's LSTM (8 as published; 1 to 128).
+    /// Hidden units of the method's LSTM: 8 (as published), 16, 32 or 64, the sizes flight
+    /// code and its exports are built for.
     #[arg(long, default_value_t = fit::DEFAULT_HIDDEN)]
     pub hidden: usize,
     /// Bias target smoothing window, s (centred moving average; 100 s as published).

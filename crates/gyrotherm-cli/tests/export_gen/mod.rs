@@ -24,11 +24,24 @@ pub fn lstm_json(
     std: &[f64],
     target: (f64, f64),
 ) -> serde_json::Value {
+    lstm_json_sized(rng, inputs, 8, mean, std, target)
+}
+
+/// [`lstm_json`] with `hidden` hidden units.
+pub fn lstm_json_sized(
+    rng: &mut Lcg,
+    inputs: usize,
+    hidden: usize,
+    mean: &[f64],
+    std: &[f64],
+    target: (f64, f64),
+) -> serde_json::Value {
+    let g = 4 * hidden;
     serde_json::json!({
         "params": {
-            "input_size": inputs, "hidden_size": 8,
-            "w_ih": rng.vec(32 * inputs), "w_hh": rng.vec(256), "b_ih": rng.vec(32),
-            "b_hh": rng.vec(32), "w_out": rng.vec(8), "b_out": rng.next(),
+            "input_size": inputs, "hidden_size": hidden,
+            "w_ih": rng.vec(g * inputs), "w_hh": rng.vec(g * hidden), "b_ih": rng.vec(g),
+            "b_hh": rng.vec(g), "w_out": rng.vec(hidden), "b_out": rng.next(),
         },
         "input_norm": {"mean": mean, "std": std},
         "target_norm": {"mean": [target.0], "std": [target.1]},

@@ -742,7 +742,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         let mut envs = Vec::new();
         for (a, comp) in model.axes.iter().zip(&comps).filter(|_| job.replica) {
             let mut specs = vec![*comp.first().spec()];
-            specs.extend(comp.further().map(|(_, s, _, _)| *s));
+            specs.extend(comp.further().into_iter().map(|(_, s, _, _)| *s));
             envs.push(
                 specs
                     .iter()

@@ -42,7 +42,7 @@ fn join(v: impl IntoIterator<Item = String>) -> String {
 }
 
 /// The C source of one target's static data and its `target_def`.
-fn target(out: &mut String, name: &str, t: &StaticTarget, nf: usize) {
+fn target<const H: usize>(out: &mut String, name: &str, t: &StaticTarget<H>, nf: usize) {
     let mut base_ptr = "0".to_owned();
     let mut lstm_ptr = "0".to_owned();
     if let Some(b) = &t.baseline {
@@ -78,7 +78,7 @@ fn target(out: &mut String, name: &str, t: &StaticTarget, nf: usize) {
     }
     if let Some(l) = &t.lstm {
         let ni = l.n_inputs as usize;
-        // w_x[k][g*8+j] = w_ih[g][j][k]; w_h[m][g*8+j] = w_hh[g][j][m]; b = b_ih + b_hh (f32,
+        // w_x[k][g*H+j] = w_ih[g][j][k]; w_h[m][g*H+j] = w_hh[g][j][m]; b = b_ih + b_hh (f32,
         // as Lstm::new adds them).
         let wx: Vec<String> = (0..ni)
             .map(|k| {
@@ -86,46 +86,49 @@ fn target(out: &mut String, name: &str, t: &StaticTarget, nf: usize) {
                     "{{{}}}",
                     join(
                         (0..4)
-                            .flat_map(|g| (0..8).map(move |j| (g, j)))
+                            .flat_map(|g| (0..H).map(move |j| (g, j)))
                             .map(|(g, j)| f(l.w_ih[g][j][k]))
                     )
                 )
             })
             .collect();
-        let wh: Vec<String> = (0..8)
+        let wh: Vec<String> = (0..H)
             .map(|m| {
                 format!(
                     "{{{}}}",
                     join(
                         (0..4)
-                            .flat_map(|g| (0..8).map(move |j| (g, j)))
+                            .flat_map(|g| (0..H).map(move |j| (g, j)))
                             .map(|(g, j)| f(l.w_hh[g][j][m]))
                     )
                 )
             })
             .collect();
         let b: Vec<String> = (0..4)
-            .flat_map(|g| (0..8).map(move |j| (g, j)))
+            .flat_map(|g| (0..H).map(move |j| (g, j)))
             .map(|(g, j)| f(l.b_ih[g][j] + l.b_hh[g][j]))
             .collect();
         let _ = writeln!(
             out,
-            "static const float {name}_wx[{ni}][32] = {{\n    {}\n}};",
+            "static const float {name}_wx[{ni}][{}] = {{\n    {}\n}};",
+            4 * H,
             wx.join(",\n    ")
         );
         let _ = writeln!(
             out,
-            "static const float {name}_wh[8][32] = {{\n    {}\n}};",
+            "static const float {name}_wh[{H}][{}] = {{\n    {}\n}};",
+            4 * H,
             wh.join(",\n    ")
         );
         let _ = writeln!(
             out,
-            "static const float {name}_b[32] = {{{}}};",
+            "static const float {name}_b[{}] = {{{}}};",
+            4 * H,
             b.join(", ")
         );
         let _ = writeln!(
             out,
-            "static const float {name}_wout[8] = {{{}}};",
+            "static const float {name}_wout[{H}] = {{{}}};",
             join(l.w_out.iter().map(|v| f(*v)))
         );
         let _ = writeln!(
@@ -156,7 +159,7 @@ fn target(out: &mut String, name: &str, t: &StaticTarget, nf: usize) {
 }
 
 /// The C source of the coverage map's static data (empty without a map).
-fn coverage(m: &StaticModel) -> String {
+fn coverage<const H: usize>(m: &StaticModel<H>) -> String {
     let Some(c) = &m.coverage else {
         return String::new();
     };
@@ -210,12 +213,16 @@ pub(crate) struct Hooks {
 }
 
 /// `(header, source)`.
-pub fn generate(m: &StaticModel, about: &str) -> (String, String) {
+pub fn generate<const H: usize>(m: &StaticModel<H>, about: &str) -> (String, String) {
     generate_with(m, about, &Hooks::default())
 }
 
 /// [`generate`] with an axis's further sensors' hooks.
-pub(crate) fn generate_with(m: &StaticModel, about: &str, hooks: &Hooks) -> (String, String) {
+pub(crate) fn generate_with<const H: usize>(
+    m: &StaticModel<H>,
+    about: &str,
+    hooks: &Hooks,
+) -> (String, String) {
     let spec = &m.spec;
     let nf = spec.n_features();
     let n_lags = spec.lags().len();
@@ -247,6 +254,7 @@ pub(crate) fn generate_with(m: &StaticModel, about: &str, hooks: &Hooks) -> (Str
         .replace("@NF@", &nf.to_string())
         .replace("@LAGS@", &lag_slots.to_string())
         .replace("@HIST@", &HISTORY_STEPS.to_string())
+        .replace("@HIDDEN@", &H.to_string())
         .replace("@MORE_STATE@", &hooks.state)
         .replace(
             "@COVERAGE_NOTE@",
@@ -272,6 +280,10 @@ pub(crate) fn generate_with(m: &StaticModel, about: &str, hooks: &Hooks) -> (Str
     let source = SOURCE
         .replace("@ABOUT@", about)
         .replace("@N_LAGS@", &n_lags.to_string())
+        .replace("@GATES@", &(4 * H).to_string())
+        .replace("@GATE_F@", &H.to_string())
+        .replace("@GATE_G@", &(2 * H).to_string())
+        .replace("@GATE_O@", &(3 * H).to_string())
         .replace("@STEP_P@", &d(p))
         .replace(
             "@BOUNDARY_TOL@",

@@ -23,7 +23,7 @@ pub use target::{ExportTarget, EXPORT_TARGETS, EXPORT_TARGET_NAMES};
 
 use std::path::{Path, PathBuf};
 
-use gyrotherm_core::compensator::{HIDDEN, LSTM_INPUTS};
+use gyrotherm_core::compensator::LSTM_INPUTS;
 use gyrotherm_core::coverage::{MAX_RATE_CELLS, MAX_TEMP_CELLS};
 use gyrotherm_core::features::MAX_FEATURES;
 use gyrotherm_core::static_model::{
@@ -122,8 +122,25 @@ impl std::str::FromStr for Lang {
 
 /// The static (flight) form of a model file: the numbers the core's compensator is built
 /// from, after the same conversions (`f64` LSTM weights to `f32`, inputs padded to
-/// `LSTM_INPUTS` slots).
+/// `LSTM_INPUTS` slots), for a model whose LSTMs (if any) have 8 hidden units; see
+/// [`sized_static_model`] for the others.
 pub fn static_model(model: &ModelFile) -> Result<StaticModel, ExportError> {
+    sized_static_model::<{ gyrotherm_core::compensator::HIDDEN }>(model)
+}
+
+/// The flight size of a model file's LSTMs ([`crate::compensate::hidden_size`]).
+pub(crate) fn model_hidden_size(
+    model: &ModelFile,
+) -> Result<crate::flight_size::HiddenSize, ExportError> {
+    crate::compensate::hidden_size([model.bias.as_ref(), model.scale.as_ref()])
+        .map_err(ExportError::Flight)
+}
+
+/// [`static_model`] at `H` hidden units (smaller LSTMs widened with zero units, larger ones
+/// refused).
+pub fn sized_static_model<const H: usize>(
+    model: &ModelFile,
+) -> Result<StaticModel<H>, ExportError> {
     let err = ExportError::Model;
     model.validate().map_err(err)?;
     let spec = model.feature_spec().map_err(err)?;
@@ -185,7 +202,10 @@ pub(crate) fn static_baseline(b: &gyrotherm_core::baseline::BaselineModel) -> St
     s
 }
 
-fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, CompensateError> {
+fn static_target<const H: usize>(
+    sub: Option<&SubModel>,
+    absent: f64,
+) -> Result<StaticTarget<H>, CompensateError> {
     let Some(sub) = sub else {
         return Ok(StaticTarget::constant(absent));
     };
@@ -196,7 +216,7 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, Co
         .map(|b| static_baseline(&b));
     let lstm = match sub.lstm() {
         Some((params, input_norm, target_norm)) => {
-            let w = crate::compensate::padded_core_lstm(params)?;
+            let w = crate::compensate::padded_core_lstm::<H>(params)?;
             let n = input_norm.mean.len();
             if n > MAX_FEATURES {
                 return Err(CompensateError::LstmInputs { inputs: n });
@@ -231,7 +251,7 @@ fn static_target(sub: Option<&SubModel>, absent: f64) -> Result<StaticTarget, Co
 }
 
 // The generators index the core's arrays by these sizes.
-const _: () = assert!(LSTM_INPUTS == MAX_FEATURES && HIDDEN == 8);
+const _: () = assert!(LSTM_INPUTS == MAX_FEATURES);
 
 /// The generated files of `model` for `lang`, as `(file name, text)`, without writing
 /// anything. Every byte of the text is one the generator chose: its templates, numbers it
@@ -239,7 +259,16 @@ const _: () = assert!(LSTM_INPUTS == MAX_FEATURES && HIDDEN == 8);
 /// files' names) is copied into it, so a model cannot inject code or directives into flight
 /// source. See [`is_generated_text`].
 pub fn generate(model: &ModelFile, lang: Lang) -> Result<Vec<(&'static str, String)>, ExportError> {
-    let m = static_model(model)?;
+    let size = model_hidden_size(model)?;
+    crate::with_hidden!(size, H => generate_sized::<H>(model, lang))
+}
+
+/// [`generate`] with the LSTMs at `H` hidden units.
+fn generate_sized<const H: usize>(
+    model: &ModelFile,
+    lang: Lang,
+) -> Result<Vec<(&'static str, String)>, ExportError> {
+    let m = sized_static_model::<H>(model)?;
     let about = describe(model)?;
     let files = match lang {
         Lang::C => {

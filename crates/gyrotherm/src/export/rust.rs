@@ -23,7 +23,7 @@ fn f32s(v: &[f32]) -> String {
     list(v, |x| f32_lit(*x))
 }
 
-fn target(out: &mut String, name: &str, t: &StaticTarget) {
+fn target<const H: usize>(out: &mut String, name: &str, t: &StaticTarget<H>) {
     let _ = writeln!(out, "    {name}: StaticTarget {{");
     let _ = writeln!(out, "        offset: {},", f64_lit(t.offset));
     match &t.baseline {
@@ -73,8 +73,18 @@ fn target(out: &mut String, name: &str, t: &StaticTarget) {
     out.push_str("    },\n");
 }
 
+/// `name` of a type generic over the hidden size at `h` units: the bare name at the default
+/// size (so an 8-unit model's text is as before), `name<h>` otherwise.
+pub(crate) fn sized_type(name: &str, h: usize) -> String {
+    if h == gyrotherm_core::compensator::HIDDEN {
+        name.to_owned()
+    } else {
+        format!("{name}<{h}>")
+    }
+}
+
 /// The module text.
-pub fn generate(m: &StaticModel, about: &str) -> String {
+pub fn generate<const H: usize>(m: &StaticModel<H>, about: &str) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -97,7 +107,7 @@ pub fn generate(m: &StaticModel, about: &str) -> String {
     );
     out.push_str("/// The model (see the module doc).\n");
     out.push_str("#[rustfmt::skip]\n#[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n");
-    out.push_str("pub static MODEL: StaticModel = ");
+    let _ = write!(out, "pub static MODEL: {} = ", sized_type("StaticModel", H));
     out.push_str(&model_expr(m));
     out.push_str(";\n");
     out
@@ -156,7 +166,7 @@ fn spec_expr(s: &gyrotherm_core::features::FeatureSpec) -> String {
 }
 
 /// The `StaticModel { ... }` expression of `m` (its fields indented by four spaces).
-pub(crate) fn model_expr(m: &StaticModel) -> String {
+pub(crate) fn model_expr<const H: usize>(m: &StaticModel<H>) -> String {
     let mut out = String::from("StaticModel {\n");
     out.push_str(&spec_expr(&m.spec));
     out.push('\n');

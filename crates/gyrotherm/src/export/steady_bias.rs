@@ -208,8 +208,8 @@ fn notes_of(model: &ModelFile, notes: &mut Vec<&'static str>) {
 
 /// One axis's flight compensator, stepped at a constant temperature.
 enum AxisComp {
-    Single(Box<gyrotherm_core::compensator::Compensator>),
-    Unit(Box<gyrotherm_core::multi::AxisCompensator>, usize),
+    Single(Box<crate::flight_size::FlightCompensator>),
+    Unit(Box<crate::flight_size::FlightAxis>, usize),
 }
 
 impl AxisComp {

@@ -49,7 +49,9 @@ use std::path::{Path, PathBuf};
 use gyrotherm_core::features::HISTORY_STEPS;
 use gyrotherm_core::static_model::{StaticBaseline, StaticModel, StaticTarget};
 
-use super::{c, describe, rust, static_baseline, static_model, write_files, ExportError, Lang};
+use super::{
+    c, describe, rust, sized_static_model, static_baseline, write_files, ExportError, Lang,
+};
 use crate::imu_model::{ImuError, ImuModel};
 use crate::model::CHECKSUM_KEY;
 
@@ -120,6 +122,15 @@ pub fn generate_imu(
     lang: Lang,
 ) -> Result<Vec<(&'static str, String)>, ExportError> {
     model.validate().map_err(ExportError::Unit)?;
+    let size = model.hidden_size().map_err(ExportError::Unit)?;
+    crate::with_hidden!(size, H => generate_imu_sized::<H>(model, lang))
+}
+
+/// [`generate_imu`] with every axis's LSTMs at `H` hidden units.
+fn generate_imu_sized<const H: usize>(
+    model: &ImuModel,
+    lang: Lang,
+) -> Result<Vec<(&'static str, String)>, ExportError> {
     let compact = serde_json::to_string(model).map_err(|e| ExportError::Unit(ImuError::Json(e)))?;
     let digest = crate::model::sha256_hex(compact.as_bytes());
     let mut axes = Vec::with_capacity(model.axes.len());
@@ -131,11 +142,12 @@ pub fn generate_imu(
             }),
             other => other,
         };
-        let first = static_model(&a.model).map_err(err)?;
+        let first = sized_static_model::<H>(&a.model).map_err(err)?;
         // The further sensors as the core axis holds them (what the stream runs).
         let core = model.axis_compensator(a).map_err(ExportError::Unit)?;
         let sensors = core
             .further()
+            .into_iter()
             .map(|(channel, spec, bias, scale)| {
                 let bias = bias.map(static_baseline);
                 let scale = scale.map(static_baseline);
@@ -160,7 +172,10 @@ pub fn generate_imu(
             })
             .collect();
         let fallback = match &a.fallback {
-            Some(f) => Some((static_model(f).map_err(err)?, describe(f).map_err(err)?)),
+            Some(f) => Some((
+                sized_static_model::<H>(f).map_err(err)?,
+                describe(f).map_err(err)?,
+            )),
             None => None,
         };
         axes.push(AxisExport {
@@ -186,15 +201,15 @@ pub fn generate_imu(
 
 /// One axis to export: its first sensor's model and channel, its further sensors, and its
 /// fallback model on the first sensor alone (with its description).
-struct AxisExport {
-    model: StaticModel,
+struct AxisExport<const H: usize> {
+    model: StaticModel<H>,
     about: String,
     channel: usize,
-    sensors: Vec<SensorExport>,
-    fallback: Option<(StaticModel, String)>,
+    sensors: Vec<SensorExport<H>>,
+    fallback: Option<(StaticModel<H>, String)>,
 }
 
-impl AxisExport {
+impl<const H: usize> AxisExport<H> {
     /// The `temp[]` entries the axis reads, first sensor first.
     fn channels(&self) -> Vec<usize> {
         std::iter::once(self.channel)
@@ -206,9 +221,9 @@ impl AxisExport {
 /// A further sensor of an axis: its `temp[]` entry, its features, its parts of B and K, and
 /// the single-axis model whose port gives its pipeline and baseline code (the axis's limits,
 /// the parts as baselines without offset).
-struct SensorExport {
+struct SensorExport<const H: usize> {
     channel: usize,
-    model: StaticModel,
+    model: StaticModel<H>,
     bias: Option<StaticBaseline>,
     scale: Option<StaticBaseline>,
 }
@@ -227,7 +242,7 @@ struct Layout<'a> {
 
 impl Layout<'_> {
     /// The comment lines (without comment markers) on the model and the column order.
-    fn about(&self, axes: &[AxisExport], gyro: &str, temp: &str) -> Vec<String> {
+    fn about<const H: usize>(&self, axes: &[AxisExport<H>], gyro: &str, temp: &str) -> Vec<String> {
         let n = axes.len();
         let mut out = vec![
             format!(
@@ -500,7 +515,10 @@ fn sensor_pieces(src: &str, parts: bool) -> String {
 /// keeps its pipeline state `m<j>`, its reading of this sample `m<j>_t` and its latest features
 /// `m<j>_feat` in the axis's state; the functions are a port of the core's `MoreParts`
 /// (gyrotherm-core's multi.rs), in its order.
-fn further_sensors(i: usize, sensors: &[SensorExport]) -> (c::Hooks, String, String) {
+fn further_sensors<const H: usize>(
+    i: usize,
+    sensors: &[SensorExport<H>],
+) -> (c::Hooks, String, String) {
     if sensors.is_empty() {
         return (c::Hooks::default(), String::new(), String::new());
     }
@@ -619,7 +637,7 @@ fn further_sensors(i: usize, sensors: &[SensorExport]) -> (c::Hooks, String, Str
 }
 
 /// `(header, source)` of the unit.
-fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
+fn generate_c<const H: usize>(axes: &[AxisExport<H>], layout: &Layout) -> (String, String) {
     let n = axes.len();
     let mut h = String::new();
     h.push_str(
@@ -637,7 +655,7 @@ fn generate_c(axes: &[AxisExport], layout: &Layout) -> (String, String) {
     let _ = writeln!(h, "#define GT_AXES {n}");
     let _ = writeln!(h, "#define GT_TEMPS {}", layout.n_temps);
     let _ = writeln!(h, "#define GT_HISTORY_STEPS {HISTORY_STEPS}");
-    h.push_str("#define GT_HIDDEN 8\n\n");
+    let _ = write!(h, "#define GT_HIDDEN {H}\n\n");
     let mut src = String::new();
     src.push_str(
         "/* gyrotherm_model.c: generated by `gyrotherm export --target c` for an inertial unit.\n \
@@ -881,7 +899,7 @@ gt_coverage gt_coverage_of_axis(const gt_state *s, int axis, double *sigma_dph);
 ";
 
 /// The Rust module of the unit.
-fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
+fn generate_rust<const H: usize>(axes: &[AxisExport<H>], layout: &Layout) -> String {
     let n = axes.len();
     let mut out = String::from(
         "//! Inertial-unit compensation model for gyrotherm-core, generated by\n\
@@ -890,8 +908,13 @@ fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
     for line in layout.about(axes, "gyro", "temps") {
         let _ = writeln!(out, "//! {line}");
     }
-    out.push_str(
-        "//! Use: `let mut unit = gyrotherm_core::unit::Unit::<AXES>::from_static_fallbacks(&MODELS, \
+    let unit_type = if H == gyrotherm_core::compensator::HIDDEN {
+        "Unit::<AXES>".to_owned()
+    } else {
+        format!("Unit::<AXES, {H}>")
+    };
+    out.push_str(&format!(
+        "//! Use: `let mut unit = gyrotherm_core::unit::{unit_type}::from_static_fallbacks(&MODELS, \
          &CHANNELS, &SENSORS, &FALLBACKS, TEMPS)?;`\n\
          //! then `unit.step(time_s, &gyro, &temps)` per sample: entry i is axis i's corrected\n\
          //! sample (axis i runs MODELS[i] on temps[CHANNELS[i]], and SENSORS[i] on the further\n\
@@ -903,12 +926,12 @@ fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
          use gyrotherm_core::compensator::TempLimits;\n\
          #[allow(unused_imports)]\n\
          use gyrotherm_core::coverage::Grid;\n\
-         use gyrotherm_core::features::{FeatureSpec, LagOutputs};\n\
+         use gyrotherm_core::features::{{FeatureSpec, LagOutputs}};\n\
          #[allow(unused_imports)]\n\
-         use gyrotherm_core::static_model::{\n    \
+         use gyrotherm_core::static_model::{{\n    \
          StaticBaseline, StaticCoverage, StaticLstm, StaticModel, StaticSensor, StaticTarget,\n\
-         };\n\n",
-    );
+         }};\n\n",
+    ));
     let _ = writeln!(
         out,
         "/// Gyro axes (gyro[] entries).\npub const AXES: usize = {n};"
@@ -928,7 +951,11 @@ fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
     );
     out.push_str("/// Each axis's model, in axis order.\n");
     out.push_str("#[rustfmt::skip]\n#[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n");
-    out.push_str("pub static MODELS: [StaticModel; AXES] = [\n");
+    let _ = writeln!(
+        out,
+        "pub static MODELS: [{}; AXES] = [",
+        rust::sized_type("StaticModel", H)
+    );
     for a in axes {
         out.push_str(&rust::model_expr(&a.model));
         out.push_str(",\n");
@@ -962,12 +989,13 @@ fn generate_rust(axes: &[AxisExport], layout: &Layout) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    out.push_str(
+    out.push_str(&format!(
         "\n/// Each axis's fallback on its first sensor alone (None: the axis has none).\n\
          #[rustfmt::skip]\n\
          #[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n\
-         pub static FALLBACKS: [Option<StaticModel>; AXES] = [\n",
-    );
+         pub static FALLBACKS: [Option<{}>; AXES] = [\n",
+        rust::sized_type("StaticModel", H)
+    ));
     for a in axes {
         match &a.fallback {
             Some((m, _)) => {

@@ -324,6 +324,18 @@ impl ModelFile {
         spec: &FeatureSpec,
         further: &[FurtherPart<'_>],
     ) -> Result<(), ModelFileError> {
+        let size = hidden_size([self.bias.as_ref(), self.scale.as_ref()])
+            .map_err(|e| ModelFileError::invalid("lstm", e.to_string()))?;
+        crate::with_hidden!(size, H => self.check_outputs_sized::<H>(spec, further))
+    }
+
+    /// [`check_outputs_with_further`](Self::check_outputs_with_further) with the LSTMs run
+    /// at `H` hidden units.
+    fn check_outputs_sized<const H: usize>(
+        &self,
+        spec: &FeatureSpec,
+        further: &[FurtherPart<'_>],
+    ) -> Result<(), ModelFileError> {
         use gyrotherm_core::features::FeaturePipeline;
         let t = &self.training;
         let (t_lo, t_hi) = (t.temp_range_c.min, t.temp_range_c.max);
@@ -362,7 +374,7 @@ impl ModelFile {
             }
         };
         let build = |target: Target, sub: Option<&SubModel>, absent: f64| {
-            target_model(sub, absent)
+            target_model::<H>(sub, absent)
                 .map_err(|e| ModelFileError::invalid(target.as_str(), e.to_string()))
         };
         let bias0 = build(Target::Bias, self.bias.as_ref(), 0.0)?;

@@ -673,6 +673,6 @@ mod seal;
 
 pub use checks::SubModelError;
 pub use coverage_map::CoverageDef;
-pub use flight::{padded_core_lstm, target_model, CompensateError};
+pub use flight::{hidden_size, padded_core_lstm, target_model, CompensateError};
 use seal::supported_list;
 pub(crate) use seal::{content_digest_of, parse_sealed, SealedTextError};

@@ -153,9 +153,9 @@ pub struct FitSettings {
     /// Random seed of the LSTM initialisation and window order.
     pub seed: u64,
     /// Hidden units of the method's LSTM ([`DEFAULT_HIDDEN`]). The trainer takes other
-    /// sizes, but a model file must run in flight, whose network is built for
-    /// [`gyrotherm_core::compensator::HIDDEN`] units: until the flight crate and its exports
-    /// take other sizes, [`FitSettings::validate`] accepts that size only.
+    /// sizes, but a model file must run in flight, whose network is built for the sizes of
+    /// [`gyrotherm_core::compensator::HIDDEN_SIZES`]: [`FitSettings::validate`] accepts
+    /// those only.
     pub hidden: usize,
     /// Bias target smoothing window, s (centred moving average).
     pub bias_window_s: f64,
