@@ -22,8 +22,9 @@ impl RecipeSettings {
     pub fn thermal_lstm() -> Self {
         RecipeSettings {
             kind: Method::ThermalLstm,
-            // Adam steps: one batch of windows each.
-            epochs: 600,
+            // Adam steps, one batch of windows each: 300 fitted the design family's sweep on
+            // two cores (docs/experiments/lstm-capacity.md).
+            epochs: 300,
             lr: 5e-3,
             hidden: THERMAL_LSTM_HIDDEN,
             window: 768,
