@@ -67,7 +67,13 @@ fn thermal_lstm_is_labelled_by_what_it_holds() {
     let flight = compensate_log(&kept.model, &held).unwrap();
     let spec = kept.model.feature_spec().unwrap();
     let table = gyrotherm::features::extract(&held, &spec).unwrap();
-    let ground = kept.model.bias.as_ref().unwrap().predict_table(&table).unwrap();
+    let ground = kept
+        .model
+        .bias
+        .as_ref()
+        .unwrap()
+        .predict_table(&table)
+        .unwrap();
     let rows = table.row_of_sample(held.len());
     let worst = rows
         .iter()
@@ -102,7 +108,11 @@ fn auto_scores_both_candidates_and_records_the_choice() {
     );
     let logs = [("s1.csv", &s1), ("s2.csv", &s2), ("t.csv", &t)];
     let auto = fit(&logs, &small(Method::Auto));
-    let choice = auto.model.method_choice.clone().expect("auto records its choice");
+    let choice = auto
+        .model
+        .method_choice
+        .clone()
+        .expect("auto records its choice");
     assert_eq!(choice.validation, Validation::LeaveOneRunOut);
     let methods: Vec<Method> = choice.candidates.iter().map(|c| c.method).collect();
     assert_eq!(methods, [Method::Thermal, Method::ThermalLstm]);

@@ -58,8 +58,7 @@ pub(crate) fn fit(
         0 => return fit_model(logs, &thermal_cfg, progress),
         1 => {
             let fit = fit_model(logs, &lstm_cfg, progress)?;
-            let Some((base, kept)) = fit.bias_training.as_ref().and_then(|t| t.held_out_rms)
-            else {
+            let Some((base, kept)) = fit.bias_training.as_ref().and_then(|t| t.held_out_rms) else {
                 // Too short for held-out blocks: nothing says the LSTM helps.
                 return fit_model(logs, &thermal_cfg, progress);
             };
@@ -154,10 +153,7 @@ fn leave_one_run_out(
             .collect();
         for (c, sub) in [&thermal_sub, &lstm_sub].into_iter().enumerate() {
             let pred = sub.predict_table(&held.table)?;
-            let resid: Vec<f64> = labelled
-                .iter()
-                .map(|&r| held.target[r] - pred[r])
-                .collect();
+            let resid: Vec<f64> = labelled.iter().map(|&r| held.target[r] - pred[r]).collect();
             let mean = resid.iter().sum::<f64>() / resid.len().max(1) as f64;
             ss[c] += resid.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>();
         }

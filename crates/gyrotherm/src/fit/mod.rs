@@ -388,7 +388,8 @@ pub fn fit_model(
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
-    if cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Chosen) {
+    if cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Chosen)
+    {
         return auto::fit(logs, cfg, progress);
     }
     let identified = if uses_identification(cfg) {
@@ -639,7 +640,11 @@ pub(crate) fn fit_model_with(
         Some((m, t)) => (Some(m), t),
         None => (None, None),
     };
-    let method = thermal_lstm::label(cfg.model_method(), bias_model.as_ref(), scale_model.as_ref());
+    let method = thermal_lstm::label(
+        cfg.model_method(),
+        bias_model.as_ref(),
+        scale_model.as_ref(),
+    );
     let model = ModelFile {
         format_version: model::FORMAT_VERSION,
         method,

@@ -26,8 +26,7 @@ use crate::baseline::{fit_fixed_effects, FixedEffectsFit, Terms};
 use crate::features::FeatureSpec;
 use crate::model::{SubModel, Target};
 use crate::nn::{
-    predict, train_normalised, Bptt, LrSchedule, NormalisedFit, Sequence, TrainConfig,
-    WindowStart,
+    predict, train_normalised, Bptt, LrSchedule, NormalisedFit, Sequence, TrainConfig, WindowStart,
 };
 use crate::settings::fit::DEFAULT_HIDDEN;
 use crate::settings::method::Method;
@@ -386,7 +385,11 @@ pub(crate) fn fit_lstm_on_base(
         lstm_verdict: Some(verdict),
         thermal: None,
         held_out_rms: sums.map(|v| {
-            let g = if verdict == LstmVerdict::Kept { gain } else { 0.0 };
+            let g = if verdict == LstmVerdict::Kept {
+                gain
+            } else {
+                0.0
+            };
             (v.rms(0.0), v.rms(g))
         }),
     };
