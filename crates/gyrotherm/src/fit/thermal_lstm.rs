@@ -4,7 +4,7 @@
 //! and trains with minibatch truncated BPTT: windows drawn at random over the training blocks,
 //! their first steps left out of the loss, Adam with cosine decay, the gradient norm clipped,
 //! stopped early on held-out blocks. It is kept only where it beats `thermal` there (the gate
-//! of [`super::residual::fit_lstm_on_base`]); otherwise the model is `thermal` alone and is
+//! of the residual recipe, [`super::residual`]); otherwise the model is `thermal` alone and is
 //! labelled so. The scale factor keeps `thermal`'s model.
 //!
 //! Why capacity: an 8-unit LSTM on the thermal model's residual did not move the worst
