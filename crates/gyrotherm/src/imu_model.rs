@@ -608,6 +608,13 @@ fn fit_axis_multi(
         if let Some(s) = &scale {
             outcome.model.scale = Some(s.first.clone());
         }
+        // Several sensors' least-squares models replace a residual LSTM of the first sensor's
+        // fit: the axis is labelled with what it holds.
+        outcome.model.method = crate::fit::thermal_lstm::label(
+            outcome.model.method,
+            outcome.model.bias.as_ref(),
+            outcome.model.scale.as_ref(),
+        );
         for (i, &j) in order[1..].iter().enumerate() {
             more.push(SensorModel {
                 lags_s: data[j].id.report.lags_s.clone(),

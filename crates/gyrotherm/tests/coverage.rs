@@ -111,6 +111,7 @@ fn coverage_is_stored_sealed_and_older_files_load_without_it() {
     let old = ModelFile {
         coverage: None,
         coverage_note: None,
+        method_choice: None,
         ..model.clone()
     };
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();

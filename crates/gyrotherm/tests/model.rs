@@ -82,6 +82,7 @@ fn lstm_model() -> ModelFile {
         coverage: None,
         columns: None,
         coverage_note: None,
+        method_choice: None,
     }
 }
 
@@ -106,6 +107,7 @@ fn poly_model() -> ModelFile {
         coverage: None,
         columns: None,
         coverage_note: None,
+        method_choice: None,
     }
 }
 
@@ -395,6 +397,7 @@ fn fitted_baseline_saves_and_flies() {
         coverage: None,
         columns: None,
         coverage_note: None,
+        method_choice: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("linear.json");
@@ -442,6 +445,7 @@ fn residual_model(reads_base: bool, lstm_inputs: usize) -> ModelFile {
         coverage: None,
         columns: None,
         coverage_note: None,
+        method_choice: None,
     }
 }
 

@@ -30,8 +30,12 @@ pub(crate) enum TargetFit {
     /// By a recipe's function on the target sets.
     Recipe(RecipeFit),
     /// From the logs: the lags are identified first, then the target is fitted
-    /// ([`super::thermal`], through [`super::fit_model`]).
-    Identified,
+    /// ([`super::thermal`], through [`super::fit_model`]); with `residual_lstm`, an LSTM is
+    /// trained on the fitted model's residual ([`super::thermal_lstm`]).
+    Identified { residual_lstm: bool },
+    /// By fitting candidate methods and keeping the one that wins on held-out validation
+    /// ([`super::auto`], through [`super::fit_model`]).
+    Chosen,
     /// By least squares on all runs at once ([`crate::baseline`], through
     /// [`super::fit_model`]).
     LeastSquares,
@@ -54,7 +58,26 @@ pub(crate) struct Fitting {
 pub(crate) fn fitting(method: Method) -> Fitting {
     use FeatureSpec as F;
     let (recipe, features, fit): (Option<fn() -> RecipeSettings>, _, _) = match method {
-        Method::Thermal => (Some(thermal), F::THERMAL_STATE, TargetFit::Identified),
+        Method::Thermal => (
+            Some(thermal),
+            F::THERMAL_STATE,
+            TargetFit::Identified {
+                residual_lstm: false,
+            },
+        ),
+        Method::ThermalLstm => (
+            Some(RecipeSettings::thermal_lstm),
+            F::THERMAL_STATE,
+            TargetFit::Identified {
+                residual_lstm: true,
+            },
+        ),
+        // Each candidate fits with its own recipe; this one is the LSTM candidate's.
+        Method::Auto => (
+            Some(RecipeSettings::auto),
+            F::THERMAL_STATE,
+            TargetFit::Chosen,
+        ),
         Method::Residual => (
             Some(RecipeSettings::residual),
             F::THERMAL_STATE,
@@ -103,6 +126,16 @@ impl RecipeSettings {
     pub fn feature_spec(&self) -> FeatureSpec {
         fitting(self.kind).features
     }
+}
+
+/// Whether the method trains an LSTM on the residual of the identified thermal model.
+pub(crate) fn residual_lstm(method: Method) -> bool {
+    matches!(
+        fitting(method).fit,
+        TargetFit::Identified {
+            residual_lstm: true
+        }
+    )
 }
 
 /// The thermal recipe: the residual recipe's knobs (its optional residual LSTM trains with

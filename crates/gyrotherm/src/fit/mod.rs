@@ -21,6 +21,7 @@
 //! Least squares itself (with or without per-run offsets) is [`crate::baseline`]; LSTM
 //! training is [`crate::nn`].
 
+pub mod auto;
 pub mod direct;
 pub mod error;
 pub mod generic;
@@ -31,6 +32,7 @@ pub mod residual;
 pub mod select;
 pub mod terms;
 pub mod thermal;
+pub mod thermal_lstm;
 
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;
@@ -77,6 +79,14 @@ pub struct FitConfig {
     pub thermal: thermal::ThermalConfig,
     #[cfg(not(feature = "experiments"))]
     pub(crate) thermal: thermal::ThermalConfig,
+    /// Check the fitted model as a model file must be checked (true). False leaves it
+    /// unchecked, for evaluation in memory of a model flight code cannot run yet (an LSTM of
+    /// another size than flight code's: see [`SubModel::predict_table`]).
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
+    pub check_model: bool,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) check_model: bool,
 }
 
 impl FitConfig {
@@ -91,6 +101,7 @@ impl FitConfig {
             scale_window_s: targets::SCALE_WINDOW_S,
             seed: 0,
             thermal: thermal::ThermalConfig::default(),
+            check_model: true,
         }
     }
 }
@@ -106,7 +117,12 @@ impl FitSettings {
             r.epochs = e;
         }
         r.validate_on_runs = self.validate_on_runs;
-        r.hidden = self.hidden;
+        // A method whose own size is larger keeps it unless another size is asked for.
+        if r.hidden == crate::settings::fit::DEFAULT_HIDDEN
+            || self.hidden != crate::settings::fit::DEFAULT_HIDDEN
+        {
+            r.hidden = self.hidden;
+        }
         r
     }
 
@@ -168,6 +184,9 @@ impl FitOutcome {
             m.training.rate_range_c_per_s.min * 60.0,
             m.training.rate_range_c_per_s.max * 60.0
         )];
+        if let Some(c) = &m.method_choice {
+            out.push(format!("  {}", c.describe()));
+        }
         // The training runs of each target, in the order the fit saw them.
         let (static_names, table_names): (Vec<&NamedLog>, Vec<&NamedLog>) =
             logs.iter().partition(|l| l.log.is_static());
@@ -284,7 +303,7 @@ fn fit_one(
 ) -> Result<(SubModel, Option<TrainSummary>), FitError> {
     if let Some(id) = identified {
         let (sub, report) = thermal::fit_target(sets, &cfg.thermal, id, target == Target::Scale)?;
-        let want_lstm = cfg.thermal.residual_lstm
+        let want_lstm = (cfg.thermal.residual_lstm || methods::residual_lstm(cfg.recipe.kind))
             && cfg.recipe.epochs > 0
             && (target == Target::Bias || cfg.recipe.scale_lstm);
         if let (
@@ -369,6 +388,10 @@ pub fn fit_model(
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
+    if cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Chosen)
+    {
+        return auto::fit(logs, cfg, progress);
+    }
     let identified = if uses_identification(cfg) {
         Some(identify(logs, cfg)?)
     } else {
@@ -379,7 +402,11 @@ pub fn fit_model(
 
 /// Whether the method identifies lags from the data (the `thermal` recipe).
 pub(crate) fn uses_identification(cfg: &FitConfig) -> bool {
-    cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Identified)
+    cfg.method.is_recipe()
+        && matches!(
+            methods::fitting(cfg.recipe.kind).fit,
+            TargetFit::Identified { .. }
+        )
 }
 
 /// Widest span a static run's gyro output may have, °/s, from its 1st to its 99th
@@ -489,7 +516,9 @@ pub(crate) fn fit_model_with(
 ) -> Result<FitOutcome, FitError> {
     let coverage = own_bias;
     // A residual LSTM's summary goes into the model's training record: fitted as before.
-    let fit_bias = own_bias || (cfg.thermal.residual_lstm && cfg.recipe.epochs > 0);
+    let fit_bias = own_bias
+        || ((cfg.thermal.residual_lstm || methods::residual_lstm(cfg.recipe.kind))
+            && cfg.recipe.epochs > 0);
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
@@ -611,9 +640,14 @@ pub(crate) fn fit_model_with(
         Some((m, t)) => (Some(m), t),
         None => (None, None),
     };
+    let method = thermal_lstm::label(
+        cfg.model_method(),
+        bias_model.as_ref(),
+        scale_model.as_ref(),
+    );
     let model = ModelFile {
         format_version: model::FORMAT_VERSION,
-        method: cfg.model_method(),
+        method,
         features: FeatureDef::from_spec(&spec),
         bias: bias_model,
         scale: scale_model,
@@ -621,6 +655,7 @@ pub(crate) fn fit_model_with(
         coverage: None,
         columns: None,
         coverage_note: None,
+        method_choice: None,
     };
     // What training covered, and the bias model's cross-validated error there.
     let coverage = model.bias.as_ref().filter(|_| coverage).map(|b| {
@@ -640,7 +675,7 @@ pub(crate) fn fit_model_with(
         coverage_note: coverage_note.clone(),
         ..model
     };
-    if own_bias {
+    if own_bias && cfg.check_model {
         model.validate()?;
     }
     Ok(FitOutcome {
@@ -671,8 +706,9 @@ pub fn fit_target(
     }
     match methods::fitting(recipe.kind).fit {
         TargetFit::Recipe(fit) => fit(train, recipe, target, n_in, seed, progress),
-        // Its features come from the logs: `fit_model` identifies them and fits it.
-        TargetFit::Identified => Err(FitError::NeedsLogs),
+        // Its features come from the logs: `fit_model` identifies them and fits it; its
+        // candidates likewise.
+        TargetFit::Identified { .. } | TargetFit::Chosen => Err(FitError::NeedsLogs),
         // Least squares on all runs at once (`fit_model`); `lstm` is read only.
         TargetFit::LeastSquares | TargetFit::None => Err(FitError::NotARecipe {
             method: recipe.kind,

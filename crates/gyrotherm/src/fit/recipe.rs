@@ -5,6 +5,7 @@
 
 use super::select::TermSelection;
 use super::terms::BaseTerms;
+use crate::nn::LrSchedule;
 use crate::settings::method::Method;
 
 /// A recipe and its knobs: how a recipe method fits (not called an LSTM recipe: the
@@ -65,6 +66,12 @@ pub struct RecipeSettings {
     /// held-out sweep it changed no outcome for the better on balance
     /// (`docs/experiments/lstm-run-gate.md`).
     pub validate_on_runs: bool,
+    /// `Residual`: minibatch truncated BPTT ([`Bptt::Sampled`](crate::nn::Bptt)): each epoch
+    /// is one Adam step on `batch` windows drawn at random over the training blocks, instead
+    /// of a pass over tiled windows (`epochs` then counts Adam steps).
+    pub sampled_windows: bool,
+    /// `Residual`: the learning-rate schedule over the Adam steps.
+    pub lr_schedule: LrSchedule,
 }
 
 /// What training reports besides the model.
@@ -102,6 +109,10 @@ pub struct TrainSummary {
     pub lstm_verdict: Option<LstmVerdict>,
     /// What the thermal recipe identified and which degradations it took (`Thermal` only).
     pub thermal: Option<super::thermal::ThermalReport>,
+    /// RMS of the base's residual on the validation blocks, target units: of the base alone
+    /// and of the base with the LSTM as kept (equal when it was left out). `Residual` with an
+    /// LSTM and validation blocks only.
+    pub held_out_rms: Option<(f64, f64)>,
 }
 
 /// What became of a trained residual LSTM.

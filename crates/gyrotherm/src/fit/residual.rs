@@ -26,7 +26,7 @@ use crate::baseline::{fit_fixed_effects, FixedEffectsFit, Terms};
 use crate::features::FeatureSpec;
 use crate::model::{SubModel, Target};
 use crate::nn::{
-    predict, train_normalised, Bptt, NormalisedFit, Sequence, TrainConfig, WindowStart,
+    predict, train_normalised, Bptt, LrSchedule, NormalisedFit, Sequence, TrainConfig, WindowStart,
 };
 use crate::settings::fit::DEFAULT_HIDDEN;
 use crate::settings::method::Method;
@@ -53,6 +53,8 @@ impl RecipeSettings {
             residual_smooth_steps: 1,
             base_input: false,
             validate_on_runs: false,
+            sampled_windows: false,
+            lr_schedule: LrSchedule::Constant,
         }
     }
 }
@@ -310,14 +312,23 @@ pub(crate) fn fit_lstm_on_base(
         epochs: recipe.epochs,
         lr: recipe.lr,
         seed,
-        bptt: Bptt::Truncated {
-            window: recipe.window.max(recipe.burn_in + 1),
-            burn_in: recipe.burn_in,
-            batch: recipe.batch.max(1),
-            start: WindowStart::Zero,
+        bptt: if recipe.sampled_windows {
+            Bptt::Sampled {
+                window: recipe.window.max(recipe.burn_in + 1),
+                burn_in: recipe.burn_in,
+                batch: recipe.batch.max(1),
+            }
+        } else {
+            Bptt::Truncated {
+                window: recipe.window.max(recipe.burn_in + 1),
+                burn_in: recipe.burn_in,
+                batch: recipe.batch.max(1),
+                start: WindowStart::Zero,
+            }
         },
         clip_grad_norm: Some(1.0),
         patience: if va.is_empty() { None } else { recipe.patience },
+        lr_schedule: recipe.lr_schedule,
         zero_output_init: true,
         ..TrainConfig::default()
     };
@@ -339,10 +350,15 @@ pub(crate) fn fit_lstm_on_base(
         _ => None,
     };
     let blocks_ok = val_improvement.is_none_or(|g| g >= recipe.min_val_improvement);
-    let gain = match val_improvement {
+    let sums = if val_blocks.is_empty() {
+        None
+    } else {
+        Some(validation_sums(&fit, &val_blocks, n_lstm)?)
+    };
+    let gain = match (val_improvement, &sums) {
         _ if !(runs_ok && blocks_ok) => 0.0,
-        None => 1.0,
-        Some(_) => validation_gain(&fit, &val_blocks, n_lstm)?,
+        (None, _) | (_, None) => 1.0,
+        (Some(_), Some(sums)) => sums.gain(),
     };
     let verdict = if gain < MIN_GAIN {
         LstmVerdict::LeftOut {
@@ -368,6 +384,14 @@ pub(crate) fn fit_lstm_on_base(
         run_gate,
         lstm_verdict: Some(verdict),
         thermal: None,
+        held_out_rms: sums.map(|v| {
+            let g = if verdict == LstmVerdict::Kept {
+                gain
+            } else {
+                0.0
+            };
+            (v.rms(0.0), v.rms(g))
+        }),
     };
     if verdict != LstmVerdict::Kept {
         // The LSTM predicted none of the held-out residual: the physical fit alone.
@@ -417,11 +441,45 @@ fn smooth_masked(x: &[f64], mask: &[bool], width: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Least-squares gain `g = Σ r·p / Σ p²`, clamped to [0, 1], of the LSTM's residual
-/// prediction `p` (raw units, each block from zero state) against the residual `r` over the
-/// counted steps of the validation blocks: shrinkage toward the baseline alone.
-fn validation_gain(fit: &NormalisedFit, val: &[Block], n_in: usize) -> Result<f64, FitError> {
-    let (mut rp, mut pp) = (0.0, 0.0);
+/// Sums over the counted steps of the validation blocks of the residual `r` and the LSTM's
+/// residual prediction `p` (raw units, each block from zero state): `Σ r²`, `Σ r·p`, `Σ p²`
+/// and the step count.
+struct ValidationSums {
+    rr: f64,
+    rp: f64,
+    pp: f64,
+    n: usize,
+}
+
+impl ValidationSums {
+    /// Least-squares gain `g = Σ r·p / Σ p²`, clamped to [0, 1]: shrinkage toward the
+    /// baseline alone.
+    fn gain(&self) -> f64 {
+        if self.pp > 0.0 {
+            (self.rp / self.pp).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// RMS of `r − g·p` (g = 0: the base alone).
+    fn rms(&self, g: f64) -> f64 {
+        let ss = self.rr - 2.0 * g * self.rp + g * g * self.pp;
+        (ss.max(0.0) / self.n.max(1) as f64).sqrt()
+    }
+}
+
+fn validation_sums(
+    fit: &NormalisedFit,
+    val: &[Block],
+    n_in: usize,
+) -> Result<ValidationSums, FitError> {
+    let mut s = ValidationSums {
+        rr: 0.0,
+        rp: 0.0,
+        pp: 0.0,
+        n: 0,
+    };
     for b in val {
         let x: Vec<f64> = b
             .rows
@@ -433,16 +491,14 @@ fn validation_gain(fit: &NormalisedFit, val: &[Block], n_in: usize) -> Result<f6
         for ((yn, r), m) in y.iter().zip(&b.target).zip(&b.mask) {
             if *m {
                 let p = fit.target_z.invert(0, *yn);
-                rp += r * p;
-                pp += p * p;
+                s.rr += r * r;
+                s.rp += r * p;
+                s.pp += p * p;
+                s.n += 1;
             }
         }
     }
-    Ok(if pp > 0.0 {
-        (rp / pp).clamp(0.0, 1.0)
-    } else {
-        0.0
-    })
+    Ok(s)
 }
 
 #[cfg(test)]

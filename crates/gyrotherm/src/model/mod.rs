@@ -322,6 +322,10 @@ pub struct ModelFile {
     /// before the reason was kept), so that a later command gives the reason training gave.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage_note: Option<String>,
+    /// How `auto` chose the method that fitted this model: every candidate's held-out score
+    /// and the choice (absent for any other method, and in older files).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method_choice: Option<MethodChoice>,
 }
 
 /// The columns of the logs a model was trained on: the header names of time, gyro output,
@@ -669,10 +673,14 @@ pub fn missing_coverage_note(model: &ModelFile) -> Option<String> {
 mod checks;
 mod coverage_map;
 mod flight;
+mod ground;
+mod method_choice;
 mod seal;
 
 pub use checks::SubModelError;
 pub use coverage_map::CoverageDef;
 pub use flight::{hidden_size, padded_core_lstm, target_model, CompensateError};
+pub use ground::GroundPredictError;
+pub use method_choice::{CandidateScore, MethodChoice, Validation};
 use seal::supported_list;
 pub(crate) use seal::{content_digest_of, parse_sealed, SealedTextError};

@@ -23,6 +23,10 @@ pub const DEFAULT_POLY_TEMP_DEGREE: u8 = 3;
 pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 /// Default hidden units of the LSTM recipes: 8, as published (He et al. 2024, §2).
 pub const DEFAULT_HIDDEN: usize = 8;
+/// Hidden units of `thermal-lstm`'s LSTM: 32, chosen against 16 on the design family
+/// (docs/experiments/lstm-capacity.md). `hidden` overrides it only when set to another size
+/// than [`DEFAULT_HIDDEN`].
+pub const THERMAL_LSTM_HIDDEN: usize = 32;
 
 /// Default least relative drop of an inertial-unit axis's cross-validated RMS for a further
 /// temperature sensor to join its model: −1, a sensor joins unless it doubles the

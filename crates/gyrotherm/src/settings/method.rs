@@ -73,6 +73,20 @@ registry! {
         "thermal time constants identified from the logs and a ridge fit on them, no \
          LSTM (the default: chosen on a family of simulated units); degrades on short \
          or coarse logs and says how";
+    /// `Thermal`'s model plus an LSTM of real capacity on its residual, reading the thermal
+    /// states and `Thermal`'s prediction; kept only where it beats `Thermal` on held-out
+    /// blocks, else the model is `Thermal` alone ([`crate::fit::thermal_lstm`]).
+    ThermalLstm = "thermal-lstm", Recipe, None,
+        "`thermal` plus a 32-unit LSTM on its residual (reading the thermal states and \
+         thermal's prediction, minibatch training), kept only where it beats `thermal` on \
+         held-out blocks (else the model is `thermal`)";
+    /// Fits `Thermal` and `ThermalLstm`, scores both on held-out validation (each training
+    /// run left out in turn, or held-out blocks of a single run) and keeps the better one
+    /// ([`crate::fit::auto`]).
+    Auto = "auto", Recipe, None,
+        "fits `thermal` and `thermal-lstm`, scores each on held-out validation (each run \
+         left out in turn; held-out blocks of a single run) and keeps the better; prints \
+         and records the scores";
     /// Least squares on thermal-state inputs plus an LSTM on its residual, kept only where it
     /// beats the least-squares base on validation blocks ([`crate::fit::residual`]).
     Residual = "residual", Recipe, None,
@@ -190,7 +204,7 @@ impl Method {
     }
 
     /// Whether the method is a recipe of its own (thermal-state features, optional LSTM):
-    /// `thermal`, `residual`, `generic`, `direct`, `published`.
+    /// `thermal`, `thermal-lstm`, `auto`, `residual`, `generic`, `direct`, `published`.
     pub const fn is_own_recipe(&self) -> bool {
         matches!(self.family(), Family::Recipe)
     }
@@ -249,7 +263,15 @@ mod tests {
         assert_eq!(METHODS[0], DEFAULT_METHOD);
         assert_eq!(
             RECIPE_NAMES,
-            ["thermal", "residual", "generic", "direct", "published"]
+            [
+                "thermal",
+                "thermal-lstm",
+                "auto",
+                "residual",
+                "generic",
+                "direct",
+                "published"
+            ]
         );
         assert_eq!(Method::parse_recipe("direct"), Ok(Method::Direct));
         assert!(Method::parse_recipe("linear").is_err());

@@ -1,0 +1,163 @@
+//! The `auto` method: fits the candidates `thermal` and `thermal-lstm`, scores each on
+//! held-out validation that mirrors the use, and keeps the better.
+//!
+//! - Two or more static runs: each is left out in turn. The candidates are fitted on the other
+//!   runs (the lags identified again without it) and predict the left-out run's bias; the score
+//!   is the RMS of their residual over every left-out run, each run's mean removed.
+//! - One static run: `thermal-lstm` holds out every few blocks of the run from its LSTM's
+//!   training; the scores are the residual RMS on those blocks of `thermal`'s model alone and
+//!   with the LSTM as kept.
+//!
+//! The lower score wins; on a tie, the first candidate (`thermal`, the simpler). The chosen
+//! method is then fitted on every run, and the model is labelled with what it holds. The scores
+//! and the choice go into the model file ([`MethodChoice`]) and the lines `train` prints. The
+//! scale factor is `thermal`'s in both candidates.
+
+use super::error::FitError;
+use super::{
+    fit_model, identify, residual, thermal, thermal_base, FitConfig, FitOutcome, NamedLog,
+    RecipeSettings,
+};
+use crate::model::{CandidateScore, MethodChoice, SubModel, Target, Validation};
+use crate::settings::method::Method;
+use crate::targets::{self, TargetSet};
+
+/// The candidates, in the order they are scored (the first wins a tie).
+pub const CANDIDATES: [Method; 2] = [Method::Thermal, Method::ThermalLstm];
+
+/// The configuration that fits candidate `method` under `auto`'s settings `cfg`: `thermal`
+/// with its own recipe, `thermal-lstm` with `auto`'s knobs (its own, as a fit was asked).
+fn candidate_config(cfg: &FitConfig, method: Method) -> FitConfig {
+    let recipe = match method {
+        Method::Thermal => RecipeSettings::of_kind(Method::Thermal),
+        m => RecipeSettings {
+            kind: m,
+            ..cfg.recipe.clone()
+        },
+    };
+    FitConfig {
+        method,
+        recipe,
+        ..cfg.clone()
+    }
+}
+
+/// Fit with `auto`: see the module documentation.
+pub(crate) fn fit(
+    logs: &[NamedLog],
+    cfg: &FitConfig,
+    progress: &(dyn Fn(Target, usize, f64) + Sync),
+) -> Result<FitOutcome, FitError> {
+    let statics: Vec<usize> = (0..logs.len())
+        .filter(|&i| targets::is_static(logs[i].log))
+        .collect();
+    let lstm_cfg = candidate_config(cfg, Method::ThermalLstm);
+    let thermal_cfg = candidate_config(cfg, Method::Thermal);
+    let (validation, scores, lstm_fit) = match statics.len() {
+        // No bias to choose on: the scale factor is `thermal`'s in either candidate.
+        0 => return fit_model(logs, &thermal_cfg, progress),
+        1 => {
+            let fit = fit_model(logs, &lstm_cfg, progress)?;
+            let Some((base, kept)) = fit.bias_training.as_ref().and_then(|t| t.held_out_rms) else {
+                // Too short for held-out blocks: nothing says the LSTM helps.
+                return fit_model(logs, &thermal_cfg, progress);
+            };
+            (Validation::HeldOutBlocks, [base, kept], Some(fit))
+        }
+        _ => (
+            Validation::LeaveOneRunOut,
+            leave_one_run_out(logs, &statics, &thermal_cfg, &lstm_cfg)?,
+            None,
+        ),
+    };
+    let chosen = if scores[1] < scores[0] {
+        Method::ThermalLstm
+    } else {
+        Method::Thermal
+    };
+    let mut fit = match (chosen, lstm_fit) {
+        (Method::ThermalLstm, Some(fit)) => fit,
+        _ => fit_model(logs, &candidate_config(cfg, chosen), progress)?,
+    };
+    fit.model.method_choice = Some(MethodChoice {
+        validation,
+        candidates: CANDIDATES
+            .iter()
+            .zip(scores)
+            .map(|(&method, bias_rms_dps)| CandidateScore {
+                method,
+                bias_rms_dps,
+            })
+            .collect(),
+        chosen,
+    });
+    Ok(fit)
+}
+
+/// Each static run left out in turn: both candidates fitted on the others, their bias residual
+/// on it. Returns each candidate's RMS over every left-out run, each run's mean removed.
+fn leave_one_run_out(
+    logs: &[NamedLog],
+    statics: &[usize],
+    thermal_cfg: &FitConfig,
+    lstm_cfg: &FitConfig,
+) -> Result<[f64; 2], FitError> {
+    let mut ss = [0.0; 2];
+    let mut n = 0usize;
+    for &k in statics {
+        let others: Vec<NamedLog> = logs
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != k)
+            .map(|(_, l)| *l)
+            .collect();
+        let id = identify(&others, thermal_cfg)?;
+        let sets_of = |ls: &[NamedLog]| -> Result<Vec<TargetSet>, FitError> {
+            ls.iter()
+                .filter(|l| targets::is_static(l.log))
+                .map(|l| {
+                    targets::bias_targets(l.log, &id.spec, thermal_cfg.bias_window_s).map_err(
+                        |source| FitError::Targets {
+                            run: l.name.to_owned(),
+                            source,
+                        },
+                    )
+                })
+                .collect()
+        };
+        let sets = sets_of(&others)?;
+        let held = sets_of(&logs[k..=k])?;
+        let (Some(held), false) = (held.first(), sets.is_empty()) else {
+            continue;
+        };
+        let (thermal_sub, _) = thermal::fit_target(&sets, &thermal_cfg.thermal, &id, false)?;
+        let SubModel::Baseline {
+            terms,
+            coefficients,
+        } = &thermal_sub
+        else {
+            continue;
+        };
+        let base = thermal_base(&sets, terms, coefficients);
+        let n_in = sets[0].table.n_features;
+        let (lstm_sub, _) = residual::fit_lstm_on_base(
+            &sets,
+            base,
+            &lstm_cfg.recipe,
+            n_in,
+            lstm_cfg.seed,
+            &mut |_, _| {},
+        )?;
+        let labelled: Vec<usize> = (0..held.table.n_rows())
+            .filter(|&r| held.mask[r] && held.target[r].is_finite())
+            .collect();
+        for (c, sub) in [&thermal_sub, &lstm_sub].into_iter().enumerate() {
+            let pred = sub.predict_table(&held.table)?;
+            let resid: Vec<f64> = labelled.iter().map(|&r| held.target[r] - pred[r]).collect();
+            let mean = resid.iter().sum::<f64>() / resid.len().max(1) as f64;
+            ss[c] += resid.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>();
+        }
+        n += labelled.len();
+    }
+    Ok(ss.map(|s| (s / n.max(1) as f64).sqrt()))
+}

@@ -1,0 +1,71 @@
+//! What `auto` records in a model file: how the candidates were scored, each one's score and
+//! the choice.
+
+use serde::{Deserialize, Serialize};
+
+use super::Method;
+
+/// How the candidates were scored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Validation {
+    /// Each static training run left out in turn: the candidates are fitted on the others
+    /// and scored on it (two or more static runs).
+    #[serde(rename = "leave-one-run-out")]
+    LeaveOneRunOut,
+    /// Held-out blocks of the training runs (one static run): every few blocks are kept out
+    /// of the LSTM's training.
+    #[serde(rename = "held-out-blocks")]
+    HeldOutBlocks,
+}
+
+impl Validation {
+    /// How it reads in a sentence.
+    pub fn text(&self) -> &'static str {
+        match self {
+            Validation::LeaveOneRunOut => "each static run left out in turn",
+            Validation::HeldOutBlocks => "held-out blocks of the static run",
+        }
+    }
+}
+
+/// One candidate's held-out score.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CandidateScore {
+    /// The candidate method.
+    pub method: Method,
+    /// RMS of the held-out bias residual, °/s (each held-out run's mean removed: a constant
+    /// bias is the turn-on offset, which no model of temperature predicts).
+    pub bias_rms_dps: f64,
+}
+
+/// `auto`'s choice.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MethodChoice {
+    /// How the candidates were scored.
+    pub validation: Validation,
+    /// Every candidate's score, in the order they were fitted.
+    pub candidates: Vec<CandidateScore>,
+    /// The candidate kept: the lowest score (the first on a tie).
+    pub chosen: Method,
+}
+
+impl MethodChoice {
+    /// One line: the validation, each candidate's score in °/h (the chosen one starred).
+    pub fn describe(&self) -> String {
+        let each: Vec<String> = self
+            .candidates
+            .iter()
+            .map(|c| {
+                let star = if c.method == self.chosen { "*" } else { "" };
+                format!("{}{star} {:.4}", c.method, c.bias_rms_dps * 3600.0)
+            })
+            .collect();
+        format!(
+            "method chosen on {} (held-out bias residual RMS, °/h; * chosen): {}",
+            self.validation.text(),
+            each.join(", ")
+        )
+    }
+}
