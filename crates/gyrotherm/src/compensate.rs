@@ -5,7 +5,7 @@
 
 use gyrotherm_core::compensator::Compensator;
 
-use crate::build_sized;
+use crate::flight_size::build_sized;
 use crate::flight_size::FlightCompensator;
 
 use crate::csvlog::TestLog;

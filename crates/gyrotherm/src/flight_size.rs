@@ -3,7 +3,7 @@
 //! Flight code fixes the size at compile time (`Compensator<H>`, 8 by default); the ground
 //! reads it from the model and holds one of the supported sizes
 //! ([`HIDDEN_SIZES`]) in an enum, boxed: a 64-unit compensator holds two networks of some
-//! 80 KB each, and each size is built in a function of its own ([`build_sized!`]) so that
+//! 80 KB each, and each size is built in a function of its own (`build_sized!`) so that
 //! no stack frame holds the largest size's value for a smaller model.
 //!
 //! A model file, or a unit file with all its axes and fallbacks, runs at one size: the
@@ -17,7 +17,10 @@ use gyrotherm_core::features::{FeatureSpec, Features};
 use gyrotherm_core::multi::AxisCompensator;
 use gyrotherm_core::unit::UnitError;
 
-use crate::imu_model::MAX_STREAM_AXES;
+/// Most gyro axes a unit model can have: the capacity of the ground stream's unit, which
+/// `compensate` runs, checked at `train` and at load (flight code fixes its own capacity,
+/// three by default: [`gyrotherm_core::unit::MAX_AXES`]).
+pub const MAX_STREAM_AXES: usize = 16;
 
 /// A hidden size the flight types are built for (see [`HIDDEN_SIZES`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
@@ -62,8 +65,6 @@ const _: () = assert!(
 );
 
 /// Evaluate `$body` with the const `$h` set to `$size`'s number of units.
-#[macro_export]
-#[doc(hidden)]
 macro_rules! with_hidden {
     ($size:expr, $h:ident => $body:expr) => {
         match $size {
@@ -89,8 +90,6 @@ macro_rules! with_hidden {
 
 /// The variant of `$ty` (an enum over the sizes) for `$size`, holding `$body` (a box)
 /// evaluated with the const `$h` set to the size.
-#[macro_export]
-#[doc(hidden)]
 macro_rules! build_sized {
     ($ty:ident, $size:expr, $h:ident => $body:expr) => {{
         match $size {
@@ -113,6 +112,10 @@ macro_rules! build_sized {
         }
     }};
 }
+
+// Used by path (`crate::flight_size::build_sized`), not exported from the crate.
+pub(crate) use build_sized;
+pub(crate) use with_hidden;
 
 /// Apply `$body` to the compensator held by any variant of `$e`.
 macro_rules! each {

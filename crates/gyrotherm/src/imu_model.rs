@@ -31,11 +31,11 @@ use gyrotherm_core::compensator::Status;
 use gyrotherm_core::features::LagOutputs;
 use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 
-use crate::build_sized;
 use crate::compensate::{boxed_compensator, hidden_size, sized_compensator};
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
+use crate::flight_size::build_sized;
 use crate::flight_size::{FlightAxis, FlightCompensator, HiddenSize};
 pub use crate::imu_error::ImuError;
 use crate::model::{
@@ -46,10 +46,7 @@ use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets;
 
-/// Most gyro axes a unit model can have: the capacity of the ground stream's unit, which
-/// `compensate` runs, checked at `train` and at load (flight code fixes its own capacity,
-/// three by default: [`gyrotherm_core::unit::MAX_AXES`]).
-pub const MAX_STREAM_AXES: usize = 16;
+pub use crate::flight_size::MAX_STREAM_AXES;
 
 /// Version of the inertial-unit file layout when an axis reads several sensors.
 pub const IMU_FORMAT_VERSION: u32 = 2;
@@ -931,8 +928,9 @@ impl ImuModel {
         Ok(())
     }
 
-    /// The flight compensator of one axis: its first sensor's [`Compensator`] and each
-    /// further sensor's pipeline and parts, reading the indices of its sensors among
+    /// The flight compensator of one axis: its first sensor's
+    /// [`Compensator`](gyrotherm_core::compensator::Compensator) and each further sensor's
+    /// pipeline and parts, reading the indices of its sensors among
     /// [`ImuModel::temp_cols`], at the unit's LSTM size ([`ImuModel::hidden_size`]).
     pub fn axis_compensator(&self, a: &ImuAxis) -> Result<FlightAxis, ImuError> {
         let size = self.hidden_size()?;

@@ -260,7 +260,7 @@ const _: () = assert!(LSTM_INPUTS == MAX_FEATURES);
 /// source. See [`is_generated_text`].
 pub fn generate(model: &ModelFile, lang: Lang) -> Result<Vec<(&'static str, String)>, ExportError> {
     let size = model_hidden_size(model)?;
-    crate::with_hidden!(size, H => generate_sized::<H>(model, lang))
+    crate::flight_size::with_hidden!(size, H => generate_sized::<H>(model, lang))
 }
 
 /// [`generate`] with the LSTMs at `H` hidden units.

@@ -123,7 +123,7 @@ pub fn generate_imu(
 ) -> Result<Vec<(&'static str, String)>, ExportError> {
     model.validate().map_err(ExportError::Unit)?;
     let size = model.hidden_size().map_err(ExportError::Unit)?;
-    crate::with_hidden!(size, H => generate_imu_sized::<H>(model, lang))
+    crate::flight_size::with_hidden!(size, H => generate_imu_sized::<H>(model, lang))
 }
 
 /// [`generate_imu`] with every axis's LSTMs at `H` hidden units.

@@ -326,7 +326,7 @@ impl ModelFile {
     ) -> Result<(), ModelFileError> {
         let size = hidden_size([self.bias.as_ref(), self.scale.as_ref()])
             .map_err(|e| ModelFileError::invalid("lstm", e.to_string()))?;
-        crate::with_hidden!(size, H => self.check_outputs_sized::<H>(spec, further))
+        crate::flight_size::with_hidden!(size, H => self.check_outputs_sized::<H>(spec, further))
     }
 
     /// [`check_outputs_with_further`](Self::check_outputs_with_further) with the LSTMs run
