@@ -63,6 +63,32 @@ def _warn(messages: Iterable[str]) -> None:
         warnings.warn(m, GyrothermWarning, stacklevel=3)
 
 
+def _export(
+    self,
+    target: str,
+    out: PathLike,
+    *,
+    instance: Optional[int] = None,
+    axis: Optional[str] = None,
+    device_id: Optional[int] = None,
+) -> List[str]:
+    """Write the model for ``target`` into the folder ``out`` (created if missing), as
+    ``gyrotherm export --target`` does: ``"c"`` (``gyrotherm_model.h`` and
+    ``gyrotherm_model.c``), ``"rust"`` (``gyrotherm_model.rs``), or an autopilot's gyro
+    temperature calibration, ``"ardupilot"`` (``gyro_tcal.parm``) or ``"px4"``
+    (``gyro_tc.params``): a cubic in temperature fitted to the model's steady-state bias.
+    ``instance`` (the autopilot's IMU, from 0), ``axis`` (``"x"``, ``"y"`` or ``"z"``: the
+    axis a single-gyro model fills) and ``device_id`` (PX4's gyro device id, required
+    there) are for the autopilot targets only. Returns the lines the CLI prints (files
+    written, the polynomial's fit per axis, what it does not carry); its warnings (a
+    narrow training range) come as ``GyrothermWarning``. Raises ``gyrotherm.ModelError``."""
+    lines, warns = self._raw.export(
+        target, os.fspath(out), instance=instance, axis=axis, device_id=device_id
+    )
+    _warn(warns)
+    return lines
+
+
 class Model:
     """A fitted compensation model: the JSON file ``gyrotherm train`` writes and
     ``gyrotherm compensate`` reads. Make one with :func:`fit` or :meth:`Model.load`."""
@@ -165,30 +191,7 @@ class Model:
         return {"rows": rows, "ok": ok, "held": held, "degraded": degraded,
                 "invalid": invalid, "warnings": warns}
 
-    def export(
-        self,
-        target: str,
-        out: PathLike,
-        *,
-        instance: Optional[int] = None,
-        axis: Optional[str] = None,
-        device_id: Optional[int] = None,
-    ) -> List[str]:
-        """Write the model for ``target`` into the folder ``out`` (created if missing), as
-        ``gyrotherm export --target`` does: ``"c"`` (``gyrotherm_model.h`` and
-        ``gyrotherm_model.c``), ``"rust"`` (``gyrotherm_model.rs``), or an autopilot's gyro
-        temperature calibration, ``"ardupilot"`` (``gyro_tcal.parm``) or ``"px4"``
-        (``gyro_tc.params``): a cubic in temperature fitted to the model's steady-state bias.
-        ``instance`` (the autopilot's IMU, from 0), ``axis`` (``"x"``, ``"y"`` or ``"z"``: the
-        axis a single-gyro model fills) and ``device_id`` (PX4's gyro device id, required
-        there) are for the autopilot targets only. Returns the lines the CLI prints (files
-        written, the polynomial's fit per axis, what it does not carry); its warnings (a
-        narrow training range) come as ``GyrothermWarning``. Raises ``gyrotherm.ModelError``."""
-        lines, warns = self._raw.export(
-            target, os.fspath(out), instance=instance, axis=axis, device_id=device_id
-        )
-        _warn(warns)
-        return lines
+    export = _export
 
     def summary(self) -> str:
         """What the model is, what it was trained on, and (after :func:`fit`) how training
@@ -287,30 +290,7 @@ class UnitModel:
             )
         return values
 
-    def export(
-        self,
-        target: str,
-        out: PathLike,
-        *,
-        instance: Optional[int] = None,
-        axis: Optional[str] = None,
-        device_id: Optional[int] = None,
-    ) -> List[str]:
-        """Write the model for ``target`` into the folder ``out`` (created if missing), as
-        ``gyrotherm export --target`` does: ``"c"`` (``gyrotherm_model.h`` and
-        ``gyrotherm_model.c``), ``"rust"`` (``gyrotherm_model.rs``), or an autopilot's gyro
-        temperature calibration, ``"ardupilot"`` (``gyro_tcal.parm``) or ``"px4"``
-        (``gyro_tc.params``): a cubic in temperature fitted to the model's steady-state bias.
-        ``instance`` (the autopilot's IMU, from 0), ``axis`` (``"x"``, ``"y"`` or ``"z"``: the
-        axis a single-gyro model fills) and ``device_id`` (PX4's gyro device id, required
-        there) are for the autopilot targets only. Returns the lines the CLI prints (files
-        written, the polynomial's fit per axis, what it does not carry); its warnings (a
-        narrow training range) come as ``GyrothermWarning``. Raises ``gyrotherm.ModelError``."""
-        lines, warns = self._raw.export(
-            target, os.fspath(out), instance=instance, axis=axis, device_id=device_id
-        )
-        _warn(warns)
-        return lines
+    export = _export
 
     def summary(self) -> str:
         """The axes, the sensor each reads and its models."""
