@@ -102,15 +102,7 @@ pub(crate) fn read_from<R: Read>(
     path: &Path,
     instance: u8,
 ) -> Result<(ImuLog, ReadReport), LogError> {
-    let corrupt = |at: u64, what: String| {
-        LogError::new(
-            Kind::Corrupt,
-            path,
-            None,
-            None,
-            format!("byte {at}: {what}"),
-        )
-    };
+    let corrupt = |at: u64, what: String| LogError::corrupt_at(path, at, what);
     let mut types: Vec<Type> = vec![Type::default(); 256];
     types[FMT_TYPE as usize].len = FMT_LEN;
     let mut at: u64 = 0;

@@ -91,6 +91,17 @@ impl LogError {
 }
 
 impl LogError {
+    /// A binary log `path` damaged at byte `at` (the autopilot formats have no lines).
+    pub(crate) fn corrupt_at(path: &std::path::Path, at: u64, what: String) -> Self {
+        LogError::new(
+            LogErrorKind::Corrupt,
+            path,
+            None,
+            None,
+            format!("byte {at}: {what}"),
+        )
+    }
+
     /// A line of `path` longer than [`MAX_LINE_BYTES`](super::MAX_LINE_BYTES) at `line`.
     pub(crate) fn line_too_long(path: impl Into<PathBuf>, line: u64) -> Self {
         LogError::new(

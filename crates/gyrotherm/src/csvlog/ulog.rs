@@ -62,15 +62,7 @@ pub(crate) fn read_from<R: Read>(
         taken: Rc::clone(&taken),
         ran_dry: Rc::clone(&ran_dry),
     };
-    let corrupt = |at: u64, what: String| {
-        LogError::new(
-            Kind::Corrupt,
-            path,
-            None,
-            None,
-            format!("byte {at}: {what}"),
-        )
-    };
+    let corrupt = |at: u64, what: String| LogError::corrupt_at(path, at, what);
     let parser = ULogParserBuilder::new(counted)
         .set_subscription_allow_list([TOPIC])
         .build()
