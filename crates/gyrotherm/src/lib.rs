@@ -109,6 +109,8 @@ pub mod spec;
 pub(crate) mod string_table;
 pub mod table_segments;
 pub mod targets;
+pub mod told;
+pub mod train;
 pub mod unit_model;
 
 pub use compensate::{compensate_log, compensator, CompensateError};

@@ -23,6 +23,7 @@ use crate::imu_model::{
 use crate::input_file::{read_capped_to_string, InputKind};
 use crate::model::{GivenColumns, ModelFile, ModelFileError, Seal};
 use crate::settings::autopilot::AutopilotSettings;
+pub use crate::told::Told;
 
 /// A model file of either form, as read.
 #[derive(Debug, Clone)]
@@ -73,20 +74,6 @@ impl From<ModelFileError> for ModelError {
     fn from(e: ModelFileError) -> Self {
         ModelError::Single(e)
     }
-}
-
-/// A line for the user about a model and what was done with it; a front end prints each as
-/// it prints its own kind of line.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Told {
-    /// A plain line.
-    Line(String),
-    /// A note (something the user may want to know).
-    Note(String),
-    /// A warning.
-    Warning(String),
-    /// An indented line under the line before.
-    Item(String),
 }
 
 /// One gyro axis of a [`Model`]: its gyro column, the temperature columns it reads (the first

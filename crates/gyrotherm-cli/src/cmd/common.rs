@@ -199,6 +199,26 @@ pub fn read_logs_with(
     Ok(out)
 }
 
+/// Read a job's logs through the library's one entry point, telling what reading did for
+/// each file and each failure, then stop if any failed.
+pub fn read_log_set(
+    paths: &[PathBuf],
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+) -> anyhow::Result<csvlog::LogSet> {
+    let read = csvlog::read_log_set(paths, opts, table_axis);
+    for f in read.files {
+        for t in &f.told {
+            tell(t);
+        }
+        if let Some(e) = f.error {
+            let e = anyhow::Error::new(e).context(format!("cannot use log {}", f.path.display()));
+            eprintln!("gyrotherm: {}", error_message(&e));
+        }
+    }
+    Ok(read.set?)
+}
+
 /// Refuse, before any work, an output path that names one of the command's inputs
 /// (`gyrotherm::atomic_file::refuse_outputs_over_inputs`): `train --out static.csv` would
 /// replace the raw log with the model.

@@ -2,13 +2,11 @@
 //! lists), one model file for the unit (`gyrotherm::imu_model`), and the reading of such logs.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 use anyhow::Context as _;
 use gyrotherm::csvlog::{self, ImuLog};
-use gyrotherm::imu_model::{self, ImuFitEvent};
+use gyrotherm::imu_model::ImuFitEvent;
 
-use super::args::TrainArgs;
 use super::common::{error_message, LogArgs};
 
 /// Read every log with the column lists, reporting each failure, then stop if any failed.
@@ -63,73 +61,6 @@ pub fn read_imu_logs_with(
         paths.len()
     );
     Ok(out)
-}
-
-/// `train` with several gyro or temperature columns: one model for the unit.
-pub fn train(args: TrainArgs) -> anyhow::Result<ExitCode> {
-    let logs = read_imu_logs(&args.input, &args.log)?;
-    for (name, l) in &logs {
-        let what = l
-            .table_axis
-            .as_deref()
-            .map_or("static".to_owned(), |a| format!("rate table on {a}"));
-        eprintln!("gyrotherm: {name}: {what}");
-    }
-    let cfg = args.fit.fit_config(args.method)?;
-    let temp_sensor = args.sensor.to_def()?;
-    let started = std::time::Instant::now();
-    let axes = logs.first().map_or(0, |(_, l)| l.gyro.len());
-    let sensors = logs.first().map_or(0, |(_, l)| l.temp.len());
-    eprintln!(
-        "gyrotherm: fitting {axes} axes on their own threads, each on {sensors} sensor(s) in turn"
-    );
-    let events = fit_event_printer(started, &logs);
-    let model =
-        imu_model::fit_imu_with_events(&logs, &cfg, &temp_sensor, &|_, _, _, _, _| {}, &events)
-            .map_err(anyhow::Error::new)
-            .context("training failed")?;
-    model
-        .save(&args.out)
-        .map_err(anyhow::Error::new)
-        .context("cannot write the model")?;
-    eprintln!(
-        "gyrotherm: wrote {} ({} model for {axes} axes) in {:.1} s",
-        args.out.display(),
-        cfg.model_method().as_str(),
-        started.elapsed().as_secs_f64()
-    );
-    for a in &model.axes {
-        // The scores are on the bias (°/s) when the axis had a static run, else on the
-        // scale factor (dimensionless): printed in the units a gyro engineer reads.
-        let on_bias = a.model.bias.is_some();
-        let scores: Vec<String> = a
-            .scores
-            .iter()
-            .map(|s| match s.cv_rms {
-                Some(r) if on_bias => format!("{} {:.4} °/h", s.temp, r * 3600.0),
-                Some(r) => format!("{} {:.2} ppm", s.temp, r * 1e6),
-                None => format!("{} -", s.temp),
-            })
-            .collect();
-        eprintln!(
-            "  {}: reads {} (bias: {}, scale factor: {}); one-sensor cross-validated RMS of the {}: {}",
-            a.gyro,
-            a.temps.join(", "),
-            if a.model.bias.is_some() {
-                "fitted"
-            } else {
-                "none"
-            },
-            if a.model.scale.is_some() {
-                "fitted"
-            } else {
-                "none"
-            },
-            if on_bias { "bias" } else { "scale factor" },
-            scores.join(", ")
-        );
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Live lines on stderr for each step of a unit fit ([`ImuFitEvent`]): the axis and sensor

@@ -4,11 +4,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::fit::{fit_model, Target};
-use gyrotherm::model::ColumnsDef;
+use gyrotherm::train::{epoch_bars, train, TrainEvent};
 
 use super::args::TrainArgs;
-use super::common::{named, read_logs};
+use super::common::{read_log_set, tell};
 use super::progress::TrainingBars;
 
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
@@ -16,48 +15,33 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         [args.out.as_path()],
         args.input.iter().map(PathBuf::as_path),
     )?;
-    if args.log.read_options().reads_unit(&args.input) {
-        return super::imu::train(args);
-    }
-    let logs = read_logs(&args.input, &args.log, &mut Vec::new())?;
-    let named = named(&logs);
+    let opts = args.log.read_options();
+    let logs = read_log_set(&args.input, &opts, args.log.table_axis.as_deref())?;
     let cfg = args.fit.fit_config(args.method)?;
-    let method = cfg.model_method();
     let temp_sensor = args.sensor.to_def()?;
     let started = std::time::Instant::now();
-    let bars = TrainingBars::new(method.is_recipe(), cfg.recipe.epochs, &[""]);
-    let outcome = fit_model(&named, &cfg, &|t: Target, e, l| bars.update("", t, e, l));
+    let epochs = epoch_bars(&logs, &cfg);
+    let bars = TrainingBars::new(epochs.is_some(), epochs.unwrap_or(0), &[""]);
+    let trained = train(&logs, &cfg, &temp_sensor, &opts, &|e| match e {
+        TrainEvent::Epoch {
+            target,
+            epoch,
+            loss,
+        } => bars.update("", target, epoch, loss),
+        TrainEvent::Step(line) => bars.println(&format!("gyrotherm: {line}")),
+        _ => {}
+    });
     bars.finish();
-    let mut outcome = outcome
+    let trained = trained
         .map_err(anyhow::Error::new)
         .context("training failed")?;
-    outcome.model.features.temp_sensor = temp_sensor;
-    // Remembered so that `compensate` reads a log of the same layout without the options.
-    outcome.model.columns = Some(ColumnsDef::of(&args.log.read_options()));
-    outcome
+    trained
         .model
         .save(&args.out)
         .map_err(anyhow::Error::new)
         .context("cannot write the model")?;
-    let m = &outcome.model;
-    eprintln!(
-        "gyrotherm: wrote {} ({} model; bias: {}, scale factor: {}) in {:.1} s",
-        args.out.display(),
-        m.method.as_str(),
-        if m.bias.is_some() {
-            "fitted"
-        } else {
-            "none (no static log)"
-        },
-        if m.scale.is_some() {
-            "fitted"
-        } else {
-            "none (no rate-table log)"
-        },
-        started.elapsed().as_secs_f64()
-    );
-    for line in outcome.describe(&named, &cfg) {
-        eprintln!("{line}");
+    for t in trained.told(&args.out, started.elapsed().as_secs_f64()) {
+        tell(&t);
     }
     Ok(ExitCode::SUCCESS)
 }

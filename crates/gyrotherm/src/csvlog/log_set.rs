@@ -1,0 +1,180 @@
+//! The logs of one job, read through one entry point ([`read_log_set`]): a single gyro's (one
+//! gyro and one temperature column, [`TestLog`]) or an inertial unit's (column lists, or an
+//! autopilot log: [`ImuLog`]). The set remembers the form it was read in, so that a job runs
+//! that form's own code; callers never ask which form they hold.
+
+use std::path::{Path, PathBuf};
+
+use super::{read_imu_logs, read_log, ImuLog, LogError, ReadOptions, ReadReport, TestLog};
+use crate::told::Told;
+
+/// The logs of one job, each with the name it is told by (its path as given).
+#[derive(Debug, Clone)]
+pub struct LogSet {
+    form: LogSetForm,
+    gap_warnings: Vec<String>,
+}
+
+/// The form a [`LogSet`] was read in: for the library's jobs, which run each form's own code.
+#[derive(Debug, Clone)]
+pub(crate) enum LogSetForm {
+    Single(Vec<(String, TestLog)>),
+    Unit(Vec<(String, ImuLog)>),
+}
+
+/// What reading one file of a set gave: the lines to tell about it, or why it cannot be used.
+#[derive(Debug)]
+pub struct FileRead {
+    pub path: PathBuf,
+    pub told: Vec<Told>,
+    pub error: Option<LogError>,
+}
+
+/// Some logs of a set could not be read (each is told by its [`FileRead`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LogSetError {
+    pub failed: usize,
+    pub of: usize,
+}
+
+impl std::fmt::Display for LogSetError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} input logs could not be read (see above)",
+            self.failed, self.of
+        )
+    }
+}
+
+impl std::error::Error for LogSetError {}
+
+/// Every file of a set as read: what to tell of each file, and the set when every file was
+/// read.
+#[derive(Debug)]
+pub struct SetRead {
+    pub files: Vec<FileRead>,
+    pub set: Result<LogSet, LogSetError>,
+}
+
+/// Read every path with the same options: as a unit's logs when the options name several
+/// gyro or temperature columns or a file's format holds a unit
+/// ([`ReadOptions::reads_unit`]), else as a single gyro's. `table_axis` names the gyro
+/// column a unit's rate table turns (None: found from the data). A unit's files are read
+/// at once, each on its own thread.
+pub fn read_log_set(paths: &[PathBuf], opts: &ReadOptions, table_axis: Option<&str>) -> SetRead {
+    let mut files = Vec::with_capacity(paths.len());
+    let mut gap_warnings = Vec::new();
+    let form = if opts.reads_unit(paths) {
+        let mut logs = Vec::new();
+        for (p, r) in paths.iter().zip(read_imu_logs(paths, opts, table_axis)) {
+            match r {
+                Ok((log, report)) => {
+                    let mut told = filled_gaps(p, &report)
+                        .map(Told::Line)
+                        .into_iter()
+                        .collect::<Vec<_>>();
+                    told.extend(report.truncation_warning(p).map(Told::Warning));
+                    if report.zero_table {
+                        told.push(Told::Line(format!(
+                            "{}: the table-rate column {} is all zeros: read as a static run",
+                            p.display(),
+                            opts.table_col
+                        )));
+                    }
+                    files.push(FileRead {
+                        path: p.clone(),
+                        told,
+                        error: None,
+                    });
+                    logs.push((p.display().to_string(), log));
+                }
+                Err(e) => files.push(FileRead {
+                    path: p.clone(),
+                    told: Vec::new(),
+                    error: Some(e),
+                }),
+            }
+        }
+        LogSetForm::Unit(logs)
+    } else {
+        let mut logs = Vec::new();
+        for p in paths {
+            match read_log(p, opts) {
+                Ok((log, report)) => {
+                    let gap = filled_gaps(p, &report);
+                    let mut told: Vec<Told> = gap.iter().cloned().map(Told::Line).collect();
+                    gap_warnings.extend(gap);
+                    told.extend(report.jitter_warning(p).map(Told::Warning));
+                    told.extend(report.truncation_warning(p).map(Told::Warning));
+                    files.push(FileRead {
+                        path: p.clone(),
+                        told,
+                        error: None,
+                    });
+                    logs.push((p.display().to_string(), log));
+                }
+                Err(e) => files.push(FileRead {
+                    path: p.clone(),
+                    told: Vec::new(),
+                    error: Some(e),
+                }),
+            }
+        }
+        LogSetForm::Single(logs)
+    };
+    let failed = files.iter().filter(|f| f.error.is_some()).count();
+    let set = if failed > 0 {
+        Err(LogSetError {
+            failed,
+            of: files.len(),
+        })
+    } else {
+        Ok(LogSet { form, gap_warnings })
+    };
+    SetRead { files, set }
+}
+
+/// The line about the samples gap filling made, if it made any.
+fn filled_gaps(path: &Path, report: &ReadReport) -> Option<String> {
+    (report.filled_gaps > 0).then(|| {
+        format!(
+            "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps-max-s)",
+            path.display(),
+            report.filled_gaps,
+            report.filled_samples
+        )
+    })
+}
+
+impl LogSet {
+    /// How many logs.
+    pub fn len(&self) -> usize {
+        match &self.form {
+            LogSetForm::Single(l) => l.len(),
+            LogSetForm::Unit(l) => l.len(),
+        }
+    }
+
+    /// Whether the set holds no log.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The names of the logs, in the order given.
+    pub fn names(&self) -> Vec<&str> {
+        match &self.form {
+            LogSetForm::Single(l) => l.iter().map(|(n, _)| n.as_str()).collect(),
+            LogSetForm::Unit(l) => l.iter().map(|(n, _)| n.as_str()).collect(),
+        }
+    }
+
+    /// The lines about gap filling, for a report that lists what reading did.
+    pub fn gap_warnings(&self) -> &[String] {
+        &self.gap_warnings
+    }
+
+    pub(crate) fn form(&self) -> &LogSetForm {
+        &self.form
+    }
+}
