@@ -94,6 +94,7 @@ pub mod imu_judge;
 pub mod imu_model;
 pub mod input_file;
 pub mod json_keys;
+pub mod judge;
 pub mod lot;
 pub mod metrics;
 pub mod model;

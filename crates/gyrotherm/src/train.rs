@@ -172,7 +172,8 @@ fn train_unit(
         "fitting {axes} axes on their own threads, each on {sensors} sensor(s) in turn"
     )));
     let started = std::time::Instant::now();
-    let steps = step_lines(started, logs, events);
+    let step = |line: String| events(TrainEvent::Step(line));
+    let steps = step_lines(started, logs, &step);
     let model = fit_imu_with_events(logs, cfg, temp_sensor, &|_, _, _, _, _| {}, &steps)
         .map_err(TrainError::Unit)?;
     let summary = format!("{} model for {axes} axes", cfg.model_method().as_str());
@@ -220,10 +221,10 @@ fn axis_lines(model: &ImuModel) -> Vec<Told> {
 /// A line for each step of a unit fit ([`ImuFitEvent`]): the axis and sensor, with the
 /// seconds since `started` (the axes run on threads, so lines of several axes interleave;
 /// each line names its axis).
-fn step_lines<'a>(
+pub(crate) fn step_lines<'a>(
     started: std::time::Instant,
     logs: &[(String, ImuLog)],
-    events: &'a (dyn Fn(TrainEvent) + Sync),
+    events: &'a (dyn Fn(String) + Sync),
 ) -> impl Fn(ImuFitEvent) + Sync + 'a {
     let gyro: Vec<String> = logs
         .first()
@@ -264,6 +265,6 @@ fn step_lines<'a>(
                 format!("[{at:6.1} s] {}: axis done, reads {}", g(axis), t(sensor))
             }
         };
-        events(TrainEvent::Step(line));
+        events(line);
     }
 }

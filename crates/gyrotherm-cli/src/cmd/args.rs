@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use gyrotherm::compare::{ColumnName, CompareConfig};
-use gyrotherm::fit::{FitConfig, NamedLog};
+use gyrotherm::fit::FitConfig;
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::fit;
 use gyrotherm::settings::{EvaluateSettings, FitSettings, Method, Rule, DEFAULT_METHOD, METHODS};
@@ -261,28 +261,6 @@ impl ColumnArgs {
             .settings(DEFAULT_METHOD)
             .compare_config(self.methods.as_deref(), tau_s)?)
     }
-}
-
-/// `--tau-s` if given, else the default for the held-out logs
-/// ([`gyrotherm::compare::default_tau_s`]), said on stderr when it is not 100 s.
-pub fn resolve_tau(tau: Option<f64>, test: &[NamedLog]) -> f64 {
-    tau_or_default(tau, || gyrotherm::compare::default_tau_s(test))
-}
-
-/// `tau`, or the library's default (`(τ, the sample period it was adjusted to)`), saying
-/// on stderr when 100 s was not a multiple of the sample period.
-pub fn tau_or_default(tau: Option<f64>, default: impl FnOnce() -> (f64, Option<f64>)) -> f64 {
-    if let Some(t) = tau {
-        return t;
-    }
-    let (t, adjusted_to) = default();
-    if let Some(period) = adjusted_to {
-        eprintln!(
-            "gyrotherm: τ = {t} s, the multiple of the {period} s sample period nearest 100 s \
-             (100 s is not one; give --tau-s to choose)"
-        );
-    }
-    t
 }
 
 #[derive(Debug, clap::Args)]

@@ -219,6 +219,34 @@ pub fn read_log_set(
     Ok(read.set?)
 }
 
+/// [`read_log_set`] for a comparison's training and held-out logs, read alike.
+pub fn read_log_sets<const N: usize>(
+    sets: [&[PathBuf]; N],
+    args: &LogArgs,
+) -> anyhow::Result<[csvlog::LogSet; N]> {
+    let reads = csvlog::read_log_sets(&sets, &args.read_options(), args.table_axis.as_deref());
+    let mut out = Vec::with_capacity(N);
+    for read in reads {
+        out.push(told_set(read)?);
+    }
+    out.try_into()
+        .map_err(|_| anyhow::anyhow!("internal: a set of logs went missing"))
+}
+
+/// Tell what reading did for each file and each failure, then stop if any failed.
+fn told_set(read: csvlog::SetRead) -> anyhow::Result<csvlog::LogSet> {
+    for f in read.files {
+        for t in &f.told {
+            tell(t);
+        }
+        if let Some(e) = f.error {
+            let e = anyhow::Error::new(e).context(format!("cannot use log {}", f.path.display()));
+            eprintln!("gyrotherm: {}", error_message(&e));
+        }
+    }
+    Ok(read.set?)
+}
+
 /// Refuse, before any work, an output path that names one of the command's inputs
 /// (`gyrotherm::atomic_file::refuse_outputs_over_inputs`): `train --out static.csv` would
 /// replace the raw log with the model.

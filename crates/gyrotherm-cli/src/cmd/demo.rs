@@ -7,13 +7,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::csvlog::{write_log, TestLog};
+use gyrotherm::csvlog::{write_log, LogSet, TestLog};
 use gyrotherm::sim::{simulate, SimConfig};
 
 use super::args::{ColumnArgs, FitArgs};
-use super::common::{builtin_profile, named};
-use super::compare::run_comparison;
-use super::print::print_table;
+use super::common::{builtin_profile, tell};
+use super::compare::Job;
 
 #[derive(Debug, clap::Args)]
 pub struct DemoArgs {
@@ -87,7 +86,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         );
         logs.push((path.display().to_string(), log));
     }
-    let named = named(&logs);
+    let test = LogSet::of_logs(logs.split_off(2));
+    let train = LogSet::of_logs(logs);
     let cfg = args
         .columns
         .compare_config(&args.fit, gyrotherm::compare::BIAS_STABILITY_TAU_S)?;
@@ -96,18 +96,16 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         "gyrotherm: fitting the {} models on the training runs ...",
         keys.join(", ")
     );
-    let mut cmp = run_comparison(&named[..2], &named[2..], &cfg)?;
-    super::compare::add_autopilot_columns(&mut cmp, &named[..2], &named[2..], &cfg)?;
-    for (fit, col) in cmp.fits.iter().zip(&cmp.columns) {
-        let path = args.dir.join(format!("model_{}.json", col.key));
-        fit.model.save(&path).map_err(anyhow::Error::new)?;
+    let job = Job { train, test, cfg };
+    let judged = job.judge(None)?;
+    for (key, model) in judged.fitted() {
+        let path = args.dir.join(format!("model_{key}.json"));
+        model.save(&path).map_err(anyhow::Error::new)?;
     }
     let mut out = std::io::stdout().lock();
-    print_table(&mut out, &cmp, &cfg)?;
-    for t in &cmp.tests {
-        for w in &t.warnings {
-            eprintln!("gyrotherm: warning: {w}");
-        }
+    judged.write_text(&mut out)?;
+    for t in judged.findings() {
+        tell(&t);
     }
     eprintln!(
         "gyrotherm: demo done in {:.1} s; logs and models are in {}",

@@ -7,12 +7,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::csvlog::{ImuLog, ReadOptions};
+use gyrotherm::csvlog::{self, ImuLog, ReadOptions};
 use gyrotherm::lot::{self, open_store, UnitInputs};
 use gyrotherm::model::GivenColumns;
 use gyrotherm::unit_model::Model;
 
-use super::common::{read_logs_with, LogArgs};
+use super::common::{error_message, read_logs_with, LogArgs};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -182,7 +182,7 @@ impl lot::HeldOutReader for HeldOut<'_> {
     }
 
     fn unit(&mut self, opts: &ReadOptions) -> anyhow::Result<Vec<(String, ImuLog)>> {
-        super::imu::read_imu_logs_with(&self.0.test, &self.0.log, opts)
+        read_imu_logs_with(&self.0.test, &self.0.log, opts)
     }
 }
 
@@ -294,4 +294,53 @@ fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
     )?;
     writeln!(w, "report: {}", page.display())?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// A unit's held-out logs read with the columns of `opts` (the unit model's).
+pub fn read_imu_logs_with(
+    paths: &[PathBuf],
+    args: &LogArgs,
+    opts: &csvlog::ReadOptions,
+) -> anyhow::Result<Vec<(String, ImuLog)>> {
+    let mut out = Vec::new();
+    let mut failed = 0;
+    // The files are read at once, each on its own thread; what each gave is told in order.
+    let read = csvlog::read_imu_logs(paths, opts, args.table_axis.as_deref());
+    for (p, r) in paths.iter().zip(read) {
+        match r.with_context(|| format!("cannot use log {}", p.display())) {
+            Ok((log, report)) => {
+                if report.filled_gaps > 0 {
+                    eprintln!(
+                        "gyrotherm: {}: filled {} gap(s) with {} interpolated sample(s) \
+                         (--fill-gaps-max-s)",
+                        p.display(),
+                        report.filled_gaps,
+                        report.filled_samples
+                    );
+                }
+                if let Some(w) = report.truncation_warning(p) {
+                    eprintln!("gyrotherm: warning: {w}");
+                }
+                if report.zero_table {
+                    eprintln!(
+                        "gyrotherm: {}: the table-rate column {} is all zeros: read as a \
+                         static run",
+                        p.display(),
+                        opts.table_col
+                    );
+                }
+                out.push((p.display().to_string(), log));
+            }
+            Err(e) => {
+                eprintln!("gyrotherm: {}", error_message(&e));
+                failed += 1;
+            }
+        }
+    }
+    anyhow::ensure!(
+        failed == 0,
+        "{failed} of {} input logs could not be read (see above)",
+        paths.len()
+    );
+    Ok(out)
 }

@@ -3,24 +3,6 @@
 
 use std::io::Write;
 
-use gyrotherm::compare::{CompareConfig, Comparison};
-
-/// The human table: the models fitted, then one block per held-out log.
-pub fn print_table(
-    w: &mut dyn Write,
-    cmp: &Comparison,
-    cfg: &CompareConfig,
-) -> std::io::Result<()> {
-    for line in cmp.headline(cfg) {
-        writeln!(w, "NOTE: {line}")?;
-    }
-    for line in cmp.model_lines() {
-        writeln!(w, "{line}")?;
-    }
-    writeln!(w)?;
-    cmp.table(cfg).write_text(w)
-}
-
 /// The figures of one column as text (the single-axis output, and each axis's block of a
 /// unit log).
 pub fn print_evaluation(

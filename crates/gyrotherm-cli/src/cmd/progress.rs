@@ -55,6 +55,14 @@ impl TrainingBars {
         }
     }
 
+    /// Run `f` (which prints on stderr) with the bars out of the way.
+    pub fn suspend(&self, f: impl FnOnce()) {
+        match self.bars.first() {
+            Some((_, _, b)) => b.suspend(f),
+            None => f(),
+        }
+    }
+
     /// Finish all bars.
     pub fn finish(&self) {
         for (_, _, b) in &self.bars {

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::Path;
 use std::process::ExitCode;
 
-use gyrotherm::spec::{ColumnVerdict, Spec, Verdict};
+use gyrotherm::spec::{Spec, Verdict};
 
 /// What `--help` says about `--spec` and the exit status.
 pub const SPEC_HELP: &str =
@@ -35,15 +35,6 @@ pub fn print(w: &mut dyn Write, v: &Verdict) -> std::io::Result<()> {
         writeln!(w, "{line}")?;
     }
     Ok(())
-}
-
-/// Each column's verdict as text; true when every column passes.
-pub fn print_columns(w: &mut dyn Write, vs: &[ColumnVerdict]) -> std::io::Result<bool> {
-    for c in vs {
-        writeln!(w, "\n{} ({}):", c.label, c.key)?;
-        print(w, &c.verdict)?;
-    }
-    Ok(vs.iter().all(|c| c.verdict.pass))
 }
 
 /// The verdict of one judged column of one log (`evaluate --spec`).

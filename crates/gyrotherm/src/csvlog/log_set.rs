@@ -63,9 +63,31 @@ pub struct SetRead {
 /// column a unit's rate table turns (None: found from the data). A unit's files are read
 /// at once, each on its own thread.
 pub fn read_log_set(paths: &[PathBuf], opts: &ReadOptions, table_axis: Option<&str>) -> SetRead {
+    read_in_form(paths, opts, table_axis, opts.reads_unit(paths))
+}
+
+/// [`read_log_set`] for the sets of one job (training and held-out logs): all in one form,
+/// a unit's when any set reads as a unit's.
+pub fn read_log_sets(
+    sets: &[&[PathBuf]],
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+) -> Vec<SetRead> {
+    let unit = opts.reads_unit(&sets.concat());
+    sets.iter()
+        .map(|paths| read_in_form(paths, opts, table_axis, unit))
+        .collect()
+}
+
+fn read_in_form(
+    paths: &[PathBuf],
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+    unit: bool,
+) -> SetRead {
     let mut files = Vec::with_capacity(paths.len());
     let mut gap_warnings = Vec::new();
-    let form = if opts.reads_unit(paths) {
+    let form = if unit {
         let mut logs = Vec::new();
         for (p, r) in paths.iter().zip(read_imu_logs(paths, opts, table_axis)) {
             match r {
@@ -148,6 +170,14 @@ fn filled_gaps(path: &Path, report: &ReadReport) -> Option<String> {
 }
 
 impl LogSet {
+    /// A single gyro's logs made in memory (simulated runs, for example), with their names.
+    pub fn of_logs(logs: Vec<(String, TestLog)>) -> LogSet {
+        LogSet {
+            form: LogSetForm::Single(logs),
+            gap_warnings: Vec::new(),
+        }
+    }
+
     /// How many logs.
     pub fn len(&self) -> usize {
         match &self.form {

@@ -40,7 +40,7 @@ pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
 pub(crate) use imu::write_imu_csv;
 pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
 pub(crate) use log_set::LogSetForm;
-pub use log_set::{read_log_set, FileRead, LogSet, LogSetError, SetRead};
+pub use log_set::{read_log_set, read_log_sets, FileRead, LogSet, LogSetError, SetRead};
 pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
