@@ -85,6 +85,7 @@ pub mod coverage_track;
 pub mod csvlog;
 mod error_chain;
 pub use error_chain::error_chain;
+pub mod evaluate;
 pub mod export;
 pub mod features;
 pub mod fit;

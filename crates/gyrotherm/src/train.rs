@@ -123,7 +123,7 @@ fn train_single(
         })
     })
     .map_err(TrainError::Single)?;
-    outcome.model.features.temp_sensor = temp_sensor.clone();
+    outcome.model.features.temp_sensor = *temp_sensor;
     outcome.model.columns = Some(ColumnsDef::of(columns));
     let m = &outcome.model;
     let summary = format!(

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseTerms, TauSet};
-use gyrotherm::csvlog::{rate_column_to_dph, TestLog};
+use gyrotherm::csvlog::rate_column_to_dph;
 use gyrotherm::report;
 use gyrotherm::settings::allan as allan_settings;
 use gyrotherm::settings::kalibr as kalibr_settings;
@@ -80,9 +80,6 @@ impl AllanArgs {
 
 /// A column read for `allan` and `evaluate`.
 pub(crate) struct ReadColumn {
-    /// The log, less the column taken (the gyro and temperature columns are moved out to
-    /// keep one copy in memory).
-    pub log: TestLog,
     /// The column's values (a mapped gyro column in °/s).
     pub values: Vec<f64>,
     /// Sample period, s.
@@ -116,7 +113,6 @@ pub(crate) fn read_column(
         );
     }
     Ok(ReadColumn {
-        log,
         values,
         tau0_s,
         log_name,

@@ -1,66 +1,47 @@
 //! `gyrotherm evaluate`: bias, bias stability and, for rate-table logs, the scale-factor
-//! figures (IEEE Std 952 / GJB 2426A definitions).
+//! figures (IEEE Std 952 / GJB 2426A definitions); for a unit's log, per axis, with a model's
+//! compensated output beside the raw one.
 
 use std::io::Write;
 use std::process::ExitCode;
 
+use gyrotherm::evaluate::{evaluate, EvaluateJob};
 use gyrotherm::settings::EvaluateSettings;
+use gyrotherm::unit_model::Model;
 
-use super::allan::{read_column, ReadColumn};
 use super::args::EvaluateArgs;
-use super::print::print_evaluation;
+use super::common::tell;
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<ExitCode> {
-    if args.model.is_some() || args.log.read_options().reads_unit(&[&args.input]) {
-        return super::imu_judge::evaluate(args);
-    }
-    let mut w = std::io::stdout().lock();
+    // The sheet and the model first: a bad one fails before the log is read.
     let spec = super::verdict::load(args.spec.as_deref())?;
-    let ReadColumn {
-        log,
-        values,
-        tau0_s,
-        log_name,
-        name,
-    } = read_column(&args.input, &args.column, &args.log)?;
+    let model = args.model.as_deref().map(Model::load).transpose()?;
     let settings = EvaluateSettings {
-        column: log_name,
+        column: args.column.clone(),
         tau_s: args.tau_s,
         settle_s: args.settle_s,
         reference_scale: args.reference_scale,
     };
-    let (mut e, tau) = settings.evaluate(&log, &values, tau0_s)?;
-    // Named as in the file (the user's --gyro-col, not the standard `gyro_dps`).
-    e.column = name;
-    if let Some(note) = tau.note(tau0_s) {
-        eprintln!("gyrotherm: {note}");
-    }
-    let verdict = match &spec {
-        Some(s) => {
-            let (rate_dps, opts, _) = settings.prepare(&values, tau0_s)?;
-            Some(super::verdict::judge_log(
-                s,
-                &log,
-                &rate_dps,
-                &opts,
-                &args.input,
-            )?)
-        }
-        None => None,
-    };
-    let code = super::verdict::exit_code(verdict.as_ref().is_none_or(|v| v.pass));
+    let read = args.log.read_options();
+    let evaluated = evaluate(&EvaluateJob {
+        input: &args.input,
+        read: &read,
+        table_axis: args.log.table_axis.as_deref(),
+        model: model.as_ref(),
+        settings: &settings,
+        spec: spec.as_ref(),
+    });
+    let evaluated = evaluated?;
+    evaluated.told.iter().for_each(tell);
+    let mut w = std::io::stdout().lock();
     if args.json {
-        let mut j = serde_json::to_value(&e)?;
-        if let (Some(v), Some(o)) = (&verdict, j.as_object_mut()) {
-            o.insert("verdict".into(), serde_json::to_value(v)?);
-        }
-        writeln!(w, "{}", serde_json::to_string_pretty(&j)?)?;
-        return Ok(code);
+        writeln!(
+            w,
+            "{}",
+            serde_json::to_string_pretty(&evaluated.to_json()?)?
+        )?;
+    } else {
+        evaluated.write_text(&mut w)?;
     }
-    print_evaluation(&mut w, &e)?;
-    if let Some(v) = &verdict {
-        writeln!(w)?;
-        super::verdict::print(&mut w, v)?;
-    }
-    Ok(code)
+    Ok(super::verdict::exit_code(evaluated.pass()))
 }

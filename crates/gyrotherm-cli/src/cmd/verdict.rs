@@ -36,21 +36,3 @@ pub fn print(w: &mut dyn Write, v: &Verdict) -> std::io::Result<()> {
     }
     Ok(())
 }
-
-/// The verdict of one judged column of one log (`evaluate --spec`).
-pub fn judge_log(
-    spec: &Spec,
-    log: &gyrotherm::TestLog,
-    rate_dps: &[f64],
-    opts: &gyrotherm::metrics::EvaluationOptions,
-    input: &Path,
-) -> anyhow::Result<Verdict> {
-    let mopts = gyrotherm::spec::MeasureOptions {
-        evaluation: *opts,
-        noise_terms: spec.needs_noise_terms(),
-    };
-    let name = input.display().to_string();
-    let f = gyrotherm::spec::measure(log, rate_dps, &mopts)
-        .map_err(|e| anyhow::Error::from(e).context(name.clone()))?;
-    Ok(gyrotherm::spec::judge(spec, &[(name, f)])?)
-}
