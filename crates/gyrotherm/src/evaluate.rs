@@ -256,7 +256,7 @@ impl Evaluated {
                 write_figures(w, figures)?;
                 if let Some(v) = verdict {
                     writeln!(w)?;
-                    crate::judge::write_verdict(w, v)?;
+                    write_verdict(w, v)?;
                 }
             }
             Form::Unit(unit) => write_unit(w, unit)?,
@@ -293,12 +293,19 @@ fn write_unit(w: &mut dyn Write, unit: &UnitEvaluation) -> std::io::Result<()> {
         if let Some(v) = &a.verdict {
             writeln!(w)?;
             writeln!(w, "axis {} ({}) against the spec:", k + 1, a.gyro)?;
-            crate::judge::write_verdict(w, v)?;
+            write_verdict(w, v)?;
         }
     }
     if let Some(v) = &unit.verdict {
         writeln!(w)?;
         writeln!(w, "{}", v.line(axes.len()))?;
+    }
+    Ok(())
+}
+
+fn write_verdict(w: &mut dyn Write, v: &Verdict) -> std::io::Result<()> {
+    for line in v.lines() {
+        writeln!(w, "{line}")?;
     }
     Ok(())
 }

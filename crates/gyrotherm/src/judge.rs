@@ -445,7 +445,7 @@ fn write_comparison(
 }
 
 /// A verdict as text, one line per figure and log, then the overall line.
-pub(crate) fn write_verdict(w: &mut dyn Write, v: &crate::spec::Verdict) -> std::io::Result<()> {
+fn write_verdict(w: &mut dyn Write, v: &crate::spec::Verdict) -> std::io::Result<()> {
     for line in v.lines() {
         writeln!(w, "{line}")?;
     }

@@ -21,11 +21,14 @@
 //! - [`input_file`]: reading the small input files (models, spec sheets, profiles).
 //! - [`json_keys`]: a JSON object that names a key twice.
 //! - `string_table`: a table of strings, as results are printed.
+//! - [`told`]: a line a job tells the user (what it read, did or warns of).
 //! - [`moving_average`]: the one centred moving average on a time axis.
 //! - [`table_segments`]: the one segmentation of a rate-table log by commanded rate.
 //! - [`allan`]: Allan-family deviations of rate data, with confidence intervals.
 //! - [`nn`]: the LSTM network on the ground: parameters, training, evaluation.
-//! - [`csvlog`]: the test-log CSV format (read, validate, write): [`read_log`] → [`TestLog`].
+//! - [`csvlog`]: the test logs (CSV, ULog, DataFlash; read, validate, write): [`read_log`] →
+//!   [`TestLog`], and a job's logs of a single gyro or a unit through one entry point
+//!   ([`csvlog::read_log_set`] → [`csvlog::LogSet`]).
 //! - [`sim`]: the thermal-chamber + FOG simulator, a source of logs ([`simulate`]).
 //! - [`features`]: the model inputs of a log (temperature, its rate, thermal lags)
 //!   ([`FeatureSpec`], [`FeatureTable`]).
@@ -57,6 +60,12 @@
 //! - [`export`]: a model as flight code (C, Rust) or autopilot parameters.
 //! - [`unit_model`]: the model of a unit of N axes, read from either file form through one
 //!   entry point ([`unit_model::Model::load`]).
+//! - [`train`]: a model trained on a job's logs, for a single gyro or a unit
+//!   ([`train::train`]).
+//! - [`judge`]: the held-out judgement of `compare` and `report`, for a single gyro or each
+//!   axis of a unit ([`judge::judge`]).
+//! - [`evaluate`](mod@evaluate): the figures of one log, raw and compensated, with a spec's
+//!   verdict ([`evaluate::evaluate`]).
 //! - [`lot`]: the test station's record of units judged against their spec sheet.
 //!
 //! ```no_run
