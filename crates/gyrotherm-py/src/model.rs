@@ -412,7 +412,7 @@ pub struct FitArgs {
     method: String,
     epochs: Option<usize>,
     seed: u64,
-    hidden: usize,
+    hidden: Option<usize>,
     bias_window_s: f64,
     settle_s: f64,
     poly_temp_degree: u8,

@@ -117,11 +117,10 @@ impl FitSettings {
             r.epochs = e;
         }
         r.validate_on_runs = self.validate_on_runs;
-        // A method whose own size is larger keeps it unless another size is asked for.
-        if r.hidden == crate::settings::fit::DEFAULT_HIDDEN
-            || self.hidden != crate::settings::fit::DEFAULT_HIDDEN
-        {
-            r.hidden = self.hidden;
+        // Each method keeps its own size (8 as published, 32 for `thermal-lstm`) unless
+        // a size is asked for.
+        if let Some(h) = self.hidden {
+            r.hidden = h;
         }
         r
     }
@@ -713,5 +712,34 @@ pub fn fit_target(
         TargetFit::LeastSquares | TargetFit::None => Err(FitError::NotARecipe {
             method: recipe.kind,
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::settings::fit::{FitSettings, DEFAULT_HIDDEN, THERMAL_LSTM_HIDDEN};
+    use crate::settings::Method;
+
+    /// Each method keeps its own LSTM size (the published 8, `thermal-lstm`'s 32) unless a
+    /// size is asked for; then that size, even the published one (a `--hidden 8` once left
+    /// `thermal-lstm` at 32).
+    #[test]
+    fn a_given_hidden_size_overrides_each_method_s_own() {
+        let size = |method, hidden| {
+            FitSettings {
+                method,
+                hidden,
+                ..FitSettings::default()
+            }
+            .fit_config()
+            .unwrap()
+            .recipe
+            .hidden
+        };
+        assert_eq!(size(Method::Published, None), DEFAULT_HIDDEN);
+        assert_eq!(size(Method::ThermalLstm, None), THERMAL_LSTM_HIDDEN);
+        assert_eq!(size(Method::ThermalLstm, Some(8)), 8);
+        assert_eq!(size(Method::ThermalLstm, Some(64)), 64);
+        assert_eq!(size(Method::Published, Some(16)), 16);
     }
 }

@@ -90,7 +90,7 @@ pub(crate) fn fit_options() -> Vec<OptionSpec> {
         choice("method", d.method.as_str(), &METHOD_NAMES),
         opt("epochs", d.epochs.map(|e| e.to_string())),
         opt("seed", Some(d.seed.to_string())),
-        opt("hidden", Some(d.hidden.to_string())),
+        opt("hidden", d.hidden.map(|h| h.to_string())),
         opt("bias_window_s", Some(d.bias_window_s.to_string())),
         opt("settle_s", Some(d.settle_s.to_string())),
         opt("poly_temp_degree", Some(d.poly_temp_degree.to_string())),

@@ -24,8 +24,7 @@ pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 /// Default hidden units of the LSTM recipes: 8, as published (He et al. 2024, §2).
 pub const DEFAULT_HIDDEN: usize = 8;
 /// Hidden units of `thermal-lstm`'s LSTM: 32, chosen against 16 on the design family
-/// (docs/experiments/lstm-capacity.md). `hidden` overrides it only when set to another size
-/// than [`DEFAULT_HIDDEN`].
+/// (docs/experiments/lstm-capacity.md). A `hidden` setting, when given, overrides it.
 pub const THERMAL_LSTM_HIDDEN: usize = 32;
 
 /// Default least relative drop of an inertial-unit axis's cross-validated RMS for a further
@@ -156,11 +155,12 @@ pub struct FitSettings {
     pub epochs: Option<usize>,
     /// Random seed of the LSTM initialisation and window order.
     pub seed: u64,
-    /// Hidden units of the method's LSTM ([`DEFAULT_HIDDEN`]). The trainer takes other
-    /// sizes, but a model file must run in flight, whose network is built for the sizes of
+    /// Hidden units of the method's LSTM (None: the method's own, [`DEFAULT_HIDDEN`] as
+    /// published, [`THERMAL_LSTM_HIDDEN`] for `thermal-lstm`). The trainer takes other sizes,
+    /// but a model file must run in flight, whose network is built for the sizes of
     /// [`gyrotherm_core::compensator::HIDDEN_SIZES`]: [`FitSettings::validate`] accepts
     /// those only.
-    pub hidden: usize,
+    pub hidden: Option<usize>,
     /// Bias target smoothing window, s (centred moving average).
     pub bias_window_s: f64,
     /// Time dropped at the start of each rate-table segment, s.
@@ -182,7 +182,7 @@ impl Default for FitSettings {
             method: DEFAULT_METHOD,
             epochs: None,
             seed: DEFAULT_SEED,
-            hidden: DEFAULT_HIDDEN,
+            hidden: None,
             bias_window_s: DEFAULT_BIAS_WINDOW_S,
             settle_s: DEFAULT_SETTLE_S,
             poly_temp_degree: DEFAULT_POLY_TEMP_DEGREE,
@@ -203,7 +203,9 @@ impl FitSettings {
                 rule: Rule::Epochs,
             });
         }
-        check("hidden", self.hidden as f64, Rule::HiddenUnits)?;
+        if let Some(h) = self.hidden {
+            check("hidden", h as f64, Rule::HiddenUnits)?;
+        }
         check("bias_window_s", self.bias_window_s, Rule::PositiveSeconds)?;
         check("settle_s", self.settle_s, Rule::NonNegativeSeconds)?;
         // `lstm`, which older model files record, is no method a fit can use.
