@@ -16,6 +16,7 @@ use pyo3::prelude::*;
 mod allan;
 mod export;
 mod figures;
+mod judge;
 mod logs;
 mod lot;
 mod model;
@@ -118,6 +119,7 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("NO_COVERAGE", model::NO_COVERAGE)?;
     allan::register(m)?;
     figures::register(m)?;
+    judge::register(m)?;
     logs::register(m)?;
     lot::register(m)?;
     model::register(m)?;

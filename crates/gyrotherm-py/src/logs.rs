@@ -8,12 +8,11 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::{py_err, LogError, MetricsError};
+use crate::{py_err, LogError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
     m.add_function(wrap_pyfunction!(reads_unit, m)?)?;
-    m.add_function(wrap_pyfunction!(evaluate_log, m)?)?;
     Ok(())
 }
 
@@ -144,72 +143,4 @@ fn read_log<'py>(
     rep.set_item("sample_period_estimated", report.sample_period_estimated)?;
     rep.set_item("path", path.display().to_string())?;
     Ok((cols, rep))
-}
-
-/// One column of a single-axis log judged as `gyrotherm evaluate --input LOG [--column C]
-/// [--spec SPEC] --json` judges it: the JSON text it prints (the column named as in the file)
-/// and the note on τ when it is not the one asked for.
-#[pyfunction]
-#[pyo3(signature = (path, options, column, spec=None, tau_s=None, settle_s=None, reference_scale=None))]
-#[allow(clippy::too_many_arguments)]
-fn evaluate_log(
-    py: Python<'_>,
-    path: PathBuf,
-    options: LogOptions,
-    column: String,
-    spec: Option<PathBuf>,
-    tau_s: Option<f64>,
-    settle_s: Option<f64>,
-    reference_scale: Option<f64>,
-) -> PyResult<(String, Option<String>)> {
-    let spec = spec
-        .map(|p| gyrotherm::spec::Spec::load(&p))
-        .transpose()
-        .map_err(py_err::<MetricsError>)?;
-    let opts = options.read_options()?;
-    py.detach(|| {
-        let name = path.display().to_string();
-        let metrics = |e: &(dyn std::error::Error + 'static)| {
-            MetricsError::new_err(format!("{name}: {}", gyrotherm::error_chain(e)))
-        };
-        let (mut log, _) = read(&path, &opts)
-            .map_err(|e| LogError::new_err(format!("cannot use log {name}: {e}")))?;
-        let log_name = opts.log_column(&column).to_owned();
-        let values = log.take_column(&log_name).map_err(|e| metrics(&e))?;
-        let tau0_s = log.sample_period_s();
-        if !(tau0_s.is_finite() && tau0_s > 0.0) {
-            return Err(MetricsError::new_err(format!(
-                "{name}: cannot tell the sample period (need at least two samples with \
-                 increasing time_s)"
-            )));
-        }
-        let settings = gyrotherm::settings::EvaluateSettings {
-            column: log_name.clone(),
-            tau_s,
-            settle_s: settle_s.unwrap_or(gyrotherm::settings::EvaluateSettings::default().settle_s),
-            reference_scale,
-        };
-        let (mut e, tau) = settings
-            .evaluate(&log, &values, tau0_s)
-            .map_err(|e| metrics(&e))?;
-        e.column = opts.file_column(&log_name).to_owned();
-        let mut j = serde_json::to_value(&e).map_err(|e| metrics(&e))?;
-        if let Some(s) = &spec {
-            let (rate_dps, eopts, _) =
-                settings.prepare(&values, tau0_s).map_err(|e| metrics(&e))?;
-            let mopts = gyrotherm::spec::MeasureOptions {
-                evaluation: eopts,
-                noise_terms: s.needs_noise_terms(),
-            };
-            let f = gyrotherm::spec::measure(&log, &rate_dps, &mopts).map_err(|e| metrics(&e))?;
-            let v = gyrotherm::spec::judge(s, &[(name.clone(), f)]).map_err(|e| metrics(&e))?;
-            if let Some(o) = j.as_object_mut() {
-                o.insert(
-                    "verdict".into(),
-                    serde_json::to_value(&v).map_err(|e| metrics(&e))?,
-                );
-            }
-        }
-        Ok((j.to_string(), tau.note(tau0_s)))
-    })
 }

@@ -16,15 +16,13 @@ use pyo3::types::{PyDict, PyList};
 use crate::allan::slice;
 use crate::logs::LogOptions;
 use crate::model::{FitArgs, RawModel};
-use crate::{py_err, CompensationError, FitError, LogError, MetricsError, ModelError};
+use crate::{py_err, CompensationError, FitError, LogError, ModelError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RawUnitModel>()?;
     m.add_function(wrap_pyfunction!(read_imu_log, m)?)?;
     m.add_function(wrap_pyfunction!(fit_unit, m)?)?;
     m.add_function(wrap_pyfunction!(load_model, m)?)?;
-    m.add_function(wrap_pyfunction!(evaluate_unit, m)?)?;
-    m.add_function(wrap_pyfunction!(compare_unit, m)?)?;
     Ok(())
 }
 
@@ -138,6 +136,11 @@ impl RawUnitModel {
             file,
             load_warnings,
         }
+    }
+
+    /// The unit's model file.
+    pub(crate) fn file(&self) -> &ImuModel {
+        &self.file
     }
 }
 
@@ -417,149 +420,5 @@ fn fit_unit(
     Ok(RawUnitModel {
         file,
         load_warnings: Vec::new(),
-    })
-}
-
-/// The figures of each axis of a unit log, as `gyrotherm evaluate --json` prints them with
-/// `--gyro-col`/`--temp-col` lists (or `--model`, whose columns are read), with `spec` each
-/// axis's verdict and the unit's (`gyrotherm::imu_judge::evaluate_imu_spec`). Returns the
-/// JSON text and the note on τ when it is not the one asked for.
-#[pyfunction]
-#[pyo3(signature = (path, options, model=None, spec=None, tau_s=None, settle_s=None, reference_scale=None))]
-#[allow(clippy::too_many_arguments)]
-fn evaluate_unit(
-    py: Python<'_>,
-    path: PathBuf,
-    options: LogOptions,
-    model: Option<PyRef<'_, RawUnitModel>>,
-    spec: Option<PathBuf>,
-    tau_s: Option<f64>,
-    settle_s: Option<f64>,
-    reference_scale: Option<f64>,
-) -> PyResult<(String, Option<String>)> {
-    let model = model.map(|m| m.file.clone());
-    let spec = spec
-        .map(|p| gyrotherm::spec::Spec::load(&p))
-        .transpose()
-        .map_err(py_err::<MetricsError>)?;
-    let base = options.read_options()?;
-    let opts = match &model {
-        Some(m) => m.read_options(&base),
-        None => base,
-    };
-    let settings = gyrotherm::settings::EvaluateSettings {
-        tau_s,
-        settle_s: settle_s.unwrap_or(gyrotherm::settings::EvaluateSettings::default().settle_s),
-        reference_scale,
-        ..Default::default()
-    };
-    py.detach(|| {
-        let (log, _) =
-            csvlog::read_imu_log(&path, &opts, options.table_axis.as_deref()).map_err(|e| {
-                LogError::new_err(format!(
-                    "cannot use log {}: {}",
-                    path.display(),
-                    gyrotherm::error_chain(&e)
-                ))
-            })?;
-        let name = path.display().to_string();
-        let e = gyrotherm::imu_judge::evaluate_imu_spec(
-            &log,
-            model.as_ref(),
-            &settings,
-            spec.as_ref(),
-            &name,
-        )
-        .map_err(|e| MetricsError::new_err(format!("{name}: {}", gyrotherm::error_chain(&e))))?;
-        let note = e.tau.note(e.axes[0].raw.sample_period_s);
-        Ok((e.to_json().to_string(), note))
-    })
-}
-
-/// Every method compared per axis on unit logs, as `gyrotherm compare --json` with
-/// `--gyro-col`/`--temp-col` lists prints it (`gyrotherm::imu_judge::compare_imu`): per axis
-/// the one-sensor methods on the sensor the one-sensor choice picks and, with several
-/// sensors, the unit's own fit on every sensor it keeps. `methods`: names as in
-/// `compare --methods` (None: the library's default list). Returns the JSON text and the
-/// notes (on τ when it is not the one asked for).
-#[pyfunction]
-#[pyo3(signature = (train, test, settings, options, methods=None, tau_s=None, spec=None))]
-#[allow(clippy::too_many_arguments)]
-fn compare_unit(
-    py: Python<'_>,
-    train: Vec<PathBuf>,
-    test: Vec<PathBuf>,
-    settings: FitArgs,
-    options: LogOptions,
-    methods: Option<Vec<String>>,
-    tau_s: Option<f64>,
-    spec: Option<PathBuf>,
-) -> PyResult<(String, Vec<String>)> {
-    let spec = spec
-        .map(|p| gyrotherm::spec::Spec::load(&p))
-        .transpose()
-        .map_err(py_err::<MetricsError>)?;
-    // A unit's comparison has method columns only (the autopilot columns are single-gyro).
-    let methods: Option<Vec<gyrotherm::compare::ColumnName>> = methods
-        .map(|m| {
-            m.iter()
-                .map(|n| crate::model::parse_method(n).map(gyrotherm::compare::ColumnName::Method))
-                .collect::<PyResult<_>>()
-        })
-        .transpose()?;
-    let fit = settings.settings()?;
-    py.detach(|| {
-        let read_all = |paths: &[PathBuf]| -> PyResult<Vec<(String, ImuLog)>> {
-            paths
-                .iter()
-                .map(|p| read(p, &options).map(|(l, _)| (p.display().to_string(), l)))
-                .collect()
-        };
-        let (train, test) = (read_all(&train)?, read_all(&test)?);
-        let mut notes = Vec::new();
-        let tau_s = match tau_s {
-            Some(t) => t,
-            None => {
-                let (t, adjusted) = gyrotherm::imu_judge::default_tau_s(&test);
-                if let Some(p) = adjusted {
-                    notes.push(format!(
-                        "τ = {t} s, the multiple of the {p} s sample period nearest 100 s \
-                         (100 s is not one; give tau_s to choose)"
-                    ));
-                }
-                t
-            }
-        };
-        let cfg = fit
-            .compare_config(methods.as_deref(), tau_s)
-            .map_err(py_err::<FitError>)?;
-        let cmp = gyrotherm::imu_judge::compare_imu(
-            &train,
-            &test,
-            &cfg,
-            &TempSensorDef::default(),
-            &|_, _, _, _, _| {},
-            &|_| {},
-        )
-        .map_err(|e| {
-            FitError::new_err(format!("comparison failed: {}", gyrotherm::error_chain(&e)))
-        })?;
-        let verdicts = spec
-            .as_ref()
-            .map(|s| {
-                gyrotherm::imu_judge::judge_unit_comparison(s, &cmp, &cfg).map_err(|e| {
-                    MetricsError::new_err(format!(
-                        "spec {}: {}",
-                        s.name,
-                        gyrotherm::error_chain(&e)
-                    ))
-                })
-            })
-            .transpose()?;
-        let j = cmp
-            .summary_json(&cfg, verdicts.as_deref())
-            .and_then(|j| serde_json::to_string(&j))
-            .map_err(|e| FitError::new_err(e.to_string()))?;
-        Ok((j, notes))
     })
 }

@@ -1,6 +1,7 @@
 """An inertial unit judged per axis from Python: ``evaluate`` (figures and spec verdicts per
 axis, the unit's verdict) and ``compare`` (the methods per axis, with the unit's own
-multi-sensor fit), against the CLI's JSON on the same logs and against figures computed
+multi-sensor fit; and a single gyro's table through the same entry), against the CLI's JSON
+on the same logs and against figures computed
 another way (each axis's column through ``bias_stability``)."""
 
 import json
@@ -104,8 +105,22 @@ def test_compare_per_axis_is_the_cli_json(cli, unit_logs):  # noqa: F811
         assert a["temp"] == u["temps"][0]
         assert f"({len(u['temps'])} sensor" in u["label"]
         assert "lstm" not in u["label"].lower()
-    with pytest.raises(gt.FitError, match="gyro_col and temp_col lists"):
+    # A unit's log read with one column each names a column the log lacks: a LogError.
+    with pytest.raises(gt.LogError, match="gyro_dps"):
         gt.compare(train=unit_logs["static"], test=unit_logs["heldout"])
+
+
+def test_compare_of_a_single_gyro_is_the_cli_json(cli, logs):
+    # One entry for both: a single gyro's logs give `gyrotherm compare --json`'s table.
+    got = gt.compare(
+        train=[logs["static"], logs["table"]], test=logs["heldout"], methods=["linear", "poly"],
+    )
+    want = json.loads(
+        cli("compare", "--json", "--methods", "linear,poly", "--train", logs["static"],
+            "--train", logs["table"], "--test", logs["heldout"]).stdout
+    )
+    assert got == want
+    assert "axes" not in got
 
 
 def test_compare_spec_is_the_cli_json_and_fails_a_column(cli, unit_logs, tmp_path):  # noqa: F811

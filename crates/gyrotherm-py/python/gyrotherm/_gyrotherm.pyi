@@ -57,25 +57,17 @@ def fit_unit(
     progress: Optional[Any] = None,
 ) -> RawUnitModel: ...
 
-def evaluate_log(
+def evaluate(
     path: str,
     options: Dict[str, Any],
     column: str,
-    spec: Optional[str] = None,
-    tau_s: Optional[float] = None,
-    settle_s: Optional[float] = None,
-    reference_scale: Optional[float] = None,
-) -> Tuple[str, Optional[str]]: ...
-def evaluate_unit(
-    path: str,
-    options: Dict[str, Any],
     model: Optional[RawUnitModel] = None,
     spec: Optional[str] = None,
     tau_s: Optional[float] = None,
     settle_s: Optional[float] = None,
     reference_scale: Optional[float] = None,
-) -> Tuple[str, Optional[str]]: ...
-def compare_unit(
+) -> Tuple[str, List[str]]: ...
+def compare(
     train: List[str],
     test: List[str],
     settings: Dict[str, Any],

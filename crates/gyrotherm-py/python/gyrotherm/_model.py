@@ -471,30 +471,17 @@ def evaluate(
     options = read_options(log_options)
     import json
 
-    if raw_model is None and not is_unit(options, [log]):
-        text, note = _g.evaluate_log(
-            os.fspath(log),
-            options,
-            str(column),
-            None if spec is None else os.fspath(spec),
-            None if tau_s is None else float(tau_s),
-            float(settle_s),
-            None if reference_scale is None else float(reference_scale),
-        )
-        if note is not None:
-            _warn([note])
-        return json.loads(text)
-    text, note = _g.evaluate_unit(
+    text, notes = _g.evaluate(
         os.fspath(log),
         options,
+        str(column),
         raw_model,
         None if spec is None else os.fspath(spec),
         None if tau_s is None else float(tau_s),
         float(settle_s),
         None if reference_scale is None else float(reference_scale),
     )
-    if note is not None:
-        _warn([note])
+    _warn(notes)
     import json
 
     return json.loads(text)
@@ -538,12 +525,15 @@ def compare(
     validate_on_runs: bool = _FIT["validate_on_runs"],
     **log_options: Any,
 ) -> Dict[str, Any]:
-    """Every method compared per axis on an inertial unit's logs, as ``gyrotherm compare
-    --json --gyro-col … --temp-col …`` prints it (``gyro_col``/``temp_col`` lists required).
+    """Every method fitted on the training logs and judged on the held-out ones, as
+    ``gyrotherm compare --json`` prints it, for a single gyro or each axis of a unit.
 
     ``train``: training logs (static and rate-table, in any order); ``test``: held-out logs.
     ``methods``: names as ``compare --methods`` (default: the library's list); the fit
-    keywords as :func:`fit`. Returns ``{"axes": [...], "across_axes": {...}}``: per axis
+    keywords as :func:`fit`. A single gyro (one ``gyro_col`` and ``temp_col``): the
+    comparison summary (``models``, ``tests`` with each column's figures per held-out log),
+    with ``spec`` also ``verdicts`` per column. An inertial unit (``gyro_col``/``temp_col``
+    lists, or an autopilot log): ``{"axes": [...], "across_axes": {...}}``: per axis
     ``gyro``, ``temp`` (the sensor the one-sensor methods read: the one whose one-sensor fit
     cross-validates best), ``comparison`` (the single-axis summary) and, with several
     sensors, ``unit_fit``: the unit's own fit of the axis as :func:`fit` builds it, on every
@@ -553,11 +543,6 @@ def compare(
     missed limit is ``verdict["pass"] == False``, not an exception. The GIL is released.
     """
     options = read_options(log_options)
-    if not is_unit(options):
-        raise _g.FitError(
-            "compare here is per axis: give gyro_col and temp_col lists (for one gyro and one "
-            "sensor use `gyrotherm compare`)"
-        )
     train_paths, test_paths = _paths(train, "train"), _paths(test, "test")
     if not train_paths or not test_paths:
         raise _g.FitError("give training logs (train=[...]) and held-out logs (test=[...])")
@@ -565,7 +550,7 @@ def compare(
         method, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
         poly_rate_degree, cross, validate_on_runs,
     )
-    text, notes = _g.compare_unit(
+    text, notes = _g.compare(
         train_paths,
         test_paths,
         settings,
