@@ -279,6 +279,20 @@ impl Model {
         }
     }
 
+    /// Read a unit's held-out logs in this model's form, with `opts` (from
+    /// [`Model::read_options`]): a unit model's as a unit's, a single-gyro model's as a single
+    /// gyro's unless the options name column lists or a file holds a unit (which
+    /// [`crate::lot::judge_model`] then refuses with what to do).
+    pub fn read_logs(
+        &self,
+        paths: &[PathBuf],
+        opts: &ReadOptions,
+        table_axis: Option<&str>,
+    ) -> crate::csvlog::SetRead {
+        let unit = self.is_unit() || opts.reads_unit(paths);
+        crate::csvlog::read_in_form(paths, opts, table_axis, unit)
+    }
+
     /// What to tell before compensating with the model read from `path`: a single-gyro
     /// model's missing coverage map, and a sample period given that compensation does not need.
     pub fn compensate_notes(&self, path: &Path, sample_period_given: bool) -> Vec<Told> {

@@ -234,7 +234,7 @@ pub fn read_log_sets<const N: usize>(
 }
 
 /// Tell what reading did for each file and each failure, then stop if any failed.
-fn told_set(read: csvlog::SetRead) -> anyhow::Result<csvlog::LogSet> {
+pub fn told_set(read: csvlog::SetRead) -> anyhow::Result<csvlog::LogSet> {
     for f in read.files {
         for t in &f.told {
             tell(t);

@@ -7,12 +7,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::csvlog::{self, ImuLog, ReadOptions};
 use gyrotherm::lot::{self, open_store, UnitInputs};
 use gyrotherm::model::GivenColumns;
 use gyrotherm::unit_model::Model;
 
-use super::common::{error_message, read_logs_with, LogArgs};
+use super::common::{told_set, LogArgs};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -128,7 +127,9 @@ fn add(a: AddArgs, given: GivenColumns) -> anyhow::Result<ExitCode> {
         settle_s: a.settle_s,
     };
     // Judge first, then open the store: a unit that cannot be judged leaves the lot as it was.
-    let (run, verdict) = lot::judge_model(&model, &inputs, &opts, &mut HeldOut(&a))?;
+    let logs = told_set(model.read_logs(&a.test, &opts, a.log.table_axis.as_deref()))?;
+    let (run, verdict) = lot::judge_model(&model, &inputs, &logs)
+        .map_err(|e| anyhow::Error::new(e).context(format!("unit {}", a.unit)))?;
     record(&a, run, |w| {
         let Some(v) = &verdict else {
             return Ok(());
@@ -150,40 +151,6 @@ fn add(a: AddArgs, given: GivenColumns) -> anyhow::Result<ExitCode> {
         }
         Ok(())
     })
-}
-
-/// `lot add`'s held-out logs, read as the command line says.
-struct HeldOut<'a>(&'a AddArgs);
-
-impl lot::HeldOutReader for HeldOut<'_> {
-    type Error = anyhow::Error;
-
-    fn not_judged(&self, e: lot::LotError) -> anyhow::Error {
-        anyhow::Error::new(e).context(format!("unit {}", self.0.unit))
-    }
-
-    fn single(&mut self, opts: &ReadOptions) -> anyhow::Result<Vec<(PathBuf, gyrotherm::TestLog)>> {
-        let a = self.0;
-        anyhow::ensure!(
-            !a.log.read_options().reads_unit(&a.test),
-            "{}: a single-axis model; --gyro-col/--temp-col lists need an inertial unit's model \
-             (`gyrotherm train` with the same lists), whose columns lot add then reads",
-            a.model.display()
-        );
-        let mut warnings = Vec::new();
-        let logs = read_logs_with(&a.test, opts, &mut warnings)?;
-        for w in &warnings {
-            eprintln!("gyrotherm: warning: {w}");
-        }
-        Ok(logs
-            .into_iter()
-            .map(|(name, log)| (PathBuf::from(name), log))
-            .collect())
-    }
-
-    fn unit(&mut self, opts: &ReadOptions) -> anyhow::Result<Vec<(String, ImuLog)>> {
-        read_imu_logs_with(&self.0.test, &self.0.log, opts)
-    }
 }
 
 /// The judged run into the lot (judged first: a unit that cannot be judged leaves the lot as
@@ -294,53 +261,4 @@ fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
     )?;
     writeln!(w, "report: {}", page.display())?;
     Ok(ExitCode::SUCCESS)
-}
-
-/// A unit's held-out logs read with the columns of `opts` (the unit model's).
-pub fn read_imu_logs_with(
-    paths: &[PathBuf],
-    args: &LogArgs,
-    opts: &csvlog::ReadOptions,
-) -> anyhow::Result<Vec<(String, ImuLog)>> {
-    let mut out = Vec::new();
-    let mut failed = 0;
-    // The files are read at once, each on its own thread; what each gave is told in order.
-    let read = csvlog::read_imu_logs(paths, opts, args.table_axis.as_deref());
-    for (p, r) in paths.iter().zip(read) {
-        match r.with_context(|| format!("cannot use log {}", p.display())) {
-            Ok((log, report)) => {
-                if report.filled_gaps > 0 {
-                    eprintln!(
-                        "gyrotherm: {}: filled {} gap(s) with {} interpolated sample(s) \
-                         (--fill-gaps-max-s)",
-                        p.display(),
-                        report.filled_gaps,
-                        report.filled_samples
-                    );
-                }
-                if let Some(w) = report.truncation_warning(p) {
-                    eprintln!("gyrotherm: warning: {w}");
-                }
-                if report.zero_table {
-                    eprintln!(
-                        "gyrotherm: {}: the table-rate column {} is all zeros: read as a \
-                         static run",
-                        p.display(),
-                        opts.table_col
-                    );
-                }
-                out.push((p.display().to_string(), log));
-            }
-            Err(e) => {
-                eprintln!("gyrotherm: {}", error_message(&e));
-                failed += 1;
-            }
-        }
-    }
-    anyhow::ensure!(
-        failed == 0,
-        "{failed} of {} input logs could not be read (see above)",
-        paths.len()
-    );
-    Ok(out)
 }

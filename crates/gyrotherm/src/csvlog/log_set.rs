@@ -79,7 +79,7 @@ pub fn read_log_sets(
         .collect()
 }
 
-fn read_in_form(
+pub(crate) fn read_in_form(
     paths: &[PathBuf],
     opts: &ReadOptions,
     table_axis: Option<&str>,

@@ -39,7 +39,7 @@ pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
 pub(crate) use imu::write_imu_csv;
 pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
-pub(crate) use log_set::LogSetForm;
+pub(crate) use log_set::{read_in_form, LogSetForm};
 pub use log_set::{read_log_set, read_log_sets, FileRead, LogSet, LogSetError, SetRead};
 pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{

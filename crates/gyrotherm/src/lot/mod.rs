@@ -29,7 +29,7 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::compensate::compensate_log;
-use crate::csvlog::{ImuLog, ReadOptions, TestLog};
+use crate::csvlog::{ImuLog, LogSet, LogSetForm, TestLog};
 use crate::fit::NamedLog;
 use crate::imu_judge::{ImuJudgeError, UnitVerdict};
 use crate::imu_model::ImuModel;
@@ -525,12 +525,12 @@ pub fn open_store(
 /// What [`judge_unit`] needs besides the logs; for an inertial unit (several gyro axes,
 /// [`judge_imu_unit`]) the same with its logs (`ImuUnitInputs`).
 #[derive(Debug, Clone)]
-pub struct UnitInputs<'a, L = (PathBuf, TestLog)> {
+pub struct UnitInputs<'a, L = (String, TestLog)> {
     pub unit: &'a str,
     pub station: &'a str,
     pub model_path: &'a Path,
-    /// The held-out logs, already read, with the paths they were read from (an inertial
-    /// unit's read with the model's columns, [`ImuModel::read_options`]).
+    /// The held-out logs, already read, with the paths they were read from, as given (an
+    /// inertial unit's read with the model's columns, [`ImuModel::read_options`]).
     pub tests: &'a [L],
     pub spec: Option<&'a Spec>,
     /// Bias-stability τ, s (None: `compare`'s default for these logs; for an inertial unit
@@ -580,20 +580,16 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
     let named: Vec<NamedLog> = u
         .tests
         .iter()
-        .map(|(p, l)| NamedLog {
-            name: p.to_str().unwrap_or("?"),
-            log: l,
-        })
+        .map(|(p, l)| NamedLog { name: p, log: l })
         .collect();
     let opts = u.measure_options(|| crate::compare::default_tau_s(&named).0);
     let mut inputs = Vec::new();
     let mut measured = Vec::new();
-    for (i, (path, log)) in u.tests.iter().enumerate() {
-        let name = path.display().to_string();
+    for (i, (name, log)) in u.tests.iter().enumerate() {
         inputs.push(Input {
             position: i as u32,
             path: name.clone(),
-            sha256: file_sha256(path)?,
+            sha256: file_sha256(Path::new(name))?,
             kind: if log.is_static() {
                 "static"
             } else {
@@ -606,7 +602,7 @@ pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotErr
                 log: name.clone(),
                 source,
             })?;
-        measured.push((name, f));
+        measured.push((name.clone(), f));
     }
     let verdict = match u.spec {
         Some(s) => Some(spec::judge(s, &measured).map_err(LotError::Spec)?),
@@ -990,28 +986,14 @@ impl ModelRunVerdict {
     }
 }
 
-/// How a front end reads a unit's held-out logs for [`judge_model`], with the read options
-/// the model gives ([`Model::read_options`]): one gyro's logs, or an inertial unit's.
-pub trait HeldOutReader {
-    /// The front end's error.
-    type Error;
-    /// The front end's error for a unit that could not be judged.
-    fn not_judged(&self, e: LotError) -> Self::Error;
-    /// One gyro's logs, with the paths they were read from.
-    fn single(&mut self, opts: &ReadOptions) -> Result<Vec<(PathBuf, TestLog)>, Self::Error>;
-    /// An inertial unit's logs, with the paths they were read from.
-    fn unit(&mut self, opts: &ReadOptions) -> Result<Vec<(String, ImuLog)>, Self::Error>;
-}
-
 /// Judge one unit with its model of either form ([`judge_unit`] for a single-gyro model,
-/// [`judge_imu_unit`] for an inertial unit's): its held-out logs read by `read` with `opts`
-/// (from [`Model::read_options`]); `u` says the rest (its `tests` are not read).
-pub fn judge_model<R: HeldOutReader>(
+/// [`judge_imu_unit`] for an inertial unit's) on its held-out logs (read in the model's form,
+/// [`Model::read_logs`]); `u` says the rest (its `tests` are not read).
+pub fn judge_model(
     model: &Model,
     u: &UnitInputs<'_, ()>,
-    opts: &ReadOptions,
-    read: &mut R,
-) -> Result<(Run, Option<ModelRunVerdict>), R::Error> {
+    logs: &LogSet,
+) -> Result<(Run, Option<ModelRunVerdict>), LotError> {
     fn with<'a, L>(u: &UnitInputs<'a, ()>, tests: &'a [L]) -> UnitInputs<'a, L> {
         UnitInputs {
             unit: u.unit,
@@ -1023,12 +1005,24 @@ pub fn judge_model<R: HeldOutReader>(
             settle_s: u.settle_s,
         }
     }
-    if model.is_unit() {
-        let tests = read.unit(opts)?;
-        let (run, v) = judge_imu_unit(&with(u, &tests)).map_err(|e| read.not_judged(e))?;
-        return Ok((run, v.map(ModelRunVerdict::Unit)));
+    match (model.is_unit(), logs.form()) {
+        (true, LogSetForm::Unit(tests)) => {
+            let (run, v) = judge_imu_unit(&with(u, tests))?;
+            Ok((run, v.map(ModelRunVerdict::Unit)))
+        }
+        (false, LogSetForm::Single(tests)) => {
+            let (run, v) = judge_unit(&with(u, tests))?;
+            Ok((run, v.map(ModelRunVerdict::Axis)))
+        }
+        (unit, _) => Err(LotError::Model {
+            path: u.model_path.to_path_buf(),
+            source: if unit {
+                "an inertial unit's model judges a unit's logs, read with its columns".into()
+            } else {
+                "a single-axis model; --gyro-col/--temp-col lists need an inertial unit's \
+                 model (`gyrotherm train` with the same lists), whose columns lot add then reads"
+                    .into()
+            },
+        }),
     }
-    let tests = read.single(opts)?;
-    let (run, v) = judge_unit(&with(u, &tests)).map_err(|e| read.not_judged(e))?;
-    Ok((run, v.map(ModelRunVerdict::Axis)))
 }
