@@ -69,15 +69,13 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         "thermal" => lstm(RecipeSettings::of_kind(Method::Thermal)),
         v if v.starts_with("tlstm") || v == "auto" || v.starts_with("auto:") => {
             // tlstm[:<hidden>[:<Adam steps>[:<windows per step>]]]: the `thermal-lstm` method;
-            // auto[:…]: the `auto` method with those knobs on its LSTM candidate. Models whose
-            // LSTM flight code does not run yet are left unchecked and compensated in memory.
+            // auto[:…]: the `auto` method with those knobs on its LSTM candidate.
             let method = if v.starts_with("auto") {
                 Method::Auto
             } else {
                 Method::ThermalLstm
             };
             let mut c = FitConfig::new(method);
-            c.check_model = false;
             let parts: Vec<&str> = v.split(':').collect();
             if let Some(h) = parts.get(1) {
                 c.recipe.hidden = h.parse().map_err(|e| format!("{v}: {e}"))?;
@@ -349,8 +347,8 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                 None => note,
             };
             for (profile, st, tab) in &tests {
-                let cs = compensate_in_memory(&fit.model, &st.log)?;
-                let ct = compensate_in_memory(&fit.model, &tab.log)?;
+                let cs = compensate_log(&fit.model, &st.log).map_err(|e| e.to_string())?;
+                let ct = compensate_log(&fit.model, &tab.log).map_err(|e| e.to_string())?;
                 let b = bias_stability_dph(&cs.gyro_comp_dps, 1.0, TAU_S)
                     .map_err(|e| e.to_string())?
                     .bias_stability_dph;
@@ -368,50 +366,6 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                 });
             }
         }
-    }
-    Ok(out)
-}
-
-/// The compensated output of `log`: through the flight compensator, except for a bias LSTM of
-/// a size flight code does not run yet, whose correction is added in memory (f64, from zero
-/// state at the log's start) to the flight compensation by the model without it.
-fn compensate_in_memory(
-    model: &gyrotherm::model::ModelFile,
-    log: &TestLog,
-) -> Result<gyrotherm::compensate::Compensated, String> {
-    use gyrotherm::model::SubModel;
-    let flight_hidden = gyrotherm_core::compensator::HIDDEN;
-    let Some(
-        bias @ SubModel::Residual {
-            terms,
-            coefficients,
-            params,
-            ..
-        },
-    ) = &model.bias
-    else {
-        return compensate_log(model, log).map_err(|e| e.to_string());
-    };
-    if params.hidden_size == flight_hidden {
-        return compensate_log(model, log).map_err(|e| e.to_string());
-    }
-    let base = SubModel::Baseline {
-        terms: terms.clone(),
-        coefficients: coefficients.clone(),
-    };
-    let without = gyrotherm::model::ModelFile {
-        bias: Some(base.clone()),
-        ..model.clone()
-    };
-    let mut out = compensate_log(&without, log).map_err(|e| e.to_string())?;
-    let spec = model.feature_spec().map_err(|e| e.to_string())?;
-    let table = gyrotherm::features::extract(log, &spec).map_err(|e| e.to_string())?;
-    let full = bias.predict_table(&table).map_err(|e| e.to_string())?;
-    let part = base.predict_table(&table).map_err(|e| e.to_string())?;
-    for (i, row) in table.row_of_sample(log.len()).into_iter().enumerate() {
-        let corr = full[row] - part[row];
-        out.bias_dps[i] += corr;
-        out.gyro_comp_dps[i] = (log.gyro_dps[i] - out.bias_dps[i]) / out.scale[i];
     }
     Ok(out)
 }

@@ -79,14 +79,6 @@ pub struct FitConfig {
     pub thermal: thermal::ThermalConfig,
     #[cfg(not(feature = "experiments"))]
     pub(crate) thermal: thermal::ThermalConfig,
-    /// Check the fitted model as a model file must be checked (true). False leaves it
-    /// unchecked, for evaluation in memory of a model flight code cannot run yet (an LSTM of
-    /// another size than flight code's: see [`SubModel::predict_table`]).
-    /// An experiment knob: public only with the `experiments` feature.
-    #[cfg(feature = "experiments")]
-    pub check_model: bool,
-    #[cfg(not(feature = "experiments"))]
-    pub(crate) check_model: bool,
 }
 
 impl FitConfig {
@@ -101,7 +93,6 @@ impl FitConfig {
             scale_window_s: targets::SCALE_WINDOW_S,
             seed: 0,
             thermal: thermal::ThermalConfig::default(),
-            check_model: true,
         }
     }
 }
@@ -674,7 +665,7 @@ pub(crate) fn fit_model_with(
         coverage_note: coverage_note.clone(),
         ..model
     };
-    if own_bias && cfg.check_model {
+    if own_bias {
         model.validate()?;
     }
     Ok(FitOutcome {
