@@ -3,11 +3,9 @@
 //! (`RawUnitModel`: load, save, compensate per axis).
 
 use std::path::PathBuf;
-use std::sync::Mutex;
 
 use gyrotherm::csvlog::{self, ImuLog, NamedSeries};
-use gyrotherm::imu_model::{self, ImuFitEvent, ImuModel};
-use gyrotherm::model::TempSensorDef;
+use gyrotherm::imu_model::{self, ImuModel};
 use gyrotherm::unit_model::{Form, Model};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -15,13 +13,12 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::allan::slice;
 use crate::logs::LogOptions;
-use crate::model::{FitArgs, RawModel};
-use crate::{py_err, CompensationError, FitError, LogError, ModelError};
+use crate::model::RawModel;
+use crate::{py_err, CompensationError, LogError, ModelError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RawUnitModel>()?;
     m.add_function(wrap_pyfunction!(read_imu_log, m)?)?;
-    m.add_function(wrap_pyfunction!(fit_unit, m)?)?;
     m.add_function(wrap_pyfunction!(load_model, m)?)?;
     Ok(())
 }
@@ -336,89 +333,4 @@ impl RawUnitModel {
             self.file.gyro_cols, self.file.temp_cols
         )
     }
-}
-
-/// Fit a unit model, as `gyrotherm train --gyro-col LIST --temp-col LIST --input S…
-/// --input T…` does (same defaults, same file). `progress(event)` gets a tuple per step:
-/// `("start"|"done"|"axis", gyro, temp, cv_rms)`.
-#[pyfunction]
-#[pyo3(signature = (static_logs, table_logs, settings, options, progress=None))]
-fn fit_unit(
-    py: Python<'_>,
-    static_logs: Vec<PathBuf>,
-    table_logs: Vec<PathBuf>,
-    settings: FitArgs,
-    options: LogOptions,
-    progress: Option<Py<PyAny>>,
-) -> PyResult<RawUnitModel> {
-    let cfg = settings.config()?;
-    let table_col = options.table_col.clone();
-    let failed: Mutex<Option<PyErr>> = Mutex::new(None);
-    let file = py.detach(|| -> PyResult<ImuModel> {
-        let mut logs: Vec<(String, ImuLog)> = Vec::new();
-        for (paths, want_static) in [(&static_logs, true), (&table_logs, false)] {
-            for p in paths {
-                let (log, _) = read(p, &options)?;
-                let name = p.display().to_string();
-                let is_static = log
-                    .table
-                    .as_ref()
-                    .is_none_or(|t| t.values.iter().all(|v| *v == 0.0));
-                if want_static != is_static {
-                    return Err(FitError::new_err(if want_static {
-                        format!("{name}: given as a static log but its {table_col} column has non-zero rates; pass it in table=[...]")
-                    } else {
-                        format!("{name}: given as a rate-table log but it has no non-zero {table_col} rate; pass it in static=[...]")
-                    }));
-                }
-                logs.push((name, log));
-            }
-        }
-        let gyro: Vec<String> = logs
-            .first()
-            .map(|(_, l)| l.gyro.iter().map(|s| s.name.clone()).collect())
-            .unwrap_or_default();
-        let temp: Vec<String> = logs
-            .first()
-            .map(|(_, l)| l.temp.iter().map(|s| s.name.clone()).collect())
-            .unwrap_or_default();
-        let events = |e: ImuFitEvent| {
-            let Some(cb) = &progress else { return };
-            let (what, axis, sensor, cv) = match e {
-                ImuFitEvent::AxisStarted { axis } => ("axis_start", axis, usize::MAX, None),
-                ImuFitEvent::SensorStarted { axis, sensor } => ("start", axis, sensor, None),
-                ImuFitEvent::SensorFinished {
-                    axis,
-                    sensor,
-                    cv_rms,
-                } => ("done", axis, sensor, cv_rms),
-                ImuFitEvent::AxisFinished { axis, sensor } => ("axis", axis, sensor, None),
-                _ => return,
-            };
-            Python::attach(|py| {
-                // An axis's start names no sensor yet.
-                let sensor = temp.get(sensor).cloned();
-                let args = (what, gyro[axis].clone(), sensor, cv);
-                if let Err(e) = cb.call1(py, args) {
-                    let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
-                    slot.get_or_insert(e);
-                }
-            });
-        };
-        imu_model::fit_imu_with_events(
-            &logs,
-            &cfg,
-            &TempSensorDef::default(),
-            &|_, _, _, _, _| {},
-            &events,
-        )
-        .map_err(|e| FitError::new_err(format!("training failed: {}", gyrotherm::error_chain(&e))))
-    })?;
-    if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        return Err(e);
-    }
-    Ok(RawUnitModel {
-        file,
-        load_warnings: Vec::new(),
-    })
 }

@@ -270,7 +270,7 @@ fn judge_unit<'a>(
             cfg.fit.model_method().as_str()
         ))));
     }
-    let step = |line: String| events(JudgeEvent::Told(Told::Line(line)));
+    let step = |s: crate::train::AxisStep| events(JudgeEvent::Told(Told::Line(s.line)));
     let steps = crate::train::step_lines(started, train, &step);
     let gyro = gyro_names(train);
     let cmp = imu_judge::compare_imu(

@@ -24,6 +24,21 @@ pub enum TrainEvent {
     },
     /// A step of the fit, as a line for the user.
     Step(String),
+    /// A step of a unit's fit, per axis and sensor (from the axes' threads).
+    Axis(AxisStep),
+}
+
+/// A step of a unit's fit: the event, the names of its axis and sensor, and its line for
+/// the user.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisStep {
+    pub event: ImuFitEvent,
+    /// The axis's gyro column.
+    pub gyro: String,
+    /// The sensor's temperature column (None when an axis starts).
+    pub temp: Option<String>,
+    /// The step as a line, with the seconds since the fit started.
+    pub line: String,
 }
 
 /// Why a model could not be trained.
@@ -172,7 +187,7 @@ fn train_unit(
         "fitting {axes} axes on their own threads, each on {sensors} sensor(s) in turn"
     )));
     let started = std::time::Instant::now();
-    let step = |line: String| events(TrainEvent::Step(line));
+    let step = |s: AxisStep| events(TrainEvent::Axis(s));
     let steps = step_lines(started, logs, &step);
     let model = fit_imu_with_events(logs, cfg, temp_sensor, &|_, _, _, _, _| {}, &steps)
         .map_err(TrainError::Unit)?;
@@ -224,7 +239,7 @@ fn axis_lines(model: &ImuModel) -> Vec<Told> {
 pub(crate) fn step_lines<'a>(
     started: std::time::Instant,
     logs: &[(String, ImuLog)],
-    events: &'a (dyn Fn(String) + Sync),
+    events: &'a (dyn Fn(AxisStep) + Sync),
 ) -> impl Fn(ImuFitEvent) + Sync + 'a {
     let gyro: Vec<String> = logs
         .first()
@@ -238,6 +253,12 @@ pub(crate) fn step_lines<'a>(
         let at = started.elapsed().as_secs_f64();
         let g = |k: usize| gyro.get(k).map_or("?", String::as_str);
         let t = |j: usize| temp.get(j).map_or("?", String::as_str);
+        let (axis, sensor) = match e {
+            ImuFitEvent::AxisStarted { axis } => (axis, None),
+            ImuFitEvent::SensorStarted { axis, sensor }
+            | ImuFitEvent::SensorFinished { axis, sensor, .. }
+            | ImuFitEvent::AxisFinished { axis, sensor } => (axis, Some(sensor)),
+        };
         let line = match e {
             ImuFitEvent::AxisStarted { axis } => format!(
                 "[{at:6.1} s] {}: axis starts ({} sensor(s) to try)",
@@ -265,6 +286,11 @@ pub(crate) fn step_lines<'a>(
                 format!("[{at:6.1} s] {}: axis done, reads {}", g(axis), t(sensor))
             }
         };
-        events(line);
+        events(AxisStep {
+            event: e,
+            gyro: g(axis).to_owned(),
+            temp: sensor.map(|j| t(j).to_owned()),
+            line,
+        });
     }
 }

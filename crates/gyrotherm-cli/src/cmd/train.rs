@@ -29,6 +29,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             loss,
         } => bars.update("", target, epoch, loss),
         TrainEvent::Step(line) => bars.println(&format!("gyrotherm: {line}")),
+        TrainEvent::Axis(step) => bars.println(&format!("gyrotherm: {}", step.line)),
         _ => {}
     });
     bars.finish();

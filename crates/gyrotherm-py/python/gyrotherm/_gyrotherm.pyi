@@ -49,14 +49,6 @@ def read_lot(db: str) -> Dict[str, Any]: ...
 def read_imu_log(path: str, options: Dict[str, Any]) -> Tuple[Dict[str, Any], Dict[str, Any]]: ...
 def reads_unit(paths: List[str], options: Dict[str, Any]) -> bool: ...
 def load_model(path: str) -> Union[RawModel, RawUnitModel]: ...
-def fit_unit(
-    static_logs: List[str],
-    table_logs: List[str],
-    settings: Dict[str, Any],
-    options: Dict[str, Any],
-    progress: Optional[Any] = None,
-) -> RawUnitModel: ...
-
 def evaluate(
     path: str,
     options: Dict[str, Any],
@@ -103,7 +95,7 @@ def fit(
     settings: Dict[str, Any],
     options: Dict[str, Any],
     progress: Optional[Any] = None,
-) -> RawModel: ...
+) -> Union[RawModel, RawUnitModel]: ...
 
 class RawModel:
     @staticmethod

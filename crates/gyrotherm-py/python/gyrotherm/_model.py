@@ -11,7 +11,7 @@ from typing import Any, Callable, Dict, Iterable, List, NamedTuple, Optional, Un
 import numpy as np
 
 from . import _gyrotherm as _g
-from ._logs import columns, is_unit, read_options
+from ._logs import columns, read_options
 
 PathLike = Union[str, "os.PathLike[str]"]
 Progress = Union[bool, Callable[[str, int, float], Any], None]
@@ -300,14 +300,23 @@ class UnitModel:
         return repr(self._raw)
 
 
-class _PrintUnitProgress:
-    """``progress=True`` for a unit: a line on stderr as each axis and sensor starts and
-    finishes, with the seconds since the fit began (the lines ``gyrotherm train`` prints)."""
+class _PrintProgress:
+    """``progress=True``: a single gyro's fit prints one line per target on stderr at most
+    every 2 s, and the last; a unit's a line as each axis and sensor starts and finishes,
+    with the seconds since the fit began (the lines ``gyrotherm train`` prints)."""
 
-    def __init__(self) -> None:
+    def __init__(self, epochs: Optional[int]) -> None:
+        self.epochs = epochs
+        self.last: Dict[str, float] = {}
         self.started = time.monotonic()
 
-    def __call__(self, event: str, gyro: str, temp: Optional[str], cv_rms: Optional[float]) -> None:
+    def __call__(self, *step: Any) -> None:
+        if len(step) == 4:
+            self._axis(*step)
+        else:
+            self._epoch(*step)
+
+    def _axis(self, event: str, gyro: str, temp: Optional[str], cv_rms: Optional[float]) -> None:
         at = time.monotonic() - self.started
         if event == "axis_start":
             text = f"{gyro}: axis starts"
@@ -320,15 +329,7 @@ class _PrintUnitProgress:
             text = f"{gyro}: axis done, reads {temp}"
         print(f"gyrotherm: [{at:6.1f} s] {text}", file=sys.stderr, flush=True)
 
-
-class _PrintProgress:
-    """``progress=True``: one line per target on stderr at most every 2 s, and the last."""
-
-    def __init__(self, epochs: Optional[int]) -> None:
-        self.epochs = epochs
-        self.last: Dict[str, float] = {}
-
-    def __call__(self, target: str, epoch: int, loss: float) -> None:
+    def _epoch(self, target: str, epoch: int, loss: float) -> None:
         now = time.monotonic()
         final = self.epochs is not None and epoch + 1 >= self.epochs
         if not final and now - self.last.get(target, -1e9) < 2.0:
@@ -404,17 +405,6 @@ def fit(
         poly_rate_degree, cross, validate_on_runs,
     )
     options = read_options(log_options)
-    if is_unit(options, static_paths + table_paths):
-        if progress is True:
-            unit_callback = _PrintUnitProgress()
-        elif progress is False or progress is None:
-            unit_callback = None
-        elif callable(progress):
-            unit_callback = progress
-        else:
-            raise TypeError("progress: give True, False or a callable(event, gyro, temp, cv_rms)")
-        raw_unit = _g.fit_unit(static_paths, table_paths, settings, options, unit_callback)
-        return UnitModel(raw_unit)
     if progress is True:
         callback = _PrintProgress(epochs)
     elif progress is False or progress is None:
@@ -422,9 +412,14 @@ def fit(
     elif callable(progress):
         callback = progress
     else:
-        raise TypeError("progress: give True, False or a callable(target, epoch, loss)")
+        raise TypeError(
+            "progress: give True, False or a callable(target, epoch, loss) (a unit: "
+            "callable(event, gyro, temp, cv_rms))"
+        )
     raw = _g.fit(static_paths, table_paths, settings, options, callback)
     _warn(raw.load_warnings)
+    if isinstance(raw, _g.RawUnitModel):
+        return UnitModel(raw)
     return Model(raw)
 
 

@@ -199,6 +199,21 @@ impl LogSet {
         }
     }
 
+    /// Per log, in order: whether it is a static run (no non-zero table rate).
+    pub fn is_static(&self) -> Vec<bool> {
+        match &self.form {
+            LogSetForm::Single(l) => l.iter().map(|(_, l)| l.is_static()).collect(),
+            LogSetForm::Unit(l) => l
+                .iter()
+                .map(|(_, l)| {
+                    l.table
+                        .as_ref()
+                        .is_none_or(|t| t.values.iter().all(|v| *v == 0.0))
+                })
+                .collect(),
+        }
+    }
+
     /// The lines about gap filling, for a report that lists what reading did.
     pub fn gap_warnings(&self) -> &[String] {
         &self.gap_warnings
