@@ -206,17 +206,7 @@ pub fn read_log_set(
     opts: &ReadOptions,
     table_axis: Option<&str>,
 ) -> anyhow::Result<csvlog::LogSet> {
-    let read = csvlog::read_log_set(paths, opts, table_axis);
-    for f in read.files {
-        for t in &f.told {
-            tell(t);
-        }
-        if let Some(e) = f.error {
-            let e = anyhow::Error::new(e).context(format!("cannot use log {}", f.path.display()));
-            eprintln!("gyrotherm: {}", error_message(&e));
-        }
-    }
-    Ok(read.set?)
+    told_set(csvlog::read_log_set(paths, opts, table_axis))
 }
 
 /// [`read_log_set`] for a comparison's training and held-out logs, read alike.
