@@ -20,6 +20,7 @@ mod judge;
 mod logs;
 mod lot;
 mod model;
+mod train;
 mod unit;
 
 // The base class has two bases (`ValueError`, `RuntimeError`), which `create_exception!`
@@ -123,6 +124,7 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     logs::register(m)?;
     lot::register(m)?;
     model::register(m)?;
+    train::register(m)?;
     unit::register(m)?;
     Ok(())
 }

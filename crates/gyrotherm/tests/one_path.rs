@@ -25,7 +25,11 @@ fn a_set_tells_each_file_and_fails_when_one_cannot_be_read() {
     let dir = tempfile::tempdir().unwrap();
     let good = dir.path().join("good.csv");
     // 1 Hz with one sample missing at t = 2: filled when allowed, and told.
-    std::fs::write(&good, "time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n4,0,20\n").unwrap();
+    std::fs::write(
+        &good,
+        "time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n4,0,20\n",
+    )
+    .unwrap();
     let missing = dir.path().join("missing.csv");
     let opts = ReadOptions {
         fill_gaps_max_s: Some(2.0),
