@@ -312,7 +312,7 @@ fn write_verdict(w: &mut dyn Write, v: &Verdict) -> std::io::Result<()> {
 
 /// The figures of one column as text (the single-axis output, and each axis's block of a
 /// unit log).
-pub fn write_figures(w: &mut dyn Write, e: &Evaluation) -> std::io::Result<()> {
+fn write_figures(w: &mut dyn Write, e: &Evaluation) -> std::io::Result<()> {
     writeln!(
         w,
         "{} ({} samples, τ0 = {} s)",

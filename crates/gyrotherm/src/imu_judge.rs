@@ -617,15 +617,10 @@ pub fn compare_imu(
         .first()
         .map(|(_, l)| l)
         .ok_or_else(|| ImuJudgeError::Layout("no training logs".into()))?;
-    let names = |l: &ImuLog| {
-        (
-            l.gyro.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-            l.temp.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-        )
-    };
-    let (gyro_cols, temp_cols) = names(first);
+    let columns = first.column_names();
+    let (gyro_cols, temp_cols) = columns.clone();
     for (n, l) in train.iter().chain(test) {
-        if names(l) != (gyro_cols.clone(), temp_cols.clone()) {
+        if l.column_names() != columns {
             return Err(ImuJudgeError::Layout(format!(
                 "{n}: every log must be read with the same gyro and temperature columns"
             )));

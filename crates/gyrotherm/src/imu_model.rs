@@ -211,14 +211,12 @@ pub fn fit_imu_full(
         .first()
         .map(|(_, l)| l)
         .ok_or_else(|| ImuError::Layout("no training logs".into()))?;
-    let gyro_cols: Vec<String> = first.gyro.iter().map(|s| s.name.clone()).collect();
-    let temp_cols: Vec<String> = first.temp.iter().map(|s| s.name.clone()).collect();
+    let columns = first.column_names();
+    let (gyro_cols, temp_cols) = columns.clone();
     // Before any fit: a model that could not be compensated is not worth the hours.
     check_axis_count(gyro_cols.len())?;
     for (name, l) in logs {
-        let g: Vec<&String> = l.gyro.iter().map(|s| &s.name).collect();
-        let t: Vec<&String> = l.temp.iter().map(|s| &s.name).collect();
-        if g != gyro_cols.iter().collect::<Vec<_>>() || t != temp_cols.iter().collect::<Vec<_>>() {
+        if l.column_names() != columns {
             return Err(ImuError::Layout(format!(
                 "{name}: the training logs must be read with the same gyro and temperature columns"
             )));

@@ -157,7 +157,7 @@ pub fn progress_bars(train: &LogSet, cfg: &CompareConfig) -> (Vec<String>, usize
 
 fn gyro_names(logs: &[(String, ImuLog)]) -> Vec<String> {
     logs.first()
-        .map(|(_, l)| l.gyro.iter().map(|s| s.name.clone()).collect())
+        .map(|(_, l)| l.column_names().0)
         .unwrap_or_default()
 }
 

@@ -241,13 +241,9 @@ pub(crate) fn step_lines<'a>(
     logs: &[(String, ImuLog)],
     events: &'a (dyn Fn(AxisStep) + Sync),
 ) -> impl Fn(ImuFitEvent) + Sync + 'a {
-    let gyro: Vec<String> = logs
+    let (gyro, temp) = logs
         .first()
-        .map(|(_, l)| l.gyro.iter().map(|s| s.name.clone()).collect())
-        .unwrap_or_default();
-    let temp: Vec<String> = logs
-        .first()
-        .map(|(_, l)| l.temp.iter().map(|s| s.name.clone()).collect())
+        .map(|(_, l)| l.column_names())
         .unwrap_or_default();
     move |e: ImuFitEvent| {
         let at = started.elapsed().as_secs_f64();

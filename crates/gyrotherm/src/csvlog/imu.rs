@@ -48,6 +48,14 @@ impl ImuLog {
         self.time_s.is_empty()
     }
 
+    /// The names of its gyro and its temperature columns, in column order.
+    pub fn column_names(&self) -> (Vec<String>, Vec<String>) {
+        (
+            self.gyro.iter().map(|s| s.name.clone()).collect(),
+            self.temp.iter().map(|s| s.name.clone()).collect(),
+        )
+    }
+
     /// Index of the gyro column the table turns.
     pub(crate) fn table_axis_index(&self) -> Option<usize> {
         let a = self.table_axis.as_deref()?;
