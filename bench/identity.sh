@@ -8,7 +8,8 @@
 # before the change, check with the one after it. The commands cover simulated logs (one gyro,
 # an inertial unit, a rate-table run, a run with sensor faults), model files for every method
 # (one gyro) and for units (3 axes × 4 sensors; 1 axis × 2 sensors), compensated logs (batch
-# and --stream), and the C and Rust exports of each model.
+# and --stream), the C and Rust exports of each model, and what the judging commands print and
+# draw (compare, report, evaluate, lot add; one gyro and a unit).
 #
 # Model files are compared after removing what may legitimately differ: the content digest,
 # the creator line and the trained-with column names (keys in $IGNORED_KEYS). Exported files are
@@ -21,7 +22,7 @@ dir="${2:-}"
 bin="${3:-target/release/gyrotherm}"
 IGNORED_KEYS="content_sha256,creator,columns,trained_columns"
 if [ -z "$mode" ] || [ -z "$dir" ] || { [ "$mode" != record ] && [ "$mode" != check ]; }; then
-    sed -n '2,16p' "$0" >&2
+    sed -n '2,17p' "$0" >&2
     exit 2
 fi
 if [ "$bin" = target/release/gyrotherm ] && [ ! -x "$bin" ]; then
@@ -72,6 +73,29 @@ produce() {
         "${g[@]}" export --model "$u.json" "$lang" c --out "x-$u-c" >/dev/null
         "${g[@]}" export --model "$u.json" "$lang" rust --out "x-$u-rust" >/dev/null
     done
+    # What the judging commands print and draw, for one gyro and a unit, with a spec sheet:
+    # the comparison (text, JSON), the report (its table and page), the evaluation (a column,
+    # a model's output, a unit's axes) and a lot record. A missed limit exits 1, not an error.
+    printf 'name = "loose"\n[limits]\nbias_stability_dph = { max = 1 }\n' >spec.toml
+    local lists=(--gyro-col gyro_x_dps,gyro_y_dps,gyro_z_dps --temp-col temp_case_c,temp_x_c)
+    local judged=(--methods linear,thermal --spec spec.toml)
+    "${g[@]}" compare --train s.csv --train t.csv --test held.csv "${judged[@]}" >j-compare.txt || [ $? -eq 1 ]
+    "${g[@]}" compare --json --train s.csv --train t.csv --test held.csv "${judged[@]}" \
+        >j-compare.json.txt || [ $? -eq 1 ]
+    "${g[@]}" compare --train us.csv --train ut.csv --test uf.csv "${lists[@]}" "${judged[@]}" \
+        >j-compare-unit.txt || [ $? -eq 1 ]
+    "${g[@]}" report --train s.csv --train t.csv --test held.csv "${judged[@]}" --out j-report \
+        >j-report.txt || [ $? -eq 1 ]
+    "${g[@]}" report --train us.csv --train ut.csv --test uf.csv "${lists[@]}" "${judged[@]}" \
+        --out j-report-unit >j-report-unit.txt || [ $? -eq 1 ]
+    "${g[@]}" evaluate --input held.csv --spec spec.toml >j-evaluate.txt || [ $? -eq 1 ]
+    "${g[@]}" evaluate --json --input held.csv --model m-thermal.json >j-evaluate-model.json.txt
+    "${g[@]}" evaluate --input uf.csv "${lists[@]}" --spec spec.toml >j-evaluate-unit.txt || [ $? -eq 1 ]
+    "${g[@]}" lot add --db j-lot.db --unit A1 --model m-thermal.json --test held.csv \
+        --spec spec.toml >j-lot.txt || [ $? -eq 1 ]
+    "${g[@]}" lot add --db j-lot.db --unit U1 --model u3.json --test uf.csv --spec spec.toml \
+        >j-lot-unit.txt || [ $? -eq 1 ]
+    rm -f j-lot.db
     cd - >/dev/null
 }
 
