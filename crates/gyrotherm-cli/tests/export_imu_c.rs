@@ -13,7 +13,9 @@
 //! (NaN from line 350 on: the axes reading it as a further sensor run on their fallback in
 //! even units, stay degraded in odd ones), time glitches and lasting clock resets and jumps,
 //! huge and non-finite gyro samples. The units' column names hold `*/` and `??`: none reaches
-//! the generated text.
+//! the generated text. In every fourth unit the first model's LSTMs have 32 hidden units
+//! (drawn anew), so the unit runs at 32 and its 8-unit models (fallbacks, other axes) are
+//! widened with zero units.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -37,6 +39,31 @@ const LONG_LINES: usize = 70_000;
 /// clock runs on at 1 Hz, each step one more than the last.
 fn long_stream(u: usize) -> bool {
     u % 40 == 13
+}
+
+/// Whether unit `u`'s first axis model has its LSTMs at 32 hidden units.
+fn wide_lstm(u: usize) -> bool {
+    u % 4 == 3
+}
+
+/// `model` with each LSTM (plain or residual) replaced by one of `hidden` units drawn from
+/// `rng`, reading the same inputs with the same normalisation.
+fn with_hidden(mut model: serde_json::Value, hidden: usize, rng: &mut Lcg) -> serde_json::Value {
+    for target in ["bias", "scale"] {
+        for kind in ["lstm", "residual"] {
+            let Some(l) = model.get_mut(target).and_then(|t| t.get_mut(kind)) else {
+                continue;
+            };
+            let inputs = l["params"]["input_size"].as_u64().unwrap() as usize;
+            let g = 4 * hidden;
+            l["params"] = serde_json::json!({
+                "input_size": inputs, "hidden_size": hidden,
+                "w_ih": rng.vec(g * inputs), "w_hh": rng.vec(g * hidden), "b_ih": rng.vec(g),
+                "b_hh": rng.vec(g), "w_out": rng.vec(hidden), "b_out": rng.next(),
+            });
+        }
+    }
+    model
 }
 
 fn have_gcc() -> bool {
@@ -72,7 +99,10 @@ fn unit_model(u: usize) -> (serde_json::Value, usize, usize) {
     let mut several = false;
     let axes: Vec<serde_json::Value> = (0..n_axes)
         .map(|k| {
-            let model = generated_model(3 * u + k);
+            let mut model = generated_model(3 * u + k);
+            if wide_lstm(u) && k == 0 {
+                model = with_hidden(model, 32, &mut Lcg(0x3232 + u as u64));
+            }
             // Draw the sensors: a shuffled list of the unit's, then how many to read.
             let mut order: Vec<usize> = (0..n_temps).collect();
             for i in (1..n_temps).rev() {
@@ -275,6 +305,8 @@ fn generated_unit_c_equals_the_unit_stream() {
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_c");
     let (mut lines, mut axis_lines, mut differ, mut statuses) = (0usize, 0, 0, [0usize; 5]);
     let mut long_lines = 0usize;
+    // Units that ran at 32 hidden units (every fourth: its first model's LSTMs).
+    let mut wide_units = 0usize;
     let mut verdicts = [0usize; 5];
     // Axis-lines by the number of sensors the axis reads (1 to 4).
     let mut by_sensors = [0usize; 5];
@@ -289,6 +321,9 @@ fn generated_unit_c_equals_the_unit_stream() {
             let (json, axes, temps) = unit_model(u);
             let m = gyrotherm::imu_model::ImuModel::from_json(&json.to_string())
                 .unwrap_or_else(|e| panic!("generated unit {u}: {e}"));
+            if m.hidden_size().unwrap().units() == 32 {
+                wide_units += 1;
+            }
             let mdir = bdir.join(format!("u{u}"));
             let files =
                 gyrotherm::export::unit::export_imu(&m, gyrotherm::export::Lang::C, &mdir).unwrap();
@@ -496,6 +531,8 @@ fn generated_unit_c_equals_the_unit_stream() {
     // units whose further sensor dies for good).
     assert!(statuses.iter().all(|v| *v > 500), "statuses {statuses:?}");
     assert!(verdicts.iter().all(|v| *v > 500), "verdicts {verdicts:?}");
+    // Every fourth unit ran at 32 hidden units (an axis model of kind LSTM, widened).
+    assert_eq!(wide_units, UNITS / 4);
     // The three long streams were compared.
     assert_eq!(long_lines, 3 * LONG_LINES);
     // Axes reading each number of sensors were compared.
