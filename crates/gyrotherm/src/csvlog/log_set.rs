@@ -86,64 +86,32 @@ pub(crate) fn read_in_form(
     unit: bool,
 ) -> SetRead {
     let mut files = Vec::with_capacity(paths.len());
+    // A single gyro's gap-filling lines again, for a report that lists what reading did.
     let mut gap_warnings = Vec::new();
     let form = if unit {
-        let mut logs = Vec::new();
-        for (p, r) in paths.iter().zip(read_imu_logs(paths, opts, table_axis)) {
-            match r {
-                Ok((log, report)) => {
-                    let mut told = filled_gaps(p, &report)
-                        .map(Told::Line)
-                        .into_iter()
-                        .collect::<Vec<_>>();
-                    told.extend(report.truncation_warning(p).map(Told::Warning));
-                    if report.zero_table {
-                        told.push(Told::Line(format!(
-                            "{}: the table-rate column {} is all zeros: read as a static run",
-                            p.display(),
-                            opts.table_col
-                        )));
-                    }
-                    files.push(FileRead {
-                        path: p.clone(),
-                        told,
-                        error: None,
-                    });
-                    logs.push((p.display().to_string(), log));
-                }
-                Err(e) => files.push(FileRead {
-                    path: p.clone(),
-                    told: Vec::new(),
-                    error: Some(e),
-                }),
+        let read = read_imu_logs(paths, opts, table_axis);
+        LogSetForm::Unit(keep(paths, read, &mut files, |p, report| {
+            let mut told: Vec<Told> = filled_gaps(p, report).map(Told::Line).into_iter().collect();
+            told.extend(report.truncation_warning(p).map(Told::Warning));
+            if report.zero_table {
+                told.push(Told::Line(format!(
+                    "{}: the table-rate column {} is all zeros: read as a static run",
+                    p.display(),
+                    opts.table_col
+                )));
             }
-        }
-        LogSetForm::Unit(logs)
+            told
+        }))
     } else {
-        let mut logs = Vec::new();
-        for p in paths {
-            match read_log(p, opts) {
-                Ok((log, report)) => {
-                    let gap = filled_gaps(p, &report);
-                    let mut told: Vec<Told> = gap.iter().cloned().map(Told::Line).collect();
-                    gap_warnings.extend(gap);
-                    told.extend(report.jitter_warning(p).map(Told::Warning));
-                    told.extend(report.truncation_warning(p).map(Told::Warning));
-                    files.push(FileRead {
-                        path: p.clone(),
-                        told,
-                        error: None,
-                    });
-                    logs.push((p.display().to_string(), log));
-                }
-                Err(e) => files.push(FileRead {
-                    path: p.clone(),
-                    told: Vec::new(),
-                    error: Some(e),
-                }),
-            }
-        }
-        LogSetForm::Single(logs)
+        let read = paths.iter().map(|p| read_log(p, opts));
+        LogSetForm::Single(keep(paths, read, &mut files, |p, report| {
+            let gap = filled_gaps(p, report);
+            gap_warnings.extend(gap.clone());
+            let mut told: Vec<Told> = gap.map(Told::Line).into_iter().collect();
+            told.extend(report.jitter_warning(p).map(Told::Warning));
+            told.extend(report.truncation_warning(p).map(Told::Warning));
+            told
+        }))
     };
     let failed = files.iter().filter(|f| f.error.is_some()).count();
     let set = if failed > 0 {
@@ -155,6 +123,32 @@ pub(crate) fn read_in_form(
         Ok(LogSet { form, gap_warnings })
     };
     SetRead { files, set }
+}
+
+/// The logs read, named by their paths as given; each file's lines to tell (`told`, from its
+/// report) or its error into `files`, in the order of `paths`.
+fn keep<L>(
+    paths: &[PathBuf],
+    read: impl IntoIterator<Item = Result<(L, ReadReport), LogError>>,
+    files: &mut Vec<FileRead>,
+    mut told: impl FnMut(&Path, &ReadReport) -> Vec<Told>,
+) -> Vec<(String, L)> {
+    let mut logs = Vec::new();
+    for (p, r) in paths.iter().zip(read) {
+        let (told, error) = match r {
+            Ok((log, report)) => {
+                logs.push((p.display().to_string(), log));
+                (told(p, &report), None)
+            }
+            Err(e) => (Vec::new(), Some(e)),
+        };
+        files.push(FileRead {
+            path: p.clone(),
+            told,
+            error,
+        });
+    }
+    logs
 }
 
 /// The line about the samples gap filling made, if it made any.
