@@ -43,8 +43,22 @@ impl SqliteStore {
             path: path.to_path_buf(),
             busy_timeout_ms,
         };
-        store.prepare_schema(create)?;
-        Ok(store)
+        // SQLite answers "busy" at once, without waiting, where waiting could deadlock: when
+        // stations open a new file together and one switches it to WAL while another reads
+        // its version. Preparing the schema is safe to repeat (it reads the version again
+        // and creates only inside an IMMEDIATE transaction), so it is retried up to the busy
+        // timeout.
+        let started = std::time::Instant::now();
+        loop {
+            match store.prepare_schema(create) {
+                Err(LotError::Locked { .. })
+                    if started.elapsed().as_millis() < u128::from(busy_timeout_ms) =>
+                {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                other => return other.map(|()| store),
+            }
+        }
     }
 
     /// The lot's name in messages (a password in a mistyped URL masked).
