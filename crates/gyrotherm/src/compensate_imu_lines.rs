@@ -31,9 +31,8 @@ use std::path::Path;
 use gyrotherm_core::compensator::{Corrected, Status};
 
 use crate::compensate_lines::{
-    check_added_columns, lines_to_file, parse_number, read_header, read_line_capped, record,
-    split_and_time, too_long_error, Cadence, Fields, FileError, LineCheck, LineRead, LinesError,
-    Mode, MAX_LINE_BYTES,
+    gyro_not_a_number, lines_to_file, parse_number, push_corrected, push_invalid, read_header,
+    run_lines, Cadence, Fields, FileError, LineCheck, LineModel, LinesError, Mode,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 pub use crate::imu_model::MAX_STREAM_AXES;
@@ -117,7 +116,7 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
     mode: Mode,
     flush_each_row: bool,
 ) -> Result<ImuLinesSummary, LinesError> {
-    let mut unit = flight_unit(model).map_err(LinesError::Unit)?;
+    let unit = flight_unit(model).map_err(LinesError::Unit)?;
     let n_axes = model.gyro_cols.len();
     let read = model.temps_read();
     let (Some(gyro0), Some(temp0)) = (model.gyro_cols.first(), read.first()) else {
@@ -132,21 +131,19 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
         temp_col: (*temp0).to_owned(),
         ..opts.clone()
     };
-    let (headers, mut line_no) = read_header(&mut input, source, &first)?;
-    let err = |kind, line, column: Option<&str>, message: String| {
-        LinesError::Log(LogError::new(kind, source, Some(line), column, message))
-    };
+    let (headers, line_no) = read_header(&mut input, source, &first)?;
     let find = |name: &str, what: &str| {
         headers.iter().position(|h| h == name).ok_or_else(|| {
-            err(
+            LinesError::Log(LogError::new(
                 LogErrorKind::MissingColumn,
-                line_no,
+                source,
+                Some(line_no),
                 Some(name),
                 format!(
                     "{what} column not found, and the model needs it; the header has: {}",
                     headers.join(", ")
                 ),
-            )
+            ))
         })
     };
     let ti = find(&opts.time_col, "time")?;
@@ -165,148 +162,105 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
                 .transpose()
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let gyro_scale = opts.gyro_unit.dps_per_unit();
-    let delimiter = opts.delimiter;
-    let decimal_comma = delimiter != b',';
-    let added = output_columns(model);
-    check_added_columns(&headers, added.iter().map(String::as_str), source, line_no)?;
-    let mut writer = LogWriter::with_delimiter(
-        output,
-        headers
-            .iter()
-            .map(String::as_str)
-            .chain(added.iter().map(String::as_str)),
-        delimiter,
-    )?;
-    writer.set_flush_each_row(flush_each_row);
-    let mut summary = ImuLinesSummary {
-        per_axis: vec![[0; 5]; n_axes],
-        ..ImuLinesSummary::default()
-    };
-    let mut fields = Fields::default();
-    let mut buf = Vec::new();
-    let mut last_time: Option<(f64, u64)> = None;
     // The axes share one time axis; the first axis's compensator steps as they all do.
-    let mut cadence = unit
+    let Some(mut cadence) = unit
         .axis(0)
-        .map(|a| Cadence::new(a.first().spec(), a.first().limits().degraded_after_s));
-    let mut gyro = vec![0.0; n_axes];
-    let mut temps = vec![0.0; ci.len()];
-    // A line with no usable output: its fields (or empty ones), every axis invalid.
-    let malformed = |writer: &mut LogWriter<W>,
-                     summary: &mut ImuLinesSummary,
-                     keep: Option<(&Fields, &[u8])>|
-     -> std::io::Result<()> {
-        for k in 0..headers.len() {
-            writer.push_raw(keep.map_or(&[][..], |(f, line)| f.get(line, k)));
-        }
-        for counts in &mut summary.per_axis {
-            for _ in 0..3 {
-                writer.push_raw(b"");
-            }
-            writer.push_raw(Status::Invalid.as_str().as_bytes());
-            counts[Status::Invalid as usize] += 1;
-        }
-        summary.malformed += 1;
-        writer.end_row()
+        .map(|a| Cadence::new(a.first().spec(), a.first().limits().degraded_after_s))
+    else {
+        return Err(LinesError::Unit(ImuError::Layout(
+            "the model lists no gyro column".into(),
+        )));
     };
     let check = LineCheck {
         source,
         headers: &headers,
-        delimiter,
+        delimiter: opts.delimiter,
         time_index: ti,
         mode,
     };
-    loop {
-        let read = read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)?;
-        if read == LineRead::Eof {
-            break;
+    let mut axes = Axes {
+        gyro: vec![0.0; n_axes],
+        temps: vec![0.0; ci.len()],
+        unit,
+        gyro_columns: gi,
+        temp_columns: ci,
+        gyro_scale: opts.gyro_unit.dps_per_unit(),
+        per_axis: vec![[0; 5]; n_axes],
+    };
+    let added = output_columns(model);
+    let counts = run_lines(
+        &mut input,
+        output,
+        flush_each_row,
+        &check,
+        added.iter().map(String::as_str),
+        line_no,
+        &mut cadence,
+        &mut axes,
+    )?;
+    Ok(ImuLinesSummary {
+        rows: counts.rows,
+        malformed: counts.malformed,
+        per_axis: axes.per_axis,
+        warnings: cadence.warning().into_iter().collect(),
+    })
+}
+
+/// A unit's part of the line loop: every axis steps on the line's time, its gyro field and
+/// the temperature fields it reads.
+struct Axes {
+    unit: Box<StreamUnit>,
+    /// The gyro columns' indices, in the model's order.
+    gyro_columns: Vec<usize>,
+    /// Per model temperature column, its index (none when no axis reads it).
+    temp_columns: Vec<Option<usize>>,
+    gyro_scale: f64,
+    /// The line's gyro rates (°/s) and temperatures, as parsed.
+    gyro: Vec<f64>,
+    temps: Vec<f64>,
+    per_axis: Vec<[u64; 5]>,
+}
+
+impl LineModel for Axes {
+    fn parse(
+        &mut self,
+        fields: &Fields,
+        line: &[u8],
+        check: &LineCheck<'_>,
+        line_no: u64,
+    ) -> Result<(), LinesError> {
+        let decimal_comma = check.delimiter != b',';
+        for (g, &k) in self.gyro.iter_mut().zip(&self.gyro_columns) {
+            *g = match parse_number(fields.get(line, k), decimal_comma) {
+                Some(v) => v * self.gyro_scale,
+                // One axis's fault: the others go on.
+                None if check.mode == Mode::Stream => f64::NAN,
+                None => return Err(gyro_not_a_number(check, fields, line, line_no, k)),
+            };
         }
-        line_no += 1;
-        if read == LineRead::TooLong {
-            if mode == Mode::Strict {
-                return Err(too_long_error(source, line_no));
-            }
-            summary.rows += 1;
-            malformed(&mut writer, &mut summary, None)?;
-            continue;
+        // A temperature that is not a number is a sensor fault: NaN, held.
+        for (c, k) in self.temps.iter_mut().zip(&self.temp_columns) {
+            *c = k
+                .and_then(|k| parse_number(fields.get(line, k), decimal_comma))
+                .unwrap_or(f64::NAN);
         }
-        let Some(line) = record(&buf) else {
-            continue;
-        };
-        summary.rows += 1;
-        let parsed: Result<f64, LinesError> = (|| {
-            let time_s = split_and_time(&mut fields, line, &check, line_no, last_time)?;
-            for (g, &k) in gyro.iter_mut().zip(&gi) {
-                *g = match parse_number(fields.get(line, k), decimal_comma) {
-                    Some(v) => v * gyro_scale,
-                    // One axis's fault: the others go on.
-                    None if mode == Mode::Stream => f64::NAN,
-                    None => {
-                        return Err(err(
-                            LogErrorKind::NotANumber,
-                            line_no,
-                            Some(&headers[k]),
-                            format!(
-                                "{:?} is not a number; fix the value or comment the line out \
-                                 with '#'",
-                                String::from_utf8_lossy(fields.get(line, k))
-                            ),
-                        ))
-                    }
-                };
-            }
-            // A temperature that is not a number is a sensor fault: NaN, held.
-            for (c, k) in temps.iter_mut().zip(&ci) {
-                *c = k
-                    .and_then(|k| parse_number(fields.get(line, k), decimal_comma))
-                    .unwrap_or(f64::NAN);
-            }
-            Ok(time_s)
-        })();
-        let time_s = match parsed {
-            Ok(t) => t,
-            Err(e) if mode == Mode::Strict => return Err(e),
-            Err(_) => {
-                let keep = fields.len() == headers.len();
-                malformed(&mut writer, &mut summary, keep.then_some((&fields, line)))?;
-                continue;
-            }
-        };
-        if let (Some((t0, _)), Some(c)) = (last_time, cadence.as_mut()) {
-            c.step(time_s - t0, mode, source, line_no)?;
-        }
-        last_time = Some((time_s, line_no));
-        let out: [Corrected; MAX_STREAM_AXES] = unit.step(time_s, &gyro, &temps);
-        for k in 0..fields.len() {
-            writer.push_raw(fields.get(line, k));
-        }
-        for (c, counts) in out.iter().zip(&mut summary.per_axis) {
-            writer.push_f64(c.bias_dps);
-            writer.push_f64(c.scale);
-            match c.rate() {
-                Some(r) => writer.push_f64(r),
-                None => writer.push_raw(b""),
-            }
-            writer.push_raw(c.status.as_str().as_bytes());
+        Ok(())
+    }
+
+    fn step<W: Write>(&mut self, time_s: f64, writer: &mut LogWriter<W>) {
+        let out: [Corrected; MAX_STREAM_AXES] = self.unit.step(time_s, &self.gyro, &self.temps);
+        for (c, counts) in out.iter().zip(&mut self.per_axis) {
+            push_corrected(writer, c);
             counts[c.status as usize] += 1;
         }
-        writer.end_row()?;
     }
-    writer.flush()?;
-    if summary.rows == 0 {
-        return Err(err(
-            LogErrorKind::NoData,
-            line_no,
-            None,
-            "no data rows after the header; the log is empty or holds only comments".into(),
-        ));
+
+    fn malformed<W: Write>(&mut self, writer: &mut LogWriter<W>) {
+        for counts in &mut self.per_axis {
+            push_invalid(writer);
+            counts[Status::Invalid as usize] += 1;
+        }
     }
-    if let Some(c) = cadence.as_mut() {
-        c.finish(mode, source, line_no)?;
-        summary.warnings.extend(c.warning());
-    }
-    Ok(summary)
 }
 
 /// Compensate the unit log `input` into the CSV file `out` ([`Mode::Strict`]), written to a

@@ -658,6 +658,144 @@ impl Cadence {
     }
 }
 
+/// The part of the line loop that belongs to the model: a single gyro's compensator, or a
+/// unit's axes. [`run_lines`] does the rest, alike for both.
+pub(crate) trait LineModel {
+    /// Read the model's gyro and temperature fields of a line already split (its time read);
+    /// an error makes the line malformed.
+    fn parse(
+        &mut self,
+        fields: &Fields,
+        line: &[u8],
+        check: &LineCheck<'_>,
+        line_no: u64,
+    ) -> Result<(), LinesError>;
+    /// Step at `time_s` with what [`LineModel::parse`] read, and write the columns it adds.
+    fn step<W: Write>(&mut self, time_s: f64, writer: &mut LogWriter<W>);
+    /// Write the columns it adds to a line with no usable output (all `invalid`).
+    fn malformed<W: Write>(&mut self, writer: &mut LogWriter<W>);
+}
+
+/// Lines read after the header.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LineCounts {
+    /// Data lines written (= data lines read).
+    pub rows: u64,
+    /// Lines written as malformed ([`Mode::Stream`] only).
+    pub malformed: u64,
+}
+
+/// The data lines after the header (ending at line `line_no`) into `output`, whose header is
+/// the input's and the model's `added` columns (refused when the input has one of them
+/// already): each line split and its time read ([`split_and_time`]), the model's fields
+/// parsed and stepped, and written with every input field as it was, then the model's columns; a malformed line stops a [`Mode::Strict`] run
+/// and is written as `invalid` in a [`Mode::Stream`] one. `cadence` judges the time steps;
+/// its warning is the caller's to take.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run_lines<'a, R: BufRead, W: Write, M: LineModel>(
+    input: &mut R,
+    output: W,
+    flush_each_row: bool,
+    check: &LineCheck<'a>,
+    added: impl IntoIterator<Item = &'a str> + Clone,
+    mut line_no: u64,
+    cadence: &mut Cadence,
+    model: &mut M,
+) -> Result<LineCounts, LinesError> {
+    let (source, mode, n_fields) = (check.source, check.mode, check.headers.len());
+    check_added_columns(check.headers, added.clone(), source, line_no)?;
+    let mut writer = LogWriter::with_delimiter(
+        output,
+        check.headers.iter().map(String::as_str).chain(added),
+        check.delimiter,
+    )?;
+    writer.set_flush_each_row(flush_each_row);
+    let writer = &mut writer;
+    let mut counts = LineCounts::default();
+    let mut fields = Fields::default();
+    let mut buf = Vec::new();
+    let mut last_time: Option<(f64, u64)> = None;
+    loop {
+        let read = read_line_capped(input, &mut buf, MAX_LINE_BYTES)?;
+        if read == LineRead::Eof {
+            break;
+        }
+        line_no += 1;
+        let line = match read {
+            LineRead::TooLong if mode == Mode::Strict => {
+                return Err(too_long_error(source, line_no))
+            }
+            LineRead::TooLong => None,
+            _ => match record(&buf) {
+                Some(line) => Some(line),
+                None => continue,
+            },
+        };
+        counts.rows += 1;
+        let parsed = line.map(|line| {
+            split_and_time(&mut fields, line, check, line_no, last_time)
+                .and_then(|t| model.parse(&fields, line, check, line_no).map(|()| t))
+        });
+        match parsed {
+            Some(Ok(time_s)) => {
+                if let Some((t0, _)) = last_time {
+                    cadence.step(time_s - t0, mode, source, line_no)?;
+                }
+                last_time = Some((time_s, line_no));
+                let line = line.unwrap_or_default();
+                for k in 0..fields.len() {
+                    writer.push_raw(fields.get(line, k));
+                }
+                model.step(time_s, writer);
+            }
+            Some(Err(e)) if mode == Mode::Strict => return Err(e),
+            // A line too long keeps none of its fields; one that does not split into the
+            // header's fields keeps them empty.
+            _ => {
+                let keep = line.filter(|_| fields.len() == n_fields);
+                for k in 0..n_fields {
+                    writer.push_raw(keep.map_or(&[][..], |line| fields.get(line, k)));
+                }
+                model.malformed(writer);
+                counts.malformed += 1;
+            }
+        }
+        writer.end_row()?;
+    }
+    writer.flush()?;
+    if counts.rows == 0 {
+        return Err(LinesError::Log(LogError::new(
+            LogErrorKind::NoData,
+            source,
+            Some(line_no),
+            None,
+            "no data rows after the header; the log is empty or holds only comments",
+        )));
+    }
+    cadence.finish(mode, source, line_no)?;
+    Ok(counts)
+}
+
+/// A gyro field of `line` that is not a number: the error naming its column.
+pub(crate) fn gyro_not_a_number(
+    check: &LineCheck<'_>,
+    fields: &Fields,
+    line: &[u8],
+    line_no: u64,
+    k: usize,
+) -> LinesError {
+    LinesError::Log(LogError::new(
+        LogErrorKind::NotANumber,
+        check.source,
+        Some(line_no),
+        Some(&check.headers[k]),
+        format!(
+            "{:?} is not a number; fix the value or comment the line out with '#'",
+            String::from_utf8_lossy(fields.get(line, k))
+        ),
+    ))
+}
+
 /// Refuses a log whose header already has a column compensation adds (a log compensated
 /// before): the output would hold two columns of one name, and a reader would take either.
 pub(crate) fn check_added_columns<'a>(
@@ -702,12 +840,8 @@ pub fn compensate_lines<R: BufRead, W: Write>(
     mode: Mode,
     flush_each_row: bool,
 ) -> Result<LinesSummary, LinesError> {
-    let mut comp = crate::compensate::compensator(model).map_err(LinesError::Model)?;
-    // The file's map was checked when it was loaded.
-    let cover = model.coverage.as_ref().and_then(|c| c.to_core().ok());
-    let (headers, mut line_no) = read_header(&mut input, source, opts)?;
-    let mut buf = Vec::new();
-    let too_long = |line| too_long_error(source, line);
+    let comp = crate::compensate::compensator(model).map_err(LinesError::Model)?;
+    let (headers, line_no) = read_header(&mut input, source, opts)?;
     let col = |name: &str| headers.iter().position(|h| h == name);
     let (Some(ti), Some(gi), Some(ci)) = (
         col(&opts.time_col),
@@ -723,146 +857,127 @@ pub fn compensate_lines<R: BufRead, W: Write>(
             "a mapped column is missing from the header",
         )));
     };
-    check_added_columns(&headers, OUTPUT_COLUMNS, source, line_no)?;
-    let gyro_scale = opts.gyro_unit.dps_per_unit();
-    let delimiter = opts.delimiter;
-    let decimal_comma = delimiter != b',';
-    let mut writer = LogWriter::with_delimiter(
-        output,
-        headers.iter().map(String::as_str).chain(OUTPUT_COLUMNS),
-        delimiter,
-    )?;
-    writer.set_flush_each_row(flush_each_row);
-    let err = |kind, line, column: Option<&str>, message: String| {
-        LinesError::Log(LogError::new(kind, source, Some(line), column, message))
-    };
-    let mut summary = LinesSummary::default();
-    let mut fields = Fields::default();
-    let mut last_time: Option<(f64, u64)> = None;
-    let mut temp_seen = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut rate_seen = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut cadence = Cadence::new(comp.spec(), comp.limits().degraded_after_s);
     let check = LineCheck {
         source,
         headers: &headers,
-        delimiter,
+        delimiter: opts.delimiter,
         time_index: ti,
         mode,
     };
-    loop {
-        let read = read_line_capped(&mut input, &mut buf, MAX_LINE_BYTES)?;
-        if read == LineRead::Eof {
-            break;
-        }
-        line_no += 1;
-        if read == LineRead::TooLong {
-            if mode == Mode::Strict {
-                return Err(too_long(line_no));
-            }
-            summary.rows += 1;
-            for _ in 0..headers.len() + 3 {
-                writer.push_raw(b"");
-            }
-            writer.push_raw(Status::Invalid.as_str().as_bytes());
-            push_verdict(&mut writer, None);
-            summary.count(Status::Invalid);
-            summary.malformed += 1;
-            writer.end_row()?;
-            continue;
-        }
-        let Some(line) = record(&buf) else {
-            continue;
-        };
-        summary.rows += 1;
-        // Parse; `None` is a malformed line (with the reason for strict mode).
-        let parsed: Result<(f64, f64, f64), LinesError> = (|| {
-            let time_s = split_and_time(&mut fields, line, &check, line_no, last_time)?;
-            let gyro = match parse_number(fields.get(line, gi), decimal_comma) {
-                Some(g) => g * gyro_scale,
-                None => {
-                    return Err(err(
-                        LogErrorKind::NotANumber,
-                        line_no,
-                        Some(&headers[gi]),
-                        format!(
-                            "{:?} is not a number; fix the value or comment the line out \
-                             with '#'",
-                            String::from_utf8_lossy(fields.get(line, gi))
-                        ),
-                    ))
-                }
-            };
-            // A temperature that is not a number is a sensor fault: NaN, held.
-            let temp = parse_number(fields.get(line, ci), decimal_comma).unwrap_or(f64::NAN);
-            Ok((time_s, gyro, temp))
-        })();
-        let c: Option<Corrected> = match parsed {
-            Ok((t, g, temp)) => {
-                if let Some((t0, _)) = last_time {
-                    cadence.step(t - t0, mode, source, line_no)?;
-                }
-                last_time = Some((t, line_no));
-                Some(comp.step(t, g, temp))
-            }
-            Err(e) if mode == Mode::Strict => return Err(e),
-            Err(_) => None,
-        };
-        match c {
-            Some(c) => {
-                for k in 0..fields.len() {
-                    writer.push_raw(fields.get(line, k));
-                }
-                writer.push_f64(c.bias_dps);
-                writer.push_f64(c.scale);
-                match c.rate() {
-                    Some(r) => writer.push_f64(r),
-                    None => writer.push_raw(b""),
-                }
-                writer.push_raw(c.status.as_str().as_bytes());
-                summary.count(c.status);
-                let verdict = cover.as_ref().and_then(|m| m.verdict_of(comp.features()));
-                if let Some(v) = verdict {
-                    summary.coverage[v.coverage as usize] += 1;
-                }
-                push_verdict(&mut writer, verdict);
-                if c.status == Status::Ok {
-                    if let Some([t, r, ..]) = comp.features().map(|f| f.as_slice()) {
-                        temp_seen = (temp_seen.0.min(*t), temp_seen.1.max(*t));
-                        rate_seen = (rate_seen.0.min(*r), rate_seen.1.max(*r));
-                    }
-                }
-            }
-            None => {
-                let keep = fields.len() == headers.len();
-                for k in 0..headers.len() {
-                    writer.push_raw(if keep { fields.get(line, k) } else { b"" });
-                }
-                for _ in 0..3 {
-                    writer.push_raw(b"");
-                }
-                writer.push_raw(Status::Invalid.as_str().as_bytes());
-                push_verdict(&mut writer, None);
-                summary.count(Status::Invalid);
-                summary.malformed += 1;
-            }
-        }
-        writer.end_row()?;
-    }
-    writer.flush()?;
-    if summary.rows == 0 {
-        return Err(err(
-            LogErrorKind::NoData,
-            line_no,
-            None,
-            "no data rows after the header; the log is empty or holds only comments".into(),
-        ));
-    }
-    cadence.finish(mode, source, line_no)?;
+    let mut cadence = Cadence::new(comp.spec(), comp.limits().degraded_after_s);
+    let mut gyro = OneGyro {
+        // The file's map was checked when it was loaded.
+        cover: model.coverage.as_ref().and_then(|c| c.to_core().ok()),
+        comp,
+        columns: (gi, ci),
+        gyro_scale: opts.gyro_unit.dps_per_unit(),
+        read: (0.0, 0.0),
+        summary: LinesSummary::default(),
+        temp_seen: (f64::INFINITY, f64::NEG_INFINITY),
+        rate_seen: (f64::INFINITY, f64::NEG_INFINITY),
+    };
+    let counts = run_lines(
+        &mut input,
+        output,
+        flush_each_row,
+        &check,
+        OUTPUT_COLUMNS,
+        line_no,
+        &mut cadence,
+        &mut gyro,
+    )?;
+    let OneGyro {
+        mut summary,
+        temp_seen,
+        rate_seen,
+        ..
+    } = gyro;
+    (summary.rows, summary.malformed) = (counts.rows, counts.malformed);
     if temp_seen.0 <= temp_seen.1 {
         summary.warnings = crate::compensate::range_warnings(model, temp_seen, rate_seen);
     }
     summary.warnings.extend(cadence.warning());
     Ok(summary)
+}
+
+/// A single gyro's part of the line loop: one compensator, its coverage verdict per line, and
+/// the temperatures and rates it ran on (for the extrapolation warnings).
+struct OneGyro {
+    comp: crate::flight_size::FlightCompensator,
+    cover: Option<gyrotherm_core::coverage::CoverageMap>,
+    /// The gyro and temperature columns' indices.
+    columns: (usize, usize),
+    gyro_scale: f64,
+    /// The line's gyro (°/s) and temperature, as parsed.
+    read: (f64, f64),
+    summary: LinesSummary,
+    temp_seen: (f64, f64),
+    rate_seen: (f64, f64),
+}
+
+impl LineModel for OneGyro {
+    fn parse(
+        &mut self,
+        fields: &Fields,
+        line: &[u8],
+        check: &LineCheck<'_>,
+        line_no: u64,
+    ) -> Result<(), LinesError> {
+        let decimal_comma = check.delimiter != b',';
+        let (gi, ci) = self.columns;
+        let Some(gyro) = parse_number(fields.get(line, gi), decimal_comma) else {
+            return Err(gyro_not_a_number(check, fields, line, line_no, gi));
+        };
+        // A temperature that is not a number is a sensor fault: NaN, held.
+        let temp = parse_number(fields.get(line, ci), decimal_comma).unwrap_or(f64::NAN);
+        self.read = (gyro * self.gyro_scale, temp);
+        Ok(())
+    }
+
+    fn step<W: Write>(&mut self, time_s: f64, writer: &mut LogWriter<W>) {
+        let c = self.comp.step(time_s, self.read.0, self.read.1);
+        push_corrected(writer, &c);
+        self.summary.count(c.status);
+        let verdict = self
+            .cover
+            .as_ref()
+            .and_then(|m| m.verdict_of(self.comp.features()));
+        if let Some(v) = verdict {
+            self.summary.coverage[v.coverage as usize] += 1;
+        }
+        push_verdict(writer, verdict);
+        if c.status == Status::Ok {
+            if let Some([t, r, ..]) = self.comp.features().map(|f| f.as_slice()) {
+                self.temp_seen = (self.temp_seen.0.min(*t), self.temp_seen.1.max(*t));
+                self.rate_seen = (self.rate_seen.0.min(*r), self.rate_seen.1.max(*r));
+            }
+        }
+    }
+
+    fn malformed<W: Write>(&mut self, writer: &mut LogWriter<W>) {
+        push_invalid(writer);
+        push_verdict(writer, None);
+        self.summary.count(Status::Invalid);
+    }
+}
+
+/// The `bias_dps` (or `G_bias`), `scale`, compensated rate and `status` fields of a step.
+pub(crate) fn push_corrected<W: Write>(writer: &mut LogWriter<W>, c: &Corrected) {
+    writer.push_f64(c.bias_dps);
+    writer.push_f64(c.scale);
+    match c.rate() {
+        Some(r) => writer.push_f64(r),
+        None => writer.push_raw(b""),
+    }
+    writer.push_raw(c.status.as_str().as_bytes());
+}
+
+/// The same four fields of a line with no usable output: empty, and `invalid`.
+pub(crate) fn push_invalid<W: Write>(writer: &mut LogWriter<W>) {
+    for _ in 0..3 {
+        writer.push_raw(b"");
+    }
+    writer.push_raw(Status::Invalid.as_str().as_bytes());
 }
 
 /// The `coverage` and `sigma_dph` fields of an output row (both empty without a verdict).
