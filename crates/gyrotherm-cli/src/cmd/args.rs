@@ -46,10 +46,7 @@ pub struct FitArgs {
     /// Random seed of the LSTM initialisation and window order.
     #[arg(long, default_value_t = fit::DEFAULT_SEED)]
     pub seed: u64,
-    /// Hidden units of the method's LSTM: 8, 16, 32 or 64, the sizes flight code and its
-    /// exports are built for (default: the method's own, 8 as published, 32 for
-    /// thermal-lstm).
-    #[arg(long)]
+    #[arg(long, help = fit::hidden_help())]
     pub hidden: Option<usize>,
     /// Bias target smoothing window, s (centred moving average; 100 s as published).
     #[arg(long, default_value_t = fit::DEFAULT_BIAS_WINDOW_S,

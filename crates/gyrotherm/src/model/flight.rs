@@ -5,7 +5,7 @@ use super::*;
 
 use crate::flight_size::HiddenSize;
 use gyrotherm_core::compensator::ModelError as FlightModelError;
-use gyrotherm_core::compensator::{NormalisedLstm, TargetModel, HIDDEN_SIZES, LSTM_INPUTS};
+use gyrotherm_core::compensator::{NormalisedLstm, TargetModel, LSTM_INPUTS};
 
 /// Widen an LSTM to the flight input count and `H` hidden units: input columns beyond
 /// `input_size` get weight 0, and so do hidden units beyond `hidden_size` (their state stays
@@ -132,7 +132,7 @@ impl std::fmt::Display for CompensateError {
             CompensateError::HiddenSize { hidden } => write!(
                 f,
                 "the LSTM has {hidden} hidden units; flight code runs {}",
-                sizes_text()
+                crate::settings::fit::hidden_sizes_text()
             ),
             CompensateError::Params(e) => e.fmt(f),
             CompensateError::Baseline(e) => e.fmt(f),
@@ -154,14 +154,5 @@ impl std::error::Error for CompensateError {
             CompensateError::Flight(e) => e.source(),
             CompensateError::LstmInputs { .. } | CompensateError::HiddenSize { .. } => None,
         }
-    }
-}
-
-/// "8, 16, 32 or 64": the sizes flight code runs.
-pub(crate) fn sizes_text() -> String {
-    let n: Vec<String> = HIDDEN_SIZES.iter().map(|h| h.to_string()).collect();
-    match n.split_last() {
-        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
-        _ => n.join(""),
     }
 }

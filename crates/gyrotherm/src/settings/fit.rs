@@ -27,6 +27,29 @@ pub const DEFAULT_HIDDEN: usize = 8;
 /// (docs/experiments/lstm-capacity.md). A `hidden` setting, when given, overrides it.
 pub const THERMAL_LSTM_HIDDEN: usize = 32;
 
+/// The hidden sizes flight code and its exports are built for, as text: "8, 16, 32 or 64".
+pub fn hidden_sizes_text() -> String {
+    let n: Vec<String> = gyrotherm_core::compensator::HIDDEN_SIZES
+        .iter()
+        .map(|h| h.to_string())
+        .collect();
+    match n.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => n.join(""),
+    }
+}
+
+/// What the hidden-size setting does, with the sizes it takes and its defaults: the help
+/// of every front end's option.
+pub fn hidden_help() -> String {
+    format!(
+        "Hidden units of the method's LSTM: {}, the sizes flight code and its exports are \
+         built for (default: the method's own, {DEFAULT_HIDDEN} as published, \
+         {THERMAL_LSTM_HIDDEN} for thermal-lstm)",
+        hidden_sizes_text()
+    )
+}
+
 /// Default least relative drop of an inertial-unit axis's cross-validated RMS for a further
 /// temperature sensor to join its model: −1, a sensor joins unless it doubles the
 /// cross-validated RMS (chosen on the design family against +0.02, which kept one sensor
