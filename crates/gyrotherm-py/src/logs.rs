@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use gyrotherm::csvlog::{self, GyroUnit, ReadOptions, TestLog};
+use gyrotherm::csvlog::{self, GyroUnit, ImuLog, ReadOptions, TestLog};
 use gyrotherm::settings::read;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -12,7 +12,6 @@ use crate::{py_err, LogError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
-    m.add_function(wrap_pyfunction!(reads_unit, m)?)?;
     Ok(())
 }
 
@@ -80,20 +79,16 @@ pub fn read_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     Ok(out)
 }
 
-/// Whether reading `paths` with `options` gives inertial units (several gyro or temperature
-/// columns named, or a format that holds a unit: an autopilot's log).
-#[pyfunction]
-fn reads_unit(paths: Vec<PathBuf>, options: LogOptions) -> PyResult<bool> {
-    Ok(options.read_options()?.reads_unit(&paths))
-}
-
 /// Read a whole log; the error is the library's message (file, line, column, the fix).
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<(TestLog, csvlog::ReadReport), String> {
     csvlog::read_log(path, opts).map_err(|e| gyrotherm::error_chain(&e))
 }
 
 /// Read a log into a dict of numpy arrays (extra columns: float arrays when every value is a
-/// number, else lists of str) and a report dict.
+/// number, else lists of str) and a report dict: a single gyro's, or an inertial unit's when
+/// the options name several columns or the file holds a unit (the library says which,
+/// [`ReadOptions::reads_unit`]); a unit's report also names its gyro and temperature columns
+/// and the table's axis.
 #[pyfunction]
 fn read_log<'py>(
     py: Python<'py>,
@@ -101,11 +96,43 @@ fn read_log<'py>(
     options: LogOptions,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let opts = options.read_options()?;
-    let (log, report) = py
-        .detach(|| read(&path, &opts))
-        .map_err(LogError::new_err)?;
-    let sample_period = log.sample_period_s();
     let cols = PyDict::new(py);
+    let rep = PyDict::new(py);
+    let (report, sample_period) = if opts.reads_unit(&[&path]) {
+        let (log, report) = py
+            .detach(|| csvlog::read_imu_log(&path, &opts, options.table_axis.as_deref()))
+            .map_err(|e| LogError::new_err(gyrotherm::error_chain(&e)))?;
+        // As the single-axis reader states it: the first axis's view.
+        let period = match (log.gyro.is_empty(), log.temp.is_empty()) {
+            (false, false) => gyrotherm::imu_judge::axis_test_log(&log, 0, 0).sample_period_s(),
+            _ => f64::NAN,
+        };
+        unit_columns(&cols, &rep, log)?;
+        (report, period)
+    } else {
+        let (log, report) = py
+            .detach(|| read(&path, &opts))
+            .map_err(LogError::new_err)?;
+        let period = log.sample_period_s();
+        gyro_columns(&cols, &opts, log)?;
+        (report, period)
+    };
+    rep.set_item("rows", report.rows)?;
+    rep.set_item("filled_samples", report.filled_samples)?;
+    rep.set_item("filled_gaps", report.filled_gaps)?;
+    rep.set_item(
+        "sample_period_s",
+        sample_period.is_finite().then_some(sample_period),
+    )?;
+    rep.set_item("sample_period_estimated", report.sample_period_estimated)?;
+    rep.set_item("path", path.display().to_string())?;
+    Ok((cols, rep))
+}
+
+/// A single gyro's columns under the file's names (the user's columns), as a unit's are
+/// keyed; the gyro in °/s.
+fn gyro_columns(cols: &Bound<'_, PyDict>, opts: &ReadOptions, log: TestLog) -> PyResult<()> {
+    let py = cols.py();
     let extras: Vec<(String, Option<Vec<f64>>, Vec<String>)> = log
         .extra
         .iter()
@@ -118,8 +145,6 @@ fn read_log<'py>(
         table_dps,
         ..
     } = log;
-    // Under the file's names (the user's columns), as the unit reader keys them; the gyro in
-    // °/s.
     cols.set_item(&opts.time_col, time_s.into_pyarray(py))?;
     cols.set_item(&opts.gyro_col, gyro_dps.into_pyarray(py))?;
     cols.set_item(&opts.temp_col, temp_c.into_pyarray(py))?;
@@ -132,15 +157,44 @@ fn read_log<'py>(
             None => cols.set_item(name, text)?,
         }
     }
-    let rep = PyDict::new(py);
-    rep.set_item("rows", report.rows)?;
-    rep.set_item("filled_samples", report.filled_samples)?;
-    rep.set_item("filled_gaps", report.filled_gaps)?;
+    Ok(())
+}
+
+/// A unit's columns: time, each gyro (°/s) and temperature under its name, the table rate as
+/// `table_dps`, the pass-through columns; the report's gyro and temperature columns and
+/// table axis.
+fn unit_columns(cols: &Bound<'_, PyDict>, rep: &Bound<'_, PyDict>, log: ImuLog) -> PyResult<()> {
+    let py = cols.py();
     rep.set_item(
-        "sample_period_s",
-        sample_period.is_finite().then_some(sample_period),
+        "gyro_cols",
+        log.gyro.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
     )?;
-    rep.set_item("sample_period_estimated", report.sample_period_estimated)?;
-    rep.set_item("path", path.display().to_string())?;
-    Ok((cols, rep))
+    rep.set_item(
+        "temp_cols",
+        log.temp.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
+    )?;
+    rep.set_item("table_axis", log.table_axis.clone())?;
+    let ImuLog {
+        time_s,
+        gyro,
+        temp,
+        table,
+        extra,
+        ..
+    } = log;
+    cols.set_item(csvlog::TIME_COL, time_s.into_pyarray(py))?;
+    for s in gyro.into_iter().chain(temp) {
+        cols.set_item(s.name, s.values.into_pyarray(py))?;
+    }
+    if let Some(t) = table {
+        cols.set_item(csvlog::DEFAULT_TABLE_COL, t.values.into_pyarray(py))?;
+    }
+    for c in extra {
+        let numeric: Option<Vec<f64>> = c.values.iter().map(|v| v.trim().parse().ok()).collect();
+        match numeric {
+            Some(v) => cols.set_item(c.name, v.into_pyarray(py))?,
+            None => cols.set_item(c.name, c.values)?,
+        }
+    }
+    Ok(())
 }

@@ -1,10 +1,8 @@
-//! Inertial units: logs read with column lists (`read_imu_log`), the unit fit (`fit_unit`,
-//! the CLI's `train` with `--gyro-col`/`--temp-col` lists) and the unit model file
-//! (`RawUnitModel`: load, save, compensate per axis).
+//! Inertial units: the unit model file (`RawUnitModel`: load, save, compensate per axis).
 
 use std::path::PathBuf;
 
-use gyrotherm::csvlog::{self, ImuLog, NamedSeries};
+use gyrotherm::csvlog::{ImuLog, NamedSeries};
 use gyrotherm::imu_model::{self, ImuModel};
 use gyrotherm::unit_model::{Form, Model};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -12,85 +10,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::allan::slice;
-use crate::logs::LogOptions;
 use crate::model::RawModel;
-use crate::{py_err, CompensationError, LogError, ModelError};
+use crate::{py_err, CompensationError, ModelError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RawUnitModel>()?;
-    m.add_function(wrap_pyfunction!(read_imu_log, m)?)?;
     m.add_function(wrap_pyfunction!(load_model, m)?)?;
     Ok(())
-}
-
-fn read(path: &std::path::Path, options: &LogOptions) -> PyResult<(ImuLog, csvlog::ReadReport)> {
-    let opts = options.read_options()?;
-    csvlog::read_imu_log(path, &opts, options.table_axis.as_deref())
-        .map_err(|e| LogError::new_err(gyrotherm::error_chain(&e)))
-}
-
-/// Read a unit log: a dict of numpy arrays (time, each gyro in °/s and each temperature
-/// under its column name, the table rate as `table_dps`, the pass-through columns) and a
-/// report dict (with the gyro and temperature columns and the table's axis).
-#[pyfunction]
-fn read_imu_log<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-    options: LogOptions,
-) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
-    let (log, report) = py.detach(|| read(&path, &options))?;
-    let sample_period = imu_judge_period(&log);
-    let cols = PyDict::new(py);
-    let rep = PyDict::new(py);
-    rep.set_item(
-        "gyro_cols",
-        log.gyro.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-    )?;
-    rep.set_item(
-        "temp_cols",
-        log.temp.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-    )?;
-    rep.set_item("table_axis", log.table_axis.clone())?;
-    let ImuLog {
-        time_s,
-        gyro,
-        temp,
-        table,
-        extra,
-        ..
-    } = log;
-    cols.set_item(csvlog::TIME_COL, time_s.into_pyarray(py))?;
-    for s in gyro.into_iter().chain(temp) {
-        cols.set_item(s.name, s.values.into_pyarray(py))?;
-    }
-    if let Some(t) = table {
-        cols.set_item(csvlog::DEFAULT_TABLE_COL, t.values.into_pyarray(py))?;
-    }
-    for c in extra {
-        let numeric: Option<Vec<f64>> = c.values.iter().map(|v| v.trim().parse().ok()).collect();
-        match numeric {
-            Some(v) => cols.set_item(c.name, v.into_pyarray(py))?,
-            None => cols.set_item(c.name, c.values)?,
-        }
-    }
-    rep.set_item("rows", report.rows)?;
-    rep.set_item("filled_samples", report.filled_samples)?;
-    rep.set_item("filled_gaps", report.filled_gaps)?;
-    rep.set_item(
-        "sample_period_s",
-        sample_period.is_finite().then_some(sample_period),
-    )?;
-    rep.set_item("sample_period_estimated", report.sample_period_estimated)?;
-    rep.set_item("path", path.display().to_string())?;
-    Ok((cols, rep))
-}
-
-/// The sample period as the single-axis reader states it (the first axis's view).
-fn imu_judge_period(log: &ImuLog) -> f64 {
-    if log.gyro.is_empty() || log.temp.is_empty() {
-        return f64::NAN;
-    }
-    gyrotherm::imu_judge::axis_test_log(log, 0, 0).sample_period_s()
 }
 
 /// Read and check a model file of either form (`gyrotherm::unit_model::Model::load`): a

@@ -44,13 +44,6 @@ def read_options(options: Dict[str, Any]) -> Dict[str, Any]:
     return out
 
 
-def is_unit(options: Dict[str, Any], paths=()) -> bool:
-    """Whether full options (:func:`read_options`) name several gyro or temperature columns,
-    or a log of ``paths`` is of a format that holds a unit (PX4 ULog, ArduPilot DataFlash):
-    an inertial unit's log."""
-    return _g.reads_unit([os.fspath(p) for p in paths], options)
-
-
 def _pandas():
     try:
         import pandas  # noqa: F401
@@ -85,8 +78,7 @@ def read_log(path: PathLike, *, as_frame: Optional[bool] = None, **options: Any)
     Raises ``gyrotherm.LogError`` naming file, line and column.
     """
     opts = read_options(options)
-    reader = _g.read_imu_log if is_unit(opts, [path]) else _g.read_log
-    cols, report = reader(os.fspath(path), opts)
+    cols, report = _g.read_log(os.fspath(path), opts)
     pd = _pandas()
     if as_frame is None:
         as_frame = pd is not None
