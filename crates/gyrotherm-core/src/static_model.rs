@@ -174,7 +174,9 @@ pub struct StaticSensor {
 }
 
 impl<const H: usize> StaticTarget<H> {
-    fn to_target(&self) -> Result<TargetModel<H>, ModelError> {
+    /// The compensator's model of this target, checked as [`Compensator::from_static`]
+    /// checks it.
+    pub fn to_target(&self) -> Result<TargetModel<H>, ModelError> {
         let baseline = match &self.baseline {
             None => None,
             Some(b) => Some(b.to_model()?),

@@ -26,12 +26,11 @@ use std::path::{Path, PathBuf};
 use gyrotherm_core::compensator::LSTM_INPUTS;
 use gyrotherm_core::coverage::{MAX_RATE_CELLS, MAX_TEMP_CELLS};
 use gyrotherm_core::features::MAX_FEATURES;
-use gyrotherm_core::static_model::{
-    StaticBaseline, StaticCoverage, StaticLstm, StaticModel, StaticTarget,
-};
+use gyrotherm_core::static_model::{StaticCoverage, StaticModel};
 
 use crate::compensate::CompensateError;
-use crate::model::{ModelFile, ModelFileError, SubModel, Target, CHECKSUM_KEY};
+pub(crate) use crate::model::static_baseline;
+use crate::model::{static_target, ModelFile, ModelFileError, SubModel, Target, CHECKSUM_KEY};
 
 /// Why a model cannot be exported.
 #[derive(Debug)]
@@ -183,71 +182,6 @@ fn static_coverage(model: &ModelFile) -> Result<Option<StaticCoverage>, ExportEr
         sigma_dph,
         growth_per_cell: map.growth_per_cell(),
     }))
-}
-
-/// A core baseline as plain data.
-pub(crate) fn static_baseline(b: &gyrotherm_core::baseline::BaselineModel) -> StaticBaseline {
-    let mut s = StaticBaseline {
-        n_features: b.n_features() as u8,
-        n_terms: b.n_terms() as u8,
-        powers: [[0; MAX_FEATURES]; gyrotherm_core::baseline::MAX_TERMS],
-        coefficients: [0.0; gyrotherm_core::baseline::MAX_TERMS],
-    };
-    for j in 0..b.n_terms() {
-        if let Some((p, c)) = b.term(j) {
-            s.powers[j][..p.len()].copy_from_slice(p);
-            s.coefficients[j] = c;
-        }
-    }
-    s
-}
-
-fn static_target<const H: usize>(
-    sub: Option<&SubModel>,
-    absent: f64,
-) -> Result<StaticTarget<H>, CompensateError> {
-    let Some(sub) = sub else {
-        return Ok(StaticTarget::constant(absent));
-    };
-    let baseline = sub
-        .baseline_core()
-        .transpose()
-        .map_err(CompensateError::Baseline)?
-        .map(|b| static_baseline(&b));
-    let lstm = match sub.lstm() {
-        Some((params, input_norm, target_norm)) => {
-            let w = crate::compensate::padded_core_lstm::<H>(params)?;
-            let n = input_norm.mean.len();
-            if n > MAX_FEATURES {
-                return Err(CompensateError::LstmInputs { inputs: n });
-            }
-            let mut mean = [0.0; MAX_FEATURES];
-            let mut std = [1.0; MAX_FEATURES];
-            mean[..n].copy_from_slice(&input_norm.mean);
-            std[..n].copy_from_slice(&input_norm.std);
-            Some(StaticLstm {
-                w_ih: *w.w_ih(),
-                w_hh: *w.w_hh(),
-                b_ih: *w.b_ih(),
-                b_hh: *w.b_hh(),
-                w_out: *w.w_out(),
-                b_out: w.b_out(),
-                n_inputs: n as u8,
-                input_mean: mean,
-                input_std: std,
-                target_mean: target_norm.mean[0],
-                target_std: target_norm.std[0],
-            })
-        }
-        None => None,
-    };
-    let lstm_reads_base = sub.reads_base();
-    Ok(StaticTarget {
-        offset: 0.0,
-        baseline,
-        lstm,
-        lstm_reads_base,
-    })
 }
 
 // The generators index the core's arrays by these sizes.

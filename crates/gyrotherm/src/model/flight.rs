@@ -5,7 +5,9 @@ use super::*;
 
 use crate::flight_size::HiddenSize;
 use gyrotherm_core::compensator::ModelError as FlightModelError;
-use gyrotherm_core::compensator::{NormalisedLstm, TargetModel, LSTM_INPUTS};
+use gyrotherm_core::compensator::{TargetModel, LSTM_INPUTS};
+use gyrotherm_core::features::MAX_FEATURES;
+use gyrotherm_core::static_model::{StaticBaseline, StaticLstm, StaticTarget};
 
 /// Widen an LSTM to the flight input count and `H` hidden units: input columns beyond
 /// `input_size` get weight 0, and so do hidden units beyond `hidden_size` (their state stays
@@ -54,47 +56,84 @@ pub fn hidden_size<'a>(
     Ok(size)
 }
 
-fn core_lstm<const H: usize>(
-    params: &LstmParams,
-    input_norm: &ZScore,
-    target_norm: &ZScore,
-) -> Result<NormalisedLstm<H>, CompensateError> {
-    let w = padded_core_lstm::<H>(params)?;
-    NormalisedLstm::new(
-        &w,
-        &input_norm.mean,
-        &input_norm.std,
-        target_norm.mean[0],
-        target_norm.std[0],
-    )
-    .map_err(CompensateError::Flight)
-}
-
-/// The flight model of one target (`None`: the constant `absent`) at `H` hidden units.
+/// The flight model of one target (`None`: the constant `absent`) at `H` hidden units: the
+/// compensator's own conversion of its flight form ([`static_target`]), so that what runs on
+/// the ground is what an export carries.
 pub fn target_model<const H: usize>(
     sub: Option<&SubModel>,
     absent: f64,
 ) -> Result<TargetModel<H>, CompensateError> {
+    static_target(sub, absent)?
+        .to_target()
+        .map_err(CompensateError::Flight)
+}
+
+/// The flight form of one target (`None`: the constant `absent`) at `H` hidden units, as plain
+/// data: its baseline's terms, and its LSTM widened to `H` units and the flight input count
+/// ([`padded_core_lstm`]) with its normalisation. Both the compensator ([`target_model`]) and
+/// the exports are made from it.
+pub fn static_target<const H: usize>(
+    sub: Option<&SubModel>,
+    absent: f64,
+) -> Result<StaticTarget<H>, CompensateError> {
     let Some(sub) = sub else {
-        return Ok(TargetModel::constant(absent));
+        return Ok(StaticTarget::constant(absent));
     };
     let baseline = sub
         .baseline_core()
         .transpose()
-        .map_err(CompensateError::Baseline)?;
+        .map_err(CompensateError::Baseline)?
+        .map(|b| static_baseline(&b));
     let lstm = match sub.lstm() {
         Some((params, input_norm, target_norm)) => {
-            Some(core_lstm(params, input_norm, target_norm)?)
+            let w = padded_core_lstm::<H>(params)?;
+            let n = input_norm.mean.len();
+            if n > MAX_FEATURES {
+                return Err(CompensateError::LstmInputs { inputs: n });
+            }
+            let mut mean = [0.0; MAX_FEATURES];
+            let mut std = [1.0; MAX_FEATURES];
+            mean[..n].copy_from_slice(&input_norm.mean);
+            std[..n].copy_from_slice(&input_norm.std);
+            Some(StaticLstm {
+                w_ih: *w.w_ih(),
+                w_hh: *w.w_hh(),
+                b_ih: *w.b_ih(),
+                b_hh: *w.b_hh(),
+                w_out: *w.w_out(),
+                b_out: w.b_out(),
+                n_inputs: n as u8,
+                input_mean: mean,
+                input_std: std,
+                target_mean: target_norm.mean[0],
+                target_std: target_norm.std[0],
+            })
         }
         None => None,
     };
-    let lstm_reads_base = sub.reads_base();
-    Ok(TargetModel {
+    Ok(StaticTarget {
         offset: 0.0,
         baseline,
         lstm,
-        lstm_reads_base,
+        lstm_reads_base: sub.reads_base(),
     })
+}
+
+/// A core baseline as plain data.
+pub fn static_baseline(b: &gyrotherm_core::baseline::BaselineModel) -> StaticBaseline {
+    let mut s = StaticBaseline {
+        n_features: b.n_features() as u8,
+        n_terms: b.n_terms() as u8,
+        powers: [[0; MAX_FEATURES]; gyrotherm_core::baseline::MAX_TERMS],
+        coefficients: [0.0; gyrotherm_core::baseline::MAX_TERMS],
+    };
+    for j in 0..b.n_terms() {
+        if let Some((p, c)) = b.term(j) {
+            s.powers[j][..p.len()].copy_from_slice(p);
+            s.coefficients[j] = c;
+        }
+    }
+    s
 }
 
 /// Why a model could not be turned into the flight compensator, or a log not compensated: the

@@ -679,7 +679,9 @@ mod seal;
 
 pub use checks::SubModelError;
 pub use coverage_map::CoverageDef;
-pub use flight::{hidden_size, padded_core_lstm, target_model, CompensateError};
+pub use flight::{
+    hidden_size, padded_core_lstm, static_baseline, static_target, target_model, CompensateError,
+};
 pub use ground::GroundPredictError;
 pub use method_choice::{CandidateScore, MethodChoice, Validation};
 use seal::supported_list;
