@@ -14,6 +14,12 @@
 //! sensor's one-sensor model as its `fallback` ([`ImuAxis::fallback`]), which it runs on
 //! (status `fallback`) while a further sensor is given up on.
 //!
+//! With `auto` (and [`ImuSensors::All`]) each axis keeps its several-sensor `thermal` fit,
+//! exactly as `thermal` builds it, or `thermal-lstm` on its first sensor alone, whichever
+//! scores lower on held-out validation of the training runs (as `auto` scores one gyro,
+//! [`crate::fit::auto`]); the axis's model records both scores and the choice
+//! ([`ModelFile::method_choice`]).
+//!
 //! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
 //! format is unchanged): 1 when every axis reads one sensor (as older builds wrote), 2 when
 //! an axis reads several; sealed with `content_sha256` like a single-axis file. It is read
@@ -34,6 +40,7 @@ use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 use crate::compensate::{boxed_compensator, hidden_size, sized_compensator};
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
+use crate::fit::thermal::Identified;
 use crate::fit::{
     chooses_method, fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog,
 };
@@ -46,7 +53,6 @@ use crate::model::{
 };
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
-use crate::fit::thermal::Identified;
 use crate::targets::{self, TargetSet};
 
 pub use crate::flight_size::MAX_STREAM_AXES;
@@ -898,8 +904,7 @@ fn fit_axis_auto(
                 // Too short for held-out blocks: nothing says the LSTM helps.
                 return finished(thermal);
             }
-            let (Some(t), Some(l)) = (thermal.model.bias.as_ref(), lstm.model.bias.as_ref())
-            else {
+            let (Some(t), Some(l)) = (thermal.model.bias.as_ref(), lstm.model.bias.as_ref()) else {
                 return finished(thermal);
             };
             let mut t_parts = vec![t];
@@ -1015,7 +1020,8 @@ fn leave_one_run_out(
             Some(b) => std::iter::once(&b.first).chain(&b.extra).collect(),
             None => vec![&one],
         };
-        let Some(lstm) = crate::fit::auto::lstm_on_thermal(bias0, &one, lstm_cfg).map_err(fit_err)?
+        let Some(lstm) =
+            crate::fit::auto::lstm_on_thermal(bias0, &one, lstm_cfg).map_err(fit_err)?
         else {
             continue;
         };

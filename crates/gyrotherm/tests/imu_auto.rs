@@ -80,7 +80,11 @@ fn auto_keeps_the_several_sensor_thermal_axis_where_it_scores_better() {
     let logs = runs(&[(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]);
     let (model, lines) = train_auto(logs.clone());
     let a = &model.axes[0];
-    let choice = a.model.method_choice.as_ref().expect("auto records its choice");
+    let choice = a
+        .model
+        .method_choice
+        .as_ref()
+        .expect("auto records its choice");
     assert_eq!(choice.validation, Validation::LeaveOneRunOut);
     eprintln!("{}", choice.describe());
     let methods: Vec<Method> = choice.candidates.iter().map(|c| c.method).collect();
@@ -143,7 +147,11 @@ fn auto_keeps_the_several_sensor_thermal_axis_where_it_scores_better() {
 fn with_one_static_run_auto_scores_on_held_out_blocks() {
     let (model, lines) = train_auto(runs(&[(1, None), (2, Some(0))]));
     let a = &model.axes[0];
-    let choice = a.model.method_choice.as_ref().expect("auto records its choice");
+    let choice = a
+        .model
+        .method_choice
+        .as_ref()
+        .expect("auto records its choice");
     assert_eq!(choice.validation, Validation::HeldOutBlocks);
     eprintln!("{}", choice.describe());
     let (t, l) = (
