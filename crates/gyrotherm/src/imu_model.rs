@@ -14,6 +14,12 @@
 //! sensor's one-sensor model as its `fallback` ([`ImuAxis::fallback`]), which it runs on
 //! (status `fallback`) while a further sensor is given up on.
 //!
+//! With `auto` (and [`ImuSensors::All`]) each axis keeps its several-sensor `thermal` fit,
+//! exactly as `thermal` builds it, or `thermal-lstm` on its first sensor alone, whichever
+//! scores lower on held-out validation of the training runs (as `auto` scores one gyro,
+//! [`crate::fit::auto`]); the axis's model records both scores and the choice
+//! ([`ModelFile::method_choice`]).
+//!
 //! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
 //! format is unchanged): 1 when every axis reads one sensor (as older builds wrote), 2 when
 //! an axis reads several; sealed with `content_sha256` like a single-axis file. It is read
@@ -34,7 +40,10 @@ use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 use crate::compensate::{boxed_compensator, hidden_size, sized_compensator};
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
-use crate::fit::{fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog};
+use crate::fit::thermal::Identified;
+use crate::fit::{
+    chooses_method, fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog,
+};
 use crate::flight_size::build_sized;
 use crate::flight_size::{FlightAxis, FlightCompensator, HiddenSize};
 pub use crate::imu_error::ImuError;
@@ -44,7 +53,7 @@ use crate::model::{
 };
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
-use crate::targets;
+use crate::targets::{self, TargetSet};
 
 pub use crate::flight_size::MAX_STREAM_AXES;
 
@@ -222,7 +231,9 @@ pub fn fit_imu_full(
             )));
         }
     }
-    let multi_path = settings.sensors == ImuSensors::All && uses_identification(cfg);
+    // `auto` fits each axis's several-sensor `thermal` candidate as `thermal` does.
+    let auto = settings.sensors == ImuSensors::All && chooses_method(cfg);
+    let multi_path = settings.sensors == ImuSensors::All && (uses_identification(cfg) || auto);
     // What the lag search takes of each temperature column depends on no axis: made once per
     // sensor and run (a thread per sensor) for all the axes that read it.
     let shared: Vec<Vec<Option<SharedTables>>> = if multi_path {
@@ -252,7 +263,20 @@ pub fn fit_imu_full(
             .map(|k| {
                 let (gyro_cols, temp_cols, shared) = (&gyro_cols, &temp_cols, &shared);
                 scope.spawn(move || {
-                    let axis = if multi_path {
+                    let axis = if auto {
+                        fit_axis_auto(
+                            logs,
+                            shared,
+                            k,
+                            gyro_cols,
+                            temp_cols,
+                            cfg,
+                            settings,
+                            temp_sensor,
+                            progress,
+                            events,
+                        )
+                    } else if multi_path {
                         fit_axis_multi(
                             logs,
                             shared,
@@ -392,23 +416,90 @@ fn fit_axis(
 /// A temperature column's features for the lag search (published spec, no lags).
 type SharedTables = (crate::features::FeatureTable, crate::features::FeatureTable);
 
-/// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
-/// the sensors chosen by cross-validation, one fit over the chosen sensors; `shared` the
-/// temperature columns' search features per sensor and run (empty: made here).
-#[allow(clippy::too_many_arguments)]
-fn fit_axis_multi(
+/// One axis's training data on every sensor, each sensor's lags identified on the runs given
+/// (all of them, or all but one for a fold of `auto`'s validation).
+struct AxisRuns {
+    /// The runs' columns for this axis, the temperature column of the sensor last put in place
+    /// ([`use_sensor`]).
+    axis_logs: Vec<(String, TestLog)>,
+    /// Per sensor, in column order: its identification and its bias and scale-factor training
+    /// sets (in run order).
+    per_sensor: Vec<(Identified, Vec<TargetSet>, Vec<TargetSet>)>,
+}
+
+impl AxisRuns {
+    /// Every sensor's identification and training sets, as the selection reads them.
+    fn data(&self) -> Vec<SensorData<'_>> {
+        self.per_sensor
+            .iter()
+            .map(|(id, bias, scale)| SensorData { id, bias, scale })
+            .collect()
+    }
+
+    /// The runs as the fit reads them, with the temperature column last put in place.
+    fn named(&self) -> Vec<NamedLog<'_>> {
+        self.axis_logs
+            .iter()
+            .map(|(n, l)| NamedLog { name: n, log: l })
+            .collect()
+    }
+}
+
+/// Puts sensor `j`'s temperature column in place in each run's axis columns (`runs`: the
+/// runs' indices in `logs`, in the order of `axis_logs`; the rest is the same for every
+/// sensor).
+fn use_sensor(
+    axis_logs: &mut [(String, TestLog)],
     logs: &[(String, ImuLog)],
+    runs: &[usize],
+    j: usize,
+) {
+    for ((_, a), &i) in axis_logs.iter_mut().zip(runs) {
+        a.temp_c.clear();
+        a.temp_c.extend_from_slice(&logs[i].1.temp[j].values);
+    }
+}
+
+/// The several-sensor fits' settings: the thermal recipe's (an experiment may override the
+/// ridge grid) and the selection's.
+fn multi_settings<'c>(
+    cfg: &'c FitConfig,
+    settings: &ImuFitSettings,
+) -> (
+    std::borrow::Cow<'c, crate::fit::thermal::ThermalConfig>,
+    MultiConfig,
+) {
+    // The several-sensor fits' ridge strengths (an experiment's override of the grid).
+    let multi_thermal = match settings.multi_ridge_decades {
+        None => std::borrow::Cow::Borrowed(&cfg.thermal),
+        Some((lo, hi)) => std::borrow::Cow::Owned(crate::fit::thermal::ThermalConfig {
+            ridge_grid: (lo..=hi).map(|k| 10f64.powi(k)).collect(),
+            ..cfg.thermal.clone()
+        }),
+    };
+    let mc = MultiConfig {
+        min_gain: settings.min_gain,
+        extra: settings.multi_extra,
+        first: settings.multi_first,
+        select_folds: settings.multi_select_folds,
+    };
+    (multi_thermal, mc)
+}
+
+/// Each sensor's lags identified for axis `k` on the runs `runs` (indices into `logs`) and its
+/// training sets made; `shared` the temperature columns' search features per sensor and run
+/// of `logs` (empty: made here).
+#[allow(clippy::too_many_arguments)]
+fn prepare_axis(
+    logs: &[(String, ImuLog)],
+    runs: &[usize],
     shared: &[Vec<Option<SharedTables>>],
     k: usize,
     gyro_cols: &[String],
     temp_cols: &[String],
     cfg: &FitConfig,
-    settings: &ImuFitSettings,
-    temp_sensor: &TempSensorDef,
-    progress: &ImuProgress,
     events: &ImuEvents,
-) -> Result<ImuAxis, ImuError> {
-    events(ImuFitEvent::AxisStarted { axis: k });
+) -> Result<AxisRuns, ImuError> {
     let fit_err = |j: usize, source: FitError| ImuError::Fit {
         gyro: gyro_cols[k].clone(),
         temp: temp_cols[j].clone(),
@@ -427,16 +518,10 @@ fn fit_axis_multi(
     // run for the four sensors.
     // One copy of each run's columns for this axis; each sensor in turn puts its temperature
     // column in place (the rest is the same for every sensor).
-    let mut axis_logs: Vec<(String, TestLog)> = logs
+    let mut axis_logs: Vec<(String, TestLog)> = runs
         .iter()
-        .map(|(n, l)| (n.clone(), l.axis_data(k, 0)))
+        .map(|&i| (logs[i].0.clone(), logs[i].1.axis_data(k, 0)))
         .collect();
-    let use_sensor = |axis_logs: &mut [(String, TestLog)], j: usize| {
-        for ((_, a), (_, l)) in axis_logs.iter_mut().zip(logs) {
-            a.temp_c.clear();
-            a.temp_c.extend_from_slice(&l.temp[j].values);
-        }
-    };
     let samples: Vec<(bool, Result<targets::GyroSamples, targets::TargetError>)> = axis_logs
         .iter()
         .map(|(_, a)| {
@@ -453,7 +538,7 @@ fn fit_axis_multi(
     let mut per_sensor = Vec::with_capacity(temp_cols.len());
     for j in 0..temp_cols.len() {
         events(ImuFitEvent::SensorStarted { axis: k, sensor: j });
-        use_sensor(&mut axis_logs, j);
+        use_sensor(&mut axis_logs, logs, runs, j);
         let named: Vec<NamedLog> = axis_logs
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
@@ -463,18 +548,20 @@ fn fit_axis_multi(
         let prepared: Option<Vec<crate::fit::thermal::Prepared>> = shared
             .get(j)
             .into_iter()
-            .flatten()
+            .flat_map(|per_run| runs.iter().map(move |&i| per_run.get(i)))
             .zip(&samples)
             .map(|(t, (_, s))| match (t, s) {
-                (Some((published, base)), Ok(samples)) => Some(crate::fit::thermal::Prepared {
-                    samples,
-                    published,
-                    base,
-                }),
+                (Some(Some((published, base))), Ok(samples)) => {
+                    Some(crate::fit::thermal::Prepared {
+                        samples,
+                        published,
+                        base,
+                    })
+                }
                 _ => None,
             })
             .collect();
-        let id = match prepared.filter(|p| p.len() == logs.len()) {
+        let id = match prepared.filter(|p| p.len() == runs.len()) {
             Some(p) => {
                 let runs: Vec<(&str, &TestLog)> =
                     axis_logs.iter().map(|(n, l)| (n.as_str(), l)).collect();
@@ -497,24 +584,101 @@ fn fit_axis_multi(
         }
         per_sensor.push((id, bias, scale));
     }
-    let data: Vec<SensorData> = per_sensor
+    Ok(AxisRuns {
+        axis_logs,
+        per_sensor,
+    })
+}
+
+/// The bias model on the sensors `order` (two or more): one fit over them (averaged over each
+/// sensor first with [`multi::FirstBy::Average`], an experiment), then averaged with the
+/// first sensor's one-sensor model `one` by the experiment's weight `blend` (0: not at all).
+#[allow(clippy::too_many_arguments)]
+fn several_sensor_bias(
+    data: &[SensorData],
+    order: &[usize],
+    multi_thermal: &crate::fit::thermal::ThermalConfig,
+    mc: &MultiConfig,
+    shared: Option<&multi::Shared>,
+    one: Option<&SubModel>,
+    blend: f64,
+) -> Result<multi::MultiFit, crate::fit::thermal::ThermalError> {
+    let b = if mc.first == multi::FirstBy::Average {
+        multi::fit_multi_averaged(data, order, multi_thermal, mc, false)
+    } else {
+        multi::fit_multi_with(data, order, multi_thermal, mc, false, shared)
+    }?;
+    Ok(blend_with_one(b, one, blend))
+}
+
+/// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
+/// the sensors chosen by cross-validation, one fit over the chosen sensors; `shared` the
+/// temperature columns' search features per sensor and run (empty: made here).
+#[allow(clippy::too_many_arguments)]
+fn fit_axis_multi(
+    logs: &[(String, ImuLog)],
+    shared: &[Vec<Option<SharedTables>>],
+    k: usize,
+    gyro_cols: &[String],
+    temp_cols: &[String],
+    cfg: &FitConfig,
+    settings: &ImuFitSettings,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
+) -> Result<ImuAxis, ImuError> {
+    events(ImuFitEvent::AxisStarted { axis: k });
+    let all: Vec<usize> = (0..logs.len()).collect();
+    let mut runs = prepare_axis(logs, &all, shared, k, gyro_cols, temp_cols, cfg, events)?;
+    let (axis, j0) = thermal_axis(
+        logs,
+        &all,
+        &mut runs,
+        k,
+        gyro_cols,
+        temp_cols,
+        cfg,
+        settings,
+        temp_sensor,
+        progress,
+        events,
+    )?;
+    events(ImuFitEvent::AxisFinished {
+        axis: k,
+        sensor: j0,
+    });
+    Ok(axis)
+}
+
+/// The several-sensor `thermal` axis on the prepared `runs` (of `logs`, indices `all`): the
+/// sensors chosen by cross-validation, one fit over them, the first sensor's one-sensor model
+/// as the fallback. Returns the axis and its first sensor's column index; `runs` is left with
+/// that sensor's column in place.
+#[allow(clippy::too_many_arguments)]
+fn thermal_axis(
+    logs: &[(String, ImuLog)],
+    all: &[usize],
+    runs: &mut AxisRuns,
+    k: usize,
+    gyro_cols: &[String],
+    temp_cols: &[String],
+    cfg: &FitConfig,
+    settings: &ImuFitSettings,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
+) -> Result<(ImuAxis, usize), ImuError> {
+    let fit_err = |j: usize, source: FitError| ImuError::Fit {
+        gyro: gyro_cols[k].clone(),
+        temp: temp_cols[j].clone(),
+        source: Box::new(source),
+    };
+    let (multi_thermal, mc) = multi_settings(cfg, settings);
+    let data: Vec<SensorData> = runs
+        .per_sensor
         .iter()
         .map(|(id, bias, scale)| SensorData { id, bias, scale })
         .collect();
-    // The several-sensor fits' ridge strengths (an experiment's override of the grid).
-    let multi_thermal = match settings.multi_ridge_decades {
-        None => std::borrow::Cow::Borrowed(&cfg.thermal),
-        Some((lo, hi)) => std::borrow::Cow::Owned(crate::fit::thermal::ThermalConfig {
-            ridge_grid: (lo..=hi).map(|k| 10f64.powi(k)).collect(),
-            ..cfg.thermal.clone()
-        }),
-    };
-    let mc = MultiConfig {
-        min_gain: settings.min_gain,
-        extra: settings.multi_extra,
-        first: settings.multi_first,
-        select_folds: settings.multi_select_folds,
-    };
     let (order, single, shared) = multi::select_shared(&data, &multi_thermal, &mc);
     let scores: Vec<SensorScore> = temp_cols
         .iter()
@@ -533,9 +697,10 @@ fn fit_axis_multi(
         });
     }
     let j0 = order[0];
-    let (id0, bias0, scale0) = &per_sensor[j0];
-    use_sensor(&mut axis_logs, j0);
-    let named: Vec<NamedLog> = axis_logs
+    let (id0, bias0, scale0) = &runs.per_sensor[j0];
+    use_sensor(&mut runs.axis_logs, logs, all, j0);
+    let named: Vec<NamedLog> = runs
+        .axis_logs
         .iter()
         .map(|(n, l)| NamedLog { name: n, log: l })
         .collect();
@@ -561,18 +726,15 @@ fn fit_axis_multi(
         let has_scale = data.iter().all(|d| !d.scale.is_empty());
         let bias = has_bias
             .then(|| {
-                if mc.first == multi::FirstBy::Average {
-                    multi::fit_multi_averaged(&data, &order, &multi_thermal, &mc, false)
-                } else {
-                    multi::fit_multi_with(
-                        &data,
-                        &order,
-                        &multi_thermal,
-                        &mc,
-                        false,
-                        shared.as_ref(),
-                    )
-                }
+                several_sensor_bias(
+                    &data,
+                    &order,
+                    &multi_thermal,
+                    &mc,
+                    shared.as_ref(),
+                    outcome.model.bias.as_ref(),
+                    settings.blend,
+                )
             })
             .transpose()
             .map_err(thermal_err)?;
@@ -593,7 +755,6 @@ fn fit_axis_multi(
         } else {
             None
         };
-        let bias = bias.map(|b| blend_with_one(b, outcome.model.bias.as_ref(), settings.blend));
         if let Some(b) = &bias {
             outcome.model.bias = Some(b.first.clone());
             multi_cv_rms = b.cv_rms;
@@ -618,19 +779,318 @@ fn fit_axis_multi(
             });
         }
     }
-    events(ImuFitEvent::AxisFinished {
-        axis: k,
-        sensor: j0,
-    });
-    Ok(ImuAxis {
+    Ok((
+        ImuAxis {
+            gyro: gyro_cols[k].clone(),
+            temps: order.iter().map(|&j| temp_cols[j].clone()).collect(),
+            scores,
+            model: outcome.model,
+            more,
+            multi_cv_rms,
+            fallback,
+        },
+        j0,
+    ))
+}
+
+/// One axis with `auto`: its several-sensor `thermal` fit ([`thermal_axis`], as `--method
+/// thermal` builds it) against `thermal-lstm` on its first sensor (the residual LSTM on that
+/// sensor's one-sensor `thermal` fit, which is the several-sensor axis's fallback), scored as
+/// [`crate::fit::auto`] scores one gyro: each static run left out in turn when there are two
+/// or more (both candidates fitted again without it, the lags identified again), else the
+/// LSTM's held-out blocks of the static run. Both are scored on the same rows by the same
+/// prediction ([`axis_bias_on`]); the lower RMS wins, `thermal` on a tie. The axis's model
+/// records the scores and the choice ([`ModelFile::method_choice`]).
+#[allow(clippy::too_many_arguments)]
+fn fit_axis_auto(
+    logs: &[(String, ImuLog)],
+    shared: &[Vec<Option<SharedTables>>],
+    k: usize,
+    gyro_cols: &[String],
+    temp_cols: &[String],
+    cfg: &FitConfig,
+    settings: &ImuFitSettings,
+    temp_sensor: &TempSensorDef,
+    progress: &ImuProgress,
+    events: &ImuEvents,
+) -> Result<ImuAxis, ImuError> {
+    use crate::fit::auto::{candidate_config, choose};
+    use crate::model::Validation;
+    use crate::settings::method::Method;
+    let thermal_cfg = candidate_config(cfg, Method::Thermal);
+    let lstm_cfg = candidate_config(cfg, Method::ThermalLstm);
+    events(ImuFitEvent::AxisStarted { axis: k });
+    let all: Vec<usize> = (0..logs.len()).collect();
+    let mut runs = prepare_axis(
+        logs,
+        &all,
+        shared,
+        k,
+        gyro_cols,
+        temp_cols,
+        &thermal_cfg,
+        events,
+    )?;
+    let (mut thermal, j0) = thermal_axis(
+        logs,
+        &all,
+        &mut runs,
+        k,
+        gyro_cols,
+        temp_cols,
+        &thermal_cfg,
+        settings,
+        temp_sensor,
+        progress,
+        events,
+    )?;
+    let fit_err = |source: FitError| ImuError::Fit {
         gyro: gyro_cols[k].clone(),
-        temps: order.iter().map(|&j| temp_cols[j].clone()).collect(),
+        temp: temp_cols[j0].clone(),
+        source: Box::new(source),
+    };
+    let finished = |axis: ImuAxis| {
+        events(ImuFitEvent::AxisFinished {
+            axis: k,
+            sensor: j0,
+        });
+        Ok(axis)
+    };
+    // `thermal-lstm` on the first sensor, on every run (its lags and training sets the ones
+    // the several-sensor fit made for that sensor).
+    let lstm_fit = || -> Result<FitOutcome, ImuError> {
+        let (id0, bias0, scale0) = &runs.per_sensor[j0];
+        let mut outcome = crate::fit::fit_model_with(
+            &runs.named(),
+            &lstm_cfg,
+            Some(id0.clone()),
+            true,
+            Some((bias0, scale0)),
+            &|t, e, loss| progress(k, j0, t, e, loss),
+        )
+        .map_err(fit_err)?;
+        outcome.model.features.temp_sensor = *temp_sensor;
+        Ok(outcome)
+    };
+    // The `thermal-lstm` candidate's axis: its model on the first sensor alone, the sensors'
+    // one-sensor scores as the selection gave them.
+    let lstm_axis = |model: ModelFile, scores: Vec<SensorScore>| ImuAxis {
+        gyro: gyro_cols[k].clone(),
+        temps: vec![temp_cols[j0].clone()],
         scores,
-        model: outcome.model,
-        more,
-        multi_cv_rms,
-        fallback,
-    })
+        model,
+        more: Vec::new(),
+        multi_cv_rms: None,
+        fallback: None,
+    };
+    let statics: Vec<usize> = all
+        .iter()
+        .copied()
+        .filter(|&i| targets::is_static(&runs.axis_logs[i].1))
+        .collect();
+    let (choice, lstm) = match (statics.len(), settings.auto_keep) {
+        // An experiment's candidate, kept without scoring (and without a recorded choice).
+        (_, Some(Method::ThermalLstm)) => {
+            return finished(lstm_axis(lstm_fit()?.model, thermal.scores))
+        }
+        (_, Some(_)) => return finished(thermal),
+        // No bias to choose on: the scale factor is `thermal`'s in either candidate.
+        (0, _) => return finished(thermal),
+        (1, _) => {
+            let lstm = lstm_fit()?;
+            let (_, bias0, _) = &runs.per_sensor[j0];
+            let held = crate::fit::residual::validation_rows(bias0, &lstm_cfg.recipe);
+            if held.iter().all(Vec::is_empty) {
+                // Too short for held-out blocks: nothing says the LSTM helps.
+                return finished(thermal);
+            }
+            let (Some(t), Some(l)) = (thermal.model.bias.as_ref(), lstm.model.bias.as_ref()) else {
+                return finished(thermal);
+            };
+            let mut t_parts = vec![t];
+            t_parts.extend(thermal.more.iter().filter_map(|m| m.bias.as_ref()));
+            let mut ss = [0.0; 2];
+            let mut n = 0;
+            for (r, rows) in held.iter().enumerate() {
+                // The training sets of the axis's sensors, in the order it reads them.
+                let sets: Vec<&TargetSet> = thermal
+                    .temps
+                    .iter()
+                    .map(|t| {
+                        let j = temp_cols.iter().position(|c| c == t).unwrap_or(j0);
+                        &runs.per_sensor[j].1[r]
+                    })
+                    .collect();
+                let (s, m) = candidates_ss(&t_parts, l, &sets, rows).map_err(fit_err)?;
+                ss[0] += s[0];
+                ss[1] += s[1];
+                n += m;
+            }
+            let scores = ss.map(|s| (s / n.max(1) as f64).sqrt());
+            (choose(Validation::HeldOutBlocks, scores), Some(lstm))
+        }
+        _ => {
+            let scores = leave_one_run_out(
+                logs,
+                shared,
+                &statics,
+                k,
+                gyro_cols,
+                temp_cols,
+                &thermal_cfg,
+                &lstm_cfg,
+                settings,
+            )?;
+            (choose(Validation::LeaveOneRunOut, scores), None)
+        }
+    };
+    if choice.chosen == Method::Thermal {
+        thermal.model.method_choice = Some(choice);
+        return finished(thermal);
+    }
+    let mut lstm = match lstm {
+        Some(l) => l,
+        None => lstm_fit()?,
+    };
+    lstm.model.method_choice = Some(choice);
+    finished(lstm_axis(lstm.model, thermal.scores))
+}
+
+/// `auto`'s scores of an axis with two or more static runs (`statics`, indices into `logs`):
+/// each left out in turn, both candidates fitted on the other runs (every sensor's lags
+/// identified again, the sensors chosen again) and their bias predicted on it. Returns each
+/// candidate's RMS over every left-out run, each run's mean removed.
+#[allow(clippy::too_many_arguments)]
+fn leave_one_run_out(
+    logs: &[(String, ImuLog)],
+    shared: &[Vec<Option<SharedTables>>],
+    statics: &[usize],
+    k: usize,
+    gyro_cols: &[String],
+    temp_cols: &[String],
+    thermal_cfg: &FitConfig,
+    lstm_cfg: &FitConfig,
+    settings: &ImuFitSettings,
+) -> Result<[f64; 2], ImuError> {
+    let (multi_thermal, mc) = multi_settings(thermal_cfg, settings);
+    let mut ss = [0.0; 2];
+    let mut n = 0usize;
+    for &h in statics {
+        let others: Vec<usize> = (0..logs.len()).filter(|&i| i != h).collect();
+        let runs = prepare_axis(
+            logs,
+            &others,
+            shared,
+            k,
+            gyro_cols,
+            temp_cols,
+            thermal_cfg,
+            &|_| {},
+        )?;
+        let data = runs.data();
+        if data.iter().any(|d| d.bias.is_empty()) {
+            continue;
+        }
+        let (order, _, sh) = multi::select_shared(&data, &multi_thermal, &mc);
+        let j0 = order[0];
+        let fit_err = |source: FitError| ImuError::Fit {
+            gyro: gyro_cols[k].clone(),
+            temp: temp_cols[j0].clone(),
+            source: Box::new(source),
+        };
+        let (id0, bias0, _) = &runs.per_sensor[j0];
+        // The first sensor's one-sensor bias model, as `thermal` fits it.
+        let (one, _) = crate::fit::thermal::fit_target(bias0, &thermal_cfg.thermal, id0, false)
+            .map_err(|e| fit_err(FitError::from(e)))?;
+        let several = (order.len() > 1)
+            .then(|| {
+                several_sensor_bias(
+                    &data,
+                    &order,
+                    &multi_thermal,
+                    &mc,
+                    sh.as_ref(),
+                    Some(&one),
+                    settings.blend,
+                )
+            })
+            .transpose()
+            .map_err(|e| fit_err(FitError::from(e)))?;
+        let t_parts: Vec<&SubModel> = match &several {
+            Some(b) => std::iter::once(&b.first).chain(&b.extra).collect(),
+            None => vec![&one],
+        };
+        let Some(lstm) =
+            crate::fit::auto::lstm_on_thermal(bias0, &one, lstm_cfg).map_err(fit_err)?
+        else {
+            continue;
+        };
+        // The left-out run's training sets on each sensor read, at this fold's lags.
+        let held: Vec<TargetSet> = order
+            .iter()
+            .map(|&j| {
+                let log = logs[h].1.axis_data(k, j);
+                targets::bias_targets(&log, &runs.per_sensor[j].0.spec, thermal_cfg.bias_window_s)
+                    .map_err(|source| {
+                        fit_err(FitError::Targets {
+                            run: logs[h].0.clone(),
+                            source,
+                        })
+                    })
+            })
+            .collect::<Result<_, _>>()?;
+        let held_refs: Vec<&TargetSet> = held.iter().collect();
+        let rows: Vec<usize> = (0..held[0].table.n_rows()).collect();
+        let (s, m) = candidates_ss(&t_parts, &lstm, &held_refs, &rows).map_err(fit_err)?;
+        ss[0] += s[0];
+        ss[1] += s[1];
+        n += m;
+    }
+    Ok(ss.map(|s| (s / n.max(1) as f64).sqrt()))
+}
+
+/// An axis's bias on a run: each part (the first sensor's model first) predicted on its
+/// sensor's feature table of the run (`sets`, same order), summed; as long as the shortest
+/// table.
+fn axis_bias_on(parts: &[&SubModel], sets: &[&TargetSet]) -> Result<Vec<f64>, FitError> {
+    let n = sets.iter().map(|s| s.table.n_rows()).min().unwrap_or(0);
+    let mut sum = vec![0.0; n];
+    for (p, s) in parts.iter().zip(sets) {
+        for (v, x) in sum.iter_mut().zip(p.predict_table(&s.table)?) {
+            *v += x;
+        }
+    }
+    Ok(sum)
+}
+
+/// The two candidates' sums of squared bias residual on `rows` of one run (the labelled ones
+/// both predict; each candidate's mean over them removed) and how many rows: `thermal` of
+/// `parts` on the sensors of `sets`, `lstm` on the first sensor's; both through
+/// [`axis_bias_on`].
+fn candidates_ss(
+    parts: &[&SubModel],
+    lstm: &SubModel,
+    sets: &[&TargetSet],
+    rows: &[usize],
+) -> Result<([f64; 2], usize), FitError> {
+    let preds = [
+        axis_bias_on(parts, sets)?,
+        axis_bias_on(&[lstm], &sets[..1])?,
+    ];
+    let first = sets[0];
+    let n = preds[0].len().min(preds[1].len());
+    let used: Vec<usize> = rows
+        .iter()
+        .copied()
+        .filter(|&r| r < n && first.mask[r] && first.target[r].is_finite())
+        .collect();
+    let mut ss = [0.0; 2];
+    for (c, pred) in preds.iter().enumerate() {
+        let resid: Vec<f64> = used.iter().map(|&r| first.target[r] - pred[r]).collect();
+        let mean = resid.iter().sum::<f64>() / resid.len().max(1) as f64;
+        ss[c] = resid.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>();
+    }
+    Ok((ss, used.len()))
 }
 
 /// The several-sensor fit averaged with the first sensor's one-sensor fit `one`, weight `w`

@@ -202,13 +202,14 @@ fn train_unit(
 
 /// Per axis: the sensors it reads, what it fitted and each sensor's cross-validated score,
 /// on the bias (°/h) when the axis had a static run, else on the scale factor (ppm): in the
-/// units a gyro engineer reads.
+/// units a gyro engineer reads; with `auto`, a second line with every candidate's score and
+/// the choice.
 fn axis_lines(model: &ImuModel) -> Vec<Told> {
     let fitted = |b: bool| if b { "fitted" } else { "none" };
     model
         .axes
         .iter()
-        .map(|a| {
+        .flat_map(|a| {
             let on_bias = a.model.bias.is_some();
             let scores: Vec<String> = a
                 .scores
@@ -219,7 +220,7 @@ fn axis_lines(model: &ImuModel) -> Vec<Told> {
                     None => format!("{} -", s.temp),
                 })
                 .collect();
-            Told::Item(format!(
+            let line = Told::Item(format!(
                 "{}: reads {} (bias: {}, scale factor: {}); one-sensor cross-validated RMS of \
                  the {}: {}",
                 a.gyro,
@@ -228,7 +229,13 @@ fn axis_lines(model: &ImuModel) -> Vec<Told> {
                 fitted(a.model.scale.is_some()),
                 if on_bias { "bias" } else { "scale factor" },
                 scores.join(", ")
-            ))
+            ));
+            let choice = a
+                .model
+                .method_choice
+                .as_ref()
+                .map(|c| Told::Item(format!("{}: {}", a.gyro, c.describe())));
+            std::iter::once(line).chain(choice)
         })
         .collect()
 }

@@ -14,6 +14,11 @@
 //! Settings (method `thermal`, the default): `case` (every axis reads the case sensor
 //! alone), `chosen` (`fit_imu` with one sensor per axis, chosen by cross-validation among
 //! the four), `all` (every axis may read every sensor; cross-validation decides which stay).
+//! With method `auto` (docs/experiments/imu-auto.md): `all-auto` (each axis keeps its `all`
+//! fit or `thermal-lstm` on its first sensor, whichever scores better on held-out validation
+//! of the training runs; the TSV's `temps` column adds the choice and both scores, °/h) and
+//! `all-lstm` (the `thermal-lstm` candidate kept on every axis, unscored); `--lstm-hidden H`
+//! and `--lstm-steps S` set that candidate's hidden units and Adam steps (default: `auto`'s).
 //!
 //! Per setting and held-out profile it prints the median and worst, over units × axes, of
 //! the bias stability (τ = 100 s) of the compensated static run as a multiple of the noise
@@ -85,7 +90,7 @@ struct FeatureBounds {
 const TABLE_RATE_DPS: f64 = 20.0;
 const TAU_S: f64 = 100.0;
 const TEST_PROFILES: [&str; 2] = ["airborne", "shock-5"];
-const SETTINGS: [&str; 3] = ["case", "chosen", "all"];
+const SETTINGS: [&str; 5] = ["case", "chosen", "all", "all-auto", "all-lstm"];
 const DEFAULT_SETTINGS: &str = "case,chosen,all";
 const HOLDS: [&str; 14] = [
     "none",
@@ -240,6 +245,9 @@ struct Job<'a> {
     multi_extra: Option<gyrotherm::fit::thermal::multi::ExtraTerms>,
     multi_first: Option<gyrotherm::fit::thermal::multi::FirstBy>,
     select_folds: Option<usize>,
+    /// `auto`'s LSTM candidate: hidden units and Adam steps (None: the method's own).
+    lstm_hidden: Option<usize>,
+    lstm_steps: Option<usize>,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -707,6 +715,19 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     if let Some(f) = job.select_folds {
         all.multi_select_folds = f;
     }
+    // `auto` (settings `all-auto`, `all-lstm`): the same thermal overrides, its own recipe.
+    let mut auto_cfg = cfg.clone();
+    auto_cfg.recipe = RecipeSettings::of_kind(Method::Auto);
+    if let Some(h) = job.lstm_hidden {
+        auto_cfg.recipe.hidden = h;
+    }
+    if let Some(e) = job.lstm_steps {
+        auto_cfg.recipe.epochs = e;
+    }
+    let lstm_kept = ImuFitSettings {
+        auto_keep: Some(Method::ThermalLstm),
+        ..all
+    };
     let mut out = Vec::new();
     for setting in settings {
         let t0 = Instant::now();
@@ -719,6 +740,8 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                 fit_imu_with(&logs, &cfg, &one, &sensor, &|_, _, _, _, _| {})
             }
             "chosen" => fit_imu_with(&train, &cfg, &one, &sensor, &|_, _, _, _, _| {}),
+            "all-auto" => fit_imu_with(&train, &auto_cfg, &all, &sensor, &|_, _, _, _, _| {}),
+            "all-lstm" => fit_imu_with(&train, &auto_cfg, &lstm_kept, &sensor, &|_, _, _, _, _| {}),
             _ => fit_imu_with(&train, &cfg, &all, &sensor, &|_, _, _, _, _| {}),
         }
         .map_err(|e| {
@@ -804,7 +827,19 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                         x_floor: b / floors[k],
                         sf_ppm: rep.sf_thermal_error_ppm,
                         fit_s,
-                        temps: axis.temps.join("+"),
+                        temps: match &axis.model.method_choice {
+                            None => axis.temps.join("+"),
+                            Some(c) => format!(
+                                "{} {}={}",
+                                axis.temps.join("+"),
+                                c.chosen,
+                                c.candidates
+                                    .iter()
+                                    .map(|s| format!("{}:{:.5}", s.method, s.bias_rms_dps * 3600.0))
+                                    .collect::<Vec<_>>()
+                                    .join(",")
+                            ),
+                        },
                         outside: cs[k].1,
                     });
                 }
@@ -947,6 +982,12 @@ fn run() -> Result<(), String> {
                 ))
             }
         },
+        lstm_hidden: get("--lstm-hidden")
+            .map(|v| v.parse().map_err(|e| format!("--lstm-hidden: {e}")))
+            .transpose()?,
+        lstm_steps: get("--lstm-steps")
+            .map(|v| v.parse().map_err(|e| format!("--lstm-steps: {e}")))
+            .transpose()?,
         select_folds: get("--select-folds")
             .map(|v| v.parse().map_err(|e| format!("--select-folds: {e}")))
             .transpose()?,

@@ -172,6 +172,15 @@ impl LogSet {
         }
     }
 
+    /// An inertial unit's logs made in memory (simulated runs, for example), with their
+    /// names.
+    pub fn of_unit_logs(logs: Vec<(String, ImuLog)>) -> LogSet {
+        LogSet {
+            form: LogSetForm::Unit(logs),
+            gap_warnings: Vec::new(),
+        }
+    }
+
     /// How many logs.
     pub fn len(&self) -> usize {
         match &self.form {

@@ -27,7 +27,7 @@ pub const CANDIDATES: [Method; 2] = [Method::Thermal, Method::ThermalLstm];
 
 /// The configuration that fits candidate `method` under `auto`'s settings `cfg`: `thermal`
 /// with its own recipe, `thermal-lstm` with `auto`'s knobs (its own, as a fit was asked).
-fn candidate_config(cfg: &FitConfig, method: Method) -> FitConfig {
+pub(crate) fn candidate_config(cfg: &FitConfig, method: Method) -> FitConfig {
     let recipe = match method {
         Method::Thermal => RecipeSettings::of_kind(Method::Thermal),
         m => RecipeSettings {
@@ -70,16 +70,24 @@ pub(crate) fn fit(
             None,
         ),
     };
+    let choice = choose(validation, scores);
+    let mut fit = match (choice.chosen, lstm_fit) {
+        (Method::ThermalLstm, Some(fit)) => fit,
+        _ => fit_model(logs, &candidate_config(cfg, choice.chosen), progress)?,
+    };
+    fit.model.method_choice = Some(choice);
+    Ok(fit)
+}
+
+/// The choice on `scores` (of [`CANDIDATES`], in order): the lowest wins, the first
+/// (`thermal`) on a tie or where a score is not a number.
+pub(crate) fn choose(validation: Validation, scores: [f64; 2]) -> MethodChoice {
     let chosen = if scores[1] < scores[0] {
         Method::ThermalLstm
     } else {
         Method::Thermal
     };
-    let mut fit = match (chosen, lstm_fit) {
-        (Method::ThermalLstm, Some(fit)) => fit,
-        _ => fit_model(logs, &candidate_config(cfg, chosen), progress)?,
-    };
-    fit.model.method_choice = Some(MethodChoice {
+    MethodChoice {
         validation,
         candidates: CANDIDATES
             .iter()
@@ -90,8 +98,35 @@ pub(crate) fn fit(
             })
             .collect(),
         chosen,
-    });
-    Ok(fit)
+    }
+}
+
+/// `thermal-lstm`'s bias model on a fitted `thermal` bias model `thermal_sub` of the training
+/// sets `sets`: the residual LSTM as the `thermal-lstm` candidate trains it (None when
+/// `thermal_sub` is not a least-squares model).
+pub(crate) fn lstm_on_thermal(
+    sets: &[TargetSet],
+    thermal_sub: &SubModel,
+    lstm_cfg: &FitConfig,
+) -> Result<Option<SubModel>, FitError> {
+    let SubModel::Baseline {
+        terms,
+        coefficients,
+    } = thermal_sub
+    else {
+        return Ok(None);
+    };
+    let base = thermal_base(sets, terms, coefficients);
+    let n_in = sets[0].table.n_features;
+    let (lstm_sub, _) = residual::fit_lstm_on_base(
+        sets,
+        base,
+        &lstm_cfg.recipe,
+        n_in,
+        lstm_cfg.seed,
+        &mut |_, _| {},
+    )?;
+    Ok(Some(lstm_sub))
 }
 
 /// Each static run left out in turn: both candidates fitted on the others, their bias residual
@@ -131,23 +166,9 @@ fn leave_one_run_out(
             continue;
         };
         let (thermal_sub, _) = thermal::fit_target(&sets, &thermal_cfg.thermal, &id, false)?;
-        let SubModel::Baseline {
-            terms,
-            coefficients,
-        } = &thermal_sub
-        else {
+        let Some(lstm_sub) = lstm_on_thermal(&sets, &thermal_sub, lstm_cfg)? else {
             continue;
         };
-        let base = thermal_base(&sets, terms, coefficients);
-        let n_in = sets[0].table.n_features;
-        let (lstm_sub, _) = residual::fit_lstm_on_base(
-            &sets,
-            base,
-            &lstm_cfg.recipe,
-            n_in,
-            lstm_cfg.seed,
-            &mut |_, _| {},
-        )?;
         let labelled: Vec<usize> = (0..held.table.n_rows())
             .filter(|&r| held.mask[r] && held.target[r].is_finite())
             .collect();

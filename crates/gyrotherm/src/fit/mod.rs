@@ -378,8 +378,7 @@ pub fn fit_model(
     if logs.is_empty() {
         return Err(FitError::NoLogs);
     }
-    if cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Chosen)
-    {
+    if chooses_method(cfg) {
         return auto::fit(logs, cfg, progress);
     }
     let identified = if uses_identification(cfg) {
@@ -388,6 +387,11 @@ pub fn fit_model(
         None
     };
     fit_model_identified(logs, cfg, identified, progress)
+}
+
+/// Whether the method chooses among candidates by held-out validation (`auto`).
+pub(crate) fn chooses_method(cfg: &FitConfig) -> bool {
+    cfg.method.is_recipe() && matches!(methods::fitting(cfg.recipe.kind).fit, TargetFit::Chosen)
 }
 
 /// Whether the method identifies lags from the data (the `thermal` recipe).

@@ -410,6 +410,40 @@ pub(crate) fn fit_lstm_on_base(
     ))
 }
 
+/// The rows of each run of `train` that [`fit_lstm_on_base`] keeps out of the LSTM's training
+/// as validation blocks (labelled, past each block's burn-in), cut as it cuts them: for
+/// scoring another model on the same rows.
+pub(crate) fn validation_rows(train: &[TargetSet], recipe: &RecipeSettings) -> Vec<Vec<usize>> {
+    let block = recipe.block_steps.max(recipe.burn_in + 1);
+    let every = recipe.validation_every;
+    let mut k = 0usize;
+    train
+        .iter()
+        .map(|s| {
+            let nr = s.table.n_rows();
+            let mut rows = Vec::new();
+            let mut start = 0;
+            while start < nr {
+                let end = (start + block).min(nr);
+                if end - start <= recipe.burn_in {
+                    break;
+                }
+                let labelled: Vec<usize> = (start + recipe.burn_in..end)
+                    .filter(|&r| s.mask[r])
+                    .collect();
+                if !labelled.is_empty() {
+                    if every > 0 && k % every == every - 1 {
+                        rows.extend(labelled);
+                    }
+                    k += 1;
+                }
+                start = end;
+            }
+            rows
+        })
+        .collect()
+}
+
 /// Centred moving average of `x` over `width` steps (1 or less: unchanged), over the labelled
 /// steps inside each window only; unlabelled steps stay NaN.
 fn smooth_masked(x: &[f64], mask: &[bool], width: usize) -> Vec<f64> {

@@ -153,6 +153,13 @@ pub struct ImuFitSettings {
     pub multi_select_folds: usize,
     #[cfg(not(feature = "experiments"))]
     pub(crate) multi_select_folds: usize,
+    /// Experiment (None: chosen by the scores): under `auto`, the candidate each axis keeps
+    /// without scoring, to measure each candidate's held-out figures.
+    /// An experiment knob: public only with the `experiments` feature.
+    #[cfg(feature = "experiments")]
+    pub auto_keep: Option<Method>,
+    #[cfg(not(feature = "experiments"))]
+    pub(crate) auto_keep: Option<Method>,
 }
 
 impl Default for ImuFitSettings {
@@ -165,6 +172,7 @@ impl Default for ImuFitSettings {
             multi_extra: DEFAULT_IMU_EXTRA_TERMS,
             multi_first: DEFAULT_IMU_FIRST,
             multi_select_folds: 0,
+            auto_keep: None,
         }
     }
 }
