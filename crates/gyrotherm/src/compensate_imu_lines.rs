@@ -1,9 +1,10 @@
 //! Compensate an inertial unit's CSV log line by line: what `gyrotherm compensate --stream`
 //! runs with a unit model ([`crate::imu_model`]).
 //!
-//! The line handling is the single-axis stream's ([`compensate_lines`](mod@crate::compensate_lines)): the header
-//! (comments and blank lines before it), the line cap [`MAX_LINE_BYTES`], the separator and
-//! decimal comma, comment and blank lines dropped, one output line per data line, and
+//! The line loop is the single-axis stream's ([`compensate_lines`](mod@crate::compensate_lines)):
+//! the header (comments and blank lines before it), the line cap
+//! [`MAX_LINE_BYTES`](crate::csvlog::MAX_LINE_BYTES), the separator and decimal comma, comment
+//! and blank lines dropped, one output line per data line, and
 //! [`Mode::Strict`] (stop on a malformed line, naming file, line and column) or
 //! [`Mode::Stream`] (write it as `invalid` and go on; a time that is a number but NaN,
 //! infinite or out of order goes to the time axes). Every input field is written as it was,
