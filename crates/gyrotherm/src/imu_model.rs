@@ -500,11 +500,7 @@ fn prepare_axis(
     cfg: &FitConfig,
     events: &ImuEvents,
 ) -> Result<AxisRuns, ImuError> {
-    let fit_err = |j: usize, source: FitError| ImuError::Fit {
-        gyro: gyro_cols[k].clone(),
-        temp: temp_cols[j].clone(),
-        source: Box::new(source),
-    };
+    let fit_err = |j: usize, source| fit_error(&gyro_cols[k], &temp_cols[j], source);
     let target_err = |j: usize, run: &str, source: targets::TargetError| {
         fit_err(
             j,
@@ -611,6 +607,15 @@ fn several_sensor_bias(
     Ok(blend_with_one(b, one, blend))
 }
 
+/// Why axis `gyro`'s fit on sensor `temp` failed.
+fn fit_error(gyro: &str, temp: &str, source: FitError) -> ImuError {
+    ImuError::Fit {
+        gyro: gyro.to_owned(),
+        temp: temp.to_owned(),
+        source: Box::new(source),
+    }
+}
+
 /// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
 /// the sensors chosen by cross-validation, one fit over the chosen sensors; `shared` the
 /// temperature columns' search features per sensor and run (empty: made here).
@@ -668,11 +673,7 @@ fn thermal_axis(
     progress: &ImuProgress,
     events: &ImuEvents,
 ) -> Result<(ImuAxis, usize), ImuError> {
-    let fit_err = |j: usize, source: FitError| ImuError::Fit {
-        gyro: gyro_cols[k].clone(),
-        temp: temp_cols[j].clone(),
-        source: Box::new(source),
-    };
+    let fit_err = |j: usize, source| fit_error(&gyro_cols[k], &temp_cols[j], source);
     let (multi_thermal, mc) = multi_settings(cfg, settings);
     let data: Vec<SensorData> = runs
         .per_sensor
@@ -844,11 +845,7 @@ fn fit_axis_auto(
         progress,
         events,
     )?;
-    let fit_err = |source: FitError| ImuError::Fit {
-        gyro: gyro_cols[k].clone(),
-        temp: temp_cols[j0].clone(),
-        source: Box::new(source),
-    };
+    let fit_err = |source| fit_error(&gyro_cols[k], &temp_cols[j0], source);
     let finished = |axis: ImuAxis| {
         events(ImuFitEvent::AxisFinished {
             axis: k,
@@ -993,11 +990,7 @@ fn leave_one_run_out(
         }
         let (order, _, sh) = multi::select_shared(&data, &multi_thermal, &mc);
         let j0 = order[0];
-        let fit_err = |source: FitError| ImuError::Fit {
-            gyro: gyro_cols[k].clone(),
-            temp: temp_cols[j0].clone(),
-            source: Box::new(source),
-        };
+        let fit_err = |source| fit_error(&gyro_cols[k], &temp_cols[j0], source);
         let (id0, bias0, _) = &runs.per_sensor[j0];
         // The first sensor's one-sensor bias model, as `thermal` fits it.
         let (one, _) = crate::fit::thermal::fit_target(bias0, &thermal_cfg.thermal, id0, false)

@@ -8,29 +8,13 @@ use gyrotherm::fit::FitConfig;
 use gyrotherm::imu_model::{fit_imu, ImuModel, IMU_FORMAT_VERSION};
 use gyrotherm::model::{TempSensorDef, Validation};
 use gyrotherm::settings::{FitSettings, Method};
-use gyrotherm::sim::imu::{imu_from_family, simulate_imu, ImuConfig};
-use gyrotherm::sim::SimConfig;
 use gyrotherm::told::Told;
 use gyrotherm::train::train;
 use gyrotherm::unit_model::Form;
 
-/// Unit 1000 (design family), `seed-shock`, with only the gyro x and the case and x-coil
-/// sensors kept (as in tests/imu_fit.rs); the table (if any) on axis `table` (a table on y or
-/// z leaves a static run for x).
-fn run(seed: u64, table: Option<usize>) -> ImuLog {
-    let mut r = SimConfig::builtin("seed-shock").unwrap();
-    r.seed = seed;
-    r.table_rate_dps = table.map(|_| 20.0);
-    let mut log = simulate_imu(&ImuConfig {
-        run: r,
-        unit: imu_from_family(1000),
-        table_axis: table.unwrap_or(0),
-    })
-    .unwrap();
-    log.gyro.truncate(1);
-    log.temp.truncate(2);
-    log
-}
+#[path = "support/unit_1000.rs"]
+mod unit_1000;
+use unit_1000::run;
 
 fn runs(which: &[(u64, Option<usize>)]) -> Vec<(String, ImuLog)> {
     which

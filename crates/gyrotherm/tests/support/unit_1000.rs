@@ -1,0 +1,24 @@
+//! A two-sensor unit's runs for the inertial-unit tests: unit 1000 of the simulated design
+//! family, `seed-shock`.
+
+use gyrotherm::csvlog::ImuLog;
+use gyrotherm::sim::imu::{imu_from_family, simulate_imu, ImuConfig};
+use gyrotherm::sim::SimConfig;
+
+/// Unit 1000 (design family), `seed-shock`, with only the gyro x and the case and x-coil
+/// sensors kept; the table (if any) on axis `table` (a table on y or z leaves a static run
+/// for x).
+pub fn run(seed: u64, table: Option<usize>) -> ImuLog {
+    let mut r = SimConfig::builtin("seed-shock").unwrap();
+    r.seed = seed;
+    r.table_rate_dps = table.map(|_| 20.0);
+    let mut log = simulate_imu(&ImuConfig {
+        run: r,
+        unit: imu_from_family(1000),
+        table_axis: table.unwrap_or(0),
+    })
+    .unwrap();
+    log.gyro.truncate(1);
+    log.temp.truncate(2);
+    log
+}
