@@ -278,16 +278,24 @@ fn compare_shows_the_published_recipe_beside_the_default() {
         .iter()
         .map(|m| m["key"].as_str().unwrap())
         .collect();
-    assert_eq!(keys, ["linear", "poly", "thermal", "published"]);
+    assert_eq!(keys, ["linear", "poly", "auto", "published"]);
     let published = &v["models"][3];
     assert_eq!(published["label"], "LSTM, He et al.");
     assert_eq!(published["method"], "published");
     assert_eq!(published["recipe"], "published");
     assert_eq!(published["bias_model"], "lstm");
     assert_eq!(published["bias_epochs"], 5);
-    // The default recipe holds no LSTM: its column is not called one.
-    assert_eq!(v["models"][2]["recipe"], "thermal");
-    assert_eq!(v["models"][2]["label"], "thermal-state LS");
+    // The default chooses between `thermal` and `thermal-lstm`; its column is named for what
+    // the chosen model holds, whichever it is.
+    let default = &v["models"][2];
+    assert_eq!(default["recipe"], "auto");
+    let (method, label) = if default["bias_model"] == "least squares" {
+        ("thermal", "thermal-state LS")
+    } else {
+        ("thermal-lstm", "LS + LSTM")
+    };
+    assert_eq!(default["method"], method);
+    assert_eq!(default["label"], label);
     let methods = v["tests"][0]["methods"].as_object().unwrap();
     for k in keys {
         assert!(methods[k]["bias_stability_dph"].is_number(), "{k}");

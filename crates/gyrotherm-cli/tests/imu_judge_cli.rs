@@ -176,11 +176,18 @@ fn compare_per_axis_matches_each_axis_compared_alone() {
     let s = sim(dir.path(), "s.csv", &["--seed", "1"]);
     let h = sim(dir.path(), "h.csv", &["--seed", "3"]);
     let args = |cmd: &mut std::process::Command| {
-        cmd.args(["compare", "--json", "--methods", "linear,poly"])
-            .args(["--temp-col", "temp_case_c", "--train"])
-            .arg(&s)
-            .arg("--test")
-            .arg(&h);
+        cmd.args([
+            "compare",
+            "--json",
+            "--method",
+            "thermal",
+            "--methods",
+            "linear,poly",
+        ])
+        .args(["--temp-col", "temp_case_c", "--train"])
+        .arg(&s)
+        .arg("--test")
+        .arg(&h);
     };
     let mut c = gyrotherm();
     args(&mut c);
@@ -247,13 +254,21 @@ fn compare_per_axis_holds_the_unit_fit_on_all_its_sensors() {
     );
     let compare = |json: bool| {
         let mut c = gyrotherm();
-        c.args(["compare", "--methods", "linear,thermal", "--tau-s", "100"])
-            .args(["--gyro-col", GYROS, "--temp-col", temps, "--train"])
-            .arg(&s)
-            .arg("--train")
-            .arg(&t)
-            .arg("--test")
-            .arg(&h);
+        c.args([
+            "compare",
+            "--method",
+            "thermal",
+            "--methods",
+            "linear,thermal",
+            "--tau-s",
+            "100",
+        ])
+        .args(["--gyro-col", GYROS, "--temp-col", temps, "--train"])
+        .arg(&s)
+        .arg("--train")
+        .arg(&t)
+        .arg("--test")
+        .arg(&h);
         if json {
             c.arg("--json");
         }
@@ -338,7 +353,15 @@ fn report_has_a_page_across_axes_and_one_per_axis() {
     let out_dir = dir.path().join("rep");
     let out = run_ok(
         gyrotherm()
-            .args(["report", "--methods", "linear", "--gyro-col", GYROS])
+            .args([
+                "report",
+                "--method",
+                "thermal",
+                "--methods",
+                "linear",
+                "--gyro-col",
+                GYROS,
+            ])
             .args(["--temp-col", "temp_case_c,temp_z_c", "--train"])
             .arg(&s)
             .arg("--train")
@@ -392,6 +415,8 @@ fn unit_on_all_sensors(dir: &Path) -> (PathBuf, PathBuf, PathBuf, PathBuf) {
         gyrotherm()
             .args([
                 "train",
+                "--method",
+                "thermal",
                 "--gyro-col",
                 GYROS,
                 "--temp-col",
@@ -612,7 +637,14 @@ fn compare_spec_judges_every_column_of_every_axis() {
     );
     let compare = |spec: &Path| {
         gyrotherm()
-            .args(["compare", "--json", "--methods", "linear,thermal"])
+            .args([
+                "compare",
+                "--json",
+                "--method",
+                "thermal",
+                "--methods",
+                "linear,thermal",
+            ])
             .args(["--gyro-col", GYROS, "--temp-col", temps, "--train"])
             .arg(&s)
             .arg("--train")
@@ -677,7 +709,13 @@ fn compare_spec_judges_every_column_of_every_axis() {
 
 fn run_text_compare(s: &Path, t: &Path, h: &Path, temps: &str, spec: &Path) -> String {
     let out = gyrotherm()
-        .args(["compare", "--methods", "linear,thermal"])
+        .args([
+            "compare",
+            "--method",
+            "thermal",
+            "--methods",
+            "linear,thermal",
+        ])
         .args(["--gyro-col", GYROS, "--temp-col", temps, "--train"])
         .arg(s)
         .arg("--train")
@@ -894,7 +932,13 @@ fn report_spec_with_lists_gives_each_axis_and_the_unit_as_evaluate_does() {
     );
     let report = |spec: &Path, out: &Path| {
         gyrotherm()
-            .args(["report", "--methods", "linear,thermal"])
+            .args([
+                "report",
+                "--method",
+                "thermal",
+                "--methods",
+                "linear,thermal",
+            ])
             .args(["--gyro-col", GYROS, "--temp-col", ALL_TEMPS, "--train"])
             .arg(&s)
             .arg("--train")

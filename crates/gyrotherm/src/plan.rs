@@ -1,8 +1,8 @@
 //! `gyrotherm plan`: what the training logs so far cover of a flight's (T, dT) envelope, and
 //! a chamber profile that covers the rest.
 //!
-//! **Coverage.** The training logs are fitted as `train` fits them by default
-//! ([`crate::settings::DEFAULT_METHOD`]); the fit's coverage map
+//! **Coverage.** The training logs are fitted with `thermal` (what the default `auto` fits
+//! first); the fit's coverage map
 //! ([`crate::coverage`]) is the region they cover. Against it: the flight log's samples,
 //! stepped as `compensate` steps them ([`crate::coverage_track`]), and a 41 × 41 lattice
 //! over the envelope's rectangle (temperature × ±rate).
@@ -34,7 +34,7 @@ use crate::settings::plan::{
     PlanSettings, LONG_SOAK_PER_LAG, MIN_CELL_S, RATE_LEVELS, RATE_MARGIN, ROOM_C, SOAK_S,
     TEMP_MARGIN_C,
 };
-use crate::settings::SettingError;
+use crate::settings::{Method, SettingError};
 use crate::sim::{Profile, Segment};
 
 /// The flight's envelope: temperature extremes (°C) and largest |dT| (°C/min).
@@ -200,12 +200,11 @@ pub fn training_coverage(
     flight: Option<&TestLog>,
     env: &Envelope,
 ) -> Result<Result<CoverageSummary, String>, PlanError> {
-    let fit = fit_model(
-        train,
-        &FitConfig::new(crate::settings::DEFAULT_METHOD),
-        &|_, _, _| {},
-    )
-    .map_err(PlanError::Fit)?;
+    // `thermal`, whatever the default: the plan needs the (T, dT) cells the training covers
+    // and the slowest lag, which `thermal` identifies and an LSTM on its residual leaves as
+    // they are (and `thermal` fits in under a second).
+    let fit = fit_model(train, &FitConfig::new(Method::Thermal), &|_, _, _| {})
+        .map_err(PlanError::Fit)?;
     let Some(def) = fit.model.coverage.as_ref() else {
         return Ok(Err(fit
             .coverage_note
@@ -235,10 +234,7 @@ pub fn training_coverage(
         .copied()
         .filter(|t| t.is_finite())
         .reduce(f64::max);
-    let bound_s = FitConfig::new(crate::settings::DEFAULT_METHOD)
-        .thermal
-        .tau_range_s
-        .1;
+    let bound_s = FitConfig::new(Method::Thermal).thermal.tau_range_s.1;
     let lag_at_bound = slowest_lag_s.is_some_and(|t| t >= 0.99 * bound_s);
     let map = def.to_core().map_err(PlanError::Coverage)?;
     const N: usize = 41;

@@ -447,15 +447,20 @@ fn the_autopilot_column_is_the_firmware_correction_of_the_exported_file() {
         name: "ramp",
         log: &test,
     }];
-    let cfg = FitSettings::default()
-        .compare_config(
-            Some(&[
-                ColumnName::Method(Method::Thermal),
-                ColumnName::Autopilot(ExportTarget::Ardupilot),
-            ]),
-            100.0,
-        )
-        .unwrap();
+    // The autopilot column is fitted to the comparison's own method's model: `thermal`, the
+    // first column's, so that the file exported from that column is the one to check.
+    let cfg = FitSettings {
+        method: Method::Thermal,
+        ..FitSettings::default()
+    }
+    .compare_config(
+        Some(&[
+            ColumnName::Method(Method::Thermal),
+            ColumnName::Autopilot(ExportTarget::Ardupilot),
+        ]),
+        100.0,
+    )
+    .unwrap();
     let mut cmp = compare(&train, &test, &cfg, &|_, _, _, _| {}).unwrap();
     autopilot::add_columns(&mut cmp, &train, &test, &cfg).unwrap();
     let keys: Vec<&str> = cmp.columns.iter().map(|c| c.key).collect();

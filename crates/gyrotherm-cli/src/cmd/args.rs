@@ -246,17 +246,22 @@ pub struct ColumnArgs {
     /// Methods to compare, comma-separated, in table order (the names of `train --method`;
     /// a recipe method's column is named by what its model holds, `published` is "LSTM, He
     /// et al."; `--epochs` applies to every LSTM), then any autopilot polynomials (`ardupilot`,
-    /// `px4`: fitted to --method's model, single gyro). Default: linear, poly, thermal,
+    /// `px4`: fitted to --method's model, single gyro). Default: linear, poly, --method,
     /// published.
     #[arg(long, value_delimiter = ',', value_name = "LIST", value_parser = column_parser())]
     pub methods: Option<Vec<ColumnName>>,
+    /// The comparison's own method: the third default column, an inertial unit's fit (the
+    /// sensor each axis reads, and the unit's column) and the model the autopilot columns are
+    /// fitted to.
+    #[arg(long, default_value_t = DEFAULT_METHOD, value_parser = method_parser())]
+    pub method: Method,
 }
 
 impl ColumnArgs {
     /// The comparison settings: the columns, the fit settings, bias stability over `tau_s`.
     pub fn compare_config(&self, fit: &FitArgs, tau_s: f64) -> anyhow::Result<CompareConfig> {
         Ok(fit
-            .settings(DEFAULT_METHOD)
+            .settings(self.method)
             .compare_config(self.methods.as_deref(), tau_s)?)
     }
 }

@@ -1,4 +1,4 @@
-//! `gyrotherm compare`: fit linear, polynomial, the default `thermal` model and the
+//! `gyrotherm compare`: fit linear, polynomial, the default method's model and the
 //! `published` method (He et al. 2024) on training logs and judge them on held-out logs — the
 //! paper's results table, for the user's own data, one column per model (for a unit, per
 //! axis and across the axes).

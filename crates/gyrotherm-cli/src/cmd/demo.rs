@@ -1,7 +1,8 @@
 //! `gyrotherm demo`: the main job on built-in defaults. Simulates a training pair (static and
 //! rate-table runs of the default unit on one chamber profile) and a held-out pair on another
-//! profile, fits linear, polynomial, the default `thermal` model and the `published` method
-//! (He et al. 2024), and prints the held-out results table, one column per model.
+//! profile, fits linear, polynomial, the default method (`auto`: the better of `thermal` and
+//! `thermal-lstm` on held-out blocks) and the `published` method (He et al. 2024), and prints
+//! the held-out results table, one column per model.
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -380,8 +380,9 @@ def fit(
     (same defaults, same checks, same file).
 
     ``static``: static logs (bias model); ``table``: rate-table logs (scale-factor model).
-    ``method``: one of ``gyrotherm.METHOD_NAMES``: ``"thermal"`` (the default),
-    ``"residual"``, ``"generic"``, ``"direct"``, ``"published"`` (He et al. 2024 as
+    ``method``: one of ``gyrotherm.METHOD_NAMES``: ``"auto"`` (the default: the
+    better of ``"thermal"`` and ``"thermal-lstm"`` on held-out runs), ``"thermal"``,
+    ``"thermal-lstm"``, ``"residual"``, ``"generic"``, ``"direct"``, ``"published"`` (He et al. 2024 as
     published), ``"linear"`` or ``"poly"``. ``bias_window_s``/``settle_s`` in
     seconds. ``progress``: True prints
     epochs and loss to stderr; a callable gets ``(target, epoch, loss)``. Log options

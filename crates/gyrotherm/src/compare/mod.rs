@@ -292,7 +292,7 @@ impl Default for CompareConfig {
             candidates: vec![
                 Candidate::linear(),
                 Candidate::poly(),
-                Candidate::of(Method::Thermal),
+                Candidate::of(DEFAULT_METHOD),
                 Candidate::published(None),
             ],
             autopilot: Vec::new(),

@@ -9,7 +9,7 @@ use crate::nn::LrSchedule;
 use crate::settings::method::Method;
 
 /// A recipe and its knobs: how a recipe method fits (not called an LSTM recipe: the
-/// thermal recipe, the default, holds no LSTM) (knobs marked `Residual` apply to `Generic` and `Direct` too).
+/// thermal recipe holds no LSTM) (knobs marked `Residual` apply to `Generic` and `Direct` too).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecipeSettings {
     /// The recipe method these knobs train ([`Method::is_own_recipe`]).

@@ -1,4 +1,4 @@
-//! The residual recipe (the default): a least-squares base on thermal-state inputs
+//! The residual recipe: a least-squares base on thermal-state inputs
 //! ([`FeatureSpec::THERMAL_STATE`]: T, dT and `T - lag_τ(T)` for τ = 300, 1000, 3000 s), each
 //! training run with its own offset, plus an LSTM on the base's residual.
 //!
