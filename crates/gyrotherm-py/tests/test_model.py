@@ -166,11 +166,12 @@ def test_read_log_fills_gaps_when_asked(tmp_path):
 def test_summary_of_a_least_squares_model_gives_lags_and_cross_validated_rms(cli, logs, tmp_path):
     # A least-squares fit trains no LSTM: no "epochs: 0" or "final loss 0"; the lags and the
     # cross-validated RMS `gyrotherm train` prints instead, in its words.
-    m = gt.fit(static=logs["static"], table=logs["table"])
+    m = gt.fit(static=logs["static"], table=logs["table"], method="thermal")
     text = m.summary()
     assert "epochs" not in text and "final loss" not in text, text
     out = tmp_path / "m.json"
-    train = cli("train", "--input", logs["static"], "--input", logs["table"], "--out", out)
+    train = cli("train", "--method", "thermal", "--input", logs["static"], "--input",
+                logs["table"], "--out", out)
     said = [l.strip() for l in train.stderr.splitlines()[1:] if l.startswith("  ")]
     assert said and all(l in text for l in said), (said, text)
     assert "lag" in text and "cross-validated" in text, text

@@ -90,12 +90,14 @@ def test_evaluate_says_what_to_do(unit_logs, tmp_path):  # noqa: F811
 
 
 def test_compare_per_axis_is_the_cli_json(cli, unit_logs):  # noqa: F811
+    # The unit's own fit `thermal` (the default `auto` takes a minute an axis).
     got = gt.compare(
         train=[unit_logs["static"], unit_logs["table"]], test=unit_logs["heldout"],
-        methods=["linear", "thermal"], gyro_col=GYROS, temp_col=TEMPS,
+        methods=["linear", "thermal"], method="thermal", gyro_col=GYROS, temp_col=TEMPS,
     )
     want = json.loads(
-        cli("compare", "--json", "--methods", "linear,thermal", "--gyro-col", ",".join(GYROS),
+        cli("compare", "--json", "--methods", "linear,thermal", "--method", "thermal",
+            "--gyro-col", ",".join(GYROS),
             "--temp-col", ",".join(TEMPS), "--train", unit_logs["static"], "--train",
             unit_logs["table"], "--test", unit_logs["heldout"]).stdout
     )
@@ -127,11 +129,12 @@ def test_compare_spec_is_the_cli_json_and_fails_a_column(cli, unit_logs, tmp_pat
     # The verdicts equal `compare --spec --json`'s (the CLI's path); a limit between the
     # columns' bias stabilities fails some column and passes another.
     train = [unit_logs["static"], unit_logs["table"]]
-    args = dict(methods=["linear", "thermal"], gyro_col=GYROS, temp_col=TEMPS)
+    args = dict(methods=["linear", "thermal"], method="thermal", gyro_col=GYROS, temp_col=TEMPS)
     loose = spec_file(tmp_path, "loose.toml", "bias_stability_dph = { max = 1e6 }\n")
     got = gt.compare(train=train, test=unit_logs["heldout"], spec=loose, **args)
     want = json.loads(
-        cli("compare", "--json", "--methods", "linear,thermal", "--gyro-col", ",".join(GYROS),
+        cli("compare", "--json", "--methods", "linear,thermal", "--method", "thermal",
+            "--gyro-col", ",".join(GYROS),
             "--temp-col", ",".join(TEMPS), "--train", unit_logs["static"], "--train",
             unit_logs["table"], "--test", unit_logs["heldout"], "--spec", loose).stdout
     )
