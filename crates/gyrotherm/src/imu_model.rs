@@ -257,52 +257,31 @@ pub fn fit_imu_full(
     } else {
         Vec::new()
     };
+    let job = UnitJob {
+        logs,
+        shared: &shared,
+        gyro_cols: &gyro_cols,
+        temp_cols: &temp_cols,
+        cfg,
+        settings,
+        temp_sensor,
+        progress,
+        events,
+    };
     type Checked = (ImuAxis, Result<(), ImuError>);
     let axes: Vec<Result<Checked, ImuError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..gyro_cols.len())
             .map(|k| {
-                let (gyro_cols, temp_cols, shared) = (&gyro_cols, &temp_cols, &shared);
                 scope.spawn(move || {
                     let axis = if auto {
-                        fit_axis_auto(
-                            logs,
-                            shared,
-                            k,
-                            gyro_cols,
-                            temp_cols,
-                            cfg,
-                            settings,
-                            temp_sensor,
-                            progress,
-                            events,
-                        )
+                        fit_axis_auto(&job, k)
                     } else if multi_path {
-                        fit_axis_multi(
-                            logs,
-                            shared,
-                            k,
-                            gyro_cols,
-                            temp_cols,
-                            cfg,
-                            settings,
-                            temp_sensor,
-                            progress,
-                            events,
-                        )
+                        fit_axis_multi(&job, k)
                     } else {
-                        fit_axis(
-                            logs,
-                            k,
-                            gyro_cols,
-                            temp_cols,
-                            cfg,
-                            temp_sensor,
-                            progress,
-                            events,
-                        )
+                        fit_axis(&job, k)
                     }?;
                     // The axis's part of the model's checks, here while other axes still fit.
-                    let checked = axis_checks(temp_cols, &axis);
+                    let checked = axis_checks(job.temp_cols, &axis);
                     Ok((axis, checked))
                 })
             })
@@ -337,17 +316,33 @@ pub fn fit_imu_full(
     Ok(model)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn fit_axis(
-    logs: &[(String, ImuLog)],
-    k: usize,
-    gyro_cols: &[String],
-    temp_cols: &[String],
-    cfg: &FitConfig,
-    temp_sensor: &TempSensorDef,
-    progress: &ImuProgress,
-    events: &ImuEvents,
-) -> Result<ImuAxis, ImuError> {
+/// One unit fit's inputs, the same for every axis (each axis's fit runs on its own thread).
+#[derive(Clone, Copy)]
+struct UnitJob<'a> {
+    logs: &'a [(String, ImuLog)],
+    /// The temperature columns' search features per sensor and run (empty: made per axis).
+    shared: &'a [Vec<Option<SharedTables>>],
+    gyro_cols: &'a [String],
+    temp_cols: &'a [String],
+    cfg: &'a FitConfig,
+    settings: &'a ImuFitSettings,
+    temp_sensor: &'a TempSensorDef,
+    progress: &'a ImuProgress<'a>,
+    events: &'a ImuEvents<'a>,
+}
+
+/// Axis `k` on the sensor whose one-sensor fit cross-validates best.
+fn fit_axis(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
+    let UnitJob {
+        logs,
+        gyro_cols,
+        temp_cols,
+        cfg,
+        temp_sensor,
+        progress,
+        events,
+        ..
+    } = *job;
     events(ImuFitEvent::AxisStarted { axis: k });
     let mut best: Option<(usize, FitOutcome)> = None;
     let mut scores = Vec::with_capacity(temp_cols.len());
@@ -486,20 +481,22 @@ fn multi_settings<'c>(
     (multi_thermal, mc)
 }
 
-/// Each sensor's lags identified for axis `k` on the runs `runs` (indices into `logs`) and its
-/// training sets made; `shared` the temperature columns' search features per sensor and run
-/// of `logs` (empty: made here).
-#[allow(clippy::too_many_arguments)]
+/// Each sensor's lags identified for axis `k` on the runs `runs` (indices into the job's logs)
+/// with `cfg` and its training sets made, telling `events`.
 fn prepare_axis(
-    logs: &[(String, ImuLog)],
+    job: &UnitJob,
     runs: &[usize],
-    shared: &[Vec<Option<SharedTables>>],
     k: usize,
-    gyro_cols: &[String],
-    temp_cols: &[String],
     cfg: &FitConfig,
     events: &ImuEvents,
 ) -> Result<AxisRuns, ImuError> {
+    let UnitJob {
+        logs,
+        shared,
+        gyro_cols,
+        temp_cols,
+        ..
+    } = *job;
     let fit_err = |j: usize, source| fit_error(&gyro_cols[k], &temp_cols[j], source);
     let target_err = |j: usize, run: &str, source: targets::TargetError| {
         fit_err(
@@ -589,7 +586,6 @@ fn prepare_axis(
 /// The bias model on the sensors `order` (two or more): one fit over them (averaged over each
 /// sensor first with [`multi::FirstBy::Average`], an experiment), then averaged with the
 /// first sensor's one-sensor model `one` by the experiment's weight `blend` (0: not at all).
-#[allow(clippy::too_many_arguments)]
 fn several_sensor_bias(
     data: &[SensorData],
     order: &[usize],
@@ -618,36 +614,13 @@ fn fit_error(gyro: &str, temp: &str, source: FitError) -> ImuError {
 
 /// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
 /// the sensors chosen by cross-validation, one fit over the chosen sensors; `shared` the
-/// temperature columns' search features per sensor and run (empty: made here).
-#[allow(clippy::too_many_arguments)]
-fn fit_axis_multi(
-    logs: &[(String, ImuLog)],
-    shared: &[Vec<Option<SharedTables>>],
-    k: usize,
-    gyro_cols: &[String],
-    temp_cols: &[String],
-    cfg: &FitConfig,
-    settings: &ImuFitSettings,
-    temp_sensor: &TempSensorDef,
-    progress: &ImuProgress,
-    events: &ImuEvents,
-) -> Result<ImuAxis, ImuError> {
+/// temperature columns' search features per sensor and run (the job's `shared`).
+fn fit_axis_multi(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
+    let events = job.events;
     events(ImuFitEvent::AxisStarted { axis: k });
-    let all: Vec<usize> = (0..logs.len()).collect();
-    let mut runs = prepare_axis(logs, &all, shared, k, gyro_cols, temp_cols, cfg, events)?;
-    let (axis, j0) = thermal_axis(
-        logs,
-        &all,
-        &mut runs,
-        k,
-        gyro_cols,
-        temp_cols,
-        cfg,
-        settings,
-        temp_sensor,
-        progress,
-        events,
-    )?;
+    let all: Vec<usize> = (0..job.logs.len()).collect();
+    let mut runs = prepare_axis(job, &all, k, job.cfg, events)?;
+    let (axis, j0) = thermal_axis(job, &all, &mut runs, k, job.cfg)?;
     events(ImuFitEvent::AxisFinished {
         axis: k,
         sensor: j0,
@@ -655,24 +628,27 @@ fn fit_axis_multi(
     Ok(axis)
 }
 
-/// The several-sensor `thermal` axis on the prepared `runs` (of `logs`, indices `all`): the
-/// sensors chosen by cross-validation, one fit over them, the first sensor's one-sensor model
-/// as the fallback. Returns the axis and its first sensor's column index; `runs` is left with
-/// that sensor's column in place.
-#[allow(clippy::too_many_arguments)]
+/// The several-sensor `thermal` axis on the prepared `runs` (of the job's logs, indices
+/// `all`), fitted with `cfg`: the sensors chosen by cross-validation, one fit over them, the
+/// first sensor's one-sensor model as the fallback. Returns the axis and its first sensor's
+/// column index; `runs` is left with that sensor's column in place.
 fn thermal_axis(
-    logs: &[(String, ImuLog)],
+    job: &UnitJob,
     all: &[usize],
     runs: &mut AxisRuns,
     k: usize,
-    gyro_cols: &[String],
-    temp_cols: &[String],
     cfg: &FitConfig,
-    settings: &ImuFitSettings,
-    temp_sensor: &TempSensorDef,
-    progress: &ImuProgress,
-    events: &ImuEvents,
 ) -> Result<(ImuAxis, usize), ImuError> {
+    let UnitJob {
+        logs,
+        gyro_cols,
+        temp_cols,
+        settings,
+        temp_sensor,
+        progress,
+        events,
+        ..
+    } = *job;
     let fit_err = |j: usize, source| fit_error(&gyro_cols[k], &temp_cols[j], source);
     let (multi_thermal, mc) = multi_settings(cfg, settings);
     let data: Vec<SensorData> = runs
@@ -802,19 +778,18 @@ fn thermal_axis(
 /// LSTM's held-out blocks of the static run. Both are scored on the same rows by the same
 /// prediction ([`axis_bias_on`]); the lower RMS wins, `thermal` on a tie. The axis's model
 /// records the scores and the choice ([`ModelFile::method_choice`]).
-#[allow(clippy::too_many_arguments)]
-fn fit_axis_auto(
-    logs: &[(String, ImuLog)],
-    shared: &[Vec<Option<SharedTables>>],
-    k: usize,
-    gyro_cols: &[String],
-    temp_cols: &[String],
-    cfg: &FitConfig,
-    settings: &ImuFitSettings,
-    temp_sensor: &TempSensorDef,
-    progress: &ImuProgress,
-    events: &ImuEvents,
-) -> Result<ImuAxis, ImuError> {
+fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
+    let UnitJob {
+        logs,
+        gyro_cols,
+        temp_cols,
+        cfg,
+        settings,
+        temp_sensor,
+        progress,
+        events,
+        ..
+    } = *job;
     use crate::fit::auto::{candidate_config, choose};
     use crate::model::Validation;
     use crate::settings::method::Method;
@@ -822,29 +797,8 @@ fn fit_axis_auto(
     let lstm_cfg = candidate_config(cfg, Method::ThermalLstm);
     events(ImuFitEvent::AxisStarted { axis: k });
     let all: Vec<usize> = (0..logs.len()).collect();
-    let mut runs = prepare_axis(
-        logs,
-        &all,
-        shared,
-        k,
-        gyro_cols,
-        temp_cols,
-        &thermal_cfg,
-        events,
-    )?;
-    let (mut thermal, j0) = thermal_axis(
-        logs,
-        &all,
-        &mut runs,
-        k,
-        gyro_cols,
-        temp_cols,
-        &thermal_cfg,
-        settings,
-        temp_sensor,
-        progress,
-        events,
-    )?;
+    let mut runs = prepare_axis(job, &all, k, &thermal_cfg, events)?;
+    let (mut thermal, j0) = thermal_axis(job, &all, &mut runs, k, &thermal_cfg)?;
     let fit_err = |source| fit_error(&gyro_cols[k], &temp_cols[j0], source);
     let finished = |axis: ImuAxis| {
         events(ImuFitEvent::AxisFinished {
@@ -927,17 +881,7 @@ fn fit_axis_auto(
             (choose(Validation::HeldOutBlocks, scores), Some(lstm))
         }
         _ => {
-            let scores = leave_one_run_out(
-                logs,
-                shared,
-                &statics,
-                k,
-                gyro_cols,
-                temp_cols,
-                &thermal_cfg,
-                &lstm_cfg,
-                settings,
-            )?;
+            let scores = leave_one_run_out(job, &statics, k, &thermal_cfg, &lstm_cfg)?;
             (choose(Validation::LeaveOneRunOut, scores), None)
         }
     };
@@ -953,37 +897,31 @@ fn fit_axis_auto(
     finished(lstm_axis(lstm.model, thermal.scores))
 }
 
-/// `auto`'s scores of an axis with two or more static runs (`statics`, indices into `logs`):
+/// `auto`'s scores of an axis with two or more static runs (`statics`, indices into the job's
+/// logs):
 /// each left out in turn, both candidates fitted on the other runs (every sensor's lags
 /// identified again, the sensors chosen again) and their bias predicted on it. Returns each
 /// candidate's RMS over every left-out run, each run's mean removed.
-#[allow(clippy::too_many_arguments)]
 fn leave_one_run_out(
-    logs: &[(String, ImuLog)],
-    shared: &[Vec<Option<SharedTables>>],
+    job: &UnitJob,
     statics: &[usize],
     k: usize,
-    gyro_cols: &[String],
-    temp_cols: &[String],
     thermal_cfg: &FitConfig,
     lstm_cfg: &FitConfig,
-    settings: &ImuFitSettings,
 ) -> Result<[f64; 2], ImuError> {
+    let UnitJob {
+        logs,
+        gyro_cols,
+        temp_cols,
+        settings,
+        ..
+    } = *job;
     let (multi_thermal, mc) = multi_settings(thermal_cfg, settings);
     let mut ss = [0.0; 2];
     let mut n = 0usize;
     for &h in statics {
         let others: Vec<usize> = (0..logs.len()).filter(|&i| i != h).collect();
-        let runs = prepare_axis(
-            logs,
-            &others,
-            shared,
-            k,
-            gyro_cols,
-            temp_cols,
-            thermal_cfg,
-            &|_| {},
-        )?;
+        let runs = prepare_axis(job, &others, k, thermal_cfg, &|_| {})?;
         let data = runs.data();
         if data.iter().any(|d| d.bias.is_empty()) {
             continue;
