@@ -848,13 +848,14 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
         // No bias to choose on: the scale factor is `thermal`'s in either candidate.
         (0, _) => return finished(thermal),
         (1, _) => {
-            let lstm = lstm_fit()?;
             let (_, bias0, _) = &runs.per_sensor[j0];
             let held = crate::fit::residual::validation_rows(bias0, &lstm_cfg.recipe);
             if held.iter().all(Vec::is_empty) {
-                // Too short for held-out blocks: nothing says the LSTM helps.
+                // Too short for held-out blocks: nothing could say the LSTM helps, so it is
+                // not trained.
                 return finished(thermal);
             }
+            let lstm = lstm_fit()?;
             let (Some(t), Some(l)) = (thermal.model.bias.as_ref(), lstm.model.bias.as_ref()) else {
                 return finished(thermal);
             };

@@ -151,3 +151,31 @@ fn auto_scores_both_candidates_and_records_the_choice() {
     assert_eq!(choice.validation, Validation::HeldOutBlocks);
     assert_eq!(choice.candidates.len(), 2);
 }
+
+/// One static run too short for the blocks `thermal-lstm` holds out (fewer than four blocks of
+/// 2048 steps): nothing could score the LSTM, so `auto` fits `thermal` alone, its model
+/// exactly, with no choice recorded.
+#[test]
+fn auto_on_a_run_too_short_for_held_out_blocks_is_thermal() {
+    let cut = |mut l: TestLog, n: usize| {
+        l.time_s.truncate(n);
+        l.gyro_dps.truncate(n);
+        l.temp_c.truncate(n);
+        if let Some(t) = l.table_dps.as_mut() {
+            t.truncate(n);
+        }
+        l
+    };
+    let s = cut(sim("seed-shock", 11, false), 6000);
+    let t = cut(sim("seed-shock", 13, true), 6000);
+    let logs = [("s.csv", &s), ("t.csv", &t)];
+    let auto = fit(&logs, &small(Method::Auto));
+    let mut own = FitConfig::new(Method::Thermal);
+    own.seed = 1;
+    let thermal = fit(&logs, &own);
+    assert_eq!(auto.model.method, Method::Thermal);
+    assert_eq!(auto.model.method_choice, None);
+    assert_eq!(auto.model.bias, thermal.model.bias);
+    assert_eq!(auto.model.scale, thermal.model.scale);
+    assert!(auto.bias_training.as_ref().is_none_or(|t| t.epochs == 0));
+}

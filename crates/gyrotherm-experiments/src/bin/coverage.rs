@@ -14,7 +14,9 @@
 //! on the confirmation family.
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin coverage -- [--family design|confirm]
-//! [--units 30] [--threads 2] [--scales 0.8,1,1.2] [--growths 0,0.25,0.5,1]`;
+//! [--units 30] [--threads 2] [--scales 0.8,1,1.2] [--growths 0,0.25,0.5,1] [--method thermal]`
+//! (`--method`: the method trained, `thermal` by default; the table is printed for every
+//! model and again for the models whose bias holds an LSTM);
 //! `bench/coverage.sh` runs it as recorded in `docs/experiments/coverage.md`.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -63,6 +65,8 @@ struct Window {
     sigma0_dph: f64,
     /// Mean σ0 · d, °/h (so that σ = scale · (sigma0 + growth · sigma0_d)).
     sigma0_d_dph: f64,
+    /// Whether the unit's bias model holds an LSTM.
+    lstm: bool,
 }
 
 fn worse(a: Coverage, b: Coverage) -> Coverage {
@@ -78,7 +82,7 @@ fn worse(a: Coverage, b: Coverage) -> Coverage {
     }
 }
 
-fn run_unit(unit_seed: u64) -> Result<Vec<Window>, String> {
+fn run_unit(unit_seed: u64, method: Method) -> Result<Vec<Window>, String> {
     let unit = random_unit(unit_seed);
     let s0 = unit_seed * 100;
     let train = [
@@ -95,8 +99,14 @@ fn run_unit(unit_seed: u64) -> Result<Vec<Window>, String> {
         .iter()
         .map(|(name, log)| NamedLog { name, log })
         .collect();
-    let mut cfg = FitConfig::new(Method::Lstm);
-    cfg.recipe = RecipeSettings::of_kind(Method::Thermal);
+    let mut cfg = if method == Method::Thermal {
+        // As recorded: the thermal recipe under the former method's name (the same fit).
+        let mut c = FitConfig::new(Method::Lstm);
+        c.recipe = RecipeSettings::of_kind(Method::Thermal);
+        c
+    } else {
+        FitConfig::new(method)
+    };
     cfg.seed = 1;
     let fit =
         fit_model(&named, &cfg, &|_, _, _| {}).map_err(|e| format!("unit {unit_seed}: {e}"))?;
@@ -111,6 +121,7 @@ fn run_unit(unit_seed: u64) -> Result<Vec<Window>, String> {
         .rescaled(1.0 / gyrotherm::settings::coverage::SIGMA_SCALE, 0.0)
         .to_core()
         .map_err(|e| e.to_string())?;
+    let lstm = fit.model.bias.as_ref().is_some_and(|b| b.lstm().is_some());
     let mut out = Vec::new();
     for (k, p) in TEST_PROFILES.iter().enumerate() {
         let s = sim(&unit, p, s0 + 50 + 10 * k as u64 + 1, false)?;
@@ -136,6 +147,7 @@ fn run_unit(unit_seed: u64) -> Result<Vec<Window>, String> {
                     resid_dph: w.1 / n,
                     sigma0_dph: w.2 / n,
                     sigma0_d_dph: w.3 / n,
+                    lstm,
                 });
                 win = None;
             }
@@ -180,6 +192,10 @@ fn run() -> Result<(), String> {
         get("--growths"),
         &gyrotherm::settings::coverage::GROWTH_PER_CELL.to_string(),
     )?;
+    let method: Method = get("--method")
+        .unwrap_or_else(|| "thermal".into())
+        .parse()
+        .map_err(|e| format!("--method: {e}"))?;
     let seeds: Vec<u64> = (0..units).map(|i| base + i).collect();
     let t0 = Instant::now();
     let next = AtomicUsize::new(0);
@@ -190,7 +206,7 @@ fn run() -> Result<(), String> {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(&seed) = seeds.get(i) else { break };
-                match run_unit(seed) {
+                match run_unit(seed, method) {
                     Ok(w) => results.lock().unwrap_or_else(|p| p.into_inner()).extend(w),
                     Err(e) => errors.lock().unwrap_or_else(|p| p.into_inner()).push(e),
                 }
@@ -221,33 +237,44 @@ fn run() -> Result<(), String> {
             n(Coverage::Outside)
         );
     }
+    let with_lstm = windows.iter().filter(|w| w.lstm).count();
     println!(
-        "| σ scale | growth / cell | within ±1σ: inside | edge | outside | airborne outside |"
+        "method {}: {with_lstm} of {} windows from models holding an LSTM (rows `lstm` below)",
+        method.as_str(),
+        windows.len()
     );
-    println!("|---|---|---|---|---|---|");
-    for &sc in &scales {
-        for &g in &growths {
-            let share = |f: &dyn Fn(&Window) -> bool| {
-                let sel: Vec<&Window> = windows.iter().filter(|w| f(w)).collect();
-                let hit = sel
+    println!(
+        "| models | σ scale | growth / cell | within ±1σ: inside | edge | outside | airborne outside |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for (label, only_lstm) in [("all", false), ("lstm", true)] {
+        for &sc in &scales {
+            for &g in &growths {
+                let share = |f: &dyn Fn(&Window) -> bool| {
+                    let sel: Vec<&Window> = windows
+                        .iter()
+                        .filter(|w| (!only_lstm || w.lstm) && f(w))
+                        .collect();
+                    let hit = sel
+                        .iter()
+                        .filter(|w| w.resid_dph.abs() <= sc * (w.sigma0_dph + g * w.sigma0_d_dph))
+                        .count();
+                    format!(
+                        "{:.1} % ({})",
+                        100.0 * hit as f64 / sel.len().max(1) as f64,
+                        sel.len()
+                    )
+                };
+                let cells: Vec<String> = classes
                     .iter()
-                    .filter(|w| w.resid_dph.abs() <= sc * (w.sigma0_dph + g * w.sigma0_d_dph))
-                    .count();
-                format!(
-                    "{:.1} % ({})",
-                    100.0 * hit as f64 / sel.len().max(1) as f64,
-                    sel.len()
-                )
-            };
-            let cells: Vec<String> = classes
-                .iter()
-                .map(|&c| share(&|w: &Window| w.coverage == c))
-                .collect();
-            let air = share(&|w: &Window| w.coverage == Coverage::Outside && w.profile == 2);
-            println!(
-                "| {sc} | {g} | {} | {} | {} | {air} |",
-                cells[0], cells[1], cells[2]
-            );
+                    .map(|&c| share(&|w: &Window| w.coverage == c))
+                    .collect();
+                let air = share(&|w: &Window| w.coverage == Coverage::Outside && w.profile == 2);
+                println!(
+                    "| {label} | {sc} | {g} | {} | {} | {} | {air} |",
+                    cells[0], cells[1], cells[2]
+                );
+            }
         }
     }
     println!(

@@ -57,6 +57,11 @@ pub(crate) fn fit(
         // No bias to choose on: the scale factor is `thermal`'s in either candidate.
         0 => return fit_model(logs, &thermal_cfg, progress),
         1 => {
+            if !has_held_out_blocks(logs, &thermal_cfg, &lstm_cfg)? {
+                // Too short for held-out blocks: nothing could say the LSTM helps, so it is
+                // not trained.
+                return fit_model(logs, &thermal_cfg, progress);
+            }
             let fit = fit_model(logs, &lstm_cfg, progress)?;
             let Some((base, kept)) = fit.bias_training.as_ref().and_then(|t| t.held_out_rms) else {
                 // Too short for held-out blocks: nothing says the LSTM helps.
@@ -77,6 +82,32 @@ pub(crate) fn fit(
     };
     fit.model.method_choice = Some(choice);
     Ok(fit)
+}
+
+/// Whether the static runs of `logs` are long enough for the blocks the `thermal-lstm`
+/// candidate holds out of its LSTM's training ([`residual::validation_rows`], cut from the
+/// training sets at the lags `thermal` identifies).
+fn has_held_out_blocks(
+    logs: &[NamedLog],
+    thermal_cfg: &FitConfig,
+    lstm_cfg: &FitConfig,
+) -> Result<bool, FitError> {
+    let id = identify(logs, thermal_cfg)?;
+    let sets: Vec<TargetSet> = logs
+        .iter()
+        .filter(|l| targets::is_static(l.log))
+        .map(|l| {
+            targets::bias_targets(l.log, &id.spec, thermal_cfg.bias_window_s).map_err(|source| {
+                FitError::Targets {
+                    run: l.name.to_owned(),
+                    source,
+                }
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(residual::validation_rows(&sets, &lstm_cfg.recipe)
+        .iter()
+        .any(|r| !r.is_empty()))
 }
 
 /// The choice on `scores` (of [`CANDIDATES`], in order): the lowest wins, the first
