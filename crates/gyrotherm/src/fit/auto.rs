@@ -6,7 +6,8 @@
 //!   is the RMS of their residual over every left-out run, each run's mean removed.
 //! - One static run: `thermal-lstm` holds out every few blocks of the run from its LSTM's
 //!   training; the scores are the residual RMS on those blocks of `thermal`'s model alone and
-//!   with the LSTM as kept.
+//!   with the LSTM as kept. A run too short for such blocks gets `thermal`, and no LSTM is
+//!   trained.
 //!
 //! The lower score wins; on a tie, the first candidate (`thermal`, the simpler). The chosen
 //! method is then fitted on every run, and the model is labelled with what it holds. The scores
