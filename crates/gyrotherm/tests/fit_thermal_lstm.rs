@@ -36,9 +36,10 @@ fn small(method: Method) -> FitConfig {
     c
 }
 
-/// Kept, the LSTM reads the thermal states and the thermal model's prediction and the model
-/// is labelled `thermal-lstm`; left out by its gate, the model is the thermal model,
-/// coefficient for coefficient, and labelled `thermal`. The scale factor is the thermal
+/// Kept, the LSTM reads the thermal states and the thermal model's prediction, the model is
+/// labelled `thermal-lstm`, and its coverage σ is the thermal model's shrunk by what the LSTM
+/// gained on the held-out blocks; left out by its gate, the model is the thermal model,
+/// coefficient for coefficient (coverage map included), and labelled `thermal`. The scale factor is the thermal
 /// model's either way. The in-memory prediction of the bias model matches the flight
 /// compensator's.
 #[test]
@@ -62,6 +63,29 @@ fn thermal_lstm_is_labelled_by_what_it_holds() {
     ));
     assert_eq!(kept.model.method, Method::ThermalLstm);
     assert_eq!(kept.model.scale, plain.model.scale);
+    // σ per cell: the thermal model's cross-validated map, shrunk by the ratio the held-out
+    // blocks measured with the LSTM and without (the counts and RMS left as they are).
+    let (pc, kc) = (
+        plain.model.coverage.as_ref().unwrap(),
+        kept.model.coverage.as_ref().unwrap(),
+    );
+    let ratio = if kept_rms < base_rms {
+        kept_rms / base_rms
+    } else {
+        1.0
+    };
+    assert!(
+        ratio < 1.0,
+        "the LSTM helped nothing on the held-out blocks"
+    );
+    assert_eq!(kc.rms_dph, pc.rms_dph);
+    assert_eq!(kc.sigma_dph.len(), pc.sigma_dph.len());
+    for (k, p) in kc.sigma_dph.iter().zip(&pc.sigma_dph) {
+        assert!(
+            (k - p * ratio).abs() <= 1e-12 * p.abs(),
+            "{k} against {p} × {ratio}"
+        );
+    }
     // Ground (f64) and flight (f32) bias over a held-out run.
     let held = sim("slow-ramp", 9, false);
     let flight = compensate_log(&kept.model, &held).unwrap();
@@ -93,6 +117,7 @@ fn thermal_lstm_is_labelled_by_what_it_holds() {
     assert_eq!(left_out.model.method, Method::Thermal);
     assert_eq!(left_out.model.bias, plain.model.bias);
     assert_eq!(left_out.model.scale, plain.model.scale);
+    assert_eq!(left_out.model.coverage, plain.model.coverage);
 }
 
 /// With two static runs, `auto` leaves each out in turn, scores both candidates on it, keeps

@@ -659,8 +659,15 @@ pub(crate) fn fit_model_with(
             &crate::coverage::CoverageSettings::default(),
         )
     });
+    // The map's σ is the least-squares base's cross-validated error. `thermal-lstm`'s LSTM,
+    // where kept, took out part of that error on the blocks held out of its training: σ
+    // shrinks by the same ratio (on-sample it would be too wide for the model as it flies).
+    let shrink = lstm_sigma_ratio(cfg, model.bias.as_ref(), bias_training.as_ref());
     let (coverage, coverage_note) = match coverage {
-        Some(Ok(c)) => (Some(c), None),
+        Some(Ok(c)) => match shrink {
+            Some(r) => (Some(c.rescaled(r, c.growth_per_cell)), None),
+            None => (Some(c), None),
+        },
         Some(Err(e)) => (None, Some(crate::error_chain::error_chain(&e))),
         None => (None, Some("no bias model: no coverage map".to_owned())),
     };
@@ -678,6 +685,21 @@ pub(crate) fn fit_model_with(
         scale_training,
         coverage_note,
     })
+}
+
+/// The ratio of the held-out blocks' bias RMS with `thermal-lstm`'s residual LSTM to without
+/// it, where the bias model holds that LSTM (None otherwise, or where it did not help).
+fn lstm_sigma_ratio(
+    cfg: &FitConfig,
+    bias: Option<&SubModel>,
+    training: Option<&TrainSummary>,
+) -> Option<f64> {
+    if cfg.recipe.kind != Method::ThermalLstm {
+        return None;
+    }
+    bias?.lstm()?;
+    let (base, kept) = training?.held_out_rms?;
+    (base.is_finite() && kept > 0.0 && kept < base).then(|| kept / base)
 }
 
 /// Fit one target (bias or scale factor) on the training runs with an LSTM recipe.
