@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Wall time of `gyrotherm train` for an inertial unit (3 axes, 4 sensors: case + one per coil)
+# Wall time of `gyrotherm train --method thermal` for an inertial unit (3 axes, 4 sensors: case + one per coil)
 # against one axis with one sensor, on the same 30,000-row runs (`seed-shock` at 1 Hz, unit
 # 1000 of the design family: a static run and a ±20 °/s rate-table run turning x), in the
 # same run of this script (record: docs/experiments/imu.md).
@@ -32,9 +32,9 @@ wall() {
 one=()
 imu=()
 for r in $(seq "$reps"); do
-    a=$(wall $bin train --input "$work/s.csv" --input "$work/t.csv" \
+    a=$(wall $bin train --method thermal --input "$work/s.csv" --input "$work/t.csv" \
         --gyro-col gyro_x_dps --temp-col temp_case_c --out "$work/one.json")
-    b=$(wall $bin train --input "$work/s.csv" --input "$work/t.csv" \
+    b=$(wall $bin train --method thermal --input "$work/s.csv" --input "$work/t.csv" \
         --gyro-col gyro_x_dps,gyro_y_dps,gyro_z_dps \
         --temp-col temp_case_c,temp_x_c,temp_y_c,temp_z_c --out "$work/imu.json")
     echo "repetition $r: one axis, one sensor ${a} s; 3 axes, 4 sensors ${b} s"
