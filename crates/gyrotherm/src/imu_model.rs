@@ -162,6 +162,12 @@ pub enum ImuFitEvent {
     },
     /// Axis `axis` is done and reads sensor `sensor` first (and any further sensors chosen).
     AxisFinished { axis: usize, sensor: usize },
+    /// `auto`: axis `axis` fits both candidates without the `run`-th of its `of` static runs
+    /// (counted from 0) and scores them on it.
+    Scoring { axis: usize, run: usize, of: usize },
+    /// `auto`: axis `axis` trains `thermal-lstm` on sensor `sensor` (a candidate to score on
+    /// held-out blocks, or the choice).
+    LstmTraining { axis: usize, sensor: usize },
 }
 
 /// Receiver of [`ImuFitEvent`]s.
@@ -810,6 +816,10 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
     // `thermal-lstm` on the first sensor, on every run (its lags and training sets the ones
     // the several-sensor fit made for that sensor).
     let lstm_fit = || -> Result<FitOutcome, ImuError> {
+        events(ImuFitEvent::LstmTraining {
+            axis: k,
+            sensor: j0,
+        });
         let (id0, bias0, scale0) = &runs.per_sensor[j0];
         let mut outcome = crate::fit::fit_model_with(
             &runs.named(),
@@ -920,7 +930,12 @@ fn leave_one_run_out(
     let (multi_thermal, mc) = multi_settings(thermal_cfg, settings);
     let mut ss = [0.0; 2];
     let mut n = 0usize;
-    for &h in statics {
+    for (run, &h) in statics.iter().enumerate() {
+        (job.events)(ImuFitEvent::Scoring {
+            axis: k,
+            run,
+            of: statics.len(),
+        });
         let others: Vec<usize> = (0..logs.len()).filter(|&i| i != h).collect();
         let runs = prepare_axis(job, &others, k, thermal_cfg, &|_| {})?;
         let data = runs.data();

@@ -257,10 +257,11 @@ pub(crate) fn step_lines<'a>(
         let g = |k: usize| gyro.get(k).map_or("?", String::as_str);
         let t = |j: usize| temp.get(j).map_or("?", String::as_str);
         let (axis, sensor) = match e {
-            ImuFitEvent::AxisStarted { axis } => (axis, None),
+            ImuFitEvent::AxisStarted { axis } | ImuFitEvent::Scoring { axis, .. } => (axis, None),
             ImuFitEvent::SensorStarted { axis, sensor }
             | ImuFitEvent::SensorFinished { axis, sensor, .. }
-            | ImuFitEvent::AxisFinished { axis, sensor } => (axis, Some(sensor)),
+            | ImuFitEvent::AxisFinished { axis, sensor }
+            | ImuFitEvent::LstmTraining { axis, sensor } => (axis, Some(sensor)),
         };
         let line = match e {
             ImuFitEvent::AxisStarted { axis } => format!(
@@ -288,6 +289,18 @@ pub(crate) fn step_lines<'a>(
             ImuFitEvent::AxisFinished { axis, sensor } => {
                 format!("[{at:6.1} s] {}: axis done, reads {}", g(axis), t(sensor))
             }
+            ImuFitEvent::Scoring { axis, run, of } => format!(
+                "[{at:6.1} s] {}: auto: fitting thermal and thermal-lstm without static run {} \
+                 of {} and scoring them on it",
+                g(axis),
+                run + 1,
+                of
+            ),
+            ImuFitEvent::LstmTraining { axis, sensor } => format!(
+                "[{at:6.1} s] {}: auto: training thermal-lstm on {}",
+                g(axis),
+                t(sensor)
+            ),
         };
         events(AxisStep {
             event: e,

@@ -9,7 +9,7 @@ use gyrotherm::imu_model::{fit_imu, ImuModel, IMU_FORMAT_VERSION};
 use gyrotherm::model::{TempSensorDef, Validation};
 use gyrotherm::settings::{FitSettings, Method};
 use gyrotherm::told::Told;
-use gyrotherm::train::train;
+use gyrotherm::train::{train, TrainEvent};
 use gyrotherm::unit_model::Form;
 
 #[path = "support/unit_1000.rs"]
@@ -34,16 +34,23 @@ fn config(method: Method) -> FitConfig {
     .unwrap()
 }
 
-/// `auto` through `train`, as the command line runs it: the unit model and the lines told.
-fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>) {
+/// `auto` through `train`, as the command line runs it: the unit model, the lines told at
+/// the end, then the progress lines told while it fitted.
+fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>, Vec<String>) {
+    let steps = std::sync::Mutex::new(Vec::new());
     let trained = train(
         &LogSet::of_unit_logs(logs),
         &config(Method::Auto),
         &TempSensorDef::default(),
         &ReadOptions::default(),
-        &|_| {},
+        &|e| {
+            if let TrainEvent::Axis(s) = e {
+                steps.lock().unwrap().push(s.line);
+            }
+        },
     )
     .unwrap();
+    let steps = steps.into_inner().unwrap();
     let lines = trained
         .told(std::path::Path::new("m.json"), 0.0)
         .into_iter()
@@ -52,7 +59,7 @@ fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>) {
         })
         .collect();
     match trained.model.into_form() {
-        Form::Unit(m) => (m, lines),
+        Form::Unit(m) => (m, lines, steps),
         Form::Single(_) => panic!("a unit's logs gave a single-gyro model"),
     }
 }
@@ -62,7 +69,17 @@ fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>) {
 #[test]
 fn auto_keeps_the_several_sensor_thermal_axis_where_it_scores_better() {
     let logs = runs(&[(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]);
-    let (model, lines) = train_auto(logs.clone());
+    let (model, lines, steps) = train_auto(logs.clone());
+    // While it fits, each left-out run is told as its fold starts.
+    for run in 1..=3 {
+        let want = format!(
+            "gyro_x_dps: auto: fitting thermal and thermal-lstm without static run {run} of 3"
+        );
+        assert!(
+            steps.iter().any(|l| l.contains(&want)),
+            "{want}: {steps:#?}"
+        );
+    }
     let a = &model.axes[0];
     let choice = a
         .model
@@ -129,7 +146,14 @@ fn auto_keeps_the_several_sensor_thermal_axis_where_it_scores_better() {
 /// through the same prediction.
 #[test]
 fn with_one_static_run_auto_scores_on_held_out_blocks() {
-    let (model, lines) = train_auto(runs(&[(1, None), (2, Some(0))]));
+    let (model, lines, steps) = train_auto(runs(&[(1, None), (2, Some(0))]));
+    // The LSTM candidate's training is told before it starts.
+    assert!(
+        steps
+            .iter()
+            .any(|l| l.contains("gyro_x_dps: auto: training thermal-lstm on")),
+        "{steps:#?}"
+    );
     let a = &model.axes[0];
     let choice = a
         .model
