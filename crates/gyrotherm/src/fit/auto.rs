@@ -15,9 +15,10 @@
 //! scale factor is `thermal`'s in both candidates.
 
 use super::error::FitError;
+use super::thermal::Identified;
 use super::{
-    fit_model, identify, residual, thermal, thermal_base, FitConfig, FitOutcome, NamedLog,
-    RecipeSettings,
+    fit_model, fit_model_identified, identify, residual, thermal, thermal_base, FitConfig,
+    FitOutcome, NamedLog, RecipeSettings,
 };
 use crate::model::{CandidateScore, MethodChoice, SubModel, Target, Validation};
 use crate::settings::method::Method;
@@ -58,12 +59,13 @@ pub(crate) fn fit(
         // No bias to choose on: the scale factor is `thermal`'s in either candidate.
         0 => return fit_model(logs, &thermal_cfg, progress),
         1 => {
-            if !has_held_out_blocks(logs, &thermal_cfg, &lstm_cfg)? {
+            let Some(id) = held_out_blocks(logs, &thermal_cfg, &lstm_cfg)? else {
                 // Too short for held-out blocks: nothing could say the LSTM helps, so it is
                 // not trained.
                 return fit_model(logs, &thermal_cfg, progress);
-            }
-            let fit = fit_model(logs, &lstm_cfg, progress)?;
+            };
+            // The candidates share the settings the lags are identified with.
+            let fit = fit_model_identified(logs, &lstm_cfg, Some(id), progress)?;
             let Some((base, kept)) = fit.bias_training.as_ref().and_then(|t| t.held_out_rms) else {
                 // Too short for held-out blocks: nothing says the LSTM helps.
                 return fit_model(logs, &thermal_cfg, progress);
@@ -85,14 +87,14 @@ pub(crate) fn fit(
     Ok(fit)
 }
 
-/// Whether the static runs of `logs` are long enough for the blocks the `thermal-lstm`
-/// candidate holds out of its LSTM's training ([`residual::validation_rows`], cut from the
-/// training sets at the lags `thermal` identifies).
-fn has_held_out_blocks(
+/// The lags `thermal` identifies on `logs`, when the static runs are long enough for the
+/// blocks the `thermal-lstm` candidate holds out of its LSTM's training
+/// ([`residual::validation_rows`], cut from the training sets at those lags); None otherwise.
+fn held_out_blocks(
     logs: &[NamedLog],
     thermal_cfg: &FitConfig,
     lstm_cfg: &FitConfig,
-) -> Result<bool, FitError> {
+) -> Result<Option<Identified>, FitError> {
     let id = identify(logs, thermal_cfg)?;
     let sets: Vec<TargetSet> = logs
         .iter()
@@ -106,9 +108,10 @@ fn has_held_out_blocks(
             })
         })
         .collect::<Result<_, _>>()?;
-    Ok(residual::validation_rows(&sets, &lstm_cfg.recipe)
+    let any = residual::validation_rows(&sets, &lstm_cfg.recipe)
         .iter()
-        .any(|r| !r.is_empty()))
+        .any(|r| !r.is_empty());
+    Ok(any.then_some(id))
 }
 
 /// The choice on `scores` (of [`CANDIDATES`], in order): the lowest wins, the first
