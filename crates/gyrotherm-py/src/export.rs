@@ -18,7 +18,7 @@ pub(crate) type Written = (Vec<String>, Vec<String>);
 /// `px4` (the library's defaults where None).
 pub(crate) fn write(
     py: Python<'_>,
-    model: Model,
+    model: &Model,
     target: &str,
     out: PathBuf,
     instance: Option<u8>,

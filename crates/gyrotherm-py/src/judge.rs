@@ -6,12 +6,11 @@ use std::path::PathBuf;
 
 use gyrotherm::evaluate::{EvaluateJob, EvaluateJobError};
 use gyrotherm::told::Told;
-use gyrotherm::unit_model::Model;
 use pyo3::prelude::*;
 
 use crate::logs::LogOptions;
 use crate::model::FitArgs;
-use crate::unit::RawUnitModel;
+use crate::model::RawModel;
 use crate::{py_err, FitError, LogError, MetricsError};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -47,13 +46,13 @@ fn evaluate(
     path: PathBuf,
     options: LogOptions,
     column: String,
-    model: Option<PyRef<'_, RawUnitModel>>,
+    model: Option<PyRef<'_, RawModel>>,
     spec: Option<PathBuf>,
     tau_s: Option<f64>,
     settle_s: Option<f64>,
     reference_scale: Option<f64>,
 ) -> PyResult<(String, Vec<String>)> {
-    let model = model.map(|m| Model::from_unit(m.file().clone()));
+    let model = model.map(|m| m.model().clone());
     let spec = load_spec(spec)?;
     let read = options.read_options()?;
     let settings = gyrotherm::settings::EvaluateSettings {

@@ -21,7 +21,6 @@ mod logs;
 mod lot;
 mod model;
 mod train;
-mod unit;
 
 // The base class has two bases (`ValueError`, `RuntimeError`), which `create_exception!`
 // cannot express: it is defined in `python/gyrotherm/_errors.py` and imported here.
@@ -117,7 +116,7 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
             .into_iter()
             .collect::<std::collections::BTreeMap<_, _>>(),
     )?;
-    m.add("NO_COVERAGE", model::NO_COVERAGE)?;
+    m.add("NO_COVERAGE", gyrotherm::unit_model::NO_COVERAGE)?;
     allan::register(m)?;
     figures::register(m)?;
     judge::register(m)?;
@@ -125,6 +124,5 @@ fn _gyrotherm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     lot::register(m)?;
     model::register(m)?;
     train::register(m)?;
-    unit::register(m)?;
     Ok(())
 }

@@ -3,12 +3,11 @@
 
 use std::path::PathBuf;
 
-use gyrotherm::compensate::{compensator, extrapolation_warnings, CompensateError};
-use gyrotherm::compensate_lines::compensate_file;
-use gyrotherm::csvlog::TestLog;
+use gyrotherm::csvlog::{ImuLog, NamedSeries, ReadOptions};
 use gyrotherm::fit::FitConfig;
 use gyrotherm::model::{GivenColumns, ModelFile};
 use gyrotherm::settings::{FitSettings, Method, SettingError, METHODS, METHOD_NAMES};
+use gyrotherm::unit_model::Model;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -22,91 +21,146 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// A model file in memory, with what training said when it came from `fit`.
+/// A model file of either form in memory (`gyrotherm::unit_model::Model`: a single gyro is a
+/// unit of one axis), with what training said when it came from `fit`.
 #[pyclass(module = "gyrotherm._gyrotherm", name = "RawModel", frozen)]
 pub struct RawModel {
-    file: ModelFile,
-    /// One line per fitted target (LSTM epochs, loss and verdict), from `fit` only.
+    model: Model,
+    /// The lines the fit told (training range, LSTM epochs, loss, choice), from `fit` only.
     training_notes: Vec<String>,
     /// What loading the file said (an unsealed file), from `load` only.
     load_warnings: Vec<String>,
 }
 
 impl RawModel {
-    /// A model read from a file, with what to tell about it.
-    pub(crate) fn loaded(file: ModelFile, load_warnings: Vec<String>) -> RawModel {
+    /// A model just trained, with what the fit told (`training_notes`).
+    pub(crate) fn trained(model: Model, training_notes: Vec<String>) -> RawModel {
         RawModel {
-            file,
-            training_notes: Vec::new(),
-            load_warnings,
-        }
-    }
-
-    /// A model just trained, with what the fit did (`training_notes`).
-    pub(crate) fn trained(file: ModelFile, training_notes: Vec<String>) -> RawModel {
-        RawModel {
-            file,
+            model,
             training_notes,
             load_warnings: Vec::new(),
         }
     }
-}
 
-/// The time, gyro and temperature arrays of one log, checked to hold one value per sample.
-fn samples<'a>(
-    time_s: &'a PyReadonlyArray1<'_, f64>,
-    gyro_dps: &'a PyReadonlyArray1<'_, f64>,
-    temp_c: &'a PyReadonlyArray1<'_, f64>,
-) -> PyResult<(&'a [f64], &'a [f64], &'a [f64])> {
-    let (t, g, c) = (
-        slice(time_s, "time_s")?,
-        slice(gyro_dps, "gyro_dps")?,
-        slice(temp_c, "temp_c")?,
-    );
-    if t.len() != g.len() || t.len() != c.len() {
-        return Err(CompensationError::new_err(format!(
-            "time_s, gyro_dps and temp_c differ in length ({}, {}, {}); give one value per sample in each",
-            t.len(),
-            g.len(),
-            c.len()
-        )));
+    /// The model.
+    pub(crate) fn model(&self) -> &Model {
+        &self.model
     }
-    Ok((t, g, c))
+
+    /// The value `f` gives for every axis's model file, when every axis gives the same; else
+    /// None.
+    fn shared<T: PartialEq>(&self, f: impl Fn(&ModelFile) -> Option<T>) -> Option<T> {
+        let base = ReadOptions::default();
+        let axes = self.model.axes(&base);
+        let mut values = axes.iter().map(|a| f(a.model));
+        let first = values.next()??;
+        values.all(|v| v.as_ref() == Some(&first)).then_some(first)
+    }
+
+    /// `time_s` and the arrays of `gyro` and `temp` (in the model's column orders) as a log
+    /// holding the model's columns, each checked to hold one value per sample.
+    fn log<'py>(
+        &self,
+        time_s: &PyReadonlyArray1<'py, f64>,
+        gyro: &[PyReadonlyArray1<'py, f64>],
+        temp: &[PyReadonlyArray1<'py, f64>],
+    ) -> PyResult<ImuLog> {
+        let (gyro_cols, temp_cols) = self.model.columns();
+        let t = slice(time_s, "time_s")?;
+        let count = |what: &str, got: usize, want: &[String]| {
+            if got == want.len() {
+                Ok(())
+            } else {
+                Err(CompensationError::new_err(format!(
+                    "{what}: {got} arrays given, the model needs {} ({})",
+                    want.len(),
+                    want.join(", ")
+                )))
+            }
+        };
+        count("gyro", gyro.len(), &gyro_cols)?;
+        count("temp", temp.len(), &temp_cols)?;
+        let series = |arrays: &[PyReadonlyArray1<'py, f64>], names: &[String]| {
+            arrays
+                .iter()
+                .zip(names)
+                .map(|(a, n)| {
+                    let v = slice(a, n)?;
+                    if v.len() != t.len() {
+                        return Err(CompensationError::new_err(format!(
+                            "{n}: {} values but {} times; give one value per sample",
+                            v.len(),
+                            t.len()
+                        )));
+                    }
+                    Ok(NamedSeries {
+                        name: n.clone(),
+                        values: v.to_vec(),
+                    })
+                })
+                .collect::<PyResult<Vec<_>>>()
+        };
+        Ok(ImuLog {
+            time_s: t.to_vec(),
+            gyro: series(gyro, &gyro_cols)?,
+            temp: series(temp, &temp_cols)?,
+            ..Default::default()
+        })
+    }
 }
 
 fn model_err(e: impl std::error::Error + 'static) -> PyErr {
     ModelError::new_err(gyrotherm::error_chain(&e))
 }
 
-type Compensated<'py> = (
+type AxisColumns<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<u8>>,
-    Vec<String>,
 );
+
+type AxisCoverage<'py> = (Bound<'py, PyArray1<u8>>, Bound<'py, PyArray1<f64>>);
+
+/// The training facts of a model file as a dict.
+fn training_dict<'py>(py: Python<'py>, m: &ModelFile) -> PyResult<Bound<'py, PyDict>> {
+    let t = &m.training;
+    let d = PyDict::new(py);
+    d.set_item("temp_range_c", (t.temp_range_c.min, t.temp_range_c.max))?;
+    d.set_item(
+        "rate_range_c_per_s",
+        (t.rate_range_c_per_s.min, t.rate_range_c_per_s.max),
+    )?;
+    d.set_item("data_digest_sha256", &t.data_digest_sha256)?;
+    d.set_item("epochs", t.epochs)?;
+    d.set_item("final_loss", t.final_loss)?;
+    d.set_item("seed", t.seed)?;
+    d.set_item("created_by", &t.created_by)?;
+    d.set_item("inputs", PyList::new(py, &t.inputs)?)?;
+    Ok(d)
+}
 
 #[pymethods]
 impl RawModel {
-    /// Read and check a model file (`load_warnings` says when it has no content checksum).
+    /// Read and check a model file of either form (`load_warnings` says when it has no
+    /// content checksum).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<RawModel> {
-        let (file, seal) = py
-            .detach(|| ModelFile::load_sealed(&path))
-            .map_err(model_err)?;
+        let model = py.detach(|| Model::load(&path)).map_err(model_err)?;
+        let load_warnings = model.load_warning(&path).into_iter().collect();
         Ok(RawModel {
-            file,
+            model,
             training_notes: Vec::new(),
-            load_warnings: seal.warning(&path).into_iter().collect(),
+            load_warnings,
         })
     }
 
-    /// Parse and check model JSON text.
+    /// Parse and check model JSON text of either form.
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<RawModel> {
-        let file = ModelFile::from_json(text).map_err(py_err::<ModelError>)?;
+        let model = Model::from_json(text).map_err(py_err::<ModelError>)?;
         Ok(RawModel {
-            file,
+            model,
             training_notes: Vec::new(),
             load_warnings: Vec::new(),
         })
@@ -114,28 +168,29 @@ impl RawModel {
 
     /// Write the model file atomically (the bytes `gyrotherm train` writes).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| self.file.save(&path)).map_err(model_err)
+        py.detach(|| self.model.save(&path)).map_err(model_err)
     }
 
     fn to_json(&self) -> PyResult<String> {
-        let mut text = self.file.to_json().map_err(py_err::<ModelError>)?;
-        text.push('\n');
-        Ok(text)
+        self.model.to_json().map_err(py_err::<ModelError>)
     }
 
+    /// The method every axis was fitted with (None where the axes differ).
     #[getter]
-    fn method(&self) -> &'static str {
-        self.file.method.as_str()
+    fn method(&self) -> Option<&'static str> {
+        self.shared(|m| Some(m.method.as_str()))
     }
 
+    /// What every axis's bias model is made of (None: none, or the axes differ).
     #[getter]
     fn bias_kind(&self) -> Option<&'static str> {
-        self.file.bias.as_ref().map(|s| s.kind())
+        self.shared(|m| m.bias.as_ref().map(|s| s.kind()))
     }
 
+    /// What every axis's scale-factor model is made of (None: none, or the axes differ).
     #[getter]
     fn scale_kind(&self) -> Option<&'static str> {
-        self.file.scale.as_ref().map(|s| s.kind())
+        self.shared(|m| m.scale.as_ref().map(|s| s.kind()))
     }
 
     #[getter]
@@ -148,81 +203,108 @@ impl RawModel {
         self.load_warnings.clone()
     }
 
-    /// Training facts of the file as a dict.
+    /// The training facts of a model of one axis as a dict (None for a unit of several:
+    /// each axis has its own, under `axes`).
     #[getter]
-    fn training<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let t = &self.file.training;
-        let d = PyDict::new(py);
-        d.set_item("temp_range_c", (t.temp_range_c.min, t.temp_range_c.max))?;
-        d.set_item(
-            "rate_range_c_per_s",
-            (t.rate_range_c_per_s.min, t.rate_range_c_per_s.max),
-        )?;
-        d.set_item("data_digest_sha256", &t.data_digest_sha256)?;
-        d.set_item("epochs", t.epochs)?;
-        d.set_item("final_loss", t.final_loss)?;
-        d.set_item("seed", t.seed)?;
-        d.set_item("created_by", &t.created_by)?;
-        d.set_item("inputs", PyList::new(py, &t.inputs)?)?;
-        Ok(d)
+    fn training<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let base = ReadOptions::default();
+        match self.model.axes(&base).as_slice() {
+            [one] => training_dict(py, one.model).map(Some),
+            _ => Ok(None),
+        }
     }
 
-    /// Compensate arrays sample by sample with the flight compensator: (bias °/s, scale,
-    /// compensated rate °/s, status, extrapolation warnings).
+    #[getter]
+    fn gyro_cols(&self) -> Vec<String> {
+        self.model.columns().0
+    }
+
+    #[getter]
+    fn temp_cols(&self) -> Vec<String> {
+        self.model.columns().1
+    }
+
+    /// Per axis: gyro, the sensors it reads, the score of each sensor tried, the method, the
+    /// kinds of its bias and scale-factor models and its training facts.
+    #[getter]
+    fn axes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let out = PyList::empty(py);
+        for a in &self.model.to_unit(&ReadOptions::default()).axes {
+            let d = PyDict::new(py);
+            d.set_item("gyro", &a.gyro)?;
+            d.set_item("temps", &a.temps)?;
+            let scores = PyDict::new(py);
+            for s in &a.scores {
+                scores.set_item(&s.temp, s.cv_rms)?;
+            }
+            d.set_item("cv_rms", scores)?;
+            d.set_item("method", a.model.method.as_str())?;
+            d.set_item("bias_kind", a.model.bias.as_ref().map(|s| s.kind()))?;
+            d.set_item("scale_kind", a.model.scale.as_ref().map(|s| s.kind()))?;
+            d.set_item("training", training_dict(py, &a.model)?)?;
+            out.append(d)?;
+        }
+        Ok(out)
+    }
+
+    /// Compensate samples with each axis's flight compensator: `gyro` one array per gyro
+    /// column and `temp` one per temperature column, in the model's orders. Per axis (bias
+    /// °/s, scale, compensated rate °/s, status), the numbers `gyrotherm compensate` writes,
+    /// and the extrapolation warnings it tells.
     fn compensate<'py>(
         &self,
         py: Python<'py>,
         time_s: PyReadonlyArray1<'py, f64>,
-        gyro_dps: PyReadonlyArray1<'py, f64>,
-        temp_c: PyReadonlyArray1<'py, f64>,
-    ) -> PyResult<Compensated<'py>> {
-        let (t, g, c) = samples(&time_s, &gyro_dps, &temp_c)?;
-        let log = TestLog {
-            time_s: t.to_vec(),
-            gyro_dps: g.to_vec(),
-            temp_c: c.to_vec(),
-            ..Default::default()
-        };
+        gyro: Vec<PyReadonlyArray1<'py, f64>>,
+        temp: Vec<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<(Vec<AxisColumns<'py>>, Vec<String>)> {
+        let log = self.log(&time_s, &gyro, &temp)?;
         let (out, warnings) = py
-            .detach(|| {
-                compensate_with_status(&self.file, &log)
-                    .map(|out| (out, extrapolation_warnings(&self.file, &log)))
-            })
+            .detach(|| self.model.compensate_log(&log))
             .map_err(py_err::<CompensationError>)?;
-        let (bias, scale, rate, status) = out;
-        Ok((
-            bias.into_pyarray(py),
-            scale.into_pyarray(py),
-            rate.into_pyarray(py),
-            status.into_pyarray(py),
-            warnings,
-        ))
+        let axes = out
+            .into_iter()
+            .map(|c| {
+                (
+                    c.bias_dps.into_pyarray(py),
+                    c.scale.into_pyarray(py),
+                    c.gyro_comp_dps.into_pyarray(py),
+                    c.status
+                        .into_iter()
+                        .map(|s| s as u8)
+                        .collect::<Vec<_>>()
+                        .into_pyarray(py),
+                )
+            })
+            .collect();
+        Ok((axes, warnings))
     }
 
-    /// Per-sample coverage verdict (code: `Coverage as u8`, 255 where there is none) and σ
-    /// (°/h, NaN where there is none), as the `coverage` and `sigma_dph` columns of
-    /// `gyrotherm compensate`; and the note when the model file has no coverage map.
+    /// Per axis, each sample's coverage verdict (code: `Coverage as u8`, 255 where there is
+    /// none) and σ (°/h, NaN where there is none), as the `coverage` and `sigma_dph` columns
+    /// of `gyrotherm compensate`; and a note per axis without a verdict.
     fn coverage<'py>(
         &self,
         py: Python<'py>,
         time_s: PyReadonlyArray1<'py, f64>,
-        gyro_dps: PyReadonlyArray1<'py, f64>,
-        temp_c: PyReadonlyArray1<'py, f64>,
-    ) -> PyResult<CoverageColumns<'py>> {
-        let (t, g, c) = samples(&time_s, &gyro_dps, &temp_c)?;
-        let (codes, sigma) = py
-            .detach(|| coverage_columns(&self.file, t, g, c))
+        gyro: Vec<PyReadonlyArray1<'py, f64>>,
+        temp: Vec<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<(Vec<AxisCoverage<'py>>, Vec<String>)> {
+        let log = self.log(&time_s, &gyro, &temp)?;
+        let (out, notes) = py
+            .detach(|| self.model.coverage_log(&log))
             .map_err(py_err::<CompensationError>)?;
-        Ok((
-            codes.into_pyarray(py),
-            sigma.into_pyarray(py),
-            gyrotherm::coverage::missing_note(&self.file),
-        ))
+        let axes = out
+            .into_iter()
+            .map(|c| (c.codes.into_pyarray(py), c.sigma_dph.into_pyarray(py)))
+            .collect();
+        Ok((axes, notes))
     }
 
-    /// Compensate a CSV log into a CSV file exactly as `gyrotherm compensate --input --out`
-    /// does (same code, same bytes; the column options not in `given` are the model's own);
-    /// returns (rows, ok, held, degraded, invalid, warnings).
+    /// Compensate a log into a CSV file exactly as `gyrotherm compensate --input --out` does
+    /// (same code, same bytes; the column options not in `given` are the model's own).
+    /// Returns the lines written, per axis the lines per status (ok, held, degraded, invalid,
+    /// fallback) and the warnings.
     fn compensate_csv(
         &self,
         py: Python<'_>,
@@ -230,7 +312,7 @@ impl RawModel {
         out: PathBuf,
         options: LogOptions,
         given: Vec<String>,
-    ) -> PyResult<(u64, u64, u64, u64, u64, Vec<String>)> {
+    ) -> PyResult<(u64, Vec<[u64; 5]>, Vec<String>)> {
         let named = |k: &str| given.iter().any(|g| g == k);
         let given = GivenColumns {
             time_col: named("time_col"),
@@ -240,12 +322,12 @@ impl RawModel {
             gyro_unit: named("gyro_unit"),
         };
         let opts = self
-            .file
+            .model
             .read_options(&options.read_options()?, given)
             .map_err(py_err::<ModelError>)?;
-        let summary = py.detach(|| compensate_file(&self.file, &input, &out, &opts));
-        let s = summary.map_err(|e| CompensationError::new_err(gyrotherm::error_chain(&e)))?;
-        Ok((s.rows, s.ok, s.held, s.degraded, s.invalid, s.warnings))
+        let done = py.detach(|| self.model.compensate_file(&input, &out, &opts));
+        let c = done.map_err(|e| CompensationError::new_err(gyrotherm::error_chain(&e)))?;
+        Ok((c.rows(), c.per_axis(), c.warnings().to_vec()))
     }
 
     /// Write the model for `target` (`c`, `rust`, `ardupilot`, `px4`) into the folder `out`:
@@ -260,137 +342,23 @@ impl RawModel {
         axis: Option<&str>,
         device_id: Option<u32>,
     ) -> PyResult<crate::export::Written> {
-        crate::export::write(
-            py,
-            gyrotherm::unit_model::Model::from_single(self.file.clone()),
-            target,
-            out,
-            instance,
-            axis,
-            device_id,
-        )
+        crate::export::write(py, &self.model, target, out, instance, axis, device_id)
     }
 
     /// A human-readable description of the model.
     fn summary(&self) -> PyResult<String> {
-        let m = &self.file;
-        let t = &m.training;
-        let spec = m.feature_spec().map_err(py_err::<ModelError>)?;
-        let mut s = format!(
-            "gyrotherm model (format {}, method {})\n",
-            m.format_version,
-            m.method.as_str()
-        );
-        s += &format!(
-            "  bias model: {}\n  scale-factor model: {}\n",
-            m.bias.as_ref().map_or("none (no static log)", |b| b.kind()),
-            m.scale
-                .as_ref()
-                .map_or("none (no rate-table log)", |b| b.kind())
-        );
-        s += &format!(
-            "  inputs: {} features, stepped every {} s (rate lag {} s)\n",
-            spec.n_features(),
-            m.features.step_period_s,
-            m.features.rate_lag_s
-        );
-        // From `fit`: what training said (`gyrotherm train`'s lines, the training range
-        // first); from a file: what the file tells.
-        if self.training_notes.is_empty() {
-            s += &format!(
-                "  training range: temperature {:.2} to {:.2} °C, rate {:.3} to {:.3} °C/min\n",
-                t.temp_range_c.min,
-                t.temp_range_c.max,
-                t.rate_range_c_per_s.min * 60.0,
-                t.rate_range_c_per_s.max * 60.0
-            );
-            for line in m.describe() {
-                s += &format!("{line}\n");
-            }
-        }
-        if let Some(seed) = t.seed {
-            s += &format!("  seed: {seed}\n");
-        }
-        s += &format!(
-            "  trained on: {}\n  written by: {}\n",
-            t.inputs.join(", "),
-            t.created_by
-        );
-        for n in &self.training_notes {
-            s += &format!("  {n}\n");
-        }
-        Ok(s)
+        self.model
+            .summary(&self.training_notes)
+            .map_err(py_err::<ModelError>)
     }
 
     fn __repr__(&self) -> String {
+        let (gyro_cols, temp_cols) = self.model.columns();
         format!(
-            "Model(method={:?}, bias={:?}, scale={:?})",
-            self.file.method.as_str(),
-            self.file.bias.as_ref().map(|s| s.kind()),
-            self.file.scale.as_ref().map(|s| s.kind())
+            "Model(gyro_cols={gyro_cols:?}, temp_cols={temp_cols:?}, method={:?})",
+            self.method()
         )
     }
-}
-
-type Columns = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<u8>);
-
-/// `compensate_log` with each sample's status code (`Status as u8`): the same flight
-/// compensator stepped over the same samples.
-fn compensate_with_status(model: &ModelFile, log: &TestLog) -> Result<Columns, CompensateError> {
-    let mut comp = compensator(model)?;
-    let n = log.len();
-    let mut out: Columns = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    for i in 0..n {
-        let c = comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
-        out.0.push(c.bias_dps);
-        out.1.push(c.scale);
-        out.2.push(c.rate_dps);
-        out.3.push(c.status as u8);
-    }
-    Ok(out)
-}
-
-type CoverageColumns<'py> = (
-    Bound<'py, PyArray1<u8>>,
-    Bound<'py, PyArray1<f64>>,
-    Option<String>,
-);
-
-/// Code of "no verdict" in [`coverage_columns`].
-pub const NO_COVERAGE: u8 = 255;
-
-/// The flight compensator stepped over the samples with the model's coverage map: the
-/// verdict of each sample's latest step, as `compensate_lines` writes it.
-fn coverage_columns(
-    model: &ModelFile,
-    t: &[f64],
-    g: &[f64],
-    c: &[f64],
-) -> Result<(Vec<u8>, Vec<f64>), CompensateError> {
-    let mut comp = compensator(model)?;
-    // The file's map was checked when it was loaded.
-    let map = model.coverage.as_ref().and_then(|m| m.to_core().ok());
-    let mut codes = Vec::with_capacity(t.len());
-    let mut sigma = Vec::with_capacity(t.len());
-    for i in 0..t.len() {
-        comp.step(t[i], g[i], c[i]);
-        match map.as_ref().and_then(|m| m.verdict_of(comp.features())) {
-            Some(v) => {
-                codes.push(v.coverage as u8);
-                sigma.push(v.sigma_dph);
-            }
-            None => {
-                codes.push(NO_COVERAGE);
-                sigma.push(f64::NAN);
-            }
-        }
-    }
-    Ok((codes, sigma))
 }
 
 /// Coverage code → name, as in the `coverage` column of `gyrotherm compensate`.

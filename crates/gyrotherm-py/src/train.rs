@@ -8,7 +8,6 @@ use gyrotherm::imu_model::ImuFitEvent;
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::told::Told;
 use gyrotherm::train::{train, TrainEvent};
-use gyrotherm::unit_model::Form;
 use pyo3::prelude::*;
 
 use crate::logs::LogOptions;
@@ -25,10 +24,12 @@ type ProgressCall<'a> = Box<dyn FnOnce(Python<'_>) -> PyResult<Py<PyAny>> + 'a>;
 
 /// Fit a model to logs, as `gyrotherm train --input S… --input T…` does (same defaults, same
 /// checks, same file): `static_logs` train the bias model, `table_logs` the scale-factor
-/// model. One gyro's logs give a `RawModel`; a unit's (column lists, or an autopilot log) a
-/// `RawUnitModel`. `progress` is called with the GIL taken, from the training threads: a
+/// model. One gyro's logs give a model of one axis; a unit's (column lists, or an autopilot
+/// log) one of each of its axes. `progress` is called with the GIL taken, from the training threads: a
 /// single gyro's `(target, epoch, loss)`, a unit's `(event, gyro, temp, cv_rms)` per axis and
-/// sensor (`"axis_start"` with `temp` None, `"start"`, `"done"`, `"axis"`).
+/// sensor (`"axis_start"` with `temp` None, `"start"`, `"done"`, `"axis"`; under `auto` also
+/// `"scoring"`, `temp` None, as each left-out run's fold starts, and `"lstm"` as a
+/// `thermal-lstm` training on sensor `temp` starts).
 #[pyfunction]
 #[pyo3(signature = (static_logs, table_logs, settings, options, progress=None))]
 fn fit(
@@ -38,7 +39,7 @@ fn fit(
     settings: FitArgs,
     options: LogOptions,
     progress: Option<Py<PyAny>>,
-) -> PyResult<Py<PyAny>> {
+) -> PyResult<RawModel> {
     let cfg = settings.config()?;
     let opts = options.read_options()?;
     let failed: Mutex<Option<PyErr>> = Mutex::new(None);
@@ -85,6 +86,8 @@ fn fit(
                         ImuFitEvent::SensorStarted { .. } => ("start", None),
                         ImuFitEvent::SensorFinished { cv_rms, .. } => ("done", cv_rms),
                         ImuFitEvent::AxisFinished { .. } => ("axis", None),
+                        ImuFitEvent::Scoring { .. } => ("scoring", None),
+                        ImuFitEvent::LstmTraining { .. } => ("lstm", None),
                         _ => return,
                     };
                     call(Box::new(move |py| cb.call1(py, (what, s.gyro, s.temp, cv))))
@@ -108,10 +111,5 @@ fn fit(
             _ => None,
         })
         .collect();
-    Ok(match trained.model.into_form() {
-        Form::Single(file) => Py::new(py, RawModel::trained(*file, notes))?.into_any(),
-        Form::Unit(file) => {
-            Py::new(py, crate::unit::RawUnitModel::loaded(file, Vec::new()))?.into_any()
-        }
-    })
+    Ok(RawModel::trained(trained.model, notes))
 }

@@ -1,4 +1,4 @@
-"""``Model.export`` and ``UnitModel.export``: the files ``gyrotherm export --target`` writes,
+"""``Model.export`` of a single gyro and of a unit: the files ``gyrotherm export --target`` writes,
 byte for byte, for every target, and the same refusals."""
 
 import warnings

@@ -1,6 +1,7 @@
 """An inertial unit from Python: ``read_log`` and ``fit`` with gyro and temperature column
-lists, ``UnitModel`` (load, save, compensate per axis), against the CLI on the same logs: the
-same model file bytes, the same compensated numbers to the last bit."""
+lists, its ``Model`` (load, save, compensate per axis; the class a single gyro's model has),
+against the CLI on the same logs: the same model file bytes, the same compensated numbers to
+the last bit."""
 
 import csv
 import json
@@ -200,3 +201,77 @@ def test_unsealed_unit_model_file_loads_with_a_warning_naming_it(unit_logs, tmp_
     with warnings.catch_warnings():
         warnings.simplefilter("error", gt.GyrothermWarning)
         gt.UnitModel.load(sealed)
+
+
+def test_one_class_holds_a_single_gyro_and_a_unit(cli, unit_logs, tmp_path):
+    """A single gyro is a unit of one axis: its model answers what a unit's does (columns,
+    axes, per-axis compensation with a dict), with the numbers of its plain-array call; the
+    old unit class name is the same class."""
+    assert gt.UnitModel is gt.Model
+    one = gt.fit(
+        static=unit_logs["static"], method="linear", gyro_col="gyro_x_dps",
+        temp_col="temp_case_c",
+    )
+    assert one.gyro_cols == ["gyro_x_dps"] and one.temp_cols == ["temp_case_c"]
+    (axis,) = one.axes
+    assert axis["gyro"] == "gyro_x_dps" and axis["temps"] == ["temp_case_c"]
+    assert axis["method"] == one.method == "linear"
+    assert axis["training"] == one.training
+    log = gt.read_log(
+        unit_logs["heldout"], gyro_col=GYROS, temp_col=TEMPS, as_frame=False
+    )
+    plain = one.compensate(log["time_s"], log["gyro_x_dps"], log["temp_case_c"])
+    keyed = one.compensate(log["time_s"], {"gyro_x_dps": log["gyro_x_dps"]},
+                           {"temp_case_c": log["temp_case_c"]})
+    assert list(keyed) == ["gyro_x_dps"]
+    for field in plain._fields:
+        np.testing.assert_array_equal(getattr(keyed["gyro_x_dps"], field), getattr(plain, field))
+    cov = one.coverage(log["time_s"], {"gyro_x_dps": log["gyro_x_dps"]},
+                       {"temp_case_c": log["temp_case_c"]})
+    flat = one.coverage(log["time_s"], log["gyro_x_dps"], log["temp_case_c"])
+    np.testing.assert_array_equal(cov["gyro_x_dps"].coverage, flat.coverage)
+
+    unit = gt.fit(static=unit_logs["static"], method="linear", gyro_col=GYROS, temp_col=TEMPS)
+    assert unit.training is None and unit.method == "linear"
+    with pytest.raises(gt.CompensationError, match="one array given, the model has 3 axes"):
+        unit.compensate(log["time_s"], log["gyro_x_dps"], log["temp_case_c"])
+
+
+def test_unit_compensate_csv_counts_each_axis_as_the_cli_writes_it(cli, unit_logs, tmp_path):
+    path = tmp_path / "unit.json"
+    cli(
+        "train", "--method", "linear", "--gyro-col", ",".join(GYROS), "--temp-col",
+        ",".join(TEMPS), "--input", unit_logs["static"], "--out", path,
+    )
+    model = gt.Model.load(path)
+    cli("compensate", "--model", path, "--input", unit_logs["heldout"], "--out", tmp_path / "c.csv")
+    res = model.compensate_csv(unit_logs["heldout"], tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "c.csv").read_bytes()
+    want = read_csv_columns(tmp_path / "c.csv")
+    assert res["rows"] == len(want["time_s"])
+    for g in GYROS:
+        for status, n in res["axes"][g].items():
+            assert n == want[f"{g}_status"].count(status), (g, status)
+    assert res["ok"] == sum(a["ok"] for a in res["axes"].values())
+
+
+def test_unit_auto_fit_tells_each_fold_and_lstm_training(unit_logs, capfd):
+    """``auto`` on a unit with two static runs scores both candidates with each run left out
+    (a ``scoring`` event per fold), training ``thermal-lstm`` as it goes (``lstm``)."""
+    events = []
+    gt.fit(
+        static=[unit_logs["static"], unit_logs["heldout"]], method="auto", epochs=3,
+        gyro_col=["gyro_x_dps"], temp_col=TEMPS, progress=lambda *e: events.append(e),
+    )
+    kinds = [e[0] for e in events]
+    assert kinds.count("scoring") == 2, events
+    assert all(e[2] is None for e in events if e[0] == "scoring")
+    assert "lstm" in kinds and all(e[2] in TEMPS for e in events if e[0] == "lstm"), events
+    capfd.readouterr()
+    gt.fit(
+        static=[unit_logs["static"], unit_logs["heldout"]], method="auto", epochs=3,
+        gyro_col=["gyro_x_dps"], temp_col=TEMPS, progress=True,
+    )
+    err = capfd.readouterr().err
+    assert "gyro_x_dps: auto: fitting thermal and thermal-lstm without a static run" in err, err
+    assert "gyro_x_dps: auto: training thermal-lstm on temp_" in err, err

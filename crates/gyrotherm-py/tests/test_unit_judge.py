@@ -36,7 +36,7 @@ LOOSE = "bias_dph = { min = -1e6, max = 1e6 }\nbias_stability_dph = { max = 1e6 
 
 def test_evaluate_per_axis_is_the_cli_json(cli, unit_logs, unit_model, tmp_path):  # noqa: F811
     spec = spec_file(tmp_path, "loose.toml", LOOSE)
-    got = gt.evaluate(unit_logs["heldout"], gt.UnitModel.load(unit_model), spec=spec)
+    got = gt.evaluate(unit_logs["heldout"], gt.Model.load(unit_model), spec=spec)
     want = json.loads(
         cli("evaluate", "--json", "--model", unit_model, "--input", unit_logs["heldout"],
             "--spec", spec).stdout

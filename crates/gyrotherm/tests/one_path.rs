@@ -158,3 +158,55 @@ fn train_on_a_unit_s_set_tells_each_axis_step_with_its_names() {
     .unwrap();
     assert_eq!(got.to_json().unwrap(), want.to_json().unwrap());
 }
+
+#[test]
+fn a_single_gyro_model_in_memory_is_a_unit_of_one_axis_with_the_compensator_s_numbers() {
+    let log = short_log(9);
+    let name = "s".to_owned();
+    let file = fit_model(
+        &[NamedLog {
+            name: &name,
+            log: &log,
+        }],
+        &FitConfig::new(Method::Linear),
+        &|_, _, _| {},
+    )
+    .unwrap()
+    .model;
+    let model = gyrotherm::unit_model::Model::from_single(file.clone());
+    // The text round-trips in its form, with the bytes the file's own code writes.
+    let text = model.to_json().unwrap();
+    assert_eq!(text, format!("{}\n", file.to_json().unwrap()));
+    let back = gyrotherm::unit_model::Model::from_json(&text).unwrap();
+    assert_eq!(back.to_json().unwrap(), text);
+    // No columns recorded: the standard names.
+    let (gyro, temp) = model.columns();
+    assert_eq!(
+        (gyro.as_slice(), temp.as_slice()),
+        (&["gyro_dps".to_owned()][..], &["temp_c".to_owned()][..])
+    );
+
+    let series = |name: &str, values: &[f64]| gyrotherm::csvlog::NamedSeries {
+        name: name.to_owned(),
+        values: values.to_vec(),
+    };
+    let unit_log = gyrotherm::csvlog::ImuLog {
+        time_s: log.time_s.clone(),
+        gyro: vec![series("gyro_dps", &log.gyro_dps)],
+        temp: vec![series("temp_c", &log.temp_c)],
+        ..Default::default()
+    };
+    let (axes, _) = model.compensate_log(&unit_log).unwrap();
+    // Independently: the single-gyro flight compensator stepped over the same samples.
+    let mut comp = gyrotherm::compensate::compensator(&file).unwrap();
+    assert_eq!(axes.len(), 1);
+    for i in 0..log.len() {
+        let c = comp.step(log.time_s[i], log.gyro_dps[i], log.temp_c[i]);
+        assert_eq!(
+            axes[0].gyro_comp_dps[i].to_bits(),
+            c.rate_dps.to_bits(),
+            "sample {i}"
+        );
+        assert_eq!(axes[0].status[i], c.status);
+    }
+}

@@ -8,8 +8,9 @@
 - Logs and models: ``read_log``, ``read_lot`` (a lot database of ``gyrotherm lot``), ``fit`` → ``Model`` (``save``, ``Model.load``,
   ``compensate``, ``summary``, ``export``: C, Rust, ArduPilot or PX4 parameters, as
   ``gyrotherm export --target``); model files are the CLI's JSON.
-- Inertial units: ``gyro_col``/``temp_col`` lists in ``read_log`` and ``fit`` (→ ``UnitModel``:
-  one file for the unit, ``compensate`` per axis), as the CLI's comma-separated lists;
+- Inertial units: ``gyro_col``/``temp_col`` lists in ``read_log`` and ``fit`` (→ the same
+  ``Model``: one file for the unit, ``compensate`` per axis; a single gyro is a unit of one
+  axis), as the CLI's comma-separated lists;
   ``evaluate`` (figures and spec verdicts per axis) and ``compare`` (methods per axis, with
   the unit's own multi-sensor fit) as ``gyrotherm evaluate``/``compare --json`` print them.
 

@@ -91,7 +91,8 @@ def _export(
 
 class Model:
     """A fitted compensation model: the JSON file ``gyrotherm train`` writes and
-    ``gyrotherm compensate`` reads. Make one with :func:`fit` or :meth:`Model.load`."""
+    ``gyrotherm compensate`` reads, of a single gyro or of an inertial unit (a single gyro is a
+    unit of one axis). Make one with :func:`fit` or :meth:`Model.load`."""
 
     def __init__(self, raw: "_g.RawModel") -> None:
         if not isinstance(raw, _g.RawModel):
@@ -99,19 +100,16 @@ class Model:
         self._raw = raw
 
     @classmethod
-    def load(cls, path: PathLike) -> Union["Model", "UnitModel"]:
-        """Read and check a model file (raises ``gyrotherm.ModelError``; warns,
-        ``GyrothermWarning``, when the file has no content checksum). An inertial unit's file
-        (``train`` with column lists) comes back as a :class:`UnitModel`."""
-        raw = _g.load_model(os.fspath(path))
+    def load(cls, path: PathLike) -> "Model":
+        """Read and check a model file of either form (raises ``gyrotherm.ModelError``; warns,
+        ``GyrothermWarning``, when the file has no content checksum)."""
+        raw = _g.RawModel.load(os.fspath(path))
         _warn(raw.load_warnings)
-        if isinstance(raw, _g.RawUnitModel):
-            return UnitModel(raw)
         return cls(raw)
 
     @classmethod
     def from_json(cls, text: str) -> "Model":
-        """Parse and check model JSON text."""
+        """Parse and check model JSON text of either form."""
         return cls(_g.RawModel.from_json(text))
 
     def save(self, path: PathLike) -> None:
@@ -123,181 +121,187 @@ class Model:
         return self._raw.to_json()
 
     @property
-    def method(self) -> str:
-        """The method (``gyrotherm.METHOD_NAMES``; ``"lstm"`` for files written before the
-        methods were one list)."""
+    def method(self) -> Optional[str]:
+        """The method every axis was fitted with (``gyrotherm.METHOD_NAMES``; ``"lstm"`` for
+        files written before the methods were one list); None where a unit's axes differ
+        (see :attr:`axes`)."""
         return self._raw.method
 
     @property
     def bias_kind(self) -> Optional[str]:
-        """What the bias model is made of (None: no bias model)."""
+        """What every axis's bias model is made of (None: no bias model, or the axes
+        differ)."""
         return self._raw.bias_kind
 
     @property
     def scale_kind(self) -> Optional[str]:
-        """What the scale-factor model is made of (None: no scale-factor model)."""
+        """What every axis's scale-factor model is made of (None: no scale-factor model, or
+        the axes differ)."""
         return self._raw.scale_kind
 
     @property
-    def training(self) -> Dict[str, Any]:
-        """Training facts from the file (ranges, digest, epochs, loss, seed, inputs)."""
+    def training(self) -> Optional[Dict[str, Any]]:
+        """Training facts of a model of one axis (ranges, digest, epochs, loss, seed,
+        inputs); None for a unit of several, whose axes each have theirs in :attr:`axes`."""
         return self._raw.training
-
-    def compensate(self, time_s, gyro_dps, temp_c) -> Compensation:
-        """Compensate samples (time s increasing, gyro output °/s, temperature °C) with the
-        flight compensator, sample by sample: the numbers ``gyrotherm compensate`` writes.
-        Warns (``GyrothermWarning``) where the temperature or its rate leaves the training
-        range. Every sample gets a status (``STATUS_NAMES``) instead of an exception."""
-        arrays = [np.ascontiguousarray(a, dtype=np.float64) for a in (time_s, gyro_dps, temp_c)]
-        for name, a in zip(("time_s", "gyro_dps", "temp_c"), arrays):
-            if a.ndim != 1:
-                raise _g.CompensationError(f"{name}: need a 1-D array, got shape {a.shape}")
-        bias, scale, rate, status, warns = self._raw.compensate(*arrays)
-        _warn(warns)
-        return Compensation(bias, scale, rate, status)
-
-    def coverage(self, time_s, gyro_dps, temp_c) -> CoverageVerdicts:
-        """Per sample, whether the temperature and its rate lie inside, at the edge of or
-        outside the region the training logs covered, and the 1σ residual bias error there
-        (°/h): the ``coverage`` and ``sigma_dph`` columns ``gyrotherm compensate`` writes for
-        the same samples. Warns (``GyrothermWarning``) when the model file has no coverage
-        map (every code is then ``NO_COVERAGE``)."""
-        arrays = [np.ascontiguousarray(a, dtype=np.float64) for a in (time_s, gyro_dps, temp_c)]
-        for name, a in zip(("time_s", "gyro_dps", "temp_c"), arrays):
-            if a.ndim != 1:
-                raise _g.CompensationError(f"{name}: need a 1-D array, got shape {a.shape}")
-        codes, sigma, note = self._raw.coverage(*arrays)
-        if note is not None:
-            _warn([note])
-        return CoverageVerdicts(codes, sigma)
-
-    def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]:
-        """``gyrotherm compensate --input INPUT --out OUT`` with the same log options (a column
-        option not given is the model's, as the CLI reads it): every
-        input column, then ``bias_dps``, ``scale``, ``gyro_comp_dps``, ``status``, ``coverage`` and
-        ``sigma_dph``. Returns
-        the rows written, the count per status and the extrapolation warnings (also issued as
-        warnings)."""
-        if options.get("fill_gaps_max_s") is not None:
-            raise _g.CompensationError(
-                "fill_gaps_max_s does not apply to compensate: the compensator bridges time gaps "
-                "itself and writes one output line per input line"
-            )
-        # Columns not named here are the model's own (the ones it was trained on).
-        rows, ok, held, degraded, invalid, warns = self._raw.compensate_csv(
-            os.fspath(input), os.fspath(out), read_options(options), sorted(options)
-        )
-        _warn(warns)
-        return {"rows": rows, "ok": ok, "held": held, "degraded": degraded,
-                "invalid": invalid, "warnings": warns}
-
-    export = _export
-
-    def summary(self) -> str:
-        """What the model is, what it was trained on, and (after :func:`fit`) how training
-        went."""
-        return self._raw.summary()
-
-    def __repr__(self) -> str:
-        return repr(self._raw)
-
-
-class UnitModel:
-    """An inertial unit's model: the file ``gyrotherm train`` writes with ``--gyro-col`` and
-    ``--temp-col`` lists (per axis a bias and a scale-factor model, the columns it needs).
-    Make one with :func:`fit` (column lists) or :meth:`UnitModel.load`."""
-
-    def __init__(self, raw: "_g.RawUnitModel") -> None:
-        if not isinstance(raw, _g.RawUnitModel):
-            raise TypeError("make a UnitModel with gyrotherm.fit(...) or UnitModel.load(path)")
-        self._raw = raw
-
-    @classmethod
-    def load(cls, path: PathLike) -> "UnitModel":
-        """Read and check a unit model file (raises ``gyrotherm.ModelError``; warns with
-        ``gyrotherm.GyrothermWarning`` when it has no content checksum)."""
-        raw = _g.RawUnitModel.load(os.fspath(path))
-        _warn(raw.load_warnings)
-        return cls(raw)
-
-    @classmethod
-    def from_json(cls, text: str) -> "UnitModel":
-        """Parse and check unit model JSON text."""
-        return cls(_g.RawUnitModel.from_json(text))
-
-    def save(self, path: PathLike) -> None:
-        """Write the file (atomically; the same bytes as ``gyrotherm train``)."""
-        self._raw.save(os.fspath(path))
-
-    def to_json(self) -> str:
-        """The file's text."""
-        return self._raw.to_json()
 
     @property
     def gyro_cols(self) -> List[str]:
-        """The gyro columns, in the order of the axes."""
+        """The gyro columns, in the order of the axes (one for a single gyro)."""
         return self._raw.gyro_cols
 
     @property
     def temp_cols(self) -> List[str]:
-        """The temperature columns the unit's log must hold."""
+        """The temperature columns a log must hold."""
         return self._raw.temp_cols
 
     @property
     def axes(self) -> List[Dict[str, Any]]:
         """Per axis: ``gyro``, ``temps`` (the sensors its model reads), ``cv_rms`` (the
         cross-validated RMS of each sensor tried, None without cross-validation),
-        ``method``, ``bias_kind`` and ``scale_kind``."""
+        ``method``, ``bias_kind``, ``scale_kind`` and ``training``."""
         return self._raw.axes
 
-    def compensate(self, time_s, gyro, temp) -> Dict[str, Compensation]:
-        """Compensate a unit's samples with each axis's flight compensator: ``gyro`` and
-        ``temp`` map each of :attr:`gyro_cols` and :attr:`temp_cols` to its samples (a dict,
-        or sequences in those orders). Returns per gyro column its :class:`Compensation`,
-        the numbers ``gyrotherm compensate`` writes as ``G_bias``, ``G_scale``, ``G_comp``
-        and ``G_status``."""
+    def _samples(self, time_s, gyro, temp):
+        """The arrays the binding takes, and whether one axis was given as a plain array."""
         t = np.ascontiguousarray(time_s, dtype=np.float64)
-        g = self._ordered(gyro, self.gyro_cols, "gyro")
-        c = self._ordered(temp, self.temp_cols, "temp")
+        one = _one_series(gyro)
+        if one:
+            if len(self.gyro_cols) != 1:
+                raise _g.CompensationError(
+                    f"gyro: one array given, the model has {len(self.gyro_cols)} axes "
+                    f"({', '.join(self.gyro_cols)}); give a dict keyed by gyro column"
+                )
+            gyro = [gyro]
+            if _one_series(temp):
+                temp = [temp]
+        g = _ordered(gyro, self.gyro_cols, "gyro")
+        c = _ordered(temp, self.temp_cols, "temp")
         for name, a in [("time_s", t), *zip(self.gyro_cols, g), *zip(self.temp_cols, c)]:
             if a.ndim != 1:
                 raise _g.CompensationError(f"{name}: need a 1-D array, got shape {a.shape}")
-        out = self._raw.compensate(t, g, c)
-        return {name: Compensation(*cols) for name, cols in zip(self.gyro_cols, out)}
+        if one and not len(t) == len(g[0]) == len(c[0]):
+            raise _g.CompensationError(
+                f"time_s, gyro_dps and temp_c differ in length ({len(t)}, {len(g[0])}, "
+                f"{len(c[0])}); give one value per sample in each"
+            )
+        return t, g, c, one
+
+    def compensate(self, time_s, gyro, temp):
+        """Compensate samples with each axis's flight compensator, sample by sample: the
+        numbers ``gyrotherm compensate`` writes. Every sample gets a status
+        (``STATUS_NAMES``) instead of an exception; warns (``GyrothermWarning``) where the
+        temperature or its rate leaves the training range.
+
+        A single gyro: ``time_s`` (s, increasing), ``gyro`` (output, °/s) and ``temp`` (°C)
+        as arrays; returns its :class:`Compensation`. Any model: ``gyro`` and ``temp`` map
+        each of :attr:`gyro_cols` and :attr:`temp_cols` to its samples (a dict, or sequences
+        in those orders); returns per gyro column its :class:`Compensation` (the CLI's
+        ``G_bias``, ``G_scale``, ``G_comp`` and ``G_status``)."""
+        t, g, c, one = self._samples(time_s, gyro, temp)
+        axes, warns = self._raw.compensate(t, g, c)
+        _warn(warns)
+        out = {name: Compensation(*cols) for name, cols in zip(self.gyro_cols, axes)}
+        return next(iter(out.values())) if one else out
+
+    def coverage(self, time_s, gyro, temp):
+        """Per sample, whether the temperature and its rate lie inside, at the edge of or
+        outside the region the training logs covered, and the 1σ residual bias error there
+        (°/h): the ``coverage`` and ``sigma_dph`` columns ``gyrotherm compensate`` writes for
+        the same samples. Arrays as :meth:`compensate` takes them; a :class:`CoverageVerdicts`
+        for a single gyro's arrays, else one per gyro column. Warns (``GyrothermWarning``)
+        where an axis has no verdict: a model file without a coverage map, or a unit's axis
+        that reads several sensors (every code is then ``NO_COVERAGE``)."""
+        t, g, c, one = self._samples(time_s, gyro, temp)
+        axes, notes = self._raw.coverage(t, g, c)
+        _warn(notes)
+        out = {name: CoverageVerdicts(*cols) for name, cols in zip(self.gyro_cols, axes)}
+        return next(iter(out.values())) if one else out
 
     def compensate_log(self, log) -> Dict[str, Compensation]:
         """:meth:`compensate` of a log as :func:`read_log` returns it (read with the model's
-        columns: ``gyro_col=model.gyro_cols, temp_col=model.temp_cols``)."""
+        columns: ``gyro_col=model.gyro_cols, temp_col=model.temp_cols``): per gyro column."""
         (t,) = columns(log, ["time_s"])
         return self.compensate(
             t, columns(log, self.gyro_cols), columns(log, self.temp_cols)
         )
 
-    @staticmethod
-    def _ordered(values, names: List[str], what: str):
-        if isinstance(values, dict) or hasattr(values, "keys"):
-            missing = [n for n in names if n not in values]
-            if missing:
-                raise _g.CompensationError(
-                    f"{what}: no samples for {', '.join(missing)}, which the model needs"
-                )
-            values = [values[n] for n in names]
-        values = [np.ascontiguousarray(v, dtype=np.float64) for v in values]
-        if len(values) != len(names):
+    def compensate_csv(self, input: PathLike, out: PathLike, **options: Any) -> Dict[str, Any]:
+        """``gyrotherm compensate --input INPUT --out OUT`` with the same log options (a column
+        option not given is the model's, as the CLI reads it): every input column, then per
+        axis its compensated columns (a single gyro's ``bias_dps``, ``scale``,
+        ``gyro_comp_dps``, ``status``, ``coverage`` and ``sigma_dph``). Returns the rows
+        written, the lines per status over every axis (``ok``, ``held``, ``degraded``,
+        ``invalid``, ``fallback``), the same per gyro column (``axes``) and the warnings (also
+        issued as warnings)."""
+        if options.get("fill_gaps_max_s") is not None:
             raise _g.CompensationError(
-                f"{what}: {len(values)} arrays given, the model needs {len(names)} "
-                f"({', '.join(names)})"
+                "fill_gaps_max_s does not apply to compensate: the compensator bridges time gaps "
+                "itself and writes one output line per input line"
             )
-        return values
+        # Columns not named here are the model's own (the ones it was trained on).
+        rows, per_axis, warns = self._raw.compensate_csv(
+            os.fspath(input), os.fspath(out), read_options(options), sorted(options)
+        )
+        _warn(warns)
+        keys = ("ok", "held", "degraded", "invalid", "fallback")
+        axes = {g: dict(zip(keys, n)) for g, n in zip(self.gyro_cols, per_axis)}
+        result: Dict[str, Any] = {"rows": rows}
+        result.update({k: sum(a[k] for a in axes.values()) for k in keys})
+        result["axes"] = axes
+        result["warnings"] = warns
+        return result
 
     export = _export
 
     def summary(self) -> str:
-        """The axes, the sensor each reads and its models."""
+        """What the model is, what it was trained on and (after :func:`fit`) how training
+        went; a unit's axes, the sensor each reads and its models."""
         return self._raw.summary()
 
     def __repr__(self) -> str:
         return repr(self._raw)
+
+
+#: The name an inertial unit's model had when it was a class of its own; it is :class:`Model`.
+UnitModel = Model
+
+
+def _keyed(values) -> bool:
+    return isinstance(values, dict) or hasattr(values, "keys")
+
+
+def _one_series(values) -> bool:
+    """Whether ``values`` are one axis's samples (a 1-D array or a sequence of numbers), not
+    one array per column."""
+    if isinstance(values, np.ndarray):
+        return values.ndim == 1
+    if _keyed(values):
+        return False
+    try:
+        first = next(iter(values))
+    except StopIteration:
+        return True
+    except TypeError:
+        return False
+    return np.ndim(first) == 0
+
+
+def _ordered(values, names: List[str], what: str):
+    if _keyed(values):
+        missing = [n for n in names if n not in values]
+        if missing:
+            raise _g.CompensationError(
+                f"{what}: no samples for {', '.join(missing)}, which the model needs"
+            )
+        values = [values[n] for n in names]
+    values = [np.ascontiguousarray(v, dtype=np.float64) for v in values]
+    if len(values) != len(names):
+        raise _g.CompensationError(
+            f"{what}: {len(values)} arrays given, the model needs {len(names)} "
+            f"({', '.join(names)})"
+        )
+    return values
 
 
 class _PrintProgress:
@@ -322,6 +326,11 @@ class _PrintProgress:
             text = f"{gyro}: axis starts"
         elif event == "start":
             text = f"{gyro}: fitting on {temp}"
+        elif event == "scoring":
+            text = (f"{gyro}: auto: fitting thermal and thermal-lstm without a static run and "
+                    "scoring them on it")
+        elif event == "lstm":
+            text = f"{gyro}: auto: training thermal-lstm on {temp}"
         elif event == "done":
             score = "-" if cv_rms is None else f"{cv_rms:.3e}"
             text = f"{gyro}: {temp} done (cross-validated RMS {score})"
@@ -375,7 +384,7 @@ def fit(
     validate_on_runs: bool = _FIT["validate_on_runs"],
     progress: Progress = False,
     **log_options: Any,
-) -> Union[Model, "UnitModel"]:
+) -> Model:
     """Fit a compensation model, as ``gyrotherm train --input S… --input T… --method …``
     (same defaults, same checks, same file).
 
@@ -390,12 +399,14 @@ def fit(
     The GIL is released while reading and training.
 
     An inertial unit: ``gyro_col`` and ``temp_col`` as lists (or the CLI's comma-separated
-    text) fit every axis as ``gyrotherm train --gyro-col … --temp-col …`` does and return a
-    :class:`UnitModel` (the same file). Table logs go in ``table`` (one per axis; the axis is
+    text) fit every axis as ``gyrotherm train --gyro-col … --temp-col …`` does and return its
+    :class:`Model` (the same file). Table logs go in ``table`` (one per axis; the axis is
     found, or named by ``table_axis=``). ``progress``: True prints a line as each axis and
     sensor starts and finishes; a callable gets ``(event, gyro, temp, cv_rms)``, event
     ``"axis_start"`` (``temp`` None), ``"start"``, ``"done"`` (with the sensor's
-    cross-validated RMS) or ``"axis"`` (the axis is done and reads ``temp``).
+    cross-validated RMS) or ``"axis"`` (the axis is done and reads ``temp``); with ``"auto"``
+    also ``"scoring"`` (``temp`` None) as each left-out static run's fold starts and ``"lstm"``
+    as a ``thermal-lstm`` training on sensor ``temp`` starts.
     """
     static_paths = _paths(static, "static")
     table_paths = _paths(table, "table")
@@ -419,8 +430,6 @@ def fit(
         )
     raw = _g.fit(static_paths, table_paths, settings, options, callback)
     _warn(raw.load_warnings)
-    if isinstance(raw, _g.RawUnitModel):
-        return UnitModel(raw)
     return Model(raw)
 
 
@@ -431,7 +440,7 @@ EVALUATE_DEFAULTS: Dict[str, Any] = dict(_g.EVALUATE_DEFAULTS)
 
 def evaluate(
     log: PathLike,
-    model: Union["UnitModel", PathLike, None] = None,
+    model: Union[Model, PathLike, None] = None,
     *,
     column: str = EVALUATE_DEFAULTS["column"],
     spec: Optional[PathLike] = None,
@@ -461,8 +470,8 @@ def evaluate(
     """
     raw_model = None
     if model is not None:
-        if not isinstance(model, UnitModel):
-            model = UnitModel.load(model)
+        if not isinstance(model, Model):
+            model = Model.load(model)
         raw_model = model._raw
     options = read_options(log_options)
     import json

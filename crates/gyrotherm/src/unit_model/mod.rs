@@ -24,6 +24,10 @@ use crate::input_file::{read_capped_to_string, InputKind};
 use crate::model::{GivenColumns, ModelFile, ModelFileError, Seal};
 use crate::settings::autopilot::AutopilotSettings;
 pub use crate::told::Told;
+pub use samples::{AxisCoverage, SamplesError, NO_COVERAGE};
+
+mod samples;
+mod summary;
 
 /// A model file of either form, as read.
 #[derive(Debug, Clone)]
@@ -49,6 +53,8 @@ pub enum ModelError {
     Single(ModelFileError),
     /// An inertial unit's model file at `path`.
     Unit { path: PathBuf, source: ImuError },
+    /// An inertial unit's model text, read without a file.
+    UnitText(ImuError),
 }
 
 impl std::fmt::Display for ModelError {
@@ -56,6 +62,7 @@ impl std::fmt::Display for ModelError {
         match self {
             ModelError::Single(e) => e.fmt(f),
             ModelError::Unit { path, .. } => write!(f, "cannot use model {}", path.display()),
+            ModelError::UnitText(_) => f.write_str("cannot use the unit model text"),
         }
     }
 }
@@ -65,7 +72,7 @@ impl std::error::Error for ModelError {
         match self {
             // Transparent: the file's error is this error's own.
             ModelError::Single(e) => e.source(),
-            ModelError::Unit { source, .. } => Some(source),
+            ModelError::Unit { source, .. } | ModelError::UnitText(source) => Some(source),
         }
     }
 }
@@ -122,6 +129,26 @@ impl Model {
             form: Form::Single(Box::new(m)),
             seal,
         })
+    }
+
+    /// Parse and check model text of either form, as [`Model::load`] checks a file.
+    pub fn from_json(text: &str) -> Result<Model, ModelError> {
+        Self::from_text(text).map_err(|e| match e {
+            TextError::Single(e) => ModelError::Single(e),
+            TextError::Unit(e) => ModelError::UnitText(e),
+        })
+    }
+
+    /// The file's text: the bytes [`Model::save`] writes, in the form it was read from.
+    pub fn to_json(&self) -> Result<String, ModelError> {
+        match &self.form {
+            Form::Single(m) => {
+                let mut text = m.to_json()?;
+                text.push('\n');
+                Ok(text)
+            }
+            Form::Unit(m) => m.to_json().map_err(ModelError::UnitText),
+        }
     }
 
     /// A single-gyro model as a one-axis unit (sealed: it was made, not read).
@@ -445,6 +472,32 @@ impl Model {
 }
 
 impl Compensation {
+    /// Data lines written (= data lines read).
+    pub fn rows(&self) -> u64 {
+        match &self.0 {
+            Counts::Single(s) => s.rows,
+            Counts::Unit(s, _) => s.rows,
+        }
+    }
+
+    /// Per axis, in column order, the lines per status: ok, held, degraded, invalid (a
+    /// malformed line is invalid), fallback.
+    pub fn per_axis(&self) -> Vec<[u64; 5]> {
+        match &self.0 {
+            Counts::Single(s) => vec![[s.ok, s.held, s.degraded, s.invalid, 0]],
+            Counts::Unit(s, _) => s.per_axis.clone(),
+        }
+    }
+
+    /// The warnings of the run: extrapolation (a single-gyro model's) and time steps longer
+    /// than the compensator runs at.
+    pub fn warnings(&self) -> &[String] {
+        match &self.0 {
+            Counts::Single(s) => &s.warnings,
+            Counts::Unit(s, _) => &s.warnings,
+        }
+    }
+
     /// What to tell about the run: a file run writes `wrote OUT (...)`, a stream (`out` None)
     /// its counts; then temperature faults and warnings, as each form tells them.
     pub fn told(&self, out: Option<&Path>) -> Vec<Told> {
