@@ -40,7 +40,7 @@ pub(crate) fn boxed_compensator<const H: usize>(
 }
 
 /// [`compensator`] at `H` hidden units (an LSTM of the model larger than `H` is refused).
-pub fn sized_compensator<const H: usize>(
+pub(crate) fn sized_compensator<const H: usize>(
     model: &ModelFile,
 ) -> Result<Compensator<H>, CompensateError> {
     let spec = model.feature_spec().map_err(CompensateError::Model)?;
@@ -80,7 +80,7 @@ pub fn compensate_log(model: &ModelFile, log: &TestLog) -> Result<Compensated, C
 
 /// Warnings, with the numbers, when `log` leaves the model's training temperature or
 /// temperature-rate range (the model then extrapolates).
-pub fn extrapolation_warnings(model: &ModelFile, log: &TestLog) -> Vec<String> {
+pub(crate) fn extrapolation_warnings(model: &ModelFile, log: &TestLog) -> Vec<String> {
     let Ok(spec) = model.feature_spec() else {
         return Vec::new();
     };
@@ -129,7 +129,3 @@ pub(crate) fn range_warnings(
     }
     out
 }
-
-/// Columns appended by [`compensate_lines`](crate::compensate_lines::compensate_lines) before
-/// its `status` column.
-pub const OUTPUT_COLUMNS: [&str; 3] = ["bias_dps", "scale", "gyro_comp_dps"];

@@ -42,11 +42,11 @@ use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
 pub use crate::flight_size::StreamUnit;
 
 /// Suffixes of the columns added per gyro column, in order.
-pub const AXIS_SUFFIXES: [&str; 4] = ["bias", "scale", "comp", "status"];
+pub(crate) const AXIS_SUFFIXES: [&str; 4] = ["bias", "scale", "comp", "status"];
 
 /// The names of the columns added for `model`: `G_bias`, `G_scale`, `G_comp`, `G_status`
 /// per gyro column G.
-pub fn output_columns(model: &ImuModel) -> Vec<String> {
+pub(crate) fn output_columns(model: &ImuModel) -> Vec<String> {
     model
         .gyro_cols
         .iter()
@@ -267,7 +267,7 @@ impl LineModel for Axes {
 /// Compensate the unit log `input` into the CSV file `out` ([`Mode::Strict`]), written to a
 /// temporary file and renamed into place: what `gyrotherm compensate --input --out` does with
 /// a unit model. The same lines as the stream for every log the strict mode accepts.
-pub fn compensate_imu_file(
+pub(crate) fn compensate_imu_file(
     model: &ImuModel,
     input: &Path,
     out: &Path,

@@ -41,7 +41,7 @@ use crate::model::ModelFile;
 pub use crate::csvlog::MAX_LINE_BYTES;
 
 /// Columns appended to every row, in order.
-pub const OUTPUT_COLUMNS: [&str; 6] = [
+pub(crate) const OUTPUT_COLUMNS: [&str; 6] = [
     "bias_dps",
     "scale",
     "gyro_comp_dps",

@@ -38,7 +38,7 @@ pub enum HiddenSize {
 
 impl HiddenSize {
     /// The size of `units` hidden units, `None` when flight code is not built for it.
-    pub fn of_units(units: usize) -> Option<Self> {
+    pub(crate) fn of_units(units: usize) -> Option<Self> {
         match units {
             8 => Some(HiddenSize::H8),
             16 => Some(HiddenSize::H16),
@@ -244,7 +244,7 @@ pub enum FlightAxis {
 }
 
 /// A further sensor as [`AxisCompensator::further`] gives it.
-pub type FurtherSensor<'a> = (
+pub(crate) type FurtherSensor<'a> = (
     usize,
     &'a FeatureSpec,
     Option<&'a gyrotherm_core::baseline::BaselineModel>,
@@ -324,7 +324,7 @@ impl StreamUnit {
     /// A unit of `axes` (all of one size) on `n_temps` temperature channels, refused as
     /// [`Unit::push_axis`](gyrotherm_core::unit::Unit::push_axis) refuses an axis. The error names the axis (0-based) that does not
     /// fit.
-    pub fn of_axes(n_temps: usize, axes: Vec<FlightAxis>) -> Result<Self, (usize, UnitError)> {
+    pub(crate) fn of_axes(n_temps: usize, axes: Vec<FlightAxis>) -> Result<Self, (usize, UnitError)> {
         let size = axes.first().map(FlightAxis::hidden);
         for (i, a) in axes.iter().enumerate() {
             if i >= MAX_STREAM_AXES {

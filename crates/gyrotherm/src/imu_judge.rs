@@ -10,12 +10,12 @@
 //! are, so a one-axis figure and its per-axis counterpart are the same number.
 //!
 //! With several temperature columns the comparison fits the unit as `train` with the same
-//! lists and fit settings builds it ([`fit_imu_with_events`]): per axis the sensors
+//! lists and fit settings builds it (`fit_imu_with_events`): per axis the sensors
 //! cross-validation keeps. Each axis's table then holds every one-sensor method fitted on
 //! the sensor that axis's one-sensor choice picks (the sensor whose one-sensor fit has the
 //! lowest cross-validated RMS, the unit fit's first sensor; so the one-sensor columns differ
 //! only by method), and beside them the unit's own fit of the axis on all the sensors it
-//! keeps ([`UnitFitColumn`], named for what it holds and how many sensors it reads).
+//! keeps (`UnitFitColumn`, named for what it holds and how many sensors it reads).
 
 use serde::Serialize;
 
@@ -125,7 +125,7 @@ pub fn axis_test_log(log: &ImuLog, axis: usize, temp: usize) -> TestLog {
 /// The figures of one axis: of the raw gyro column, and of its compensated output when a
 /// unit model was given.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AxisEvaluation {
+pub(crate) struct AxisEvaluation {
     /// The gyro column.
     pub gyro: String,
     /// The temperature columns its model reads (empty without a model).
@@ -204,7 +204,7 @@ impl UnitVerdict {
 /// What [`evaluate_imu_spec`] returns: the axes' figures (each with its verdict when a spec
 /// sheet was given), the τ used, and the unit's verdict.
 #[derive(Debug, Clone, PartialEq)]
-pub struct UnitEvaluation {
+pub(crate) struct UnitEvaluation {
     pub axes: Vec<AxisEvaluation>,
     pub tau: ResolvedTau,
     pub verdict: Option<UnitVerdict>,
@@ -230,7 +230,7 @@ impl UnitEvaluation {
 /// ([`crate::compare::default_tau_s`]) on the first axis's view of the held-out logs (every
 /// axis shares the time column). Returns τ and, when it is not 100 s, the sample period it
 /// is a multiple of.
-pub fn default_tau_s(test: &[(String, ImuLog)]) -> (f64, Option<f64>) {
+pub(crate) fn default_tau_s(test: &[(String, ImuLog)]) -> (f64, Option<f64>) {
     let axis0: Vec<(String, TestLog)> = test
         .iter()
         .filter(|(_, l)| !l.gyro.is_empty() && !l.temp.is_empty())
@@ -251,7 +251,7 @@ pub fn default_tau_s(test: &[(String, ImuLog)]) -> (f64, Option<f64>) {
 /// single-axis log, [`axis_test_log`]): the compensated output when `model` is given (the
 /// unit as it is flown), else the raw gyro column. `log_name` names the log in the
 /// verdicts' lines. The unit passes only when every axis passes.
-pub fn evaluate_imu_spec(
+pub(crate) fn evaluate_imu_spec(
     log: &ImuLog,
     model: Option<&ImuModel>,
     settings: &EvaluateSettings,
@@ -488,7 +488,7 @@ fn judge_axis(
 /// The unit's own fit of one axis in a comparison: the model `train` with the same lists
 /// builds for it, on every sensor cross-validation keeps.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct UnitFitColumn {
+pub(crate) struct UnitFitColumn {
     /// What the model holds and what it reads, e.g. `thermal-state LS (3 sensors: temp_x_c,
     /// temp_case_c, temp_y_c)`.
     pub label: String,
@@ -534,7 +534,7 @@ impl UnitFitColumn {
 
 /// One axis of a unit comparison: the single-axis logs it was judged on and the comparison.
 #[derive(Debug, Clone)]
-pub struct AxisComparison {
+pub(crate) struct AxisComparison {
     /// The gyro column.
     pub gyro: String,
     /// The temperature column every one-sensor method of this axis reads.
@@ -551,7 +551,7 @@ pub struct AxisComparison {
 
 impl AxisComparison {
     /// The training logs as named logs (what the single-axis report takes).
-    pub fn train_named(&self) -> Vec<NamedLog<'_>> {
+    pub(crate) fn train_named(&self) -> Vec<NamedLog<'_>> {
         self.train
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
@@ -559,7 +559,7 @@ impl AxisComparison {
     }
 
     /// The held-out logs as named logs.
-    pub fn test_named(&self) -> Vec<NamedLog<'_>> {
+    pub(crate) fn test_named(&self) -> Vec<NamedLog<'_>> {
         self.test
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
@@ -579,7 +579,7 @@ impl AxisComparison {
 
     /// One line per fitted model, as the single-axis comparison prints them, then the unit
     /// fit's line.
-    pub fn model_lines(&self) -> Vec<String> {
+    pub(crate) fn model_lines(&self) -> Vec<String> {
         let mut lines = self.comparison.model_lines();
         if let Some(u) = &self.unit_fit {
             lines.push(format!(
@@ -593,7 +593,7 @@ impl AxisComparison {
 
 /// A unit comparison: one comparison per axis, in gyro column order.
 #[derive(Debug, Clone)]
-pub struct ImuComparison {
+pub(crate) struct ImuComparison {
     pub axes: Vec<AxisComparison>,
 }
 
@@ -605,7 +605,7 @@ pub(crate) type ImuCompareProgress<'a> =
 /// `compare` on unit logs: the sensor per axis from the unit fit with `cfg.fit` (skipped
 /// with one temperature column; `events` tells its steps), then every column of `cfg`
 /// fitted and judged per axis on that sensor, the axes on their own threads.
-pub fn compare_imu(
+pub(crate) fn compare_imu(
     train: &[(String, ImuLog)],
     test: &[(String, ImuLog)],
     cfg: &CompareConfig,
@@ -722,7 +722,7 @@ pub fn compare_imu(
 /// One axis of a unit comparison judged against a spec sheet: each method's column and the
 /// unit's own fit, on the axis's held-out logs.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AxisVerdicts {
+pub(crate) struct AxisVerdicts {
     pub gyro: String,
     /// The one-sensor methods' columns, as `compare --spec` judges a single axis.
     pub columns: Vec<spec::ColumnVerdict>,
@@ -780,7 +780,7 @@ pub(crate) fn unit_verdicts(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<(String, 
 
 /// One line per judged column across the axes (`unit_verdicts`): `linear: FAIL on
 /// gyro_x_dps, gyro_z_dps`, `unit fit: PASS on every axis`.
-pub fn verdicts_across_axes(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<String> {
+pub(crate) fn verdicts_across_axes(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<String> {
     unit_verdicts(spec, axes)
         .into_iter()
         .map(|(n, v)| {
@@ -796,7 +796,7 @@ pub fn verdicts_across_axes(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<String> {
 /// Every axis of a unit comparison judged against `spec`: each column's compensated output on
 /// each held-out log, with the comparison's τ and settle time (the single-axis rule,
 /// [`spec::judge_comparison`]).
-pub fn judge_unit_comparison(
+pub(crate) fn judge_unit_comparison(
     spec: &Spec,
     cmp: &ImuComparison,
     cfg: &CompareConfig,
@@ -852,7 +852,7 @@ pub(crate) const UNIT_FIT_HEADER: &str = "unit fit (axis's sensors)";
 
 /// One axis in `gyrotherm compare --json` for a unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AxisSummary {
+pub(crate) struct AxisSummary {
     pub gyro: String,
     /// The sensor the one-sensor methods read.
     pub temp: String,
@@ -866,14 +866,14 @@ pub struct AxisSummary {
 /// A unit comparison as `gyrotherm compare --json` prints it: per axis the single-axis
 /// summary, then the table across axes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ImuComparisonSummary {
+pub(crate) struct ImuComparisonSummary {
     pub axes: Vec<AxisSummary>,
     pub across_axes: AcrossAxes,
 }
 
 /// The table across axes as JSON: its headers and rows of formatted cells.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AcrossAxes {
+pub(crate) struct AcrossAxes {
     pub headers: Vec<String>,
     pub rows: Vec<Vec<String>>,
 }
@@ -882,7 +882,7 @@ impl ImuComparison {
     /// `gyrotherm compare --json` of the unit (and Python's `compare`): the
     /// [`summary`](Self::summary), with `verdicts` (each axis's, [`judge_unit_comparison`])
     /// when it was judged against a spec.
-    pub fn summary_json(
+    pub(crate) fn summary_json(
         &self,
         cfg: &CompareConfig,
         verdicts: Option<&[AxisVerdicts]>,
@@ -990,7 +990,7 @@ impl ImuComparison {
 }
 
 /// `t` as aligned text: the header, a rule, the rows (columns padded to their widest cell).
-pub fn write_text_table(w: &mut dyn std::io::Write, t: &Table) -> std::io::Result<()> {
+pub(crate) fn write_text_table(w: &mut dyn std::io::Write, t: &Table) -> std::io::Result<()> {
     let n = t
         .headers
         .len()

@@ -37,7 +37,7 @@ use gyrotherm_core::compensator::Status;
 use gyrotherm_core::features::LagOutputs;
 use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
 
-use crate::compensate::{boxed_compensator, hidden_size, sized_compensator};
+use crate::compensate::{hidden_size, sized_compensator};
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::thermal::Identified;
@@ -45,7 +45,7 @@ use crate::fit::{
     chooses_method, fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog,
 };
 use crate::flight_size::build_sized;
-use crate::flight_size::{FlightAxis, FlightCompensator, HiddenSize};
+use crate::flight_size::{FlightAxis, HiddenSize};
 pub use crate::imu_error::ImuError;
 use crate::model::{
     content_digest_of, parse_sealed, ModelFile, Seal, SealedTextError, SubModel, Target,
@@ -63,7 +63,7 @@ pub const IMU_FORMAT_VERSION: u32 = 2;
 /// written as before).
 pub const IMU_FORMAT_VERSION_ONE_SENSOR: u32 = 1;
 /// The key that marks an inertial-unit model file.
-pub const IMU_VERSION_KEY: &str = "imu_format_version";
+pub(crate) const IMU_VERSION_KEY: &str = "imu_format_version";
 
 /// A sensor tried for an axis and its score.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -143,7 +143,7 @@ pub(crate) fn is_imu_model_text(text: &str) -> bool {
 
 /// Progress of an inertial-unit fit: axis index, sensor index, and the fit's own progress
 /// (target, epoch, loss), as [`fit_model`] reports it.
-pub type ImuProgress<'a> = dyn Fn(usize, usize, crate::fit::Target, usize, f64) + Sync + 'a;
+pub(crate) type ImuProgress<'a> = dyn Fn(usize, usize, crate::fit::Target, usize, f64) + Sync + 'a;
 
 /// A step of an inertial-unit fit, as it happens (from the axes' threads): what a caller
 /// needs to say which axis and sensor are being fitted.
@@ -171,7 +171,7 @@ pub enum ImuFitEvent {
 }
 
 /// Receiver of [`ImuFitEvent`]s.
-pub type ImuEvents<'a> = dyn Fn(ImuFitEvent) + Sync + 'a;
+pub(crate) type ImuEvents<'a> = dyn Fn(ImuFitEvent) + Sync + 'a;
 
 /// Fit every axis of the unit with the default [`ImuFitSettings`] (see [`fit_imu_with`]).
 pub fn fit_imu(
@@ -184,7 +184,7 @@ pub fn fit_imu(
 }
 
 /// [`fit_imu`], telling `events` as each axis and each sensor tried starts and finishes.
-pub fn fit_imu_with_events(
+pub(crate) fn fit_imu_with_events(
     logs: &[(String, ImuLog)],
     cfg: &FitConfig,
     temp_sensor: &TempSensorDef,
@@ -214,7 +214,7 @@ pub fn fit_imu_with(
 }
 
 /// [`fit_imu_with`], telling `events` as each axis and each sensor tried starts and finishes.
-pub fn fit_imu_full(
+pub(crate) fn fit_imu_full(
     logs: &[(String, ImuLog)],
     cfg: &FitConfig,
     settings: &ImuFitSettings,
@@ -1337,7 +1337,7 @@ impl ImuModel {
     /// [`Compensator`](gyrotherm_core::compensator::Compensator) and each further sensor's
     /// pipeline and parts, reading the indices of its sensors among
     /// [`ImuModel::temp_cols`], at the unit's LSTM size ([`ImuModel::hidden_size`]).
-    pub fn axis_compensator(&self, a: &ImuAxis) -> Result<FlightAxis, ImuError> {
+    pub(crate) fn axis_compensator(&self, a: &ImuAxis) -> Result<FlightAxis, ImuError> {
         let size = self.hidden_size()?;
         Ok(build_sized!(FlightAxis, size, H => boxed_axis::<H>(&self.temp_cols, a)?))
     }
@@ -1450,7 +1450,7 @@ impl ImuModel {
     }
 
     /// Index of each axis's first (or only) sensor in the temperature columns.
-    pub fn sensor_index(&self) -> Vec<usize> {
+    pub(crate) fn sensor_index(&self) -> Vec<usize> {
         self.axes
             .iter()
             .map(|a| {
@@ -1480,34 +1480,6 @@ pub struct AxisCompensated {
     pub scale: Vec<f64>,
     pub gyro_comp_dps: Vec<f64>,
     pub status: Vec<Status>,
-}
-
-/// The one-sensor flight compensators of every axis, in axis order; refused for a model whose
-/// axes read several sensors (use [`imu_axis_compensators`]).
-pub fn imu_compensators(model: &ImuModel) -> Result<Vec<FlightCompensator>, ImuError> {
-    let size = model.hidden_size()?;
-    model
-        .axes
-        .iter()
-        .map(|a| {
-            if !a.more.is_empty() {
-                return Err(ImuError::Layout(format!(
-                    "axis {} reads {} sensors: it needs the multi-sensor compensator",
-                    a.gyro,
-                    a.temps.len()
-                )));
-            }
-            let one = |source| ImuError::Compensate {
-                gyro: a.gyro.clone(),
-                source: Box::new(source),
-            };
-            Ok(build_sized!(
-                FlightCompensator,
-                size,
-                H => boxed_compensator::<H>(&a.model).map_err(one)?
-            ))
-        })
-        .collect()
 }
 
 /// The flight compensators of every axis, in axis order, each reading its own sensors

@@ -104,7 +104,7 @@ impl Candidate {
     }
 
     /// Whether fitting this column trains an LSTM (and reports its epochs).
-    pub fn trains_lstm(&self, base: &FitConfig) -> bool {
+    pub(crate) fn trains_lstm(&self, base: &FitConfig) -> bool {
         let c = self.fit_config(base);
         c.method.is_recipe()
             && c.recipe.epochs > 0
@@ -251,7 +251,7 @@ impl FitSettings {
 /// ([`metrics::default_tau_s`]). Returns τ and, when it is not [`BIAS_STABILITY_TAU_S`], the
 /// sample period it is a multiple of; a caller should say so (one sample per 15 s gives
 /// τ = 105 s). Rate-table logs count only when no log is static.
-pub fn default_tau_s(test: &[NamedLog]) -> (f64, Option<f64>) {
+pub(crate) fn default_tau_s(test: &[NamedLog]) -> (f64, Option<f64>) {
     let periods = |static_only: bool| {
         test.iter()
             .filter(move |t| !static_only || t.log.is_static())
@@ -562,7 +562,7 @@ pub fn compare(
 /// A step of [`compare_with_stages`], for a progress line.
 #[derive(Debug, Clone, Copy)]
 #[non_exhaustive]
-pub enum Stage<'a> {
+pub(crate) enum Stage<'a> {
     /// Fitting column `key` (`index` of `of`, 0-based) begins.
     Fitting {
         key: &'static str,
@@ -580,7 +580,7 @@ pub enum Stage<'a> {
 }
 
 /// [`compare`], telling `stage` as each column is fitted and each held-out log judged.
-pub fn compare_with_stages(
+pub(crate) fn compare_with_stages(
     train: &[NamedLog],
     test: &[NamedLog],
     cfg: &CompareConfig,

@@ -8,7 +8,7 @@ use crate::settings::export::ExportTarget;
 impl Comparison {
     /// One line per fitted model: its sub-models, and why no residual LSTM was kept when
     /// none was.
-    pub fn model_lines(&self) -> Vec<String> {
+    pub(crate) fn model_lines(&self) -> Vec<String> {
         self.fits
             .iter()
             .zip(&self.columns)

@@ -72,7 +72,7 @@ impl ReadOptions {
 
     /// Whether the options name more than one gyro or temperature column (an inertial unit's
     /// log, read with [`crate::csvlog::read_imu_log`]).
-    pub fn is_multi_column(&self) -> bool {
+    pub(crate) fn is_multi_column(&self) -> bool {
         self.gyro_col.contains(COLUMN_LIST_SEPARATOR)
             || self.temp_col.contains(COLUMN_LIST_SEPARATOR)
     }

@@ -49,7 +49,7 @@ impl LogFormat {
     }
 
     /// The file extensions that select the format, lower case, without the dot.
-    pub fn extensions(self) -> &'static [&'static str] {
+    pub(crate) fn extensions(self) -> &'static [&'static str] {
         match self {
             LogFormat::Csv => &["csv", "txt", "tsv"],
             LogFormat::Ulog => &["ulg"],
@@ -59,7 +59,7 @@ impl LogFormat {
 
     /// The format a file's extension names (any case); CSV for any other extension or none,
     /// as every log was read before there was a list of formats.
-    pub fn of_path(path: &Path) -> LogFormat {
+    pub(crate) fn of_path(path: &Path) -> LogFormat {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -74,7 +74,7 @@ impl LogFormat {
 
     /// Whether a log of this format always holds a unit of several gyro axes (an autopilot's
     /// three-axis sensor) rather than the columns the read options name.
-    pub fn holds_unit(self) -> bool {
+    pub(crate) fn holds_unit(self) -> bool {
         !matches!(self, LogFormat::Csv)
     }
 }
@@ -99,7 +99,7 @@ impl std::str::FromStr for LogFormat {
 impl ReadOptions {
     /// The format `path` is read in: the one the options name, else the one its extension
     /// names ([`LogFormat::of_path`]).
-    pub fn format_of(&self, path: &Path) -> LogFormat {
+    pub(crate) fn format_of(&self, path: &Path) -> LogFormat {
         self.format.unwrap_or_else(|| LogFormat::of_path(path))
     }
 
@@ -158,7 +158,7 @@ fn pick(
         .collect()
 }
 
-/// Read an autopilot's log (a format that [holds a unit](LogFormat::holds_unit)) from any
+/// Read an autopilot's log (a format that holds a unit) from any
 /// byte source, `source` naming it in messages: as [`read_imu_log`](super::read_imu_log) reads
 /// such a file, every axis. A CSV source is read line by line by
 /// [`LogReader`](super::LogReader) instead, so it is refused here.

@@ -49,7 +49,7 @@ impl ImuLog {
     }
 
     /// The names of its gyro and its temperature columns, in column order.
-    pub fn column_names(&self) -> (Vec<String>, Vec<String>) {
+    pub(crate) fn column_names(&self) -> (Vec<String>, Vec<String>) {
         (
             self.gyro.iter().map(|s| s.name.clone()).collect(),
             self.temp.iter().map(|s| s.name.clone()).collect(),

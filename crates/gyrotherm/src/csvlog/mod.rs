@@ -264,7 +264,7 @@ pub struct ReadOptions {
     /// Field separator: `b','` (default), `b';'` or `b'\t'`. With any separator but the
     /// comma, numbers may use a decimal comma (`0,5`), as European loggers write them.
     pub delimiter: u8,
-    /// The file format (None: by the file's extension, [`LogFormat::of_path`]).
+    /// The file format (None: by the file's extension, `LogFormat::of_path`).
     pub format: Option<LogFormat>,
     /// Which of an autopilot's sensors of the same kind to read (PX4's multi-instance,
     /// ArduPilot's `I`); CSV logs ignore it.

@@ -28,12 +28,12 @@ use crate::settings::autopilot::{AutopilotSettings, ARDUPILOT_INSTANCES};
 use super::steady_bias::AutopilotError;
 
 /// The file written.
-pub const FILE_NAME: &str = "gyro_tcal.parm";
+pub(crate) const FILE_NAME: &str = "gyro_tcal.parm";
 /// The firmware's reference temperature, °C (`TEMP_REFERENCE`).
-pub const TEMP_REFERENCE_C: f64 = 35.0;
+pub(crate) const TEMP_REFERENCE_C: f64 = 35.0;
 /// The firmware's coefficient scale (`SCALE_FACTOR`): the parameters hold 1e6 × rad/s per
 /// °C^k.
-pub const SCALE_FACTOR: f64 = 1.0e6;
+pub(crate) const SCALE_FACTOR: f64 = 1.0e6;
 
 /// The parameter file of `steady` for ArduPilot's IMU `settings.instance + 1`.
 pub fn generate(

@@ -86,7 +86,7 @@ pub enum Lang {
 }
 
 /// Names of the export languages.
-pub const LANG_NAMES: [&str; 2] = ["c", "rust"];
+pub(crate) const LANG_NAMES: [&str; 2] = ["c", "rust"];
 
 impl Lang {
     /// The name on the command line (`--target`).

@@ -23,11 +23,11 @@ use super::ExportError;
 use crate::settings::autopilot::{AutopilotSettings, PX4_INSTANCES};
 
 /// The file written.
-pub const FILE_NAME: &str = "gyro_tc.params";
+pub(crate) const FILE_NAME: &str = "gyro_tc.params";
 /// MAVLink `MAV_PARAM_TYPE_INT32`.
-pub const TYPE_INT32: u8 = 6;
+pub(crate) const TYPE_INT32: u8 = 6;
 /// MAVLink `MAV_PARAM_TYPE_REAL32`.
-pub const TYPE_REAL32: u8 = 9;
+pub(crate) const TYPE_REAL32: u8 = 9;
 
 /// The parameter file of `steady` for PX4's gyro slot `settings.instance`.
 pub fn generate(

@@ -40,7 +40,7 @@
 //! names, which come from the model file, are never written into it (a name could close a
 //! comment and add code). The files give the order by index (`gyro[i]` is the model's i-th
 //! gyro column, `temp[j]` its j-th temperature column, and which `temp[]` each axis reads)
-//! with the model's content hash; [`column_map`] gives the names for that order, which
+//! with the model's content hash; `column_map` gives the names for that order, which
 //! `gyrotherm export` prints on stderr.
 
 use std::fmt::Write as _;
@@ -93,7 +93,7 @@ fn ordinal(n: usize) -> String {
 
 /// The unit's name-to-index map, one line each, for the user (stderr): the names come from
 /// the model file and go nowhere into generated source.
-pub fn column_map(model: &ImuModel) -> Vec<String> {
+pub(crate) fn column_map(model: &ImuModel) -> Vec<String> {
     let mut out = Vec::new();
     for (i, (g, a)) in model.gyro_cols.iter().zip(&model.axes).enumerate() {
         let reads: Vec<String> = a
@@ -966,7 +966,7 @@ fn generate_rust<const H: usize>(axes: &[AxisExport<H>], layout: &Layout) -> Str
             out,
             "\n/// Axis {i}'s further sensors, in order.\n#[rustfmt::skip]\n\
              #[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n\
-             pub static SENSORS_A{i}: [StaticSensor; {}] = [",
+             pub(crate) static SENSORS_A{i}: [StaticSensor; {}] = [",
             a.sensors.len()
         );
         for s in &a.sensors {

@@ -25,7 +25,7 @@ use crate::settings::method::Method;
 use crate::targets::{self, TargetSet};
 
 /// The candidates, in the order they are scored (the first wins a tie).
-pub const CANDIDATES: [Method; 2] = [Method::Thermal, Method::ThermalLstm];
+pub(crate) const CANDIDATES: [Method; 2] = [Method::Thermal, Method::ThermalLstm];
 
 /// The configuration that fits candidate `method` under `auto`'s settings `cfg`: `thermal`
 /// with its own recipe, `thermal-lstm` with `auto`'s knobs (its own, as a fit was asked).

@@ -20,7 +20,7 @@ pub struct RecipeSettings {
     /// Adam learning rate (0.01 as published).
     pub lr: f64,
     /// Hidden units of the LSTM (8 as published:
-    /// [`DEFAULT_HIDDEN`](crate::settings::fit::DEFAULT_HIDDEN)).
+    /// `DEFAULT_HIDDEN`).
     pub hidden: usize,
     /// `Residual`: steps per truncated-BPTT window.
     pub window: usize,

@@ -29,7 +29,7 @@ pub const GAP_STEPS: usize = 200;
 /// Relative margin within which a smaller term set is preferred to the best-scoring one: the
 /// spread of one set's cross-validated score over training seeds of one unit (±10 %;
 /// measured in `docs/experiments/term-selection.md`).
-pub const PARSIMONY_TOL: f64 = 0.10;
+pub(crate) const PARSIMONY_TOL: f64 = 0.10;
 
 /// How a term set was chosen.
 #[derive(Debug, Clone, PartialEq)]
@@ -165,7 +165,7 @@ pub(crate) fn pooled_within_run_rms(runs: &[Vec<f64>]) -> f64 {
 }
 
 /// Choose among `cands` by blocked cross-validation: the candidate with the fewest terms whose
-/// cross-validated RMS residual is within [`PARSIMONY_TOL`] of the least (the
+/// cross-validated RMS residual is within `PARSIMONY_TOL` of the least (the
 /// one-standard-error rule's idea, Hastie, Tibshirani & Friedman, *The Elements of Statistical
 /// Learning*, 2nd ed., §7.10: prefer the simpler model when the difference is within the
 /// score's own noise). An error when no candidate can be fitted on every fold.

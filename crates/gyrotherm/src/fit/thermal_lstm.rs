@@ -19,7 +19,7 @@ use crate::settings::method::Method;
 
 impl RecipeSettings {
     /// The `thermal-lstm` recipe with its default knobs.
-    pub fn thermal_lstm() -> Self {
+    pub(crate) fn thermal_lstm() -> Self {
         RecipeSettings {
             kind: Method::ThermalLstm,
             // Adam steps, one batch of windows each: 300 fitted the design family's sweep on
@@ -42,7 +42,7 @@ impl RecipeSettings {
         }
     }
 
-    /// The `auto` recipe: its LSTM candidate's knobs ([`Self::thermal_lstm`]), under its own
+    /// The `auto` recipe: its LSTM candidate's knobs (`Self::thermal_lstm`), under its own
     /// name.
     pub fn auto() -> Self {
         RecipeSettings {

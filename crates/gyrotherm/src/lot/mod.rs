@@ -1,6 +1,6 @@
 //! A lot: the test station's record of units judged against their spec sheet.
 //!
-//! [`judge_unit`] compensates a unit's held-out logs with its model (the flight compensator,
+//! `judge_unit` compensates a unit's held-out logs with its model (the flight compensator,
 //! as `gyrotherm compare` does for one model), measures every figure of
 //! [`crate::spec::FIGURES`] on each, judges them against the spec sheet when
 //! one is given, and returns a [`Run`]: the unit, the time, the gyrotherm version, the
@@ -168,7 +168,7 @@ impl Run {
     }
 
     /// Whether this is an inertial unit's run (with axes).
-    pub fn is_unit(&self) -> bool {
+    pub(crate) fn is_unit(&self) -> bool {
         !self.axes.is_empty()
     }
 
@@ -522,8 +522,8 @@ pub fn open_store(
     }
 }
 
-/// What [`judge_unit`] needs besides the logs; for an inertial unit (several gyro axes,
-/// [`judge_imu_unit`]) the same with its logs (`ImuUnitInputs`).
+/// What `judge_unit` needs besides the logs; for an inertial unit (several gyro axes,
+/// `judge_imu_unit`) the same with its logs (`ImuUnitInputs`).
 #[derive(Debug, Clone)]
 pub struct UnitInputs<'a, L = (String, TestLog)> {
     pub unit: &'a str,
@@ -534,7 +534,7 @@ pub struct UnitInputs<'a, L = (String, TestLog)> {
     pub tests: &'a [L],
     pub spec: Option<&'a Spec>,
     /// Bias-stability τ, s (None: `compare`'s default for these logs; for an inertial unit
-    /// [`crate::imu_judge::default_tau_s`]).
+    /// `crate::imu_judge::default_tau_s`).
     pub tau_s: Option<f64>,
     /// Settle time at each table segment start, s.
     pub settle_s: f64,
@@ -572,7 +572,7 @@ pub(crate) fn file_sha256(path: &Path) -> Result<String, LotError> {
 
 /// Judge one unit: compensate each held-out log with its model, measure every figure, judge
 /// against the spec; the [`Run`] to record (dated now), and the spec's verdict when given.
-pub fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotError> {
+pub(crate) fn judge_unit(u: &UnitInputs) -> Result<(Run, Option<spec::Verdict>), LotError> {
     check_unit_name(u.unit.trim())?;
     let (text, model_sha256) = u.model_text()?;
     let (model, _) = ModelFile::from_json_sealed(&text).map_err(|e| u.model_err(e.into()))?;
@@ -738,7 +738,7 @@ pub struct ImuRunVerdict {
 /// it), judge each axis and the unit against the spec
 /// (`crate::imu_judge::judge_unit_figures`); the [`Run`] to record (dated now, a row per
 /// axis in [`Run::axes`], each figure with its axis) and the verdicts when a spec is given.
-pub fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>), LotError> {
+pub(crate) fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>), LotError> {
     check_unit_name(u.unit.trim())?;
     let (text, model_sha256) = u.model_text()?;
     let model = ImuModel::from_json(&text).map_err(|e| u.model_err(e.into()))?;
@@ -986,8 +986,8 @@ impl ModelRunVerdict {
     }
 }
 
-/// Judge one unit with its model of either form ([`judge_unit`] for a single-gyro model,
-/// [`judge_imu_unit`] for an inertial unit's) on its held-out logs (read in the model's form,
+/// Judge one unit with its model of either form (`judge_unit` for a single-gyro model,
+/// `judge_imu_unit` for an inertial unit's) on its held-out logs (read in the model's form,
 /// [`Model::read_logs`]); `u` says the rest (its `tests` are not read).
 pub fn judge_model(
     model: &Model,

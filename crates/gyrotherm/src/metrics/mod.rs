@@ -182,7 +182,7 @@ fn samples_per_mean(sample_period_s: f64, tau_s: f64) -> Result<usize, MetricsEr
 /// He et al. 2024) when it is a whole number of sample periods, otherwise the whole multiple
 /// of the period nearest to it (at least one period). Returns `(τ, adjusted)`; a caller
 /// should say so when `adjusted` (a log at one sample per 15 s gets τ = 105 s).
-pub fn default_tau_s(sample_period_s: f64, preferred_s: f64) -> (f64, bool) {
+pub(crate) fn default_tau_s(sample_period_s: f64, preferred_s: f64) -> (f64, bool) {
     if !(sample_period_s.is_finite() && sample_period_s > 0.0) {
         return (preferred_s, false);
     }

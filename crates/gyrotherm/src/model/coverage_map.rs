@@ -73,7 +73,7 @@ impl CoverageDef {
     }
 
     /// Pooled RMS of the held-out residual over all cells, °/h.
-    pub fn pooled_rms_dph(&self) -> f64 {
+    pub(crate) fn pooled_rms_dph(&self) -> f64 {
         let (ss, n) = self
             .count
             .iter()

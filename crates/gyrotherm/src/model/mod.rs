@@ -37,18 +37,18 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 /// The format version this build writes.
-pub const FORMAT_VERSION: u32 = 1;
+pub(crate) const FORMAT_VERSION: u32 = 1;
 /// The format versions this build reads.
-pub const SUPPORTED_VERSIONS: &[u32] = &[1];
+pub(crate) const SUPPORTED_VERSIONS: &[u32] = &[1];
 
 /// Largest |coefficient| of a least-squares term: far beyond any fit of a gyro's drift in
 /// °C and °C/s, short of what makes f64 sums overflow.
-pub const MAX_PLAUSIBLE_COEFFICIENT: f64 = 1e15;
+pub(crate) const MAX_PLAUSIBLE_COEFFICIENT: f64 = 1e15;
 /// Largest |bias| a model may predict inside its training range, °/s: beyond the measuring
 /// range of any fibre optic gyro.
-pub const MAX_PLAUSIBLE_BIAS_DPS: f64 = 1e3;
+pub(crate) const MAX_PLAUSIBLE_BIAS_DPS: f64 = 1e3;
 /// Range of scale factor K (nominal 1) a model may predict inside its training range.
-pub const PLAUSIBLE_SCALE: (f64, f64) = (0.1, 10.0);
+pub(crate) const PLAUSIBLE_SCALE: (f64, f64) = (0.1, 10.0);
 /// Most feature steps of one probe run in the training-range check (a ramp at the slowest
 /// rate stops there).
 const MAX_PROBE_STEPS: usize = 20_000;
@@ -124,7 +124,7 @@ impl Default for TempSensorDef {
 
 impl TempSensorDef {
     /// The file form of core limits.
-    pub fn from_core(l: &TempLimits) -> Self {
+    pub(crate) fn from_core(l: &TempLimits) -> Self {
         TempSensorDef {
             min_c: l.min_c,
             max_c: l.max_c,
@@ -294,7 +294,7 @@ pub struct TrainingInfo {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelFile {
-    /// [`FORMAT_VERSION`].
+    /// `FORMAT_VERSION`.
     pub format_version: u32,
     /// How it was fitted.
     pub method: Method,

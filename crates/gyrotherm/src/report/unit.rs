@@ -101,7 +101,7 @@ pub(crate) fn axis_verdict_table(a: &AxisVerdicts) -> Table {
 /// `judged` (a spec sheet and [`crate::imu_judge::judge_unit_comparison`]'s verdicts), the
 /// page shows the unit's verdict of each column across the axes and, in each axis's section,
 /// the axis's verdicts.
-pub fn write_unit_report(
+pub(crate) fn write_unit_report(
     dir: &Path,
     cmp: &ImuComparison,
     cfg: &CompareConfig,

@@ -131,7 +131,7 @@ impl EvaluateSettings {
 
     /// τ for a column of `samples` values every `tau0_s`: the one given, or the default; at
     /// most half the log (two means).
-    pub fn resolve_tau(&self, tau0_s: f64, samples: usize) -> Result<ResolvedTau, EvaluateError> {
+    pub(crate) fn resolve_tau(&self, tau0_s: f64, samples: usize) -> Result<ResolvedTau, EvaluateError> {
         let r = match self.tau_s {
             Some(tau_s) => ResolvedTau {
                 tau_s,
@@ -178,7 +178,7 @@ impl EvaluateSettings {
 
     /// What [`evaluate`](Self::evaluate) judges, before it judges it: the column's values in
     /// °/s, the figures' options and the τ used (also what a spec sheet is judged on).
-    pub fn prepare(
+    pub(crate) fn prepare(
         &self,
         values: &[f64],
         tau0_s: f64,

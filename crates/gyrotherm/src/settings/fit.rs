@@ -22,13 +22,13 @@ pub const DEFAULT_POLY_TEMP_DEGREE: u8 = 3;
 /// Default highest power of dT in the `poly` bias model.
 pub const DEFAULT_POLY_RATE_DEGREE: u8 = 1;
 /// Default hidden units of the LSTM recipes: 8, as published (He et al. 2024, §2).
-pub const DEFAULT_HIDDEN: usize = 8;
+pub(crate) const DEFAULT_HIDDEN: usize = 8;
 /// Hidden units of `thermal-lstm`'s LSTM: 32, chosen against 16 on the design family
 /// (docs/experiments/lstm-capacity.md). A `hidden` setting, when given, overrides it.
-pub const THERMAL_LSTM_HIDDEN: usize = 32;
+pub(crate) const THERMAL_LSTM_HIDDEN: usize = 32;
 
 /// The hidden sizes flight code and its exports are built for, as text: "8, 16, 32 or 64".
-pub fn hidden_sizes_text() -> String {
+pub(crate) fn hidden_sizes_text() -> String {
     let n: Vec<String> = gyrotherm_core::compensator::HIDDEN_SIZES
         .iter()
         .map(|h| h.to_string())
@@ -54,7 +54,7 @@ pub fn hidden_help() -> String {
 /// temperature sensor to join its model: −1, a sensor joins unless it doubles the
 /// cross-validated RMS (chosen on the design family against +0.02, which kept one sensor
 /// per axis: docs/experiments/imu.md).
-pub const DEFAULT_IMU_MIN_GAIN: f64 = -1.0;
+pub(crate) const DEFAULT_IMU_MIN_GAIN: f64 = -1.0;
 
 /// The terms each further sensor of an inertial-unit axis adds: its temperature and its lag
 /// differences, linearly. `T, T², T³` and the lags with the first sensor chosen by the
@@ -62,12 +62,12 @@ pub const DEFAULT_IMU_MIN_GAIN: f64 = -1.0;
 /// (5.88 → 4.41× the noise floor) but not the confirmation family's (5.25 → 5.31×), for
 /// about 60 % more training time: kept as an experiment option
 /// (docs/experiments/imu-worst-model.md).
-pub const DEFAULT_IMU_EXTRA_TERMS: ExtraTerms = ExtraTerms::Linear;
+pub(crate) const DEFAULT_IMU_EXTRA_TERMS: ExtraTerms = ExtraTerms::Linear;
 
 /// How an inertial-unit axis chooses the sensor that comes first (with the full basis): the
 /// lowest one-sensor cross-validated RMS (see [`DEFAULT_IMU_EXTRA_TERMS`] for the variant
 /// tried against it).
-pub const DEFAULT_IMU_FIRST: FirstBy = FirstBy::Single;
+pub(crate) const DEFAULT_IMU_FIRST: FirstBy = FirstBy::Single;
 
 /// An inertial unit's lag search (only the search: the sensor selection and the final fits
 /// use every labelled step) scores each candidate on every fifth labelled step of its
@@ -76,10 +76,10 @@ pub const DEFAULT_IMU_FIRST: FirstBy = FirstBy::Single;
 /// on the design family against every step (same median and worst case within its noise)
 /// and every tenth step (a higher worst case): docs/experiments/imu.md. The one-axis fit
 /// searches on every step.
-pub const IMU_IDENTIFY_EVERY: usize = 5;
+pub(crate) const IMU_IDENTIFY_EVERY: usize = 5;
 
 /// The terms a further sensor adds (`extra_terms`; the default
-/// is [`DEFAULT_IMU_EXTRA_TERMS`]).
+/// is `DEFAULT_IMU_EXTRA_TERMS`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ExtraTerms {
     /// `T` and each lag difference, linearly.
@@ -94,7 +94,7 @@ pub enum ExtraTerms {
     Same,
 }
 
-/// Which sensor comes first (gets the full basis; the default is [`DEFAULT_IMU_FIRST`]).
+/// Which sensor comes first (gets the full basis; the default is `DEFAULT_IMU_FIRST`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FirstBy {
     /// The lowest one-sensor cross-validated RMS.
@@ -102,7 +102,7 @@ pub enum FirstBy {
     /// The lowest cross-validated RMS of the model on every sensor with it first.
     Combined,
     /// The bias model is the average of the fits with each chosen sensor first
-    /// ([`fit_multi_averaged`](crate::fit::thermal::multi::fit_multi_averaged)); the order (and the scale factor) as `Single`.
+    /// (`fit_multi_averaged`); the order (and the scale factor) as `Single`.
     Average,
 }
 
@@ -138,9 +138,9 @@ pub struct ImuFitSettings {
     pub multi_ridge_decades: Option<(i32, i32)>,
     #[cfg(not(feature = "experiments"))]
     pub(crate) multi_ridge_decades: Option<(i32, i32)>,
-    /// The further sensors' terms ([`DEFAULT_IMU_EXTRA_TERMS`]; the others are experiments).
+    /// The further sensors' terms (`DEFAULT_IMU_EXTRA_TERMS`; the others are experiments).
     pub multi_extra: ExtraTerms,
-    /// How the first sensor is chosen ([`DEFAULT_IMU_FIRST`]; the others are experiments).
+    /// How the first sensor is chosen (`DEFAULT_IMU_FIRST`; the others are experiments).
     /// An experiment knob: public only with the `experiments` feature.
     #[cfg(feature = "experiments")]
     pub multi_first: FirstBy,
@@ -186,8 +186,8 @@ pub struct FitSettings {
     pub epochs: Option<usize>,
     /// Random seed of the LSTM initialisation and window order.
     pub seed: u64,
-    /// Hidden units of the method's LSTM (None: the method's own, [`DEFAULT_HIDDEN`] as
-    /// published, [`THERMAL_LSTM_HIDDEN`] for `thermal-lstm`). The trainer takes other sizes,
+    /// Hidden units of the method's LSTM (None: the method's own, `DEFAULT_HIDDEN` as
+    /// published, `THERMAL_LSTM_HIDDEN` for `thermal-lstm`). The trainer takes other sizes,
     /// but a model file must run in flight, whose network is built for the sizes of
     /// [`gyrotherm_core::compensator::HIDDEN_SIZES`]: [`FitSettings::validate`] accepts
     /// those only.

@@ -411,7 +411,7 @@ impl Spec {
     }
 
     /// Whether any limit is on an Allan noise term (which costs an Allan curve per log).
-    pub fn needs_noise_terms(&self) -> bool {
+    pub(crate) fn needs_noise_terms(&self) -> bool {
         self.limits().any(|(d, _)| d.from == LogKind::Static)
     }
 }

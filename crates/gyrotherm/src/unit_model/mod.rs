@@ -160,7 +160,7 @@ impl Model {
     }
 
     /// An inertial unit's model (sealed: it was made, not read).
-    pub fn from_unit(m: ImuModel) -> Model {
+    pub(crate) fn from_unit(m: ImuModel) -> Model {
         Model {
             form: Form::Unit(m),
             seal: Seal::Verified,
@@ -406,9 +406,9 @@ impl Model {
     }
 
     /// Write the model for `target` into `dir`: flight code (C, Rust; [`Model::export`]) or
-    /// an autopilot's parameter file ([`Model::export_autopilot`]), with the polynomial's fit
+    /// an autopilot's parameter file (`Model::export_autopilot`), with the polynomial's fit
     /// and what it does not carry. What to tell comes with the outcome, also when it failed
-    /// (`axis_given` as for [`Model::export_autopilot`]).
+    /// (`axis_given` as for `Model::export_autopilot`).
     pub fn write_export(
         &self,
         target: ExportTarget,
@@ -444,7 +444,7 @@ impl Model {
 
     /// The autopilot's parameters for the model (see [`autopilot::generate`]), with what to
     /// tell first when the command line named an axis (`axis_given`) that a unit's columns fix.
-    pub fn export_autopilot(
+    pub(crate) fn export_autopilot(
         &self,
         target: ExportTarget,
         settings: &AutopilotSettings,

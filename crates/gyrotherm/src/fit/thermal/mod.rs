@@ -351,7 +351,7 @@ fn run_data<'a>(
 
 /// Identify the lags from the training logs (the static runs' bias, or without static runs
 /// the rate-table runs' scale factor) and return the feature spec the model will read.
-pub fn identify(
+pub(crate) fn identify(
     logs: &[(&str, &TestLog)],
     cfg: &ThermalConfig,
     bias_window_s: f64,

@@ -1,6 +1,6 @@
 //! The thermal recipe on several temperature sensors of one axis.
 //!
-//! Each sensor's lags are identified on its own ([`identify`], as for a one-sensor fit). The
+//! Each sensor's lags are identified on its own (`identify`, as for a one-sensor fit). The
 //! axis model is the first sensor's terms ([`basis`], with its constant) plus, for each
 //! further sensor, its temperature and its lag differences, linearly (`T_s, D_s1, …`): a
 //! difference between sensors (a gradient) is a linear combination of these columns. One
@@ -255,7 +255,7 @@ pub fn cv_rms<'a>(
 /// One target's design over a first sensor's terms and further sensors' columns, in a fixed
 /// order, with its per-segment statistics: the cross-validation (and fit) of the first sensor
 /// with any further sensors taken in that order comes from these, to the bit, instead of from
-/// a design of its own. Every trial of [`select_shared`] and the fits after it read the same rows
+/// a design of its own. Every trial of `select_shared` and the fits after it read the same rows
 /// and the same values in each column; only which columns differs, and each entry of the
 /// statistics is a sum over rows of its own columns alone.
 pub struct Shared {
@@ -399,7 +399,7 @@ pub(crate) fn cv_rms_with<'a>(
 /// score; the trials' cross-validation comes from one [`Shared`] design over the best sensor
 /// and every other in ranked order, which it also returns (for `fit_multi_with` and
 /// `cv_rms_with`; None where there was nothing to try or it could not be made).
-pub fn select_shared(
+pub(crate) fn select_shared(
     sensors: &[SensorData],
     cfg: &ThermalConfig,
     multi: &MultiConfig,
@@ -459,7 +459,7 @@ pub fn select_shared(
 
 /// A fitted target on several sensors: the first sensor's model (constant first, its
 /// terms) and each further sensor's coefficients over `extra_terms`.
-pub struct MultiFit {
+pub(crate) struct MultiFit {
     pub first: SubModel,
     pub extra: Vec<SubModel>,
     pub cv_rms: Option<f64>,
@@ -552,7 +552,7 @@ pub(crate) fn fit_multi_with<'a>(
 /// sensor gets the nonlinear terms, instead of one chosen by a cross-validation that cannot
 /// tell them apart on chamber runs. Its `cv_rms` is the mean of the fits' (an upper bound of
 /// the average's own on the same folds), `ridge` the first fit's.
-pub fn fit_multi_averaged<'a>(
+pub(crate) fn fit_multi_averaged<'a>(
     sensors: &[SensorData<'a>],
     order: &[usize],
     cfg: &ThermalConfig,
