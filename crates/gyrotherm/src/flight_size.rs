@@ -324,7 +324,10 @@ impl StreamUnit {
     /// A unit of `axes` (all of one size) on `n_temps` temperature channels, refused as
     /// [`Unit::push_axis`](gyrotherm_core::unit::Unit::push_axis) refuses an axis. The error names the axis (0-based) that does not
     /// fit.
-    pub(crate) fn of_axes(n_temps: usize, axes: Vec<FlightAxis>) -> Result<Self, (usize, UnitError)> {
+    pub(crate) fn of_axes(
+        n_temps: usize,
+        axes: Vec<FlightAxis>,
+    ) -> Result<Self, (usize, UnitError)> {
         let size = axes.first().map(FlightAxis::hidden);
         for (i, a) in axes.iter().enumerate() {
             if i >= MAX_STREAM_AXES {

@@ -165,55 +165,91 @@ pub(crate) fn lstm_on_thermal(
 }
 
 /// Each static run left out in turn: both candidates fitted on the others, their bias residual
-/// on it. Returns each candidate's RMS over every left-out run, each run's mean removed.
+/// on it. Returns each candidate's RMS over every left-out run, each run's mean removed. The
+/// folds run at once, each on a thread of its own (an LSTM's training alone keeps two cores
+/// only partly busy); their sums are taken in run order, so the scores do not depend on which
+/// fold finished first.
 fn leave_one_run_out(
     logs: &[NamedLog],
     statics: &[usize],
     thermal_cfg: &FitConfig,
     lstm_cfg: &FitConfig,
 ) -> Result<[f64; 2], FitError> {
+    let folds: Vec<Result<Option<Fold>, FitError>> = std::thread::scope(|s| {
+        let handles: Vec<_> = statics
+            .iter()
+            .map(|&k| s.spawn(move || fold(logs, k, thermal_cfg, lstm_cfg)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join().unwrap_or(Err(FitError::ThreadPanicked {
+                    target: Target::Bias,
+                }))
+            })
+            .collect()
+    });
     let mut ss = [0.0; 2];
     let mut n = 0usize;
-    for &k in statics {
-        let others: Vec<NamedLog> = logs
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| *i != k)
-            .map(|(_, l)| *l)
-            .collect();
-        let id = identify(&others, thermal_cfg)?;
-        let sets_of = |ls: &[NamedLog]| -> Result<Vec<TargetSet>, FitError> {
-            ls.iter()
-                .filter(|l| targets::is_static(l.log))
-                .map(|l| {
-                    targets::bias_targets(l.log, &id.spec, thermal_cfg.bias_window_s).map_err(
-                        |source| FitError::Targets {
-                            run: l.name.to_owned(),
-                            source,
-                        },
-                    )
-                })
-                .collect()
-        };
-        let sets = sets_of(&others)?;
-        let held = sets_of(&logs[k..=k])?;
-        let (Some(held), false) = (held.first(), sets.is_empty()) else {
-            continue;
-        };
-        let (thermal_sub, _) = thermal::fit_target(&sets, &thermal_cfg.thermal, &id, false)?;
-        let Some(lstm_sub) = lstm_on_thermal(&sets, &thermal_sub, lstm_cfg)? else {
-            continue;
-        };
-        let labelled: Vec<usize> = (0..held.table.n_rows())
-            .filter(|&r| held.mask[r] && held.target[r].is_finite())
-            .collect();
-        for (c, sub) in [&thermal_sub, &lstm_sub].into_iter().enumerate() {
-            let pred = sub.predict_table(&held.table)?;
-            let resid: Vec<f64> = labelled.iter().map(|&r| held.target[r] - pred[r]).collect();
-            let mean = resid.iter().sum::<f64>() / resid.len().max(1) as f64;
-            ss[c] += resid.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>();
+    for f in folds {
+        if let Some((fold_ss, fold_n)) = f? {
+            ss[0] += fold_ss[0];
+            ss[1] += fold_ss[1];
+            n += fold_n;
         }
-        n += labelled.len();
     }
     Ok(ss.map(|s| (s / n.max(1) as f64).sqrt()))
+}
+
+/// A fold's sums of squared residuals (each candidate's) and the samples they sum over.
+type Fold = ([f64; 2], usize);
+
+/// Static run `k` left out: both candidates fitted on the other runs, their residual on it
+/// (None when the fold has nothing to score).
+fn fold(
+    logs: &[NamedLog],
+    k: usize,
+    thermal_cfg: &FitConfig,
+    lstm_cfg: &FitConfig,
+) -> Result<Option<Fold>, FitError> {
+    let others: Vec<NamedLog> = logs
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != k)
+        .map(|(_, l)| *l)
+        .collect();
+    let id = identify(&others, thermal_cfg)?;
+    let sets_of = |ls: &[NamedLog]| -> Result<Vec<TargetSet>, FitError> {
+        ls.iter()
+            .filter(|l| targets::is_static(l.log))
+            .map(|l| {
+                targets::bias_targets(l.log, &id.spec, thermal_cfg.bias_window_s).map_err(
+                    |source| FitError::Targets {
+                        run: l.name.to_owned(),
+                        source,
+                    },
+                )
+            })
+            .collect()
+    };
+    let sets = sets_of(&others)?;
+    let held = sets_of(&logs[k..=k])?;
+    let (Some(held), false) = (held.first(), sets.is_empty()) else {
+        return Ok(None);
+    };
+    let (thermal_sub, _) = thermal::fit_target(&sets, &thermal_cfg.thermal, &id, false)?;
+    let Some(lstm_sub) = lstm_on_thermal(&sets, &thermal_sub, lstm_cfg)? else {
+        return Ok(None);
+    };
+    let labelled: Vec<usize> = (0..held.table.n_rows())
+        .filter(|&r| held.mask[r] && held.target[r].is_finite())
+        .collect();
+    let mut ss = [0.0; 2];
+    for (c, sub) in [&thermal_sub, &lstm_sub].into_iter().enumerate() {
+        let pred = sub.predict_table(&held.table)?;
+        let resid: Vec<f64> = labelled.iter().map(|&r| held.target[r] - pred[r]).collect();
+        let mean = resid.iter().sum::<f64>() / resid.len().max(1) as f64;
+        ss[c] = resid.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>();
+    }
+    Ok(Some((ss, labelled.len())))
 }

@@ -453,7 +453,10 @@ fn percentile_span(v: &[f64]) -> Option<f64> {
 
 /// The `thermal` recipe's identification on the training logs (the first part of
 /// [`fit_model`]).
-pub(crate) fn identify(logs: &[NamedLog], cfg: &FitConfig) -> Result<thermal::Identified, FitError> {
+pub(crate) fn identify(
+    logs: &[NamedLog],
+    cfg: &FitConfig,
+) -> Result<thermal::Identified, FitError> {
     check_logs(logs, &feature_spec(cfg))?;
     let named: Vec<(&str, &TestLog)> = logs.iter().map(|l| (l.name, l.log)).collect();
     Ok(thermal::identify(

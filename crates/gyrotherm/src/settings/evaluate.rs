@@ -131,7 +131,11 @@ impl EvaluateSettings {
 
     /// τ for a column of `samples` values every `tau0_s`: the one given, or the default; at
     /// most half the log (two means).
-    pub(crate) fn resolve_tau(&self, tau0_s: f64, samples: usize) -> Result<ResolvedTau, EvaluateError> {
+    pub(crate) fn resolve_tau(
+        &self,
+        tau0_s: f64,
+        samples: usize,
+    ) -> Result<ResolvedTau, EvaluateError> {
         let r = match self.tau_s {
             Some(tau_s) => ResolvedTau {
                 tau_s,
