@@ -966,7 +966,7 @@ fn generate_rust<const H: usize>(axes: &[AxisExport<H>], layout: &Layout) -> Str
             out,
             "\n/// Axis {i}'s further sensors, in order.\n#[rustfmt::skip]\n\
              #[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n\
-             pub(crate) static SENSORS_A{i}: [StaticSensor; {}] = [",
+             pub static SENSORS_A{i}: [StaticSensor; {}] = [",
             a.sensors.len()
         );
         for s in &a.sensors {
