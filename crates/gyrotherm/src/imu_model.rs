@@ -904,6 +904,12 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
         Some(l) => l,
         None => lstm_fit()?,
     };
+    if lstm.model.method != Method::ThermalLstm {
+        // Its gate kept no LSTM: the fit is the first sensor's `thermal` alone, less than the
+        // `thermal` candidate holds.
+        thermal.model.method_choice = Some(choice.with_lstm_left_out());
+        return finished(thermal);
+    }
     lstm.model.method_choice = Some(choice);
     finished(lstm_axis(lstm.model, thermal.scores))
 }

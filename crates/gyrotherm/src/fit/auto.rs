@@ -78,11 +78,16 @@ pub(crate) fn fit(
             None,
         ),
     };
-    let choice = choose(validation, scores);
+    let mut choice = choose(validation, scores);
     let mut fit = match (choice.chosen, lstm_fit) {
         (Method::ThermalLstm, Some(fit)) => fit,
         _ => fit_model(logs, &candidate_config(cfg, choice.chosen), progress)?,
     };
+    if choice.chosen == Method::ThermalLstm && fit.model.method != Method::ThermalLstm {
+        // Its gate kept no LSTM: what the scores chose is not what the fit holds.
+        choice = choice.with_lstm_left_out();
+        fit = fit_model(logs, &thermal_cfg, progress)?;
+    }
     fit.model.method_choice = Some(choice);
     Ok(fit)
 }
@@ -133,6 +138,7 @@ pub(crate) fn choose(validation: Validation, scores: [f64; 2]) -> MethodChoice {
             })
             .collect(),
         chosen,
+        lstm_left_out: false,
     }
 }
 

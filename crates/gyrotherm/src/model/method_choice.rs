@@ -47,8 +47,14 @@ pub struct MethodChoice {
     pub validation: Validation,
     /// Every candidate's score, in the order they were fitted.
     pub candidates: Vec<CandidateScore>,
-    /// The candidate kept: the lowest score (the first on a tie).
+    /// The candidate kept: the lowest score (the first on a tie), unless `lstm_left_out`.
     pub chosen: Method,
+    /// `thermal-lstm` scored lower, but its fit on every training run kept no LSTM (its own
+    /// gate on held-out blocks left the LSTM out), so `thermal` was kept: that fit would have
+    /// been `thermal`'s model form without what the `thermal` candidate holds (an inertial
+    /// unit's further sensors). Absent (false) in files that do not need it.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub lstm_left_out: bool,
 }
 
 impl MethodChoice {
@@ -62,10 +68,24 @@ impl MethodChoice {
                 format!("{}{star} {:.4}", c.method, c.bias_rms_dps * 3600.0)
             })
             .collect();
+        let left_out = if self.lstm_left_out {
+            "; thermal-lstm scored lower, but its fit on every run kept no LSTM, so thermal stays"
+        } else {
+            ""
+        };
         format!(
-            "method chosen on {} (held-out bias residual RMS, °/h; * chosen): {}",
+            "method chosen on {} (held-out bias residual RMS, °/h; * chosen): {}{left_out}",
             self.validation.text(),
             each.join(", ")
         )
+    }
+
+    /// The choice with `thermal` kept because the chosen `thermal-lstm` fit kept no LSTM.
+    pub(crate) fn with_lstm_left_out(self) -> MethodChoice {
+        MethodChoice {
+            chosen: Method::Thermal,
+            lstm_left_out: true,
+            ..self
+        }
     }
 }
