@@ -88,6 +88,29 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
             }
             c
         }
+        v if v.starts_with("dlstm") => {
+            // dlstm[:<hidden>[:<Adam steps>[:<windows per step>]]]: an LSTM alone on the fixed
+            // thermal-state inputs (T, dT, T − lags of 300, 1000, 3000 s; the `direct` recipe's
+            // constant base holding each run's offset), trained as `thermal-lstm` trains its
+            // LSTM (windows drawn at random, cosine decay, early stopping, gate).
+            let mut r = RecipeSettings::of_kind(Method::ThermalLstm);
+            let direct = RecipeSettings::of_kind(Method::Direct);
+            r.kind = Method::Direct;
+            r.base = direct.base;
+            r.scale_base = direct.scale_base;
+            r.base_input = false;
+            let parts: Vec<&str> = v.split(':').collect();
+            if let Some(h) = parts.get(1) {
+                r.hidden = h.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            if let Some(e) = parts.get(2) {
+                r.epochs = e.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            if let Some(b) = parts.get(3) {
+                r.batch = b.parse().map_err(|e| format!("{v}: {e}"))?;
+            }
+            lstm(r)
+        }
         v if v.starts_with("thermal-lstm") => {
             // thermal-lstm[:<base input 0|1>[:<runs gate 0|1>[:<epochs>[:<min improvement>
             // [:<residual smoothing steps>]]]]]: the thermal model with a residual LSTM on
@@ -140,8 +163,8 @@ fn method_config(name: &str) -> Result<FitConfig, String> {
         other => {
             return Err(format!(
                 "unknown method {other:?}: linear, poly, residual, residual-ls, generic, \
-                 published, direct, thermal, thermal:..., thermal-lstm:..., tlstm:..., \
-                 auto, auto:..."
+                 published, direct, dlstm:..., thermal, thermal:..., thermal-lstm:..., \
+                 tlstm:..., auto, auto:..."
             ))
         }
     })
@@ -286,7 +309,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             })
             .collect();
         for m in job.methods {
-            let capacity = m.starts_with("tlstm") || m.starts_with("auto");
+            let capacity = m.starts_with("tlstm") || m.starts_with("auto") || m.starts_with("dlstm");
             if setting == "planned" && m != "linear" && m != "thermal" && !capacity {
                 // The planned setting asks whether the chamber profile helps the default
                 // method; linear stays for the 0.7 × linear share.
