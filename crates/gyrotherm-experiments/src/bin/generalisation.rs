@@ -309,7 +309,8 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             })
             .collect();
         for m in job.methods {
-            let capacity = m.starts_with("tlstm") || m.starts_with("auto") || m.starts_with("dlstm");
+            let capacity =
+                m.starts_with("tlstm") || m.starts_with("auto") || m.starts_with("dlstm");
             if setting == "planned" && m != "linear" && m != "thermal" && !capacity {
                 // The planned setting asks whether the chamber profile helps the default
                 // method; linear stays for the 0.7 × linear share.
