@@ -1,4 +1,4 @@
-//! An inertial unit's log: several gyro and temperature columns in one file
+//! An inertial unit's CSV log ([`ImuLog`] in memory): several gyro and temperature columns in one file
 //! ([`super::column_list`] says how they are named).
 //!
 //! Reading goes through [`read_log`](super::read_log) with the first gyro and the first
@@ -13,103 +13,7 @@ use std::path::Path;
 use super::column_list::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::number::{parse_f64, parse_f64_decimal_comma};
-use super::{ExtraColumn, LogWriter, ReadOptions, ReadReport, TestLog, TIME_COL};
-
-/// A named column of numbers.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct NamedSeries {
-    pub name: String,
-    pub values: Vec<f64>,
-}
-
-/// An inertial unit's log in memory: gyro outputs in °/s, temperatures in °C, in the order of
-/// the column lists.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ImuLog {
-    /// Time, s, strictly increasing.
-    pub time_s: Vec<f64>,
-    /// Gyro outputs, °/s.
-    pub gyro: Vec<NamedSeries>,
-    /// Temperatures, °C (a sensor fault may leave NaN in a simulated log being written).
-    pub temp: Vec<NamedSeries>,
-    /// Table rate, °/s, and its column name (None: static run).
-    pub table: Option<NamedSeries>,
-    /// The gyro column the table turns (None: static run).
-    pub table_axis: Option<String>,
-    /// Other columns, passed through.
-    pub extra: Vec<ExtraColumn>,
-}
-
-impl ImuLog {
-    pub fn len(&self) -> usize {
-        self.time_s.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.time_s.is_empty()
-    }
-
-    /// The names of its gyro and its temperature columns, in column order.
-    pub(crate) fn column_names(&self) -> (Vec<String>, Vec<String>) {
-        (
-            self.gyro.iter().map(|s| s.name.clone()).collect(),
-            self.temp.iter().map(|s| s.name.clone()).collect(),
-        )
-    }
-
-    /// Index of the gyro column the table turns.
-    pub(crate) fn table_axis_index(&self) -> Option<usize> {
-        let a = self.table_axis.as_deref()?;
-        self.gyro.iter().position(|g| g.name == a)
-    }
-
-    /// One axis as a single-axis log without pass-through columns (what a fit reads): gyro
-    /// `axis`, temperature `temp`, the table rate only when the table turns this axis.
-    pub fn axis_data(&self, axis: usize, temp: usize) -> TestLog {
-        TestLog {
-            time_s: self.time_s.clone(),
-            gyro_dps: self.gyro[axis].values.clone(),
-            temp_c: self.temp[temp].values.clone(),
-            table_dps: (self.table_axis_index() == Some(axis))
-                .then(|| self.table.as_ref().map(|t| t.values.clone()))
-                .flatten(),
-            extra: Vec::new(),
-        }
-    }
-
-    /// One axis as a single-axis log: gyro `axis` with temperature `temp`; the table rate only
-    /// when the table turns this axis (for the others the run is static); the other gyro and
-    /// temperature columns and the pass-through ones as pass-through text.
-    pub fn axis_log(&self, axis: usize, temp: usize) -> TestLog {
-        let text = |s: &NamedSeries| ExtraColumn {
-            name: s.name.clone(),
-            values: s.values.iter().map(|v| format!("{v}")).collect(),
-        };
-        let extra = self
-            .gyro
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| *k != axis)
-            .map(|(_, s)| text(s))
-            .chain(
-                self.temp
-                    .iter()
-                    .enumerate()
-                    .filter(|(k, _)| *k != temp)
-                    .map(|(_, s)| text(s)),
-            )
-            .chain(self.extra.iter().cloned())
-            .collect();
-        TestLog {
-            time_s: self.time_s.clone(),
-            gyro_dps: self.gyro[axis].values.clone(),
-            temp_c: self.temp[temp].values.clone(),
-            table_dps: (self.table_axis_index() == Some(axis))
-                .then(|| self.table.as_ref().map(|t| t.values.clone()))
-                .flatten(),
-            extra,
-        }
-    }
-}
+use super::{ExtraColumn, ImuLog, LogWriter, NamedSeries, ReadOptions, ReadReport, TIME_COL};
 
 /// The gyro the table turns: the one whose output has a slope on the table rate within
 /// [`TABLE_AXIS_SLOPE_RANGE`] (least squares over the samples, table rate and output

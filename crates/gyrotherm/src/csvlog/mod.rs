@@ -1,4 +1,10 @@
-//! The test-log CSV format, read and written by every command.
+//! Logs: the log in memory ([`repr`]: [`ImuLog`], N gyro axes and M temperature sensors, and
+//! [`TestLog`], one axis with one temperature) apart from the file formats that read and write
+//! it ([`LogFormat`]: CSV here and in the files below, PX4 ULog in `ulog.rs`, ArduPilot
+//! DataFlash in `dataflash.rs`), and the one entry point every job reads through
+//! ([`read_log_set`]).
+//!
+//! The CSV format, read and written by every command:
 //!
 //! A header row, then one row per sample. Required columns `time_s` (s), `gyro_dps` (°/s),
 //! `temp_c` (°C); optional `table_dps` (rate-table input rate, °/s; absent means a static
@@ -27,6 +33,7 @@ mod imu;
 mod log_set;
 mod number;
 mod reader;
+pub mod repr;
 mod step_means;
 mod ulog;
 pub(crate) mod writer;
@@ -38,12 +45,16 @@ pub use error::{LogError, LogErrorKind};
 pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
 pub(crate) use imu::write_imu_csv;
-pub use imu::{read_imu_log, read_imu_logs, write_imu_log, ImuLog, NamedSeries};
+pub use imu::{read_imu_log, read_imu_logs, write_imu_log};
 pub(crate) use log_set::{read_in_form, LogSetForm};
 pub use log_set::{read_log_set, read_log_sets, FileRead, LogSet, LogSetError, SetRead};
 pub(crate) use number::parse_f64_decimal_comma;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
+};
+pub use repr::{
+    ColumnError, ExtraColumn, ImuLog, NamedSeries, TestLog, DEFAULT_TABLE_COL, GYRO_COL, NOISE_COL,
+    TEMP_COL, TIME_COL, TRUE_BIAS_COL, TRUE_SCALE_COL,
 };
 pub use step_means::{SAMPLES_COL, SENSOR_GYRO_COLS, STEP_S};
 pub(crate) use writer::short_f64;
@@ -56,135 +67,6 @@ use std::path::Path;
 /// the compensator's stream): a log line holds a few numbers, and one endless line (a file
 /// without line breaks, `/dev/zero`) must not take unbounded memory.
 pub const MAX_LINE_BYTES: usize = 64 * 1024;
-
-/// Standard column names.
-pub const TIME_COL: &str = "time_s";
-/// Gyro output, °/s.
-pub const GYRO_COL: &str = "gyro_dps";
-/// Temperature, °C.
-pub const TEMP_COL: &str = "temp_c";
-/// Rate-table input rate, °/s (optional).
-pub const DEFAULT_TABLE_COL: &str = "table_dps";
-
-/// Names of the simulator's truth columns (written with `simulate --truth`).
-pub const TRUE_BIAS_COL: &str = "true_bias_dps";
-/// True scale factor K (dimensionless, 1.0 nominal) in Ĝ = B + K·G.
-pub const TRUE_SCALE_COL: &str = "true_scale";
-/// Noise-only part of the gyro output, °/s.
-pub const NOISE_COL: &str = "noise_dps";
-
-/// One test log in memory. `gyro_dps` is always in °/s, whatever the file's unit.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct TestLog {
-    /// Time, s, strictly increasing.
-    pub time_s: Vec<f64>,
-    /// Gyro output, °/s.
-    pub gyro_dps: Vec<f64>,
-    /// Temperature, °C.
-    pub temp_c: Vec<f64>,
-    /// Rate-table input rate, °/s (None: static test).
-    pub table_dps: Option<Vec<f64>>,
-    /// Other columns, passed through to outputs unchanged (raw text of each field).
-    pub extra: Vec<ExtraColumn>,
-}
-
-/// A pass-through column.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ExtraColumn {
-    pub name: String,
-    pub values: Vec<String>,
-}
-
-impl TestLog {
-    pub fn len(&self) -> usize {
-        self.time_s.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.time_s.is_empty()
-    }
-    /// Median of the time steps, s (NaN for fewer than two samples).
-    pub fn sample_period_s(&self) -> f64 {
-        let mut d: Vec<f64> = self.time_s.windows(2).map(|w| w[1] - w[0]).collect();
-        if d.is_empty() {
-            return f64::NAN;
-        }
-        // The element a sort would put there, without the sort.
-        let mid = d.len() / 2;
-        *d.select_nth_unstable_by(mid, f64::total_cmp).1
-    }
-    /// A pass-through column parsed as numbers (None if absent or not all numeric).
-    pub fn extra_f64(&self, name: &str) -> Option<Vec<f64>> {
-        let col = self.extra.iter().find(|c| c.name == name)?;
-        col.values.iter().map(|v| v.trim().parse().ok()).collect()
-    }
-    /// True for a static test: no table column, or a table column that is zero throughout.
-    pub fn is_static(&self) -> bool {
-        self.table_dps
-            .as_ref()
-            .is_none_or(|t| t.iter().all(|v| *v == 0.0))
-    }
-    /// The numeric column `name` (a standard column or a numeric pass-through column). The
-    /// gyro and temperature columns are moved out (left empty here) so a long log is held
-    /// once; the others are copied.
-    pub fn take_column(&mut self, name: &str) -> Result<Vec<f64>, ColumnError> {
-        match name {
-            GYRO_COL => Ok(std::mem::take(&mut self.gyro_dps)),
-            TEMP_COL => Ok(std::mem::take(&mut self.temp_c)),
-            TIME_COL => Ok(self.time_s.clone()),
-            DEFAULT_TABLE_COL => self.table_dps.clone().ok_or(ColumnError::NoTable),
-            name => self.extra_f64(name).ok_or_else(|| {
-                if self.extra.iter().any(|c| c.name == name) {
-                    ColumnError::NotNumeric {
-                        name: name.to_owned(),
-                    }
-                } else {
-                    ColumnError::Missing {
-                        name: name.to_owned(),
-                        available: self.column_names(),
-                    }
-                }
-            }),
-        }
-    }
-    /// Names of the columns held: the standard ones present, then the pass-through ones.
-    pub(crate) fn column_names(&self) -> Vec<String> {
-        [GYRO_COL, TEMP_COL]
-            .into_iter()
-            .chain(self.table_dps.as_ref().map(|_| DEFAULT_TABLE_COL))
-            .chain(self.extra.iter().map(|c| c.name.as_str()))
-            .map(str::to_owned)
-            .collect()
-    }
-}
-
-/// Why [`TestLog::take_column`] has no numbers for a column.
-#[derive(Debug, Clone, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum ColumnError {
-    /// `table_dps` asked for on a log without one.
-    NoTable,
-    /// No column of that name.
-    Missing {
-        name: String,
-        available: Vec<String>,
-    },
-    /// The pass-through column holds a field that is not a number.
-    NotNumeric { name: String },
-}
-
-impl std::fmt::Display for ColumnError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ColumnError::NoTable => write!(f, "no table_dps column in this log"),
-            ColumnError::Missing { name, available } => {
-                write!(f, "no column `{name}`; available: {}", available.join(", "))
-            }
-            ColumnError::NotNumeric { name } => write!(f, "column `{name}` is not all numeric"),
-        }
-    }
-}
-
-impl std::error::Error for ColumnError {}
 
 /// Factor from a rate column's unit, read from its name suffix, to °/h: `*_dps` 3600,
 /// `*_dph` 1, `*_rad_s` / `*_rps` 3600·180/π; None for a name without a rate unit.
