@@ -275,3 +275,43 @@ def test_unit_auto_fit_tells_each_fold_and_lstm_training(unit_logs, capfd):
     err = capfd.readouterr().err
     assert "gyro_x_dps: auto: fitting thermal and thermal-lstm without a static run" in err, err
     assert "gyro_x_dps: auto: training thermal-lstm on temp_" in err, err
+
+
+def test_unit_coverage_per_axis_and_why_an_axis_has_none(unit_logs):
+    """A unit's coverage comes per gyro column: an axis reading one sensor gets its map's
+    verdicts; an axis reading several has none (``NO_COVERAGE``), and a warning says why."""
+    log = gt.read_log(unit_logs["heldout"], gyro_col=GYROS, temp_col=TEMPS, as_frame=False)
+    seen = set()
+    for temps in (TEMPS, TEMPS[:1]):
+        model = gt.fit(
+            static=unit_logs["static"], table=unit_logs["table"], method="thermal",
+            gyro_col=GYROS, temp_col=temps,
+        )
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            cov = model.coverage(
+                log["time_s"], {g: log[g] for g in GYROS}, {t: log[t] for t in temps}
+            )
+        assert list(cov) == GYROS
+        notes = [str(w.message) for w in caught if issubclass(w.category, gt.GyrothermWarning)]
+        seen |= check_axes(model, cov, notes, log)
+    # Both kinds of axis were met.
+    assert seen == {1, 2}, seen
+
+
+def check_axes(model, cov, notes, log):
+    seen = set()
+    for a in model.axes:
+        seen.add(min(len(a["temps"]), 2))
+        c = cov[a["gyro"]]
+        assert len(c.coverage) == len(log["time_s"]) == len(c.sigma_dph)
+        if len(a["temps"]) > 1:
+            assert set(c.coverage.tolist()) == {gt.NO_COVERAGE}
+            assert any(n.startswith(f"{a['gyro']}: reads {len(a['temps'])} sensors") for n in notes), notes
+        else:
+            codes = set(c.coverage.tolist())
+            assert codes <= set(gt.COVERAGE_NAMES) | {gt.NO_COVERAGE}
+            assert codes & set(gt.COVERAGE_NAMES), "an axis with a map gives verdicts"
+            judged = c.coverage != gt.NO_COVERAGE
+            assert np.isfinite(c.sigma_dph[judged]).all() and (c.sigma_dph[judged] > 0).all()
+    return seen
