@@ -893,7 +893,12 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
         }
         _ => {
             let scores = leave_one_run_out(job, &statics, k, &thermal_cfg, &lstm_cfg)?;
-            (choose(Validation::LeaveOneRunOut, scores), None)
+            let mut choice = choose(Validation::LeaveOneRunOut, scores);
+            if choice.folds_left_out_the_lstm() {
+                // The folds say nothing of the LSTM: its fit on every run decides by its gate.
+                choice.chosen = Method::ThermalLstm;
+            }
+            (choice, None)
         }
     };
     if choice.chosen == Method::Thermal {

@@ -9,8 +9,11 @@
 //!   with the LSTM as kept. A run too short for such blocks gets `thermal`, and no LSTM is
 //!   trained.
 //!
-//! The lower score wins; on a tie, the first candidate (`thermal`, the simpler). The chosen
-//! method is then fitted on every run, and the model is labelled with what it holds. The scores
+//! The lower score wins; on a tie, the first candidate (`thermal`, the simpler), except where
+//! every left-out run's fold left its LSTM out (its gate), so that the scores are equal: the
+//! folds then say nothing of the LSTM, and `thermal-lstm`'s fit on every run decides by its own
+//! gate. The chosen method is then fitted on every run, and the model is labelled with what
+//! it holds; where the chosen `thermal-lstm` keeps no LSTM, `thermal` stays. The scores
 //! and the choice go into the model file ([`MethodChoice`]) and the lines `train` prints. The
 //! scale factor is `thermal`'s in both candidates.
 
@@ -79,6 +82,11 @@ pub(crate) fn fit(
         ),
     };
     let mut choice = choose(validation, scores);
+    if choice.folds_left_out_the_lstm() {
+        // No fold could say anything of the LSTM: its fit on every run, its own gate on
+        // held-out blocks deciding, is what `thermal-lstm` would fly.
+        choice.chosen = Method::ThermalLstm;
+    }
     let mut fit = match (choice.chosen, lstm_fit) {
         (Method::ThermalLstm, Some(fit)) => fit,
         _ => fit_model(logs, &candidate_config(cfg, choice.chosen), progress)?,

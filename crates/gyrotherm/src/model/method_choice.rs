@@ -68,16 +68,33 @@ impl MethodChoice {
                 format!("{}{star} {:.4}", c.method, c.bias_rms_dps * 3600.0)
             })
             .collect();
-        let left_out = if self.lstm_left_out {
-            "; thermal-lstm scored lower, but its fit on every run kept no LSTM, so thermal stays"
-        } else {
-            ""
+        let left_out = match (self.folds_left_out_the_lstm(), self.lstm_left_out) {
+            (true, true) => {
+                "; every fold left the LSTM out (equal scores), and so did thermal-lstm's fit on \
+                 every run: thermal stays"
+            }
+            (true, false) => {
+                "; every fold left the LSTM out (equal scores): thermal-lstm's fit on every run \
+                 kept it by its own gate"
+            }
+            (false, true) => {
+                "; thermal-lstm scored lower, but its fit on every run kept no LSTM, so thermal \
+                 stays"
+            }
+            (false, false) => "",
         };
         format!(
             "method chosen on {} (held-out bias residual RMS, °/h; * chosen): {}{left_out}",
             self.validation.text(),
             each.join(", ")
         )
+    }
+
+    /// Whether the candidates were scored on left-out runs and scored alike: every fold's
+    /// LSTM was left out by its gate, so the folds say nothing of it.
+    pub fn folds_left_out_the_lstm(&self) -> bool {
+        self.validation == Validation::LeaveOneRunOut
+            && matches!(&self.candidates[..], [a, b] if a.bias_rms_dps == b.bias_rms_dps)
     }
 
     /// The choice with `thermal` kept because the chosen `thermal-lstm` fit kept no LSTM.
@@ -87,5 +104,62 @@ impl MethodChoice {
             lstm_left_out: true,
             ..self
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn choice(validation: Validation, scores: [f64; 2], chosen: Method) -> MethodChoice {
+        MethodChoice {
+            validation,
+            candidates: [Method::Thermal, Method::ThermalLstm]
+                .into_iter()
+                .zip(scores)
+                .map(|(method, bias_rms_dps)| CandidateScore {
+                    method,
+                    bias_rms_dps,
+                })
+                .collect(),
+            chosen,
+            lstm_left_out: false,
+        }
+    }
+
+    #[test]
+    fn equal_left_out_scores_say_nothing_of_the_lstm_and_the_line_says_what_decided() {
+        let tie = choice(
+            Validation::LeaveOneRunOut,
+            [2e-6, 2e-6],
+            Method::ThermalLstm,
+        );
+        assert!(tie.folds_left_out_the_lstm());
+        assert!(
+            tie.describe().contains("kept it by its own gate"),
+            "{}",
+            tie.describe()
+        );
+        let gated = tie.with_lstm_left_out();
+        assert_eq!(gated.chosen, Method::Thermal);
+        assert!(
+            gated.describe().contains("and so did"),
+            "{}",
+            gated.describe()
+        );
+        // Held-out blocks tie only where the LSTM's own gate left it out: nothing to defer to.
+        let blocks = choice(Validation::HeldOutBlocks, [2e-6, 2e-6], Method::Thermal);
+        assert!(!blocks.folds_left_out_the_lstm());
+        let scored = choice(
+            Validation::LeaveOneRunOut,
+            [2e-6, 1e-6],
+            Method::ThermalLstm,
+        );
+        assert!(!scored.folds_left_out_the_lstm());
+        let line = scored.describe();
+        assert!(
+            !line.contains("equal scores") && !line.contains("no LSTM"),
+            "{line}"
+        );
     }
 }
