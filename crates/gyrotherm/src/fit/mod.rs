@@ -662,10 +662,10 @@ pub(crate) fn fit_model_with(
             &crate::coverage::CoverageSettings::default(),
         )
     });
-    // The map's σ is the least-squares base's cross-validated error. `thermal-lstm`'s LSTM,
-    // where kept, took out part of that error on the blocks held out of its training: σ
-    // shrinks by the same ratio (on-sample it would be too wide for the model as it flies).
-    let shrink = lstm_sigma_ratio(cfg, model.bias.as_ref(), bias_training.as_ref());
+    // The map's σ is the least-squares base's cross-validated error. A residual LSTM, where
+    // kept, took out part of that error on the blocks held out of its training: σ shrinks by
+    // the same ratio (on-sample it would be too wide for the model as it flies).
+    let shrink = lstm_sigma_ratio(model.bias.as_ref(), bias_training.as_ref());
     let (coverage, coverage_note) = match coverage {
         Some(Ok(c)) => match shrink {
             Some(r) => (Some(c.rescaled(r, c.growth_per_cell)), None),
@@ -690,16 +690,10 @@ pub(crate) fn fit_model_with(
     })
 }
 
-/// The ratio of the held-out blocks' bias RMS with `thermal-lstm`'s residual LSTM to without
-/// it, where the bias model holds that LSTM (None otherwise, or where it did not help).
-fn lstm_sigma_ratio(
-    cfg: &FitConfig,
-    bias: Option<&SubModel>,
-    training: Option<&TrainSummary>,
-) -> Option<f64> {
-    if cfg.recipe.kind != Method::ThermalLstm {
-        return None;
-    }
+/// The ratio of the held-out blocks' bias RMS with the residual LSTM to without it, where the
+/// bias model holds one (`thermal-lstm`, `residual`, `generic`; None otherwise, or where it
+/// did not help).
+fn lstm_sigma_ratio(bias: Option<&SubModel>, training: Option<&TrainSummary>) -> Option<f64> {
     bias?.lstm()?;
     let (base, kept) = training?.held_out_rms?;
     (base.is_finite() && kept > 0.0 && kept < base).then(|| kept / base)
