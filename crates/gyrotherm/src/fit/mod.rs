@@ -665,7 +665,7 @@ pub(crate) fn fit_model_with(
     // The map's σ is the least-squares base's cross-validated error. A residual LSTM, where
     // kept, took out part of that error on the blocks held out of its training: σ shrinks by
     // the same ratio (on-sample it would be too wide for the model as it flies).
-    let shrink = lstm_sigma_ratio(model.bias.as_ref(), bias_training.as_ref());
+    let shrink = lstm_sigma_ratio(cfg, model.bias.as_ref(), bias_training.as_ref());
     let (coverage, coverage_note) = match coverage {
         Some(Ok(c)) => match shrink {
             Some(r) => (Some(c.rescaled(r, c.growth_per_cell)), None),
@@ -691,9 +691,21 @@ pub(crate) fn fit_model_with(
 }
 
 /// The ratio of the held-out blocks' bias RMS with the residual LSTM to without it, where the
-/// bias model holds one (`thermal-lstm`, `residual`, `generic`; None otherwise, or where it
-/// did not help).
-fn lstm_sigma_ratio(bias: Option<&SubModel>, training: Option<&TrainSummary>) -> Option<f64> {
+/// bias model holds one on a least-squares thermal base (`thermal-lstm`, `residual`,
+/// `generic`; None otherwise, or where it did not help). `direct`'s base is a constant, whose
+/// map is no σ of the LSTM's error to shrink: shrunk, it was too narrow everywhere (47 %
+/// within ±1σ outside coverage on the design family).
+fn lstm_sigma_ratio(
+    cfg: &FitConfig,
+    bias: Option<&SubModel>,
+    training: Option<&TrainSummary>,
+) -> Option<f64> {
+    if !matches!(
+        cfg.recipe.kind,
+        Method::ThermalLstm | Method::Residual | Method::Generic
+    ) {
+        return None;
+    }
     bias?.lstm()?;
     let (base, kept) = training?.held_out_rms?;
     (base.is_finite() && kept > 0.0 && kept < base).then(|| kept / base)
