@@ -9,8 +9,8 @@
 
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
 use gyrotherm::imu_judge::axis_test_log;
-use gyrotherm::imu_model::{compensate_imu, ImuModel};
-use gyrotherm::model::{TempSensorDef, Validation};
+use gyrotherm::imu_model::{compensate_imu, ImuAxis, ImuModel};
+use gyrotherm::model::{MethodChoice, TempSensorDef, Validation};
 use gyrotherm::plan::{propose, resolve_envelope};
 use gyrotherm::settings::plan::PlanSettings;
 use gyrotherm::settings::{FitSettings, Method};
@@ -103,12 +103,9 @@ fn round_trips_and_flies(model: &ImuModel, logs: &[(String, ImuLog)]) {
     assert!(out[0].gyro_comp_dps.iter().all(|r| r.is_finite()));
 }
 
-#[test]
-fn an_axis_whose_thermal_lstm_fit_keeps_no_lstm_keeps_the_several_sensor_thermal() {
-    // Design unit 1007's gyro x with its case and x-coil sensors.
-    let logs = logs(1007, &[0, 1]);
-    let model = auto_unit(&logs);
-    let a = &model.axes[0];
+/// The axis's recorded choice, scored on the left-out runs, with `thermal`'s and
+/// `thermal-lstm`'s scores (°/s), printed.
+fn left_out_scores(a: &ImuAxis) -> (&MethodChoice, f64, f64) {
     let choice = a
         .model
         .method_choice
@@ -116,10 +113,20 @@ fn an_axis_whose_thermal_lstm_fit_keeps_no_lstm_keeps_the_several_sensor_thermal
         .expect("auto records its choice");
     eprintln!("{}", choice.describe());
     assert_eq!(choice.validation, Validation::LeaveOneRunOut);
-    let (t, l) = (
+    (
+        choice,
         choice.candidates[0].bias_rms_dps,
         choice.candidates[1].bias_rms_dps,
-    );
+    )
+}
+
+#[test]
+fn an_axis_whose_thermal_lstm_fit_keeps_no_lstm_keeps_the_several_sensor_thermal() {
+    // Design unit 1007's gyro x with its case and x-coil sensors.
+    let logs = logs(1007, &[0, 1]);
+    let model = auto_unit(&logs);
+    let a = &model.axes[0];
+    let (choice, t, l) = left_out_scores(a);
     // Measured by this test (60 Adam steps, seed 0; the line it prints): several-sensor
     // `thermal` 0.0151 °/h, `thermal-lstm` on the case sensor 0.0149 °/h over the two
     // left-out static runs; the fit on both runs then keeps no LSTM.
@@ -161,17 +168,7 @@ fn an_axis_whose_lstm_wins_and_is_kept_flies_thermal_lstm_as_the_single_gyro_pat
     let logs = logs(1009, &[1]);
     let model = auto_unit(&logs);
     let a = &model.axes[0];
-    let choice = a
-        .model
-        .method_choice
-        .as_ref()
-        .expect("auto records its choice");
-    eprintln!("{}", choice.describe());
-    assert_eq!(choice.validation, Validation::LeaveOneRunOut);
-    let (t, l) = (
-        choice.candidates[0].bias_rms_dps,
-        choice.candidates[1].bias_rms_dps,
-    );
+    let (choice, t, l) = left_out_scores(a);
     // Measured by this test (the line it prints): `thermal` 0.0220 °/h, `thermal-lstm`
     // 0.0210 °/h over the two left-out static runs.
     assert!(
