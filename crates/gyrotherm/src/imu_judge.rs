@@ -613,19 +613,16 @@ pub(crate) fn compare_imu(
     progress: &ImuCompareProgress,
     events: &ImuEvents,
 ) -> Result<ImuComparison, ImuJudgeError> {
-    let first = train
-        .first()
-        .map(|(_, l)| l)
-        .ok_or_else(|| ImuJudgeError::Layout("no training logs".into()))?;
-    let columns = first.column_names();
-    let (gyro_cols, temp_cols) = columns.clone();
-    for (n, l) in train.iter().chain(test) {
-        if l.column_names() != columns {
-            return Err(ImuJudgeError::Layout(format!(
-                "{n}: every log must be read with the same gyro and temperature columns"
-            )));
-        }
+    if train.is_empty() {
+        return Err(ImuJudgeError::Layout("no training logs".into()));
     }
+    let (gyro_cols, temp_cols) = ImuLog::shared_columns(train.iter().chain(test))
+        .map_err(|n| {
+            ImuJudgeError::Layout(format!(
+                "{n}: every log must be read with the same gyro and temperature columns"
+            ))
+        })?
+        .unwrap_or_default();
     let unit = if temp_cols.len() == 1 {
         None
     } else {

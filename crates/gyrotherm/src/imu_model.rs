@@ -222,21 +222,15 @@ pub(crate) fn fit_imu_full(
     progress: &ImuProgress,
     events: &ImuEvents,
 ) -> Result<ImuModel, ImuError> {
-    let first = logs
-        .first()
-        .map(|(_, l)| l)
+    let (gyro_cols, temp_cols) = ImuLog::shared_columns(logs)
+        .map_err(|name| {
+            ImuError::Layout(format!(
+                "{name}: the training logs must be read with the same gyro and temperature columns"
+            ))
+        })?
         .ok_or_else(|| ImuError::Layout("no training logs".into()))?;
-    let columns = first.column_names();
-    let (gyro_cols, temp_cols) = columns.clone();
     // Before any fit: a model that could not be compensated is not worth the hours.
     check_axis_count(gyro_cols.len())?;
-    for (name, l) in logs {
-        if l.column_names() != columns {
-            return Err(ImuError::Layout(format!(
-                "{name}: the training logs must be read with the same gyro and temperature columns"
-            )));
-        }
-    }
     // `auto` fits each axis's several-sensor `thermal` candidate as `thermal` does.
     let auto = settings.sensors == ImuSensors::All && chooses_method(cfg);
     let multi_path = settings.sensors == ImuSensors::All && (uses_identification(cfg) || auto);

@@ -146,6 +146,9 @@ pub struct NamedSeries {
     pub values: Vec<f64>,
 }
 
+/// The names of a unit log's gyro columns and of its temperature columns, in column order.
+pub(crate) type UnitColumns = (Vec<String>, Vec<String>);
+
 /// An inertial unit's log in memory: gyro outputs in °/s, temperatures in °C, in the order of
 /// the column lists.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -173,11 +176,28 @@ impl ImuLog {
     }
 
     /// The names of its gyro and its temperature columns, in column order.
-    pub(crate) fn column_names(&self) -> (Vec<String>, Vec<String>) {
+    pub(crate) fn column_names(&self) -> UnitColumns {
         (
             self.gyro.iter().map(|s| s.name.clone()).collect(),
             self.temp.iter().map(|s| s.name.clone()).collect(),
         )
+    }
+
+    /// The gyro and temperature columns that every log of `logs` holds (None without logs),
+    /// or the name of the first log whose columns differ from the first log's.
+    pub(crate) fn shared_columns<'a>(
+        logs: impl IntoIterator<Item = &'a (String, ImuLog)>,
+    ) -> Result<Option<UnitColumns>, &'a str> {
+        let mut columns = None;
+        for (name, l) in logs {
+            let c = l.column_names();
+            match &columns {
+                None => columns = Some(c),
+                Some(first) if *first != c => return Err(name),
+                Some(_) => {}
+            }
+        }
+        Ok(columns)
     }
 
     /// Index of the gyro column the table turns.
@@ -232,5 +252,39 @@ impl ImuLog {
                 .flatten(),
             extra,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit(gyros: &[&str], temps: &[&str]) -> ImuLog {
+        let series = |n: &&str| NamedSeries {
+            name: (*n).to_owned(),
+            values: vec![0.0],
+        };
+        ImuLog {
+            time_s: vec![0.0],
+            gyro: gyros.iter().map(series).collect(),
+            temp: temps.iter().map(series).collect(),
+            ..ImuLog::default()
+        }
+    }
+
+    #[test]
+    fn shared_columns_are_the_first_log_s_or_name_the_first_log_that_differs() {
+        let a = ("a.csv".to_owned(), unit(&["gx", "gy"], &["t0", "t1"]));
+        let b = ("b.csv".to_owned(), unit(&["gx", "gy"], &["t0", "t1"]));
+        let c = ("c.csv".to_owned(), unit(&["gx", "gy"], &["t1", "t0"]));
+        let none: [(String, ImuLog); 0] = [];
+        assert_eq!(ImuLog::shared_columns(&none), Ok(None));
+        let want = (
+            vec!["gx".into(), "gy".into()],
+            vec!["t0".into(), "t1".into()],
+        );
+        assert_eq!(ImuLog::shared_columns([&a, &b]), Ok(Some(want)));
+        // The temperature order differs: another column layout.
+        assert_eq!(ImuLog::shared_columns([&a, &b, &c]), Err("c.csv"));
     }
 }
