@@ -791,7 +791,7 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
         ..
     } = *job;
     use crate::fit::auto::{candidate_config, choose};
-    use crate::model::Validation;
+    use crate::model::{MethodChoice, Validation};
     use crate::settings::method::Method;
     let thermal_cfg = candidate_config(cfg, Method::Thermal);
     let lstm_cfg = candidate_config(cfg, Method::ThermalLstm);
@@ -843,6 +843,14 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
         .copied()
         .filter(|&i| targets::is_static(&runs.axis_logs[i].1))
         .collect();
+    // Several sensors: the one-sensor LSTM candidate is not scored. Decided on design units
+    // 1000-1002, confirmed on 5001-5003 (docs/experiments/imu-auto.md): where it was kept
+    // there, it was worse on the held-out flight (up to +52 %) though it scored better on the
+    // left-out static runs.
+    if thermal.temps.len() > 1 && !statics.is_empty() && settings.auto_keep.is_none() {
+        thermal.model.method_choice = Some(MethodChoice::several_sensors());
+        return finished(thermal);
+    }
     let (choice, lstm) = match (statics.len(), settings.auto_keep) {
         // An experiment's candidate, kept without scoring (and without a recorded choice).
         (_, Some(Method::ThermalLstm)) => {

@@ -16,6 +16,12 @@ pub enum Validation {
     /// of the LSTM's training.
     #[serde(rename = "held-out-blocks")]
     HeldOutBlocks,
+    /// Not scored: an inertial unit's axis whose `thermal` fit reads several temperature
+    /// sensors keeps it. The `thermal-lstm` candidate reads one sensor, and left-out static
+    /// runs, where the sensors agree, cannot show what the other sensors are worth in flight
+    /// (docs/experiments/imu-auto.md).
+    #[serde(rename = "several-sensors")]
+    SeveralSensors,
 }
 
 impl Validation {
@@ -24,6 +30,10 @@ impl Validation {
         match self {
             Validation::LeaveOneRunOut => "each static run left out in turn",
             Validation::HeldOutBlocks => "held-out blocks of the static run",
+            Validation::SeveralSensors => {
+                "no scoring: thermal reads several temperature sensors on this axis, the LSTM \
+                 candidate one"
+            }
         }
     }
 }
@@ -60,6 +70,9 @@ pub struct MethodChoice {
 impl MethodChoice {
     /// One line: the validation, each candidate's score in °/h (the chosen one starred).
     pub fn describe(&self) -> String {
+        if self.candidates.is_empty() {
+            return format!("{} kept, {}", self.chosen, self.validation.text());
+        }
         let each: Vec<String> = self
             .candidates
             .iter()
@@ -95,6 +108,16 @@ impl MethodChoice {
     pub fn folds_left_out_the_lstm(&self) -> bool {
         self.validation == Validation::LeaveOneRunOut
             && matches!(&self.candidates[..], [a, b] if a.bias_rms_dps == b.bias_rms_dps)
+    }
+
+    /// `thermal` kept unscored on a unit axis that reads several sensors.
+    pub(crate) fn several_sensors() -> MethodChoice {
+        MethodChoice {
+            validation: Validation::SeveralSensors,
+            candidates: Vec::new(),
+            chosen: Method::Thermal,
+            lstm_left_out: false,
+        }
     }
 
     /// The choice with `thermal` kept because the chosen `thermal-lstm` fit kept no LSTM.
