@@ -68,7 +68,8 @@ pub struct MethodChoice {
 }
 
 impl MethodChoice {
-    /// One line: the validation, each candidate's score in °/h (the chosen one starred).
+    /// One line: the validation, each candidate's score in °/h (the chosen one starred); for a
+    /// choice made without scores, what was kept and why.
     pub fn describe(&self) -> String {
         if self.candidates.is_empty() {
             return format!("{} kept, {}", self.chosen, self.validation.text());
