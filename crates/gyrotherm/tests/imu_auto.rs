@@ -6,7 +6,7 @@
 
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
 use gyrotherm::fit::FitConfig;
-use gyrotherm::imu_model::{fit_imu, ImuModel, IMU_FORMAT_VERSION};
+use gyrotherm::imu_model::{fit_imu, ImuAxis, ImuModel, IMU_FORMAT_VERSION};
 use gyrotherm::model::{TempSensorDef, Validation};
 use gyrotherm::settings::{FitSettings, Method};
 use gyrotherm::told::Told;
@@ -16,6 +16,10 @@ use gyrotherm::unit_model::Form;
 #[path = "support/unit_1000.rs"]
 mod unit_1000;
 use unit_1000::run;
+
+#[path = "support/unit_choice.rs"]
+mod unit_choice;
+use unit_choice::{assert_kept_unscored, recorded, scores};
 
 fn runs(which: &[(u64, Option<usize>)]) -> Vec<(String, ImuLog)> {
     which
@@ -36,20 +40,9 @@ fn one_sensor(which: &[(u64, Option<usize>)]) -> Vec<(String, ImuLog)> {
 
 /// The recorded choice's two scores (°/s), checked: `thermal` and `thermal-lstm` in that
 /// order, finite, and the lower one chosen (`thermal` on a tie).
-fn scored(a: &gyrotherm::imu_model::ImuAxis, validation: Validation) -> (f64, f64) {
-    let choice = a
-        .model
-        .method_choice
-        .as_ref()
-        .expect("auto records its choice");
-    eprintln!("{}", choice.describe());
-    assert_eq!(choice.validation, validation);
-    let methods: Vec<Method> = choice.candidates.iter().map(|c| c.method).collect();
-    assert_eq!(methods, [Method::Thermal, Method::ThermalLstm]);
-    let (t, l) = (
-        choice.candidates[0].bias_rms_dps,
-        choice.candidates[1].bias_rms_dps,
-    );
+fn scored(a: &ImuAxis, validation: Validation) -> (f64, f64) {
+    let choice = recorded(a);
+    let (t, l) = scores(choice, validation);
     assert!(t.is_finite() && l.is_finite() && t > 0.0, "{t} {l}");
     let lower = if l < t {
         Method::ThermalLstm
@@ -118,14 +111,7 @@ fn auto_keeps_a_several_sensor_thermal_axis_unscored() {
         "{steps:#?}"
     );
     let a = &model.axes[0];
-    let choice = a
-        .model
-        .method_choice
-        .as_ref()
-        .expect("auto records its choice");
-    assert_eq!(choice.validation, Validation::SeveralSensors);
-    assert!(choice.candidates.is_empty());
-    assert_eq!(choice.chosen, Method::Thermal);
+    assert_kept_unscored(a);
     // The axis is `--method thermal`'s, to the bit, but for the recorded choice.
     let thermal = fit_imu(
         &logs,
@@ -135,7 +121,6 @@ fn auto_keeps_a_several_sensor_thermal_axis_unscored() {
     )
     .unwrap();
     assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
-    assert!(a.fallback.is_some());
     let mut same = a.clone();
     same.model.method_choice = None;
     assert_eq!(same, thermal.axes[0]);

@@ -19,6 +19,10 @@ use gyrotherm::sim::{simulate, Profile, SimConfig};
 use gyrotherm::train::train;
 use gyrotherm::unit_model::Form;
 
+#[path = "support/unit_choice.rs"]
+mod unit_choice;
+use unit_choice::{assert_kept_unscored, recorded, scores};
+
 /// Design unit `unit`'s gyro x on `profile`, with the temperature columns `sensors` (indices
 /// among the case's, then each coil's).
 fn run(unit: u64, sensors: &[usize], profile: Profile, seed: u64, table: bool) -> ImuLog {
@@ -104,20 +108,11 @@ fn round_trips_and_flies(model: &ImuModel, logs: &[(String, ImuLog)]) {
 }
 
 /// The axis's recorded choice, scored on the left-out runs, with `thermal`'s and
-/// `thermal-lstm`'s scores (°/s), printed.
+/// `thermal-lstm`'s scores (°/s).
 fn left_out_scores(a: &ImuAxis) -> (&MethodChoice, f64, f64) {
-    let choice = a
-        .model
-        .method_choice
-        .as_ref()
-        .expect("auto records its choice");
-    eprintln!("{}", choice.describe());
-    assert_eq!(choice.validation, Validation::LeaveOneRunOut);
-    (
-        choice,
-        choice.candidates[0].bias_rms_dps,
-        choice.candidates[1].bias_rms_dps,
-    )
+    let choice = recorded(a);
+    let (t, l) = scores(choice, Validation::LeaveOneRunOut);
+    (choice, t, l)
 }
 
 #[test]
@@ -128,23 +123,9 @@ fn an_axis_whose_thermal_reads_several_sensors_keeps_it_unscored() {
     let logs = logs(1007, &[0, 1]);
     let model = auto_unit(&logs);
     let a = &model.axes[0];
-    let choice = a
-        .model
-        .method_choice
-        .as_ref()
-        .expect("auto records its choice");
     // Kept: `thermal`, unscored, with the reason recorded and told.
-    assert_eq!(choice.validation, Validation::SeveralSensors);
-    assert!(choice.candidates.is_empty());
-    assert_eq!(choice.chosen, Method::Thermal);
-    assert!(
-        choice.describe().contains("several temperature sensors"),
-        "{}",
-        choice.describe()
-    );
-    assert_eq!(a.model.method, Method::Thermal);
+    assert_kept_unscored(a);
     assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
-    assert!(a.fallback.is_some());
     // The axis is `--method thermal`'s, to the bit, but for the recorded choice.
     let thermal_cfg = FitSettings {
         method: Method::Thermal,

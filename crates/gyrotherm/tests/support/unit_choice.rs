@@ -1,0 +1,40 @@
+//! Reading and checking the choice `auto` records on an inertial unit's axis.
+
+use gyrotherm::imu_model::ImuAxis;
+use gyrotherm::model::{MethodChoice, Validation};
+use gyrotherm::settings::Method;
+
+/// The axis's recorded choice, its line printed.
+pub fn recorded(a: &ImuAxis) -> &MethodChoice {
+    let choice = a
+        .model
+        .method_choice
+        .as_ref()
+        .expect("auto records its choice");
+    eprintln!("{}", choice.describe());
+    choice
+}
+
+/// The choice's two scores (°/s), checked: made by `validation`, `thermal`'s then
+/// `thermal-lstm`'s.
+pub fn scores(choice: &MethodChoice, validation: Validation) -> (f64, f64) {
+    assert_eq!(choice.validation, validation);
+    let methods: Vec<Method> = choice.candidates.iter().map(|c| c.method).collect();
+    assert_eq!(methods, [Method::Thermal, Method::ThermalLstm]);
+    (
+        choice.candidates[0].bias_rms_dps,
+        choice.candidates[1].bias_rms_dps,
+    )
+}
+
+/// The axis kept its several-sensor `thermal` fit without scoring, and its choice says why.
+pub fn assert_kept_unscored(a: &ImuAxis) {
+    let choice = recorded(a);
+    assert_eq!(choice.validation, Validation::SeveralSensors);
+    assert!(choice.candidates.is_empty());
+    assert_eq!(choice.chosen, Method::Thermal);
+    assert!(choice.describe().contains("several temperature sensors"));
+    assert_eq!(a.model.method, Method::Thermal);
+    assert!(a.temps.len() > 1, "{:?}", a.scores);
+    assert!(a.fallback.is_some());
+}
