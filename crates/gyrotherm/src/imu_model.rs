@@ -603,6 +603,32 @@ fn several_sensor_bias(
     Ok(blend_with_one(b, one, blend))
 }
 
+/// The several-sensor bias fit `b` of the sensors `order` with `thermal-lstm`'s residual LSTM
+/// (`cfg`'s recipe) on its first part: the LSTM reads the first sensor's thermal states and the
+/// first part's prediction, and learns the residual of the whole fit (each run's target less
+/// the further sensors' parts, which the flight axis adds as they are). The first part alone
+/// where the LSTM's gate left it out.
+fn lstm_on_several(
+    data: &[SensorData],
+    order: &[usize],
+    b: &multi::MultiFit,
+    cfg: &FitConfig,
+) -> Result<SubModel, FitError> {
+    let mut sets: Vec<TargetSet> = data[order[0]].bias.to_vec();
+    for (r, set) in sets.iter_mut().enumerate() {
+        for (part, &j) in b.extra.iter().zip(&order[1..]) {
+            let further = part.predict_table(&data[j].bias[r].table)?;
+            for (row, y) in set.target.iter_mut().enumerate() {
+                match further.get(row) {
+                    Some(p) => *y -= p,
+                    None => set.mask[row] = false,
+                }
+            }
+        }
+    }
+    Ok(crate::fit::auto::lstm_on_thermal(&sets, &b.first, cfg)?.unwrap_or_else(|| b.first.clone()))
+}
+
 /// Why axis `gyro`'s fit on sensor `temp` failed.
 fn fit_error(gyro: &str, temp: &str, source: FitError) -> ImuError {
     ImuError::Fit {
@@ -733,7 +759,11 @@ fn thermal_axis(
             None
         };
         if let Some(b) = &bias {
-            outcome.model.bias = Some(b.first.clone());
+            outcome.model.bias = Some(if crate::fit::wants_residual_lstm(cfg) {
+                lstm_on_several(&data, &order, b, cfg).map_err(|e| fit_err(j0, e))?
+            } else {
+                b.first.clone()
+            });
             multi_cv_rms = b.cv_rms;
             // The coverage map's error estimate is the one-sensor model's.
             outcome.model.coverage = None;
@@ -741,8 +771,9 @@ fn thermal_axis(
         if let Some(s) = &scale {
             outcome.model.scale = Some(s.first.clone());
         }
-        // Several sensors' least-squares models replace a residual LSTM of the first sensor's
-        // fit: the axis is labelled with what it holds.
+        // With `thermal-lstm`, the first sensor's residual LSTM was trained again on the
+        // residual of the several-sensor fit; the axis is labelled with what it holds (its
+        // gate may have left the LSTM out).
         outcome.model.method = crate::fit::thermal_lstm::label(
             outcome.model.method,
             outcome.model.bias.as_ref(),

@@ -17,7 +17,8 @@
 //! With method `auto` (docs/experiments/imu-auto.md): `all-auto` (each axis keeps its `all`
 //! fit or `thermal-lstm` on its first sensor, whichever scores better on held-out validation
 //! of the training runs; the TSV's `temps` column adds the choice and both scores, °/h) and
-//! `all-lstm` (the `thermal-lstm` candidate kept on every axis, unscored); `--lstm-hidden H`
+//! `all-lstm` (the `thermal-lstm` candidate kept on every axis, unscored); `all-tlstm`
+//! (`--method thermal-lstm`: every axis's `all` fit with the residual LSTM on it); `--lstm-hidden H`
 //! and `--lstm-steps S` set that candidate's hidden units and Adam steps (default: `auto`'s).
 //!
 //! Per setting and held-out profile it prints the median and worst, over units × axes, of
@@ -90,7 +91,7 @@ struct FeatureBounds {
 const TABLE_RATE_DPS: f64 = 20.0;
 const TAU_S: f64 = 100.0;
 const TEST_PROFILES: [&str; 2] = ["airborne", "shock-5"];
-const SETTINGS: [&str; 5] = ["case", "chosen", "all", "all-auto", "all-lstm"];
+const SETTINGS: [&str; 6] = ["case", "chosen", "all", "all-auto", "all-lstm", "all-tlstm"];
 const DEFAULT_SETTINGS: &str = "case,chosen,all";
 const HOLDS: [&str; 14] = [
     "none",
@@ -724,6 +725,10 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     if let Some(e) = job.lstm_steps {
         auto_cfg.recipe.epochs = e;
     }
+    // `thermal-lstm` by name (setting `all-tlstm`): the several-sensor fit with the residual
+    // LSTM on it, at the same knobs.
+    let mut tlstm_cfg = auto_cfg.clone();
+    tlstm_cfg.recipe.kind = Method::ThermalLstm;
     let lstm_kept = ImuFitSettings {
         auto_keep: Some(Method::ThermalLstm),
         ..all
@@ -742,6 +747,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             "chosen" => fit_imu_with(&train, &cfg, &one, &sensor, &|_, _, _, _, _| {}),
             "all-auto" => fit_imu_with(&train, &auto_cfg, &all, &sensor, &|_, _, _, _, _| {}),
             "all-lstm" => fit_imu_with(&train, &auto_cfg, &lstm_kept, &sensor, &|_, _, _, _, _| {}),
+            "all-tlstm" => fit_imu_with(&train, &tlstm_cfg, &all, &sensor, &|_, _, _, _, _| {}),
             _ => fit_imu_with(&train, &cfg, &all, &sensor, &|_, _, _, _, _| {}),
         }
         .map_err(|e| {

@@ -283,6 +283,12 @@ fn fit_baseline(sets: &[TargetSet], terms: &Terms) -> Result<SubModel, FitError>
     Ok(SubModel::from_fit(&fit))
 }
 
+/// Whether `cfg` trains an LSTM on the thermal recipe's bias residual (`thermal-lstm`, or the
+/// thermal recipe's experiment knob), with training steps to take.
+pub(crate) fn wants_residual_lstm(cfg: &FitConfig) -> bool {
+    (cfg.thermal.residual_lstm || methods::residual_lstm(cfg.recipe.kind)) && cfg.recipe.epochs > 0
+}
+
 /// Fit one target with the configured method.
 fn fit_one(
     sets: &[TargetSet],
@@ -293,9 +299,8 @@ fn fit_one(
 ) -> Result<(SubModel, Option<TrainSummary>), FitError> {
     if let Some(id) = identified {
         let (sub, report) = thermal::fit_target(sets, &cfg.thermal, id, target == Target::Scale)?;
-        let want_lstm = (cfg.thermal.residual_lstm || methods::residual_lstm(cfg.recipe.kind))
-            && cfg.recipe.epochs > 0
-            && (target == Target::Bias || cfg.recipe.scale_lstm);
+        let want_lstm =
+            wants_residual_lstm(cfg) && (target == Target::Bias || cfg.recipe.scale_lstm);
         if let (
             true,
             SubModel::Baseline {
