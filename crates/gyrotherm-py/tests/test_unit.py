@@ -258,8 +258,7 @@ def test_unit_compensate_csv_counts_each_axis_as_the_cli_writes_it(cli, unit_log
 def test_unit_auto_fit_tells_each_fold_and_lstm_training(unit_logs, capfd):
     """``auto`` on a unit whose axes read one sensor, with two static runs, scores both
     candidates with each run left out (a ``scoring`` event per fold), training
-    ``thermal-lstm`` as it goes (``lstm``). (Where ``thermal`` reads several sensors it is
-    kept unscored.)"""
+    ``thermal-lstm`` as it goes (``lstm``)."""
     events = []
     gt.fit(
         static=[unit_logs["static"], unit_logs["heldout"]], method="auto", epochs=3,

@@ -14,11 +14,14 @@
 //! sensor's one-sensor model as its `fallback` ([`ImuAxis::fallback`]), which it runs on
 //! (status `fallback`) while a further sensor is given up on.
 //!
-//! With `auto` (and [`ImuSensors::All`]) each axis keeps its several-sensor `thermal` fit,
-//! exactly as `thermal` builds it, or `thermal-lstm` on its first sensor alone, whichever
-//! scores lower on held-out validation of the training runs (as `auto` scores one gyro,
-//! [`crate::fit::auto`]); the axis's model records both scores and the choice
-//! ([`ModelFile::method_choice`]).
+//! With `thermal-lstm` (and [`ImuSensors::All`]) an axis that reads several sensors gets the
+//! residual LSTM on its several-sensor fit: the LSTM reads the first sensor's thermal states
+//! and learns the residual of the whole fit, and flies as the first sensor's model with the
+//! further parts added. With `auto` each axis keeps its `thermal` fit,
+//! exactly as `thermal` builds it, or that fit with the LSTM on it, exactly as `thermal-lstm`
+//! builds it, whichever scores lower on held-out validation of the training runs (as `auto`
+//! scores one gyro, [`crate::fit::auto`]); the axis's model records both scores and the
+//! choice ([`ModelFile::method_choice`]).
 //!
 //! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
 //! format is unchanged): 1 when every axis reads one sensor (as older builds wrote), 2 when
@@ -603,30 +606,47 @@ fn several_sensor_bias(
     Ok(blend_with_one(b, one, blend))
 }
 
-/// The several-sensor bias fit `b` of the sensors `order` with `thermal-lstm`'s residual LSTM
-/// (`cfg`'s recipe) on its first part: the LSTM reads the first sensor's thermal states and the
-/// first part's prediction, and learns the residual of the whole fit (each run's target less
-/// the further sensors' parts, which the flight axis adds as they are). The first part alone
-/// where the LSTM's gate left it out.
+/// `thermal-lstm`'s residual LSTM (`cfg`'s recipe) on an axis's several-sensor bias fit: the
+/// first sensor's least-squares part `first` on its training sets `first_sets`, and each
+/// further sensor's part with its sets (`further`). The LSTM reads the first sensor's thermal
+/// states and the first part's prediction, and learns the residual of the whole fit (each
+/// run's target less the further parts, which the flight axis adds as they are). Returns the
+/// first part with that LSTM, or the first part alone where the LSTM's gate left it out.
 fn lstm_on_several(
-    data: &[SensorData],
-    order: &[usize],
-    b: &multi::MultiFit,
+    first: &SubModel,
+    first_sets: &[TargetSet],
+    further: &[(&SubModel, &[TargetSet])],
     cfg: &FitConfig,
 ) -> Result<SubModel, FitError> {
-    let mut sets: Vec<TargetSet> = data[order[0]].bias.to_vec();
+    let mut sets: Vec<TargetSet> = first_sets.to_vec();
     for (r, set) in sets.iter_mut().enumerate() {
-        for (part, &j) in b.extra.iter().zip(&order[1..]) {
-            let further = part.predict_table(&data[j].bias[r].table)?;
+        for (part, part_sets) in further {
+            let p = part.predict_table(&part_sets[r].table)?;
             for (row, y) in set.target.iter_mut().enumerate() {
-                match further.get(row) {
+                match p.get(row) {
                     Some(p) => *y -= p,
                     None => set.mask[row] = false,
                 }
             }
         }
     }
-    Ok(crate::fit::auto::lstm_on_thermal(&sets, &b.first, cfg)?.unwrap_or_else(|| b.first.clone()))
+    Ok(crate::fit::auto::lstm_on_thermal(&sets, first, cfg)?.unwrap_or_else(|| first.clone()))
+}
+
+/// [`lstm_on_several`] on a several-sensor fit `b` of the sensors `order` of `data`.
+fn lstm_on_multi(
+    data: &[SensorData],
+    order: &[usize],
+    b: &multi::MultiFit,
+    cfg: &FitConfig,
+) -> Result<SubModel, FitError> {
+    let further: Vec<(&SubModel, &[TargetSet])> = b
+        .extra
+        .iter()
+        .zip(&order[1..])
+        .map(|(part, &j)| (part, data[j].bias))
+        .collect();
+    lstm_on_several(&b.first, data[order[0]].bias, &further, cfg)
 }
 
 /// Why axis `gyro`'s fit on sensor `temp` failed.
@@ -708,12 +728,20 @@ fn thermal_axis(
         .map(|(n, l)| NamedLog { name: n, log: l })
         .collect();
     let has_bias = data.iter().all(|d| !d.bias.is_empty());
+    // A residual LSTM rides on the several-sensor fit where there is one (below), so the
+    // first sensor's own fit, the fallback then, is `thermal`'s without an LSTM of its own.
+    let several_lstm = order.len() > 1 && has_bias && crate::fit::wants_residual_lstm(cfg);
+    let one_cfg = if several_lstm {
+        crate::fit::auto::candidate_config(cfg, crate::settings::method::Method::Thermal)
+    } else {
+        cfg.clone()
+    };
     // The first sensor's whole one-sensor fit, bias included: with further sensors it is the
     // axis's fallback (kept below before several sensors replace its bias and coverage map).
     // Its training sets are the ones made for the selection.
     let mut outcome = crate::fit::fit_model_with(
         &named,
-        cfg,
+        &one_cfg,
         Some(id0.clone()),
         true,
         Some((bias0, scale0)),
@@ -759,8 +787,8 @@ fn thermal_axis(
             None
         };
         if let Some(b) = &bias {
-            outcome.model.bias = Some(if crate::fit::wants_residual_lstm(cfg) {
-                lstm_on_several(&data, &order, b, cfg).map_err(|e| fit_err(j0, e))?
+            outcome.model.bias = Some(if several_lstm {
+                lstm_on_multi(&data, &order, b, cfg).map_err(|e| fit_err(j0, e))?
             } else {
                 b.first.clone()
             });
@@ -771,11 +799,11 @@ fn thermal_axis(
         if let Some(s) = &scale {
             outcome.model.scale = Some(s.first.clone());
         }
-        // With `thermal-lstm`, the first sensor's residual LSTM was trained again on the
-        // residual of the several-sensor fit; the axis is labelled with what it holds (its
-        // gate may have left the LSTM out).
+        // With `thermal-lstm`, the residual LSTM was trained on the residual of the
+        // several-sensor fit; the axis is labelled with what it holds (its gate may have left
+        // the LSTM out).
         outcome.model.method = crate::fit::thermal_lstm::label(
-            outcome.model.method,
+            cfg.model_method(),
             outcome.model.bias.as_ref(),
             outcome.model.scale.as_ref(),
         );
@@ -801,9 +829,9 @@ fn thermal_axis(
     ))
 }
 
-/// One axis with `auto`: its several-sensor `thermal` fit ([`thermal_axis`], as `--method
-/// thermal` builds it) against `thermal-lstm` on its first sensor (the residual LSTM on that
-/// sensor's one-sensor `thermal` fit, which is the several-sensor axis's fallback), scored as
+/// One axis with `auto`: its `thermal` fit ([`thermal_axis`], as `--method thermal` builds
+/// it, on one sensor or several) against `thermal-lstm` on that fit (as `--method
+/// thermal-lstm` builds it: on several sensors, [`lstm_on_several`]), scored as
 /// [`crate::fit::auto`] scores one gyro: each static run left out in turn when there are two
 /// or more (both candidates fitted again without it, the lags identified again), else the
 /// LSTM's held-out blocks of the static run. Both are scored on the same rows by the same
@@ -822,7 +850,7 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
         ..
     } = *job;
     use crate::fit::auto::{candidate_config, choose};
-    use crate::model::{MethodChoice, Validation};
+    use crate::model::Validation;
     use crate::settings::method::Method;
     let thermal_cfg = candidate_config(cfg, Method::Thermal);
     let lstm_cfg = candidate_config(cfg, Method::ThermalLstm);
@@ -838,55 +866,67 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
         });
         Ok(axis)
     };
-    // `thermal-lstm` on the first sensor, on every run (its lags and training sets the ones
-    // the several-sensor fit made for that sensor).
-    let lstm_fit = || -> Result<FitOutcome, ImuError> {
+    // The `thermal-lstm` candidate on every run: the residual LSTM on the axis's `thermal`
+    // fit. On one sensor that is `thermal-lstm` on it, as the single-gyro path fits it (its
+    // lags and training sets the ones made for the selection); on several, the LSTM on the
+    // several-sensor fit's residual, as `--method thermal-lstm` fits the axis.
+    let lstm_fit = |thermal: &ImuAxis| -> Result<ImuAxis, ImuError> {
         events(ImuFitEvent::LstmTraining {
             axis: k,
             sensor: j0,
         });
         let (id0, bias0, scale0) = &runs.per_sensor[j0];
-        let mut outcome = crate::fit::fit_model_with(
-            &runs.named(),
-            &lstm_cfg,
-            Some(id0.clone()),
-            true,
-            Some((bias0, scale0)),
-            &|t, e, loss| progress(k, j0, t, e, loss),
-        )
-        .map_err(fit_err)?;
-        outcome.model.features.temp_sensor = *temp_sensor;
-        Ok(outcome)
-    };
-    // The `thermal-lstm` candidate's axis: its model on the first sensor alone, the sensors'
-    // one-sensor scores as the selection gave them.
-    let lstm_axis = |model: ModelFile, scores: Vec<SensorScore>| ImuAxis {
-        gyro: gyro_cols[k].clone(),
-        temps: vec![temp_cols[j0].clone()],
-        scores,
-        model,
-        more: Vec::new(),
-        multi_cv_rms: None,
-        fallback: None,
+        if thermal.more.is_empty() {
+            let mut outcome = crate::fit::fit_model_with(
+                &runs.named(),
+                &lstm_cfg,
+                Some(id0.clone()),
+                true,
+                Some((bias0, scale0)),
+                &|t, e, loss| progress(k, j0, t, e, loss),
+            )
+            .map_err(fit_err)?;
+            outcome.model.features.temp_sensor = *temp_sensor;
+            return Ok(ImuAxis {
+                model: outcome.model,
+                fallback: None,
+                ..thermal.clone()
+            });
+        }
+        let (Some(first), true) = (
+            thermal.model.bias.as_ref(),
+            thermal.more.iter().all(|m| m.bias.is_some()),
+        ) else {
+            return Ok(thermal.clone());
+        };
+        let sets = |t: &String| {
+            let j = temp_cols.iter().position(|c| c == t).unwrap_or(j0);
+            &runs.per_sensor[j].1[..]
+        };
+        let further: Vec<(&SubModel, &[TargetSet])> = thermal.temps[1..]
+            .iter()
+            .zip(&thermal.more)
+            .filter_map(|(t, m)| Some((m.bias.as_ref()?, sets(t))))
+            .collect();
+        let bias = lstm_on_several(first, sets(&thermal.temps[0]), &further, &lstm_cfg)
+            .map_err(fit_err)?;
+        let mut axis = thermal.clone();
+        axis.model.method = crate::fit::thermal_lstm::label(
+            Method::ThermalLstm,
+            Some(&bias),
+            axis.model.scale.as_ref(),
+        );
+        axis.model.bias = Some(bias);
+        Ok(axis)
     };
     let statics: Vec<usize> = all
         .iter()
         .copied()
         .filter(|&i| targets::is_static(&runs.axis_logs[i].1))
         .collect();
-    // Several sensors: the one-sensor LSTM candidate is not scored. Decided on design units
-    // 1000-1002, confirmed on 5001-5003 (docs/experiments/imu-auto.md): where it was kept
-    // there, it was worse on the held-out flight (up to +52 %) though it scored better on the
-    // left-out static runs.
-    if thermal.temps.len() > 1 && !statics.is_empty() && settings.auto_keep.is_none() {
-        thermal.model.method_choice = Some(MethodChoice::several_sensors());
-        return finished(thermal);
-    }
     let (choice, lstm) = match (statics.len(), settings.auto_keep) {
         // An experiment's candidate, kept without scoring (and without a recorded choice).
-        (_, Some(Method::ThermalLstm)) => {
-            return finished(lstm_axis(lstm_fit()?.model, thermal.scores))
-        }
+        (_, Some(Method::ThermalLstm)) => return finished(lstm_fit(&thermal)?),
         (_, Some(_)) => return finished(thermal),
         // No bias to choose on: the scale factor is `thermal`'s in either candidate.
         (0, _) => return finished(thermal),
@@ -898,12 +938,10 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
                 // not trained.
                 return finished(thermal);
             }
-            let lstm = lstm_fit()?;
-            let (Some(t), Some(l)) = (thermal.model.bias.as_ref(), lstm.model.bias.as_ref()) else {
+            let lstm = lstm_fit(&thermal)?;
+            let (Some(t_parts), Some(l_parts)) = (bias_parts(&thermal), bias_parts(&lstm)) else {
                 return finished(thermal);
             };
-            let mut t_parts = vec![t];
-            t_parts.extend(thermal.more.iter().filter_map(|m| m.bias.as_ref()));
             let mut ss = [0.0; 2];
             let mut n = 0;
             for (r, rows) in held.iter().enumerate() {
@@ -916,7 +954,7 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
                         &runs.per_sensor[j].1[r]
                     })
                     .collect();
-                let (s, m) = candidates_ss(&t_parts, l, &sets, rows).map_err(fit_err)?;
+                let (s, m) = candidates_ss([&t_parts, &l_parts], &sets, rows).map_err(fit_err)?;
                 ss[0] += s[0];
                 ss[1] += s[1];
                 n += m;
@@ -940,16 +978,23 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
     }
     let mut lstm = match lstm {
         Some(l) => l,
-        None => lstm_fit()?,
+        None => lstm_fit(&thermal)?,
     };
     if lstm.model.method != Method::ThermalLstm {
-        // Its gate kept no LSTM: the fit is the first sensor's `thermal` alone, less than the
-        // `thermal` candidate holds.
+        // Its gate kept no LSTM: the fit is the `thermal` candidate's model form alone (on one
+        // sensor, less than the `thermal` candidate may hold).
         thermal.model.method_choice = Some(choice.with_lstm_left_out());
         return finished(thermal);
     }
     lstm.model.method_choice = Some(choice);
-    finished(lstm_axis(lstm.model, thermal.scores))
+    finished(lstm)
+}
+
+/// An axis's bias parts, the first sensor's first (None when a part has no bias model).
+fn bias_parts(a: &ImuAxis) -> Option<Vec<&SubModel>> {
+    std::iter::once(a.model.bias.as_ref())
+        .chain(a.more.iter().map(|m| m.bias.as_ref()))
+        .collect()
 }
 
 /// `auto`'s scores of an axis with two or more static runs (`statics`, indices into the job's
@@ -1011,11 +1056,19 @@ fn leave_one_run_out(
             Some(b) => std::iter::once(&b.first).chain(&b.extra).collect(),
             None => vec![&one],
         };
-        let Some(lstm) =
-            crate::fit::auto::lstm_on_thermal(bias0, &one, lstm_cfg).map_err(fit_err)?
-        else {
-            continue;
+        // The LSTM on this fold's `thermal` fit, as `fit_axis_auto` trains it on every run.
+        let lstm = match &several {
+            Some(b) => lstm_on_multi(&data, &order, b, lstm_cfg).map_err(fit_err)?,
+            None => {
+                match crate::fit::auto::lstm_on_thermal(bias0, &one, lstm_cfg).map_err(fit_err)? {
+                    Some(l) => l,
+                    None => continue,
+                }
+            }
         };
+        let l_parts: Vec<&SubModel> = std::iter::once(&lstm)
+            .chain(t_parts[1..].iter().copied())
+            .collect();
         // The left-out run's training sets on each sensor read, at this fold's lags.
         let held: Vec<TargetSet> = order
             .iter()
@@ -1032,7 +1085,7 @@ fn leave_one_run_out(
             .collect::<Result<_, _>>()?;
         let held_refs: Vec<&TargetSet> = held.iter().collect();
         let rows: Vec<usize> = (0..held[0].table.n_rows()).collect();
-        let (s, m) = candidates_ss(&t_parts, &lstm, &held_refs, &rows).map_err(fit_err)?;
+        let (s, m) = candidates_ss([&t_parts, &l_parts], &held_refs, &rows).map_err(fit_err)?;
         ss[0] += s[0];
         ss[1] += s[1];
         n += m;
@@ -1055,19 +1108,15 @@ fn axis_bias_on(parts: &[&SubModel], sets: &[&TargetSet]) -> Result<Vec<f64>, Fi
 }
 
 /// The two candidates' sums of squared bias residual on `rows` of one run (the labelled ones
-/// both predict; each candidate's mean over them removed) and how many rows: `thermal` of
-/// `parts` on the sensors of `sets`, `lstm` on the first sensor's; both through
+/// both predict; each candidate's mean over them removed) and how many rows: each candidate's
+/// bias parts (`thermal`'s, then `thermal-lstm`'s) on the sensors of `sets`, through
 /// [`axis_bias_on`].
 fn candidates_ss(
-    parts: &[&SubModel],
-    lstm: &SubModel,
+    parts: [&[&SubModel]; 2],
     sets: &[&TargetSet],
     rows: &[usize],
 ) -> Result<([f64; 2], usize), FitError> {
-    let preds = [
-        axis_bias_on(parts, sets)?,
-        axis_bias_on(&[lstm], &sets[..1])?,
-    ];
+    let preds = [axis_bias_on(parts[0], sets)?, axis_bias_on(parts[1], sets)?];
     let first = sets[0];
     let n = preds[0].len().min(preds[1].len());
     let used: Vec<usize> = rows

@@ -1,8 +1,8 @@
-//! `auto` on an inertial unit: per axis, the `thermal` fit (as `--method thermal` builds it)
-//! against `thermal-lstm` on the axis's first sensor. Where `thermal` reads several sensors it
-//! is kept unscored; where it reads one, both are scored on held-out validation of the
-//! training runs. The choice (and the scores) go into the axis's model and `train`'s lines,
-//! and the file round-trips through its checks.
+//! `auto` on an inertial unit: per axis, the `thermal` fit (as `--method thermal` builds it,
+//! on one sensor or several) against `thermal-lstm` on that fit (as `--method thermal-lstm`
+//! builds it), both scored on held-out validation of the training runs. The choice (and the
+//! scores) go into the axis's model and `train`'s lines, the axis kept is the one the chosen
+//! method fits by name, and the file round-trips through its checks.
 
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
 use gyrotherm::fit::FitConfig;
@@ -19,7 +19,7 @@ use unit_1000::run;
 
 #[path = "support/unit_choice.rs"]
 mod unit_choice;
-use unit_choice::{assert_kept_unscored, recorded, scores};
+use unit_choice::{recorded, scores};
 
 fn runs(which: &[(u64, Option<usize>)]) -> Vec<(String, ImuLog)> {
     which
@@ -60,7 +60,7 @@ fn config(method: Method) -> FitConfig {
     FitSettings {
         method,
         // A short LSTM training keeps the test quick; the choice is what is tested.
-        epochs: (method == Method::Auto).then_some(60),
+        epochs: matches!(method, Method::Auto | Method::ThermalLstm).then_some(60),
         ..FitSettings::default()
     }
     .fit_config()
@@ -98,56 +98,88 @@ fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>, Vec<String
 }
 
 /// A static run (seed 1) and a table run per axis (seed 2), two temperature sensors: `thermal`
-/// reads both on the x axis, so it is kept without scoring the one-sensor LSTM.
+/// reads both on the x axis, and the LSTM candidate rides on that several-sensor fit. The x
+/// axis has three static runs (its own and the y and z table runs), each left out in turn.
 #[test]
-fn auto_keeps_a_several_sensor_thermal_axis_unscored() {
+fn auto_scores_a_several_sensor_thermal_axis_against_the_lstm_on_that_fit() {
     let logs = runs(&[(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]);
     let (model, lines, steps) = train_auto(logs.clone());
-    // Nothing is scored or trained for the LSTM candidate.
-    assert!(
-        !steps
-            .iter()
-            .any(|l| l.contains("without static run") || l.contains("training thermal-lstm")),
-        "{steps:#?}"
-    );
+    for run in 1..=3 {
+        let want = format!(
+            "gyro_x_dps: auto: fitting thermal and thermal-lstm without static run {run} of 3"
+        );
+        assert!(
+            steps.iter().any(|l| l.contains(&want)),
+            "{want}: {steps:#?}"
+        );
+    }
     let a = &model.axes[0];
-    assert_kept_unscored(a);
-    // The axis is `--method thermal`'s, to the bit, but for the recorded choice.
-    let thermal = fit_imu(
+    scored(a, Validation::LeaveOneRunOut);
+    assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
+    // The axis kept is the chosen method's by name, to the bit, but for the recorded choice.
+    let chosen = a.model.method_choice.as_ref().unwrap().chosen;
+    let by_name = fit_imu(
+        &logs,
+        &config(chosen),
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap();
+    let mut same = a.clone();
+    same.model.method_choice = None;
+    assert_eq!(same, by_name.axes[0]);
+    assert_eq!(
+        serde_json::to_string(&same).unwrap(),
+        serde_json::to_string(&by_name.axes[0]).unwrap()
+    );
+    assert_eq!(model.imu_format_version, IMU_FORMAT_VERSION);
+    assert!(
+        lines.iter().any(|l| l
+            .starts_with("gyro_x_dps: method chosen on each static run left out in turn")),
+        "{lines:#?}"
+    );
+    // The file round-trips with its checks; a file without the choice (as older builds and
+    // every other method write it) loads too.
+    let text = model.to_json().unwrap();
+    assert_eq!(ImuModel::from_json(&text).unwrap(), model);
+    let older = by_name.to_json().unwrap();
+    assert!(!older.contains("method_choice"));
+    assert_eq!(ImuModel::from_json(&older).unwrap(), by_name);
+    // The choice is sealed with the rest.
+    let other = match chosen {
+        Method::Thermal => "thermal-lstm",
+        _ => "thermal",
+    };
+    let edited = text.replacen(
+        &format!("\"chosen\": \"{chosen}\""),
+        &format!("\"chosen\": \"{other}\""),
+        1,
+    );
+    assert_ne!(edited, text);
+    assert!(ImuModel::from_json(&edited).is_err());
+}
+
+/// A unit file written when `auto` kept a several-sensor `thermal` axis unscored
+/// (`"validation": "several-sensors"`) still loads, and says why it was kept.
+#[test]
+fn a_file_with_an_unscored_several_sensor_choice_still_loads() {
+    let logs = runs(&[(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]);
+    let mut model = fit_imu(
         &logs,
         &config(Method::Thermal),
         &TempSensorDef::default(),
         &|_, _, _, _, _| {},
     )
     .unwrap();
-    assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
-    let mut same = a.clone();
-    same.model.method_choice = None;
-    assert_eq!(same, thermal.axes[0]);
-    assert_eq!(
-        serde_json::to_string(&same).unwrap(),
-        serde_json::to_string(&thermal.axes[0]).unwrap()
-    );
-    assert_eq!(model.imu_format_version, IMU_FORMAT_VERSION);
-    // `train` tells the choice and why, per axis.
-    assert!(
-        lines.iter().any(|l| l.starts_with(
-            "gyro_x_dps: thermal kept, no scoring: thermal reads several temperature sensors"
-        )),
-        "{lines:#?}"
-    );
-    // The file round-trips with its checks; a file without the choice (as older builds and
-    // every other method write it) loads too.
+    let choice: gyrotherm::model::MethodChoice = serde_json::from_str(
+        r#"{"validation": "several-sensors", "candidates": [], "chosen": "thermal"}"#,
+    )
+    .unwrap();
+    assert!(choice.describe().contains("several temperature sensors"));
+    model.axes[0].model.method_choice = Some(choice);
     let text = model.to_json().unwrap();
     assert!(text.contains("\"several-sensors\""));
     assert_eq!(ImuModel::from_json(&text).unwrap(), model);
-    let older = thermal.to_json().unwrap();
-    assert!(!older.contains("method_choice"));
-    assert_eq!(ImuModel::from_json(&older).unwrap(), thermal);
-    // The choice is sealed with the rest.
-    let edited = text.replacen("\"chosen\": \"thermal\"", "\"chosen\": \"thermal-lstm\"", 1);
-    assert_ne!(edited, text);
-    assert!(ImuModel::from_json(&edited).is_err());
 }
 
 /// The same runs with one temperature sensor: the x axis has three static runs (its own and

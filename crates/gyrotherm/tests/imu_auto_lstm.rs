@@ -1,14 +1,11 @@
-//! `auto` on an inertial unit's axis:
-//! - where `thermal` reads several sensors, the axis keeps it without scoring the one-sensor
-//!   `thermal-lstm` candidate, and the file says why;
-//! - where `thermal` reads one sensor and `thermal-lstm` scores better on the left-out runs and
-//!   keeps its LSTM, the axis flies `thermal-lstm`, as the single-gyro path fits it on the
-//!   same axis and sensor, to the bit.
+//! The LSTM on an inertial unit's axis:
+//! - where `thermal` reads one sensor and `auto`'s `thermal-lstm` scores better on the
+//!   left-out runs and keeps its LSTM, the axis flies `thermal-lstm`, as the single-gyro path
+//!   fits it on the same axis and sensor, to the bit;
+//! - `thermal-lstm` by name on an axis whose `thermal` reads several sensors: the LSTM rides
+//!   on the several-sensor fit and learns the residual of the whole of it.
 //!
 //! Either way the file round-trips with its checks and the unit's flight compensator runs it.
-//!
-//! And `thermal-lstm` by name on an axis whose `thermal` reads several sensors: the LSTM rides
-//! on the several-sensor fit and learns the residual of the whole of it.
 
 use gyrotherm::csvlog::TRUE_BIAS_COL;
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
@@ -25,7 +22,7 @@ use gyrotherm::unit_model::Form;
 
 #[path = "support/unit_choice.rs"]
 mod unit_choice;
-use unit_choice::{assert_kept_unscored, recorded, scores};
+use unit_choice::{recorded, scores};
 
 /// Design unit `unit`'s gyro x on `profile`, with the temperature columns `sensors` (indices
 /// among the case's, then each coil's).
@@ -118,37 +115,6 @@ fn left_out_scores(a: &ImuAxis) -> (&MethodChoice, f64, f64) {
     let choice = recorded(a);
     let (t, l) = scores(choice, Validation::LeaveOneRunOut);
     (choice, t, l)
-}
-
-#[test]
-fn an_axis_whose_thermal_reads_several_sensors_keeps_it_unscored() {
-    // Design unit 1007's gyro x with its case and x-coil sensors: `thermal` reads both. Before
-    // the rule this axis trained `thermal-lstm` on the case sensor, which scored better on the
-    // left-out static runs (0.0149 against 0.0151 °/h) and then kept no LSTM.
-    let logs = logs(1007, &[0, 1]);
-    let model = auto_unit(&logs);
-    let a = &model.axes[0];
-    // Kept: `thermal`, unscored, with the reason recorded and told.
-    assert_kept_unscored(a);
-    assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
-    // The axis is `--method thermal`'s, to the bit, but for the recorded choice.
-    let thermal_cfg = FitSettings {
-        method: Method::Thermal,
-        ..FitSettings::default()
-    }
-    .fit_config()
-    .unwrap();
-    let thermal = gyrotherm::imu_model::fit_imu(
-        &logs,
-        &thermal_cfg,
-        &TempSensorDef::default(),
-        &|_, _, _, _, _| {},
-    )
-    .unwrap();
-    let mut same = a.clone();
-    same.model.method_choice = None;
-    assert_eq!(same, thermal.axes[0]);
-    round_trips_and_flies(&model, &logs);
 }
 
 #[test]

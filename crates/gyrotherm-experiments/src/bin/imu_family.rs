@@ -15,10 +15,10 @@
 //! alone), `chosen` (`fit_imu` with one sensor per axis, chosen by cross-validation among
 //! the four), `all` (every axis may read every sensor; cross-validation decides which stay).
 //! With method `auto` (docs/experiments/imu-auto.md): `all-auto` (each axis keeps its `all`
-//! fit or `thermal-lstm` on its first sensor, whichever scores better on held-out validation
-//! of the training runs; the TSV's `temps` column adds the choice and both scores, °/h) and
+//! fit or `thermal-lstm` on that fit, whichever scores better on held-out validation of the
+//! training runs; the TSV's `temps` column adds the choice and both scores, °/h) and
 //! `all-lstm` (the `thermal-lstm` candidate kept on every axis, unscored); `all-tlstm`
-//! (`--method thermal-lstm`: every axis's `all` fit with the residual LSTM on it); `--lstm-hidden H`
+//! (`--method thermal-lstm`: the same form, its fallback without an LSTM); `--lstm-hidden H`
 //! and `--lstm-steps S` set that candidate's hidden units and Adam steps (default: `auto`'s).
 //!
 //! Per setting and held-out profile it prints the median and worst, over units × axes, of

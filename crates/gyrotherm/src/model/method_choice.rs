@@ -17,9 +17,9 @@ pub enum Validation {
     #[serde(rename = "held-out-blocks")]
     HeldOutBlocks,
     /// Not scored: an inertial unit's axis whose `thermal` fit reads several temperature
-    /// sensors keeps it. The `thermal-lstm` candidate reads one sensor, and left-out static
-    /// runs, where the sensors agree, cannot show what the other sensors are worth in flight
-    /// (docs/experiments/imu-auto.md).
+    /// sensors kept it, in files of the build whose `thermal-lstm` candidate read one sensor
+    /// (read, no longer written: the candidate now rides on the several-sensor fit and is
+    /// scored; docs/experiments/imu-auto.md).
     #[serde(rename = "several-sensors")]
     SeveralSensors,
 }
@@ -109,16 +109,6 @@ impl MethodChoice {
     pub fn folds_left_out_the_lstm(&self) -> bool {
         self.validation == Validation::LeaveOneRunOut
             && matches!(&self.candidates[..], [a, b] if a.bias_rms_dps == b.bias_rms_dps)
-    }
-
-    /// `thermal` kept unscored on a unit axis that reads several sensors.
-    pub(crate) fn several_sensors() -> MethodChoice {
-        MethodChoice {
-            validation: Validation::SeveralSensors,
-            candidates: Vec::new(),
-            chosen: Method::Thermal,
-            lstm_left_out: false,
-        }
     }
 
     /// The choice with `thermal` kept because the chosen `thermal-lstm` fit kept no LSTM.

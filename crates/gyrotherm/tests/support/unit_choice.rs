@@ -26,15 +26,3 @@ pub fn scores(choice: &MethodChoice, validation: Validation) -> (f64, f64) {
         choice.candidates[1].bias_rms_dps,
     )
 }
-
-/// The axis kept its several-sensor `thermal` fit without scoring, and its choice says why.
-pub fn assert_kept_unscored(a: &ImuAxis) {
-    let choice = recorded(a);
-    assert_eq!(choice.validation, Validation::SeveralSensors);
-    assert!(choice.candidates.is_empty());
-    assert_eq!(choice.chosen, Method::Thermal);
-    assert!(choice.describe().contains("several temperature sensors"));
-    assert_eq!(a.model.method, Method::Thermal);
-    assert!(a.temps.len() > 1, "{:?}", a.scores);
-    assert!(a.fallback.is_some());
-}
