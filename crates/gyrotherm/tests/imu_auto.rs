@@ -97,6 +97,19 @@ fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>, Vec<String
     }
 }
 
+/// While it fitted, each of the x axis's `of` left-out runs was told as its fold started.
+fn assert_each_fold_told(steps: &[String], of: usize) {
+    for run in 1..=of {
+        let want = format!(
+            "gyro_x_dps: auto: fitting thermal and thermal-lstm without static run {run} of {of}"
+        );
+        assert!(
+            steps.iter().any(|l| l.contains(&want)),
+            "{want}: {steps:#?}"
+        );
+    }
+}
+
 /// A static run (seed 1) and a table run per axis (seed 2), two temperature sensors: `thermal`
 /// reads both on the x axis, and the LSTM candidate rides on that several-sensor fit. The x
 /// axis has three static runs (its own and the y and z table runs), each left out in turn.
@@ -104,15 +117,7 @@ fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>, Vec<String
 fn auto_scores_a_several_sensor_thermal_axis_against_the_lstm_on_that_fit() {
     let logs = runs(&[(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]);
     let (model, lines, steps) = train_auto(logs.clone());
-    for run in 1..=3 {
-        let want = format!(
-            "gyro_x_dps: auto: fitting thermal and thermal-lstm without static run {run} of 3"
-        );
-        assert!(
-            steps.iter().any(|l| l.contains(&want)),
-            "{want}: {steps:#?}"
-        );
-    }
+    assert_each_fold_told(&steps, 3);
     let a = &model.axes[0];
     scored(a, Validation::LeaveOneRunOut);
     assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
@@ -188,16 +193,7 @@ fn a_file_with_an_unscored_several_sensor_choice_still_loads() {
 fn auto_on_a_one_sensor_axis_scores_both_on_each_left_out_run() {
     let logs = one_sensor(&[(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]);
     let (model, lines, steps) = train_auto(logs);
-    // While it fits, each left-out run is told as its fold starts.
-    for run in 1..=3 {
-        let want = format!(
-            "gyro_x_dps: auto: fitting thermal and thermal-lstm without static run {run} of 3"
-        );
-        assert!(
-            steps.iter().any(|l| l.contains(&want)),
-            "{want}: {steps:#?}"
-        );
-    }
+    assert_each_fold_told(&steps, 3);
     let a = &model.axes[0];
     scored(a, Validation::LeaveOneRunOut);
     assert_eq!(a.temps.len(), 1);
