@@ -232,3 +232,48 @@ fn with_one_static_run_auto_scores_on_held_out_blocks() {
     let text = model.to_json().unwrap();
     assert_eq!(ImuModel::from_json(&text).unwrap(), model);
 }
+
+/// One Adam step cannot lower the held-out residual by the gate's 5 % (the LSTM's output
+/// layer starts at zero), so every fold leaves its LSTM out: the scores are equal, the fit on
+/// every run decides by its own gate, and that gate leaves the LSTM out too. The axis then
+/// keeps `thermal`, says so, and is `thermal`'s fit by name, to the bit.
+#[test]
+fn when_every_gate_leaves_the_lstm_out_the_axis_keeps_thermal_and_says_so() {
+    let logs = one_sensor(&[(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]);
+    let cfg = FitSettings {
+        method: Method::Auto,
+        epochs: Some(1),
+        ..FitSettings::default()
+    }
+    .fit_config()
+    .unwrap();
+    let model = fit_imu(&logs, &cfg, &TempSensorDef::default(), &|_, _, _, _, _| {}).unwrap();
+    let a = &model.axes[0];
+    let choice = recorded(a);
+    let (t, l) = scores(choice, Validation::LeaveOneRunOut);
+    assert_eq!(t, l, "every fold's gate left its LSTM out");
+    assert!(choice.folds_left_out_the_lstm());
+    assert!(choice.lstm_left_out, "{}", choice.describe());
+    assert_eq!(choice.chosen, Method::Thermal);
+    assert!(
+        choice
+            .describe()
+            .contains("and so did thermal-lstm's fit on every run"),
+        "{}",
+        choice.describe()
+    );
+    let by_name = fit_imu(
+        &logs,
+        &config(Method::Thermal),
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap();
+    let mut same = a.clone();
+    same.model.method_choice = None;
+    assert_eq!(same, by_name.axes[0]);
+    // The flag is written, sealed and read back.
+    let text = model.to_json().unwrap();
+    assert!(text.contains("\"lstm_left_out\": true"), "{text}");
+    assert_eq!(ImuModel::from_json(&text).unwrap(), model);
+}
