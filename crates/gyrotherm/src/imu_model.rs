@@ -606,18 +606,60 @@ fn several_sensor_bias(
     Ok(blend_with_one(b, one, blend))
 }
 
+/// The coverage map of an axis that reads several sensors. Its cells are the first sensor's
+/// (T, dT), which the flight axis steps; its σ is the first sensor's one-sensor map's, times
+/// the ratio of the several-sensor fit's cross-validated bias RMS (`several_cv`) to the first
+/// sensor's alone (`one_cv`), both from the same folds of the sensor selection, and times
+/// `lstm_ratio` where a residual LSTM on the several-sensor fit was kept (as a single gyro's
+/// map shrinks by its LSTM's held-out ratio). Without both scores the axis has no map, and its
+/// note says why.
+fn several_sensor_coverage(
+    model: &mut ModelFile,
+    one_cv: Option<f64>,
+    several_cv: Option<f64>,
+    lstm_ratio: Option<f64>,
+) {
+    let ratio = match (one_cv, several_cv) {
+        (Some(one), Some(several)) if one > 0.0 && several.is_finite() && several > 0.0 => {
+            several / one
+        }
+        _ => {
+            model.coverage = None;
+            model.coverage_note = Some(
+                "the several-sensor fit has no cross-validated score to scale the first \
+                 sensor's map by: no coverage map"
+                    .to_owned(),
+            );
+            return;
+        }
+    };
+    if let Some(c) = model.coverage.take() {
+        model.coverage = Some(c.rescaled(ratio, c.growth_per_cell));
+    }
+    shrink_by_lstm(model, lstm_ratio);
+}
+
+/// The map's σ times a kept LSTM's held-out ratio (`auto`'s LSTM candidate and `thermal-lstm`
+/// by name shrink the same map in the same steps, so both write the same numbers).
+fn shrink_by_lstm(model: &mut ModelFile, lstm_ratio: Option<f64>) {
+    if let (Some(r), Some(c)) = (lstm_ratio, model.coverage.as_mut()) {
+        *c = c.rescaled(r, c.growth_per_cell);
+    }
+}
+
 /// `thermal-lstm`'s residual LSTM (`cfg`'s recipe) on an axis's several-sensor bias fit: the
 /// first sensor's least-squares part `first` on its training sets `first_sets`, and each
 /// further sensor's part with its sets (`further`). The LSTM reads the first sensor's thermal
 /// states and the first part's prediction, and learns the residual of the whole fit (each
 /// run's target less the further parts, which the flight axis adds as they are). Returns the
-/// first part with that LSTM, or the first part alone where the LSTM's gate left it out.
+/// first part with that LSTM, or the first part alone where the LSTM's gate left it out; and
+/// with a kept LSTM, the ratio of the held-out blocks' RMS with it to without it.
 fn lstm_on_several(
     first: &SubModel,
     first_sets: &[TargetSet],
     further: &[(&SubModel, &[TargetSet])],
     cfg: &FitConfig,
-) -> Result<SubModel, FitError> {
+) -> Result<(SubModel, Option<f64>), FitError> {
     let mut sets: Vec<TargetSet> = first_sets.to_vec();
     for (r, set) in sets.iter_mut().enumerate() {
         for (part, part_sets) in further {
@@ -630,7 +672,15 @@ fn lstm_on_several(
             }
         }
     }
-    Ok(crate::fit::auto::lstm_on_thermal(&sets, first, cfg)?.unwrap_or_else(|| first.clone()))
+    Ok(
+        match crate::fit::auto::lstm_on_thermal(&sets, first, cfg)? {
+            Some((sub, training)) => {
+                let ratio = crate::fit::held_out_ratio(&sub, &training);
+                (sub, ratio)
+            }
+            None => (first.clone(), None),
+        },
+    )
 }
 
 /// [`lstm_on_several`] on a several-sensor fit `b` of the sensors `order` of `data`.
@@ -639,7 +689,7 @@ fn lstm_on_multi(
     order: &[usize],
     b: &multi::MultiFit,
     cfg: &FitConfig,
-) -> Result<SubModel, FitError> {
+) -> Result<(SubModel, Option<f64>), FitError> {
     let further: Vec<(&SubModel, &[TargetSet])> = b
         .extra
         .iter()
@@ -787,14 +837,14 @@ fn thermal_axis(
             None
         };
         if let Some(b) = &bias {
-            outcome.model.bias = Some(if several_lstm {
+            let (first, lstm_ratio) = if several_lstm {
                 lstm_on_multi(&data, &order, b, cfg).map_err(|e| fit_err(j0, e))?
             } else {
-                b.first.clone()
-            });
+                (b.first.clone(), None)
+            };
+            outcome.model.bias = Some(first);
             multi_cv_rms = b.cv_rms;
-            // The coverage map's error estimate is the one-sensor model's.
-            outcome.model.coverage = None;
+            several_sensor_coverage(&mut outcome.model, single[j0], b.cv_rms, lstm_ratio);
         }
         if let Some(s) = &scale {
             outcome.model.scale = Some(s.first.clone());
@@ -908,9 +958,11 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
             .zip(&thermal.more)
             .filter_map(|(t, m)| Some((m.bias.as_ref()?, sets(t))))
             .collect();
-        let bias = lstm_on_several(first, sets(&thermal.temps[0]), &further, &lstm_cfg)
-            .map_err(fit_err)?;
+        let (bias, lstm_ratio) =
+            lstm_on_several(first, sets(&thermal.temps[0]), &further, &lstm_cfg)
+                .map_err(fit_err)?;
         let mut axis = thermal.clone();
+        shrink_by_lstm(&mut axis.model, lstm_ratio);
         axis.model.method = crate::fit::thermal_lstm::label(
             Method::ThermalLstm,
             Some(&bias),
@@ -1058,10 +1110,14 @@ fn leave_one_run_out(
         };
         // The LSTM on this fold's `thermal` fit, as `fit_axis_auto` trains it on every run.
         let lstm = match &several {
-            Some(b) => lstm_on_multi(&data, &order, b, lstm_cfg).map_err(fit_err)?,
+            Some(b) => {
+                lstm_on_multi(&data, &order, b, lstm_cfg)
+                    .map_err(fit_err)?
+                    .0
+            }
             None => {
                 match crate::fit::auto::lstm_on_thermal(bias0, &one, lstm_cfg).map_err(fit_err)? {
-                    Some(l) => l,
+                    Some((l, _)) => l,
                     None => continue,
                 }
             }

@@ -44,6 +44,11 @@
 //! scale factor's inputs only (the bias reads them as they are). Applied by a replica of
 //! `compensate_imu` (checked bit-equal with `none`). One fit serves every hold.
 //!
+//! `--sigma FILE` (docs/experiments/coverage.md): per 100 s window of each held-out static
+//! run and axis, the window's coverage (its worst sample's), the mean compensated output
+//! (the residual bias, °/h) and the mean σ the model gives there, as `compensate` gives it
+//! (axes without a map give none); one line a window.
+//!
 //! `--dump DIR` (experiment, docs/experiments/imu-worst-case.md): for setting `all`, per
 //! axis, the 100 s means of the bias error and of each simulator bias term on the training
 //! static run and each held-out static run ([`dump_run`]; `bench/imu_worst_case.py` reads
@@ -214,6 +219,69 @@ struct Case {
     temps: String,
     /// How far the static run leaves the training ranges.
     outside: Outside,
+    /// `--sigma FILE`: the static run's 100 s windows ([`sigma_windows`]).
+    windows: Vec<SigmaWindow>,
+    /// Whether the axis's bias model holds an LSTM.
+    lstm: bool,
+}
+
+/// One 100 s window of a held-out static run on one axis: its coverage (the worst sample's:
+/// 0 inside, 1 edge, 2 outside), the mean compensated output (the residual bias, °/h: the true
+/// rate is 0) and the mean σ the model gives there (°/h, as `compensate` writes it).
+#[derive(Debug, Clone, Copy)]
+struct SigmaWindow {
+    coverage: u8,
+    resid_dph: f64,
+    sigma_dph: f64,
+}
+
+/// The 100 s windows of axis `a`'s compensated output `comp` on the static run `log`, with the
+/// verdicts of the axis's map stepped on its first sensor's temperature, as
+/// `Model::coverage_log` steps them (an axis without a map, or a window with a sample without
+/// a verdict, gives none).
+fn sigma_windows(
+    a: &gyrotherm::imu_model::ImuAxis,
+    log: &ImuLog,
+    comp: &[f64],
+) -> Result<Vec<SigmaWindow>, String> {
+    let Some(map) = a.model.coverage.as_ref() else {
+        return Ok(Vec::new());
+    };
+    let map = map.to_core().map_err(|e| e.to_string())?;
+    let g = log
+        .gyro
+        .iter()
+        .position(|s| s.name == a.gyro)
+        .ok_or("gyro")?;
+    let t = log
+        .temp
+        .iter()
+        .position(|s| s.name == a.temps[0])
+        .ok_or("temp")?;
+    let mut c = gyrotherm::compensate::compensator(&a.model).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    let mut w: Option<(u8, f64, f64, usize)> = None;
+    for (i, out_dps) in comp.iter().enumerate() {
+        c.step(log.time_s[i], log.gyro[g].values[i], log.temp[t].values[i]);
+        let Some(v) = map.verdict_of(c.features()) else {
+            w = None;
+            continue;
+        };
+        let x = w.get_or_insert((0, 0.0, 0.0, 0));
+        x.0 = x.0.max(v.coverage as u8);
+        x.1 += out_dps * 3600.0;
+        x.2 += v.sigma_dph;
+        x.3 += 1;
+        if x.3 == 100 {
+            out.push(SigmaWindow {
+                coverage: x.0,
+                resid_dph: x.1 / 100.0,
+                sigma_dph: x.2 / 100.0,
+            });
+            w = None;
+        }
+    }
+    Ok(out)
 }
 
 struct Job<'a> {
@@ -249,6 +317,8 @@ struct Job<'a> {
     /// `auto`'s LSTM candidate: hidden units and Adam steps (None: the method's own).
     lstm_hidden: Option<usize>,
     lstm_steps: Option<usize>,
+    /// `--sigma FILE`: collect the held-out static runs' σ windows.
+    sigma: bool,
 }
 
 /// Per feature, the min and max a sensor's features reach over the training logs.
@@ -598,6 +668,7 @@ fn dump_run(
             text.as_bytes(),
         )
         .map_err(|e| format!("{path}: {e}"))?;
+
         // The sensors and lags the axis reads, for the record.
         let more: Vec<&Vec<f64>> = model.axes[k].more.iter().map(|m| &m.lags_s).collect();
         let info = format!(
@@ -847,6 +918,12 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                             ),
                         },
                         outside: cs[k].1,
+                        lstm: axis.model.bias.as_ref().is_some_and(|b| b.lstm().is_some()),
+                        windows: if job.sigma && hold == "none" {
+                            sigma_windows(axis, st, &cs[k].0)?
+                        } else {
+                            Vec::new()
+                        },
                     });
                 }
             }
@@ -994,6 +1071,7 @@ fn run() -> Result<(), String> {
         lstm_steps: get("--lstm-steps")
             .map(|v| v.parse().map_err(|e| format!("--lstm-steps: {e}")))
             .transpose()?,
+        sigma: get("--sigma").is_some(),
         select_folds: get("--select-folds")
             .map(|v| v.parse().map_err(|e| format!("--select-folds: {e}")))
             .transpose()?,
@@ -1080,6 +1158,34 @@ fn run() -> Result<(), String> {
                 text.push_str(&format!(
                     "\t{:.4}\t{:.4}\n",
                     c.outside.frac, c.outside.min_s
+                ));
+            }
+        }
+        gyrotherm::atomic_file::write_bytes_atomically(
+            std::path::Path::new(&path),
+            text.as_bytes(),
+        )
+        .map_err(|e| format!("{path}: {e}"))?;
+    }
+    if let Some(path) = get("--sigma") {
+        // One line per 100 s window of each held-out static run and axis.
+        let mut text = String::from(
+            "unit_seed\tsetting\taxis\tprofile\tsensors\tlstm\tcoverage\tresid_dph\tsigma_dph\n",
+        );
+        for c in &cases {
+            let sensors = c.temps.split(' ').next().unwrap_or("").split('+').count();
+            for w in &c.windows {
+                text.push_str(&format!(
+                    "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.6}\t{:.6}\n",
+                    c.unit_seed,
+                    c.setting,
+                    AXIS_NAMES[c.axis],
+                    c.profile,
+                    sensors,
+                    u8::from(c.lstm),
+                    w.coverage,
+                    w.resid_dph,
+                    w.sigma_dph
                 ));
             }
         }

@@ -21,7 +21,7 @@ use super::error::FitError;
 use super::thermal::Identified;
 use super::{
     fit_model, fit_model_identified, identify, residual, thermal, thermal_base, FitConfig,
-    FitOutcome, NamedLog, RecipeSettings,
+    FitOutcome, NamedLog, RecipeSettings, TrainSummary,
 };
 use crate::model::{CandidateScore, MethodChoice, SubModel, Target, Validation};
 use crate::settings::method::Method;
@@ -151,13 +151,13 @@ pub(crate) fn choose(validation: Validation, scores: [f64; 2]) -> MethodChoice {
 }
 
 /// `thermal-lstm`'s bias model on a fitted `thermal` bias model `thermal_sub` of the training
-/// sets `sets`: the residual LSTM as the `thermal-lstm` candidate trains it (None when
-/// `thermal_sub` is not a least-squares model).
+/// sets `sets`: the residual LSTM as the `thermal-lstm` candidate trains it, with what its
+/// training measured (None when `thermal_sub` is not a least-squares model).
 pub(crate) fn lstm_on_thermal(
     sets: &[TargetSet],
     thermal_sub: &SubModel,
     lstm_cfg: &FitConfig,
-) -> Result<Option<SubModel>, FitError> {
+) -> Result<Option<(SubModel, TrainSummary)>, FitError> {
     let SubModel::Baseline {
         terms,
         coefficients,
@@ -167,15 +167,15 @@ pub(crate) fn lstm_on_thermal(
     };
     let base = thermal_base(sets, terms, coefficients);
     let n_in = sets[0].table.n_features;
-    let (lstm_sub, _) = residual::fit_lstm_on_base(
+    residual::fit_lstm_on_base(
         sets,
         base,
         &lstm_cfg.recipe,
         n_in,
         lstm_cfg.seed,
         &mut |_, _| {},
-    )?;
-    Ok(Some(lstm_sub))
+    )
+    .map(Some)
 }
 
 /// Each static run left out in turn: both candidates fitted on the others, their bias residual
@@ -252,7 +252,7 @@ fn fold(
         return Ok(None);
     };
     let (thermal_sub, _) = thermal::fit_target(&sets, &thermal_cfg.thermal, &id, false)?;
-    let Some(lstm_sub) = lstm_on_thermal(&sets, &thermal_sub, lstm_cfg)? else {
+    let Some((lstm_sub, _)) = lstm_on_thermal(&sets, &thermal_sub, lstm_cfg)? else {
         return Ok(None);
     };
     let labelled: Vec<usize> = (0..held.table.n_rows())

@@ -711,8 +711,14 @@ fn lstm_sigma_ratio(
     ) {
         return None;
     }
-    bias?.lstm()?;
-    let (base, kept) = training?.held_out_rms?;
+    held_out_ratio(bias?, training?)
+}
+
+/// The ratio of the held-out blocks' bias RMS with `bias`'s residual LSTM to without it, as
+/// `training` measured it; None where `bias` holds no LSTM or it did not help there.
+pub(crate) fn held_out_ratio(bias: &SubModel, training: &TrainSummary) -> Option<f64> {
+    bias.lstm()?;
+    let (base, kept) = training.held_out_rms?;
     (base.is_finite() && kept > 0.0 && kept < base).then(|| kept / base)
 }
 

@@ -86,9 +86,9 @@ impl Model {
 
     /// Per axis, whether each sample's temperature and rate lie inside, at the edge of or
     /// outside the region training covered, and σ there: the `coverage` and `sigma_dph`
-    /// columns a single-gyro `compensate` writes. Then a note per axis without a verdict: a
-    /// model file without a coverage map, or a unit's axis that reads several sensors (its
-    /// map is its first sensor's fit's, not the combination's).
+    /// columns a single-gyro `compensate` writes (an axis that reads several sensors: on its
+    /// first sensor's T and dT, as its flight compensator steps them). Then a note per axis
+    /// without a verdict: a model file without a coverage map.
     pub fn coverage_log(
         &self,
         log: &ImuLog,
@@ -101,15 +101,6 @@ impl Model {
                 codes: vec![NO_COVERAGE; log.len()],
                 sigma_dph: vec![f64::NAN; log.len()],
             };
-            if a.temps.len() > 1 {
-                notes.push(format!(
-                    "{}: reads {} sensors; coverage per sample is told for a model of one",
-                    a.gyro,
-                    a.temps.len()
-                ));
-                out.push(none());
-                continue;
-            }
             let Some(map) = a.model.coverage.as_ref().and_then(|m| m.to_core().ok()) else {
                 if let Some(n) = crate::coverage::missing_note(&a.model) {
                     notes.push(match self.form {

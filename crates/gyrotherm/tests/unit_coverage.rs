@@ -1,0 +1,119 @@
+//! Coverage and σ per sample on a unit's axis that reads several temperature sensors. The map
+//! is on the first sensor's (T, dT), which the flight axis steps; its σ is the first sensor's
+//! one-sensor map (the axis's fallback keeps it as fitted) times the ratio of the
+//! several-sensor fit's cross-validated bias RMS to the first sensor's alone, both recorded in
+//! the file (`multi_cv_rms`, `scores`). `Model::coverage_log` gives a verdict on every sample
+//! of such an axis once its filters have run.
+
+use gyrotherm::csvlog::ImuLog;
+use gyrotherm::imu_model::{fit_imu_with, ImuFitSettings, ImuModel, ImuSensors};
+use gyrotherm::model::TempSensorDef;
+use gyrotherm::settings::{FitSettings, Method};
+use gyrotherm::unit_model::{Model, NO_COVERAGE};
+
+#[path = "support/unit_1000.rs"]
+mod unit_1000;
+use unit_1000::run;
+
+/// As `gyrotherm train` with a static run (seed 1) and a table run per axis (seed 2).
+fn training() -> Vec<(String, ImuLog)> {
+    [(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]
+        .into_iter()
+        .map(|(seed, table)| (format!("{seed} {table:?}"), run(seed, table)))
+        .collect()
+}
+
+/// Unit 1000's x axis on both its sensors (a gain threshold of -1 keeps the second sensor
+/// unless it doubles the cross-validated RMS: the test is about the map, not the choice).
+fn several_sensor_model() -> ImuModel {
+    fit_imu_with(
+        &training(),
+        &FitSettings {
+            method: Method::Thermal,
+            ..FitSettings::default()
+        }
+        .fit_config()
+        .unwrap(),
+        &ImuFitSettings {
+            sensors: ImuSensors::All,
+            min_gain: -1.0,
+            ..ImuFitSettings::default()
+        },
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap()
+}
+
+#[test]
+fn an_axis_on_several_sensors_carries_its_first_sensors_map_scaled_by_what_the_others_took_out() {
+    let model = several_sensor_model();
+    let a = &model.axes[0];
+    assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
+    let map = a
+        .model
+        .coverage
+        .as_ref()
+        .expect("a several-sensor axis has a map");
+    let one = a
+        .fallback
+        .as_ref()
+        .and_then(|f| f.coverage.as_ref())
+        .expect("its fallback keeps the one-sensor map");
+    // The ratio from the file's own scores: the several-sensor fit's and the first sensor's.
+    let several = a.multi_cv_rms.expect("several-sensor score");
+    let first = a
+        .scores
+        .iter()
+        .find(|s| s.temp == a.temps[0])
+        .and_then(|s| s.cv_rms)
+        .expect("first sensor's score");
+    let ratio = several / first;
+    assert!(ratio.is_finite() && ratio > 0.0, "{ratio}");
+    // Same cells, same counts and held-out RMS; σ scaled, to the bit, cell by cell.
+    assert_eq!(map.grid(), one.grid());
+    assert_eq!(map.count, one.count);
+    assert_eq!(map.rms_dph, one.rms_dph);
+    assert_eq!(map.growth_per_cell, one.growth_per_cell);
+    for (s, s1) in map.sigma_dph.iter().zip(&one.sigma_dph) {
+        assert_eq!(s.to_bits(), (s1 * ratio).to_bits(), "{s} vs {s1} × {ratio}");
+    }
+    assert!(map.covered_cells() > 0);
+    // The file round-trips through its checks with the map.
+    let text = model.to_json().unwrap();
+    assert_eq!(ImuModel::from_json(&text).unwrap(), model);
+}
+
+#[test]
+fn coverage_log_gives_a_several_sensor_axis_a_verdict_on_every_sample() {
+    // Through the file, as `compensate` and Python load it.
+    let dir = std::env::temp_dir().join(format!("gyrotherm-unit-coverage-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("unit.json");
+    several_sensor_model().save(&path).unwrap();
+    let model = Model::load(&path).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let test = run(3, None);
+    let (axes, notes) = model.coverage_log(&test).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    let cov = &axes[0];
+    assert_eq!(cov.codes.len(), test.len());
+    // Every sample once the flight compensator's filters have run has a verdict and a finite,
+    // positive σ (°/h).
+    let first_verdict = cov
+        .codes
+        .iter()
+        .position(|&c| c != NO_COVERAGE)
+        .expect("some verdict");
+    assert!(
+        first_verdict < 10,
+        "first verdict at sample {first_verdict}"
+    );
+    for (c, s) in cov.codes[first_verdict..]
+        .iter()
+        .zip(&cov.sigma_dph[first_verdict..])
+    {
+        assert_ne!(*c, NO_COVERAGE);
+        assert!(s.is_finite() && *s > 0.0, "{s}");
+    }
+}
