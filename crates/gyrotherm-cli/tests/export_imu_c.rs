@@ -219,10 +219,14 @@ fn unit_stream(u: usize, axes: usize, temps: usize) -> Vec<Vec<f64>> {
 
 /// `compensate --stream` of the unit, in process: per line and axis (status index, rate or
 /// NaN when empty, bias, scale).
+/// One axis of a stream line: (status, rate, bias, scale) and (coverage, sigma_dph), the
+/// coverage 0 inside, 1 edge, 2 outside, 3 none.
+type StreamAxis = ((usize, f64, f64, f64), (usize, f64));
+
 fn stream_in_process(
     model: &gyrotherm::imu_model::ImuModel,
     rows: &[Vec<f64>],
-) -> Vec<Vec<(usize, f64, f64, f64)>> {
+) -> Vec<Vec<StreamAxis>> {
     let mut text = String::from("time_s,");
     let names: Vec<&str> = model
         .gyro_cols
@@ -257,12 +261,20 @@ fn stream_in_process(
             let num = |s: &str| s.parse::<f64>().unwrap_or(f64::NAN);
             (0..model.gyro_cols.len())
                 .map(|k| {
-                    let a = width + 4 * k;
+                    let a = width + 6 * k;
                     let status = ["ok", "held", "degraded", "invalid", "fallback"]
                         .iter()
                         .position(|s| *s == f[a + 3])
                         .unwrap();
-                    (status, num(f[a + 2]), num(f[a]), num(f[a + 1]))
+                    // Empty coverage: no verdict (3 or 4 in the C's codes).
+                    let coverage = ["inside", "edge", "outside", ""]
+                        .iter()
+                        .position(|s| *s == f[a + 4])
+                        .unwrap();
+                    (
+                        (status, num(f[a + 2]), num(f[a]), num(f[a + 1])),
+                        (coverage, num(f[a + 5])),
+                    )
                 })
                 .collect()
         })
@@ -467,7 +479,7 @@ fn generated_unit_c_equals_the_unit_stream() {
             for (line, w) in want.iter().enumerate() {
                 lines += 1;
                 let mut same_line = true;
-                for (k, &(ws, wr, wb, wk)) in w.iter().enumerate() {
+                for (k, &((ws, wr, wb, wk), (scv, ssig))) in w.iter().enumerate() {
                     let j = line * axes + k;
                     let (cs, r, b, sc) = (
                         st[j] as usize,
@@ -477,6 +489,12 @@ fn generated_unit_c_equals_the_unit_stream() {
                     );
                     let (cv, sigma) = (vals[5 * j + 3] as usize, vals[5 * j + 4]);
                     let (wc, wsig) = cover[line][k];
+                    // The stream's own coverage columns: the core's verdict, or empty.
+                    let stream_same = if wc < 3 {
+                        scv == wc && ssig.to_bits() == wsig.to_bits()
+                    } else {
+                        scv == 3 && ssig.is_nan()
+                    };
                     axis_lines += 1;
                     by_sensors[m.axes[k].temps.len()] += 1;
                     statuses[ws] += 1;
@@ -486,7 +504,8 @@ fn generated_unit_c_equals_the_unit_stream() {
                         && sc.to_bits() == wk.to_bits()
                         && (cs == 3 || r.to_bits() == wr.to_bits())
                         && cv == wc
-                        && (sigma.to_bits() == wsig.to_bits() || (sigma.is_nan() && wsig.is_nan()));
+                        && (sigma.to_bits() == wsig.to_bits() || (sigma.is_nan() && wsig.is_nan()))
+                        && stream_same;
                     if !same {
                         same_line = false;
                         if failures.len() < 5 {

@@ -196,3 +196,100 @@ fn a_missing_column_is_named_and_a_sensor_fault_stays_on_its_axes() {
         );
     }
 }
+
+/// `compensate` with a unit model writes each axis's coverage verdict and σ as
+/// `G_coverage` and `G_sigma_dph`: the same, to the bit, as the library's
+/// `Model::coverage_log` (which steps each axis's first-sensor compensator on its own and
+/// reads its map) gives for the log, on every axis, including one that reads several sensors.
+#[test]
+fn compensate_writes_each_axis_coverage_and_sigma_as_the_model_gives_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let unit = ["--imu", "--unit", "random", "--unit-seed", "1000"];
+    let prof = ["--profile", "fast-cycle"];
+    let mut inputs = vec![simulate_args(
+        dir.path(),
+        "s.csv",
+        &[&unit[..], &prof[..], &["--seed", "1"]].concat(),
+    )];
+    for ax in ["x", "y", "z"] {
+        inputs.push(simulate_args(
+            dir.path(),
+            &format!("t{ax}.csv"),
+            &[
+                &unit[..],
+                &prof[..],
+                &["--seed", "2", "--table-rate", "20", "--table-axis", ax],
+            ]
+            .concat(),
+        ));
+    }
+    let model = dir.path().join("imu.json");
+    let mut cmd = gyrotherm();
+    cmd.args(["train", "--method", "thermal", "--gyro-col", GYROS]);
+    cmd.args([
+        "--temp-col",
+        "temp_case_c,temp_x_c,temp_y_c,temp_z_c",
+        "--out",
+    ])
+    .arg(&model);
+    for i in &inputs {
+        cmd.arg("--input").arg(i);
+    }
+    run_ok(&mut cmd);
+    let run = simulate_args(
+        dir.path(),
+        "run.csv",
+        &[&unit[..], &["--profile", "airborne", "--seed", "3"]].concat(),
+    );
+    let comp = dir.path().join("comp.csv");
+    let out = run_ok(
+        gyrotherm()
+            .args(["compensate", "--model"])
+            .arg(&model)
+            .arg("--input")
+            .arg(&run)
+            .arg("--out")
+            .arg(&comp),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    let out = std::fs::read_to_string(&comp).unwrap();
+    let m = gyrotherm::unit_model::Model::load(&model).unwrap();
+    let unit_model = m.to_unit(&gyrotherm::ReadOptions::default());
+    assert!(
+        unit_model.axes.iter().any(|a| a.temps.len() > 1),
+        "no axis reads several sensors: {:?}",
+        unit_model.axes.iter().map(|a| &a.temps).collect::<Vec<_>>()
+    );
+    let opts = unit_model.read_options(&gyrotherm::ReadOptions::default());
+    let (log, _) = gyrotherm::csvlog::read_imu_log(&run, &opts, None).unwrap();
+    let (want, notes) = m.coverage_log(&log).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    for (g, w) in GYROS.split(',').zip(&want) {
+        let codes = column(&out, &format!("{g}_coverage"));
+        let sigma = column(&out, &format!("{g}_sigma_dph"));
+        assert_eq!(codes.len(), w.codes.len());
+        for i in 0..codes.len() {
+            let name = ["inside", "edge", "outside"]
+                .get(w.codes[i] as usize)
+                .copied()
+                .unwrap_or("");
+            assert_eq!(codes[i], name, "{g} line {}", i + 2);
+            if name.is_empty() {
+                assert_eq!(sigma[i], "", "{g} line {}", i + 2);
+            } else {
+                let s: f64 = sigma[i].parse().unwrap();
+                assert_eq!(s.to_bits(), w.sigma_dph[i].to_bits(), "{g} line {}", i + 2);
+            }
+        }
+        // The summary counts the verdicts.
+        let n = |c: u8| w.codes.iter().filter(|k| **k == c).count();
+        let want_line = format!(
+            "{g}: {} ok, 0 held, 0 degraded, 0 invalid, coverage: inside {}, edge {}, outside {}",
+            codes.len(),
+            n(0),
+            n(1),
+            n(2)
+        );
+        assert!(err.contains(&want_line), "{want_line}: {err}");
+    }
+}

@@ -10,7 +10,10 @@
 //! infinite or out of order goes to the time axes). Every input field is written as it was,
 //! then for each gyro column G of the model, in the model's order, the columns of batch
 //! `compensate`: `G_bias` (°/s), `G_scale`, `G_comp` (°/s; empty when the axis is
-//! `invalid`) and `G_status`.
+//! `invalid`), `G_status`, `G_coverage` and `G_sigma_dph` (the verdict of the axis's
+//! coverage map on the latest step's T and dT of its first sensor, or of its fallback's while
+//! it runs on it; empty without a verdict, as the single-axis stream's `coverage` and
+//! `sigma_dph`).
 //!
 //! The numbers are those of flight code: the flight [`Unit`](gyrotherm_core::unit::Unit) of
 //! [`gyrotherm_core::unit`] steps every axis with the line's time, gyro fields and all the
@@ -23,8 +26,8 @@
 //! on its fallback model, if the model file has one, with status `fallback`
 //! ([`gyrotherm_core::multi`]). The columns are looked up by the model's names;
 //! the log must hold every gyro column and every temperature column an axis reads (the error
-//! names the first missing); a column no axis reads is not looked for. Coverage columns and
-//! extrapolation warnings are the single-axis stream's only.
+//! names the first missing); a column no axis reads is not looked for. Extrapolation warnings
+//! are the single-axis stream's only.
 
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -32,20 +35,22 @@ use std::path::Path;
 use gyrotherm_core::compensator::{Corrected, Status};
 
 use crate::compensate_lines::{
-    gyro_not_a_number, lines_to_file, parse_number, push_corrected, push_invalid, read_header,
-    run_lines, Cadence, Fields, FileError, LineCheck, LineModel, LinesError, Mode,
+    gyro_not_a_number, lines_to_file, parse_number, push_corrected, push_invalid, push_verdict,
+    read_header, run_lines, Cadence, Fields, FileError, LineCheck, LineModel, LinesError, Mode,
 };
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
 pub use crate::imu_model::MAX_STREAM_AXES;
 use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
+use gyrotherm_core::coverage::CoverageMap;
 
 pub use crate::flight_size::StreamUnit;
 
 /// Suffixes of the columns added per gyro column, in order.
-pub(crate) const AXIS_SUFFIXES: [&str; 4] = ["bias", "scale", "comp", "status"];
+pub(crate) const AXIS_SUFFIXES: [&str; 6] =
+    ["bias", "scale", "comp", "status", "coverage", "sigma_dph"];
 
-/// The names of the columns added for `model`: `G_bias`, `G_scale`, `G_comp`, `G_status`
-/// per gyro column G.
+/// The names of the columns added for `model`: `G_bias`, `G_scale`, `G_comp`, `G_status`,
+/// `G_coverage`, `G_sigma_dph` per gyro column G.
 pub(crate) fn output_columns(model: &ImuModel) -> Vec<String> {
     model
         .gyro_cols
@@ -80,24 +85,34 @@ pub struct ImuLinesSummary {
     /// Per axis, in the model's order: lines ok, held, degraded, invalid, fallback (the
     /// codes of [`Status`]).
     pub per_axis: Vec<[u64; 5]>,
+    /// Per axis: lines per coverage verdict, inside, edge, outside (all 0 without a map).
+    pub coverage: Vec<[u64; 3]>,
     /// What the lines do not show: time steps longer than the compensator runs at.
     pub warnings: Vec<String>,
 }
 
 impl ImuLinesSummary {
     /// `N lines (m malformed); gyro_x: ok a, held b, degraded c, invalid d; ...`, with
-    /// `, fallback e` for an axis that ran on its fallback.
+    /// `, fallback e` for an axis that ran on its fallback and `, coverage: inside i, edge j,
+    /// outside k` for an axis with verdicts.
     pub fn describe(&self, gyro_cols: &[String]) -> String {
         let mut s = format!("{} lines", self.rows);
         if self.malformed > 0 {
             s.push_str(&format!(" ({} malformed)", self.malformed));
         }
-        for (g, [ok, held, degraded, invalid, fallback]) in gyro_cols.iter().zip(&self.per_axis) {
+        let none = [0; 3];
+        for (k, (g, [ok, held, degraded, invalid, fallback])) in
+            gyro_cols.iter().zip(&self.per_axis).enumerate()
+        {
             s.push_str(&format!(
                 "; {g}: ok {ok}, held {held}, degraded {degraded}, invalid {invalid}"
             ));
             if *fallback > 0 {
                 s.push_str(&format!(", fallback {fallback}"));
+            }
+            let [i, e, o] = self.coverage.get(k).unwrap_or(&none);
+            if i + e + o > 0 {
+                s.push_str(&format!(", coverage: inside {i}, edge {e}, outside {o}"));
             }
         }
         s
@@ -179,7 +194,15 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
         time_index: ti,
         mode,
     };
+    // The files' maps were checked when they were loaded.
+    let map = |m: &crate::model::ModelFile| m.coverage.as_ref().and_then(|c| c.to_core().ok());
     let mut axes = Axes {
+        maps: model
+            .axes
+            .iter()
+            .map(|a| (map(&a.model), a.fallback.as_ref().and_then(map)))
+            .collect(),
+        coverage: vec![[0; 3]; n_axes],
         gyro: vec![0.0; n_axes],
         temps: vec![0.0; ci.len()],
         unit,
@@ -203,6 +226,7 @@ pub fn compensate_imu_lines<R: BufRead, W: Write>(
         rows: counts.rows,
         malformed: counts.malformed,
         per_axis: axes.per_axis,
+        coverage: axes.coverage,
         warnings: cadence.warning().into_iter().collect(),
     })
 }
@@ -220,6 +244,9 @@ struct Axes {
     gyro: Vec<f64>,
     temps: Vec<f64>,
     per_axis: Vec<[u64; 5]>,
+    /// Per axis, its coverage map and its fallback's (None without one).
+    maps: Vec<(Option<CoverageMap>, Option<CoverageMap>)>,
+    coverage: Vec<[u64; 3]>,
 }
 
 impl LineModel for Axes {
@@ -250,15 +277,30 @@ impl LineModel for Axes {
 
     fn step<W: Write>(&mut self, time_s: f64, writer: &mut LogWriter<W>) {
         let out: [Corrected; MAX_STREAM_AXES] = self.unit.step(time_s, &self.gyro, &self.temps);
-        for (c, counts) in out.iter().zip(&mut self.per_axis) {
+        for (k, (c, counts)) in out.iter().zip(&mut self.per_axis).enumerate() {
             push_corrected(writer, c);
             counts[c.status as usize] += 1;
+            // On its fallback the axis runs the fallback's model: its map, on its features.
+            let verdict = self.unit.axis(k).and_then(|axis| {
+                let (map, fallback_map) = &self.maps[k];
+                match axis.fallback() {
+                    Some(f) if axis.on_fallback() => {
+                        fallback_map.as_ref()?.verdict_of(f.features())
+                    }
+                    _ => map.as_ref()?.verdict_of(axis.features()),
+                }
+            });
+            if let Some(v) = verdict {
+                self.coverage[k][v.coverage as usize] += 1;
+            }
+            push_verdict(writer, verdict);
         }
     }
 
     fn malformed<W: Write>(&mut self, writer: &mut LogWriter<W>) {
         for counts in &mut self.per_axis {
             push_invalid(writer);
+            push_verdict(writer, None);
             counts[Status::Invalid as usize] += 1;
         }
     }

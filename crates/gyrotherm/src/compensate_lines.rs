@@ -981,7 +981,7 @@ pub(crate) fn push_invalid<W: Write>(writer: &mut LogWriter<W>) {
 }
 
 /// The `coverage` and `sigma_dph` fields of an output row (both empty without a verdict).
-fn push_verdict<W: std::io::Write>(
+pub(crate) fn push_verdict<W: std::io::Write>(
     writer: &mut crate::csvlog::LogWriter<W>,
     verdict: Option<gyrotherm_core::coverage::Verdict>,
 ) {

@@ -533,14 +533,21 @@ impl Compensation {
                     let counts: Vec<String> = gyro_cols
                         .iter()
                         .zip(&s.per_axis)
-                        .map(|(g, n)| {
+                        .enumerate()
+                        .map(|(k, (g, n))| {
                             let fallback = if n[4] > 0 {
                                 format!(", {} fallback", n[4])
                             } else {
                                 String::new()
                             };
+                            let coverage = match s.coverage.get(k) {
+                                Some([i, e, o]) if i + e + o > 0 => {
+                                    format!(", coverage: inside {i}, edge {e}, outside {o}")
+                                }
+                                _ => String::new(),
+                            };
                             format!(
-                                "{g}: {} ok, {} held, {} degraded, {} invalid{fallback}",
+                                "{g}: {} ok, {} held, {} degraded, {} invalid{fallback}{coverage}",
                                 n[0], n[1], n[2], n[3]
                             )
                         })
