@@ -209,9 +209,10 @@ class Model:
         outside the region the training logs covered, and the 1σ residual bias error there
         (°/h): the ``coverage`` and ``sigma_dph`` columns ``gyrotherm compensate`` writes for
         the same samples. Arrays as :meth:`compensate` takes them; a :class:`CoverageVerdicts`
-        for a single gyro's arrays, else one per gyro column. Warns (``GyrothermWarning``)
-        where an axis has no verdict: a model file without a coverage map, or a unit's axis
-        that reads several sensors (every code is then ``NO_COVERAGE``)."""
+        for a single gyro's arrays, else one per gyro column (an axis that reads several
+        sensors: on its first sensor's temperature and rate). Warns (``GyrothermWarning``)
+        where an axis has no verdict: a model file without a coverage map (every code is then
+        ``NO_COVERAGE``)."""
         t, g, c, one = self._samples(time_s, gyro, temp)
         axes, notes = self._raw.coverage(t, g, c)
         _warn(notes)
