@@ -22,28 +22,36 @@ fn column(text: &str, name: &str) -> Vec<String> {
         .collect()
 }
 
-/// Unit 1000 (design family): a static run and one table run per axis on `fast-cycle`, a
-/// linear model with the case sensor and the x coil sensor.
-fn train_linear(dir: &Path) -> std::path::PathBuf {
-    let unit = ["--imu", "--unit", "random", "--unit-seed", "1000"];
+/// Unit 1000 (design family) in the simulator.
+const UNIT: [&str; 5] = ["--imu", "--unit", "random", "--unit-seed", "1000"];
+
+/// Unit 1000's training runs on `fast-cycle`: a static run (seed 1) and one table run per
+/// axis (seed 2).
+fn training_runs(dir: &Path) -> Vec<std::path::PathBuf> {
     let prof = ["--profile", "fast-cycle"];
     let mut inputs = vec![simulate_args(
         dir,
         "s.csv",
-        &[&unit[..], &prof[..], &["--seed", "1"]].concat(),
+        &[&UNIT[..], &prof[..], &["--seed", "1"]].concat(),
     )];
     for ax in ["x", "y", "z"] {
         inputs.push(simulate_args(
             dir,
             &format!("t{ax}.csv"),
             &[
-                &unit[..],
+                &UNIT[..],
                 &prof[..],
                 &["--seed", "2", "--table-rate", "20", "--table-axis", ax],
             ]
             .concat(),
         ));
     }
+    inputs
+}
+
+/// A linear model of unit 1000 with the case sensor and the x coil sensor.
+fn train_linear(dir: &Path) -> std::path::PathBuf {
+    let inputs = training_runs(dir);
     let model = dir.join("imu.json");
     let mut cmd = gyrotherm();
     cmd.args(["train", "--method", "linear", "--gyro-col", GYROS]);
@@ -204,25 +212,7 @@ fn a_missing_column_is_named_and_a_sensor_fault_stays_on_its_axes() {
 #[test]
 fn compensate_writes_each_axis_coverage_and_sigma_as_the_model_gives_them() {
     let dir = tempfile::tempdir().unwrap();
-    let unit = ["--imu", "--unit", "random", "--unit-seed", "1000"];
-    let prof = ["--profile", "fast-cycle"];
-    let mut inputs = vec![simulate_args(
-        dir.path(),
-        "s.csv",
-        &[&unit[..], &prof[..], &["--seed", "1"]].concat(),
-    )];
-    for ax in ["x", "y", "z"] {
-        inputs.push(simulate_args(
-            dir.path(),
-            &format!("t{ax}.csv"),
-            &[
-                &unit[..],
-                &prof[..],
-                &["--seed", "2", "--table-rate", "20", "--table-axis", ax],
-            ]
-            .concat(),
-        ));
-    }
+    let inputs = training_runs(dir.path());
     let model = dir.path().join("imu.json");
     let mut cmd = gyrotherm();
     cmd.args(["train", "--method", "thermal", "--gyro-col", GYROS]);
@@ -239,7 +229,7 @@ fn compensate_writes_each_axis_coverage_and_sigma_as_the_model_gives_them() {
     let run = simulate_args(
         dir.path(),
         "run.csv",
-        &[&unit[..], &["--profile", "airborne", "--seed", "3"]].concat(),
+        &[&UNIT[..], &["--profile", "airborne", "--seed", "3"]].concat(),
     );
     let comp = dir.path().join("comp.csv");
     let out = run_ok(

@@ -97,6 +97,26 @@ fn train_auto(logs: Vec<(String, ImuLog)>) -> (ImuModel, Vec<String>, Vec<String
     }
 }
 
+/// `auto`'s axis `a` is, but for its recorded choice, the x axis `method` fits by name on
+/// `logs`, to the bit (JSON included); returns that fit.
+fn assert_fitted_by_name(a: &ImuAxis, logs: &[(String, ImuLog)], method: Method) -> ImuModel {
+    let by_name = fit_imu(
+        logs,
+        &config(method),
+        &TempSensorDef::default(),
+        &|_, _, _, _, _| {},
+    )
+    .unwrap();
+    let mut same = a.clone();
+    same.model.method_choice = None;
+    assert_eq!(same, by_name.axes[0]);
+    assert_eq!(
+        serde_json::to_string(&same).unwrap(),
+        serde_json::to_string(&by_name.axes[0]).unwrap()
+    );
+    by_name
+}
+
 /// While it fitted, each of the x axis's `of` left-out runs was told as its fold started.
 fn assert_each_fold_told(steps: &[String], of: usize) {
     for run in 1..=of {
@@ -123,20 +143,7 @@ fn auto_scores_a_several_sensor_thermal_axis_against_the_lstm_on_that_fit() {
     assert_eq!(a.temps.len(), 2, "{:?}", a.scores);
     // The axis kept is the chosen method's by name, to the bit, but for the recorded choice.
     let chosen = a.model.method_choice.as_ref().unwrap().chosen;
-    let by_name = fit_imu(
-        &logs,
-        &config(chosen),
-        &TempSensorDef::default(),
-        &|_, _, _, _, _| {},
-    )
-    .unwrap();
-    let mut same = a.clone();
-    same.model.method_choice = None;
-    assert_eq!(same, by_name.axes[0]);
-    assert_eq!(
-        serde_json::to_string(&same).unwrap(),
-        serde_json::to_string(&by_name.axes[0]).unwrap()
-    );
+    let by_name = assert_fitted_by_name(a, &logs, chosen);
     assert_eq!(model.imu_format_version, IMU_FORMAT_VERSION);
     assert!(
         lines.iter().any(|l| l
@@ -262,16 +269,7 @@ fn when_every_gate_leaves_the_lstm_out_the_axis_keeps_thermal_and_says_so() {
         "{}",
         choice.describe()
     );
-    let by_name = fit_imu(
-        &logs,
-        &config(Method::Thermal),
-        &TempSensorDef::default(),
-        &|_, _, _, _, _| {},
-    )
-    .unwrap();
-    let mut same = a.clone();
-    same.model.method_choice = None;
-    assert_eq!(same, by_name.axes[0]);
+    assert_fitted_by_name(a, &logs, Method::Thermal);
     // The flag is written, sealed and read back.
     let text = model.to_json().unwrap();
     assert!(text.contains("\"lstm_left_out\": true"), "{text}");

@@ -15,15 +15,7 @@ use gyrotherm_core::compensator::Status;
 
 #[path = "support/unit_1000.rs"]
 mod unit_1000;
-use unit_1000::run;
-
-/// As `gyrotherm train` with a static run (seed 1) and a table run per axis (seed 2).
-fn training() -> Vec<(String, ImuLog)> {
-    [(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]
-        .into_iter()
-        .map(|(seed, table)| (format!("{seed} {table:?}"), run(seed, table)))
-        .collect()
-}
+use unit_1000::{run, training};
 
 fn thermal() -> gyrotherm::fit::FitConfig {
     FitSettings {

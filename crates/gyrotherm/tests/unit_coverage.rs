@@ -13,15 +13,7 @@ use gyrotherm::unit_model::{Model, NO_COVERAGE};
 
 #[path = "support/unit_1000.rs"]
 mod unit_1000;
-use unit_1000::run;
-
-/// As `gyrotherm train` with a static run (seed 1) and a table run per axis (seed 2).
-fn training() -> Vec<(String, ImuLog)> {
-    [(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]
-        .into_iter()
-        .map(|(seed, table)| (format!("{seed} {table:?}"), run(seed, table)))
-        .collect()
-}
+use unit_1000::{run, training};
 
 /// Unit 1000's x axis on both its sensors (a gain threshold of -1 keeps the second sensor
 /// unless it doubles the cross-validated RMS: the test is about the map, not the choice).

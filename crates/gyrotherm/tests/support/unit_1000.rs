@@ -22,3 +22,12 @@ pub fn run(seed: u64, table: Option<usize>) -> ImuLog {
     log.temp.truncate(2);
     log
 }
+
+/// As `gyrotherm train` with a static run (seed 1) and a table run per axis (seed 2).
+#[allow(dead_code)] // Not every test that includes this file trains on these runs.
+pub fn training() -> Vec<(String, ImuLog)> {
+    [(1, None), (2, Some(0)), (2, Some(1)), (2, Some(2))]
+        .into_iter()
+        .map(|(seed, table)| (format!("{seed} {table:?}"), run(seed, table)))
+        .collect()
+}
