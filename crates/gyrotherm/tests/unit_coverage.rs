@@ -5,7 +5,6 @@
 //! the file (`multi_cv_rms`, `scores`). `Model::coverage_log` gives a verdict on every sample
 //! of such an axis once its filters have run.
 
-use gyrotherm::csvlog::ImuLog;
 use gyrotherm::imu_model::{fit_imu_with, ImuFitSettings, ImuModel, ImuSensors};
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::{FitSettings, Method};
