@@ -4,7 +4,6 @@
 //! that read it.
 
 use gyrotherm::compensate::compensate_log;
-use gyrotherm::csvlog::ImuLog;
 use gyrotherm::imu_model::{
     compensate_imu, fit_imu_with, ImuFitSettings, ImuModel, ImuSensors, IMU_FORMAT_VERSION,
     IMU_FORMAT_VERSION_ONE_SENSOR,
