@@ -146,7 +146,7 @@ fn module_vs_stream(
         lines += 1;
         let mut same = true;
         for (k, c) in got.iter().enumerate() {
-            let a = width + 4 * k;
+            let a = width + 6 * k;
             let num = |s: &str| s.parse::<f64>().unwrap_or(f64::NAN).to_bits();
             same &= num(f[a]) == c.bias_dps.to_bits()
                 && num(f[a + 1]) == c.scale.to_bits()
