@@ -3,7 +3,7 @@
 //!
 //! For each unit of a simulated family (`gyrotherm::sim::family`; design family: unit seeds
 //! 1000.., confirmation family: 5000..; the wide family: seeds 7000.. drawn from ranges
-//! widened past the design ranges, [`wide_ranges`], physics no setting was chosen on) the default `thermal` model is trained on `seed-shock`
+//! widened past the design ranges, `gyrotherm_experiments::wide_ranges`, physics no setting was chosen on) the default `thermal` model is trained on `seed-shock`
 //! static + ±20 °/s table runs (the seeds of the generalisation benchmark), and each held-out
 //! static run (`slow-ramp`, `shock-5`, `airborne`) is compensated by the flight compensator.
 //! Over non-overlapping 100 s windows it takes the mean of the compensated output (the true
@@ -28,7 +28,6 @@ use gyrotherm::compensate::compensator;
 use gyrotherm::csvlog::TestLog;
 use gyrotherm::fit::{fit_model, FitConfig, NamedLog, RecipeSettings};
 use gyrotherm::model::Method;
-use gyrotherm::sim::family::UnitRanges;
 use gyrotherm::sim::{random_unit, simulate_series, FogUnit, SimConfig, SimSeries};
 use gyrotherm_core::coverage::Coverage;
 
@@ -38,37 +37,6 @@ const TEST_PROFILES: [&str; 3] = ["slow-ramp", "shock-5", "airborne"];
 const DESIGN_BASE_SEED: u64 = 1000;
 const CONFIRM_BASE_SEED: u64 = 5000;
 const WIDE_BASE_SEED: u64 = 7000;
-
-/// The design ranges widened: time constants a factor 2 further each way, every thermal
-/// coefficient's upper magnitude doubled, a mounting node in three units of four, sensors up
-/// to 2 minutes behind and 1 °C off. A third opinion of the physics, for checking what was
-/// chosen on the design family.
-fn wide_ranges() -> UnitRanges {
-    let d = UnitRanges::default();
-    let wider = |(lo, hi): (f64, f64)| (lo, 2.0 * hi);
-    UnitRanges {
-        mount_probability: 0.75,
-        node_tau_s: (50.0, 10000.0),
-        stress_tau_s: (1800.0, 28800.0),
-        sensor_tau_s: (5.0, 120.0),
-        sensor_offset_c: (0.0, 1.0),
-        bias_c1_dph_per_c: wider(d.bias_c1_dph_per_c),
-        bias_c2_dph_per_c2: wider(d.bias_c2_dph_per_c2),
-        bias_c3_dph_per_c3: wider(d.bias_c3_dph_per_c3),
-        shupe_dph_per_c_per_s: wider(d.shupe_dph_per_c_per_s),
-        shupe_tc_per_c: wider(d.shupe_tc_per_c),
-        shupe_grad_dph_per_c_per_s: wider(d.shupe_grad_dph_per_c_per_s),
-        stress_dph_per_c: wider(d.stress_dph_per_c),
-        rate_sat_dph: wider(d.rate_sat_dph),
-        rate_sat_c_per_s: (0.001, 0.04),
-        sf_c1_ppm_per_c: wider(d.sf_c1_ppm_per_c),
-        sf_c2_ppm_per_c2: wider(d.sf_c2_ppm_per_c2),
-        sf_c3_ppm_per_c3: wider(d.sf_c3_ppm_per_c3),
-        sf_rate_ppm_per_c_per_s: wider(d.sf_rate_ppm_per_c_per_s),
-        sf_stress_ppm_per_c: wider(d.sf_stress_ppm_per_c),
-        ..d
-    }
-}
 
 fn sim(unit: &FogUnit, profile: &str, seed: u64, table: bool) -> Result<SimSeries, String> {
     let mut c = SimConfig::builtin(profile).map_err(|e| e.to_string())?;
@@ -118,7 +86,7 @@ fn worse(a: Coverage, b: Coverage) -> Coverage {
 
 fn run_unit(unit_seed: u64, method: Method) -> Result<Vec<Window>, String> {
     let unit = if unit_seed >= WIDE_BASE_SEED {
-        wide_ranges().draw(unit_seed)
+        gyrotherm_experiments::wide_ranges().draw(unit_seed)
     } else {
         random_unit(unit_seed)
     };

@@ -2,7 +2,8 @@
 //! a unit nobody tuned the method to?
 //!
 //! Draws units of the simulated family (`gyrotherm::sim::imu::imu_from_family`; design family:
-//! unit seeds 1000.., confirmation family: 5000..), each three gyros in one housing with a
+//! unit seeds 1000.., confirmation family: 5000..; the wide family, 7000..: every gyro and the
+//! case sensor drawn from `gyrotherm_experiments::wide_ranges`, physics past the design ranges), each three gyros in one housing with a
 //! case sensor and a sensor beside each coil, and per unit:
 //!
 //! - training: `seed-shock` static + one ±20 °/s rate-table run per axis (a table turns one
@@ -27,7 +28,7 @@
 //! scale-factor thermal error (ppm) on the axis's table run; per-case figures go to a TSV.
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin imu_family -- [--family
-//! design|confirm] [--units 30] [--first 0] [--settings case,chosen,all] [--threads 2]
+//! design|confirm|wide] [--units 30] [--first 0] [--settings case,chosen,all] [--threads 2]
 //! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned|soak] [--hold none,lags,...]`;
 //! `--train soak` adds a static run with 6-hour soaks (docs/experiments/imu-soak.md); `--train planned` adds a
 //! static run on the chamber profile `gyrotherm plan` proposes from the unit's own airborne
@@ -116,6 +117,8 @@ const HOLDS: [&str; 14] = [
 ];
 const DESIGN_BASE_SEED: u64 = 1000;
 const CONFIRM_BASE_SEED: u64 = 5000;
+/// The wide family: units drawn from `gyrotherm_experiments::wide_ranges`.
+const WIDE_BASE_SEED: u64 = 7000;
 
 fn sim(
     unit: &ImuUnit,
@@ -687,7 +690,11 @@ fn dump_run(
 
 fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
     let settings = job.settings;
-    let unit = imu_from_family(unit_seed);
+    let unit = if unit_seed >= WIDE_BASE_SEED {
+        gyrotherm::sim::imu::imu_from_ranges(&gyrotherm_experiments::wide_ranges(), unit_seed)
+    } else {
+        imu_from_family(unit_seed)
+    };
     let s0 = unit_seed * 100;
     let mut train = vec![(
         "seed-shock-static".to_owned(),
@@ -963,7 +970,8 @@ fn run() -> Result<(), String> {
     let base = match family.as_str() {
         "design" => DESIGN_BASE_SEED,
         "confirm" => CONFIRM_BASE_SEED,
-        f => return Err(format!("--family {f:?}: use design or confirm")),
+        "wide" => WIDE_BASE_SEED,
+        f => return Err(format!("--family {f:?}: use design, confirm or wide")),
     };
     let units: u64 =
         get("--units").map_or(Ok(30), |v| v.parse().map_err(|e| format!("--units: {e}")))?;

@@ -97,7 +97,12 @@ pub struct ImuUnit {
 
 /// The inertial unit of seed `unit_seed` (see the module doc).
 pub fn imu_from_family(unit_seed: u64) -> ImuUnit {
-    let ranges = UnitRanges::default();
+    imu_from_ranges(&UnitRanges::default(), unit_seed)
+}
+
+/// [`imu_from_family`] with every gyro and the case sensor drawn from `ranges` instead of the
+/// design ranges (a family whose physics ranges are widened, for example).
+pub fn imu_from_ranges(ranges: &UnitRanges, unit_seed: u64) -> ImuUnit {
     let x = ranges.draw(unit_seed);
     let (mount_tau_s, case_tau_s) = (x.mount_tau_s, x.case_tau_s);
     let housing = |mut u: FogUnit, axis: &str| {
