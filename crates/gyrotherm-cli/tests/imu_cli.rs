@@ -49,6 +49,25 @@ fn training_runs(dir: &Path) -> Vec<std::path::PathBuf> {
     inputs
 }
 
+/// `compensate --model MODEL --input RUN --out DIR/comp.csv`: the output file's text and what
+/// it told on stderr.
+fn compensate(dir: &Path, model: &Path, run: &Path) -> (String, String) {
+    let comp = dir.join("comp.csv");
+    let out = run_ok(
+        gyrotherm()
+            .args(["compensate", "--model"])
+            .arg(model)
+            .arg("--input")
+            .arg(run)
+            .arg("--out")
+            .arg(&comp),
+    );
+    (
+        std::fs::read_to_string(&comp).unwrap(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// A linear model of unit 1000 with the case sensor and the x coil sensor.
 fn train_linear(dir: &Path) -> std::path::PathBuf {
     let inputs = training_runs(dir);
@@ -90,17 +109,7 @@ fn one_model_for_the_unit_compensates_each_axis() {
             "3",
         ],
     );
-    let comp = dir.path().join("comp.csv");
-    run_ok(
-        gyrotherm()
-            .args(["compensate", "--model"])
-            .arg(&model)
-            .arg("--input")
-            .arg(&run)
-            .arg("--out")
-            .arg(&comp),
-    );
-    let out = std::fs::read_to_string(&comp).unwrap();
+    let (out, _) = compensate(dir.path(), &model, &run);
     for g in GYROS.split(',') {
         let raw: Vec<f64> = column(&out, g).iter().map(|v| v.parse().unwrap()).collect();
         let bias: Vec<f64> = column(&out, &format!("{g}_bias"))
@@ -231,18 +240,7 @@ fn compensate_writes_each_axis_coverage_and_sigma_as_the_model_gives_them() {
         "run.csv",
         &[&UNIT[..], &["--profile", "airborne", "--seed", "3"]].concat(),
     );
-    let comp = dir.path().join("comp.csv");
-    let out = run_ok(
-        gyrotherm()
-            .args(["compensate", "--model"])
-            .arg(&model)
-            .arg("--input")
-            .arg(&run)
-            .arg("--out")
-            .arg(&comp),
-    );
-    let err = String::from_utf8_lossy(&out.stderr);
-    let out = std::fs::read_to_string(&comp).unwrap();
+    let (out, err) = compensate(dir.path(), &model, &run);
     let m = gyrotherm::unit_model::Model::load(&model).unwrap();
     let unit_model = m.to_unit(&gyrotherm::ReadOptions::default());
     assert!(
