@@ -5,7 +5,9 @@
 //! judges it on three held-out profiles through the flight compensator:
 //!
 //! - training, setting `one`: `seed-shock` static + ±20 °/s rate table; setting `two`: the same
-//!   plus `fast-cycle` static + table (two chamber runs); setting `planned`: `seed-shock`
+//!   plus `fast-cycle` static + table (two chamber runs); setting `planned-soak`: `planned`
+//!   with the first soak at each extreme sized from the slowest lag a `thermal` fit of the
+//!   `seed-shock` runs identifies, as `gyrotherm plan --train` sizes it; setting `planned`: `seed-shock`
 //!   static + table plus static + table on the chamber profile `gyrotherm plan` proposes for
 //!   the unit (`gyrotherm::plan::propose`, envelope from the unit's own airborne run with a
 //!   seed other than the held-out one's), methods `linear` and `thermal` only;
@@ -17,7 +19,7 @@
 //! thermal error (ppm) and the worst ±20 °/s output error (°/s).
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin generalisation -- [--family
-//! design|confirm] [--units 30] [--settings one,two,planned] [--methods linear,poly,...]
+//! design|confirm] [--units 30] [--settings one,two,planned,planned-soak] [--methods linear,poly,...]
 //! [--threads 2] [--cases FILE] [--temp-source sensor|coil]`; `bench/generalisation.sh` runs it as recorded in
 //! `docs/experiments/generalisation.md`. Settings are chosen on the design family only; the
 //! confirmation family is run once at the end.
@@ -275,22 +277,43 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             sim(&unit, p, seed + 2, true)?,
         ));
     }
-    if job.settings.iter().any(|s| s == "planned") {
+    // `planned` (training runs 4, 5) and `planned-soak` (6, 7).
+    for (k, soak) in [false, true].into_iter().enumerate() {
+        let name = if soak { "planned-soak" } else { "planned" };
+        if !job.settings.iter().any(|s| s == name) {
+            continue;
+        }
         // The flight input is an airborne run of this unit with its own seed, so the plan
         // never sees the held-out airborne runs it is judged on. The profile depends on the
-        // flight's envelope and the chamber limits only; the training logs so far
-        // (`seed-shock`) enter `gyrotherm plan`'s coverage report, not the profile.
+        // flight's envelope and the chamber limits, and with `planned-soak` on the slowest
+        // lag of the training logs so far (`seed-shock`), as `gyrotherm plan --input` sizes
+        // the first soak at each extreme.
         let flight = sim(&unit, "airborne", s0 + 31, false)?.log;
         let env = envelope_of(&flight).map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
-        let plan = propose(&env, &PlanSettings::default())
-            .map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
+        let mut settings = PlanSettings::default();
+        if soak {
+            let named: Vec<NamedLog> = train_all[..2]
+                .iter()
+                .map(|(name, log)| NamedLog { name, log })
+                .collect();
+            if let Ok(c) = gyrotherm::plan::training_coverage(&named, None, &env)
+                .map_err(|e| format!("unit {unit_seed} plan: {e}"))?
+            {
+                settings.slowest_lag_s = c.slowest_lag_s;
+            }
+        }
+        let plan = propose(&env, &settings).map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
         let profile = plan.profile();
+        while train_all.len() < 4 + 2 * k {
+            // Placeholders keep each setting's runs at their indices.
+            train_all.push(train_all[0].clone());
+        }
         train_all.push((
-            "planned-static".into(),
+            format!("{name}-static"),
             sim_profile(&unit, profile.clone(), s0 + 41, false)?.log,
         ));
         train_all.push((
-            "planned-table".into(),
+            format!("{name}-table"),
             sim_profile(&unit, profile, s0 + 42, true)?.log,
         ));
     }
@@ -299,6 +322,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         let picked: &[usize] = match setting.as_str() {
             "two" => &[0, 1, 2, 3],
             "planned" => &[0, 1, 4, 5],
+            "planned-soak" => &[0, 1, 6, 7],
             _ => &[0, 1],
         };
         let named: Vec<NamedLog> = picked
@@ -311,7 +335,7 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         for m in job.methods {
             let capacity =
                 m.starts_with("tlstm") || m.starts_with("auto") || m.starts_with("dlstm");
-            if setting == "planned" && m != "linear" && m != "thermal" && !capacity {
+            if setting.starts_with("planned") && m != "linear" && m != "thermal" && !capacity {
                 // The planned setting asks whether the chamber profile helps the default
                 // method; linear stays for the 0.7 × linear share.
                 continue;
@@ -447,9 +471,11 @@ fn run() -> Result<(), String> {
         .collect();
     if let Some(s) = settings
         .iter()
-        .find(|s| !["one", "two", "planned"].contains(&s.as_str()))
+        .find(|s| !["one", "two", "planned", "planned-soak"].contains(&s.as_str()))
     {
-        return Err(format!("--settings: unknown {s:?}; use one, two, planned"));
+        return Err(format!(
+            "--settings: unknown {s:?}; use one, two, planned, planned-soak"
+        ));
     }
     match get("--temp-source").as_deref() {
         None | Some("sensor") => {}
@@ -546,6 +572,8 @@ fn print_table(family: &str, cases: &[Case], methods: &[String], settings: &[Str
             match setting.as_str() {
                 "two" => "seed-shock + fast-cycle",
                 "planned" => "seed-shock + planned profile",
+                "planned-soak" =>
+                    "seed-shock + planned profile, first soaks sized to the slowest lag",
                 _ => "seed-shock",
             }
         );

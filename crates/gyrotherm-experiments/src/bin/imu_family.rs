@@ -29,7 +29,9 @@
 //!
 //! `cargo run --release -p gyrotherm-experiments --bin imu_family -- [--family
 //! design|confirm|wide] [--units 30] [--first 0] [--settings case,chosen,all] [--threads 2]
-//! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned|soak] [--hold none,lags,...]`;
+//! [--min-gain 0.02] [--cases FILE] [--train seed-shock|planned|planned-soak|soak] [--hold none,lags,...]`;
+//! `--train planned-soak`: `planned` with the first soak at each extreme sized from the slowest
+//! lag a `thermal` fit of the training static run identifies, as `gyrotherm plan --train` does;
 //! `--train soak` adds a static run with 6-hour soaks (docs/experiments/imu-soak.md); `--train planned` adds a
 //! static run on the chamber profile `gyrotherm plan` proposes from the unit's own airborne
 //! run (case sensor, a seed other than the held-out one's) to the training runs; `bench/imu_family.sh` runs it as recorded in `docs/experiments/imu.md`.
@@ -292,6 +294,9 @@ struct Job<'a> {
     min_gain: f64,
     /// Add a static run on the chamber profile `gyrotherm plan` proposes for the unit.
     planned: bool,
+    /// `--train planned-soak`: the planned profile's first soak at each extreme sized from the
+    /// training run's slowest identified lag, as `gyrotherm plan --train` sizes it.
+    plan_soak: bool,
     /// Add a static run with soaks of `soak_h` hours at -40 and +60 °C ([`soak_profile`]).
     soak: bool,
     soak_h: f64,
@@ -713,9 +718,24 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         let flight = case_log(&sim(&unit, "airborne", s0 + 31, None)?)?;
         let env = gyrotherm::plan::envelope_of(&flight)
             .map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
-        let plan =
-            gyrotherm::plan::propose(&env, &gyrotherm::settings::plan::PlanSettings::default())
-                .map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
+        let mut settings = gyrotherm::settings::plan::PlanSettings::default();
+        if job.plan_soak {
+            // As `gyrotherm plan --train` sizes the first soak at each extreme: from the
+            // slowest lag a `thermal` fit of the training static run identifies (the x gyro
+            // with the case sensor, a single gyro's log).
+            let static_run = case_log(&train[0].1)?;
+            let named = [gyrotherm::fit::NamedLog {
+                name: "seed-shock-static",
+                log: &static_run,
+            }];
+            if let Ok(c) = gyrotherm::plan::training_coverage(&named, None, &env)
+                .map_err(|e| format!("unit {unit_seed} plan: {e}"))?
+            {
+                settings.slowest_lag_s = c.slowest_lag_s;
+            }
+        }
+        let plan = gyrotherm::plan::propose(&env, &settings)
+            .map_err(|e| format!("unit {unit_seed} plan: {e}"))?;
         train.push((
             "planned-static".to_owned(),
             sim_profile(&unit, plan.profile(), s0 + 41, None)?,
@@ -993,11 +1013,16 @@ fn run() -> Result<(), String> {
     let min_gain: f64 = get("--min-gain").map_or(Ok(ImuFitSettings::default().min_gain), |v| {
         v.parse().map_err(|e| format!("--min-gain: {e}"))
     })?;
+    let plan_soak = get("--train").as_deref() == Some("planned-soak");
     let (planned, soak) = match get("--train").as_deref() {
         None | Some("seed-shock") => (false, false),
-        Some("planned") => (true, false),
+        Some("planned") | Some("planned-soak") => (true, false),
         Some("soak") => (false, true),
-        Some(v) => return Err(format!("--train {v:?}: use seed-shock, planned or soak")),
+        Some(v) => {
+            return Err(format!(
+                "--train {v:?}: use seed-shock, planned, planned-soak or soak"
+            ))
+        }
     };
     let holds: Vec<String> = get("--hold")
         .unwrap_or_else(|| "none".into())
@@ -1011,6 +1036,7 @@ fn run() -> Result<(), String> {
         settings: &settings,
         min_gain,
         planned,
+        plan_soak,
         soak,
         soak_h: get("--soak-hours").map_or(Ok(6.0), |v| {
             v.parse().map_err(|e| format!("--soak-hours: {e}"))
