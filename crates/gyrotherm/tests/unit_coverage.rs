@@ -75,13 +75,19 @@ fn an_axis_on_several_sensors_carries_its_first_sensors_map_scaled_by_what_the_o
     assert_eq!(ImuModel::from_json(&text).unwrap(), model);
 }
 
+/// `Model::coverage_log` on a several-sensor axis gives, sample by sample, the verdicts of its
+/// first sensor's one-sensor model (the fallback, with its own unscaled map) stepped on its own
+/// by the single-gyro compensator: the same cells and distances, so the same codes, and σ in
+/// the ratio of the two maps.
 #[test]
-fn coverage_log_gives_a_several_sensor_axis_a_verdict_on_every_sample() {
+fn coverage_log_gives_a_several_sensor_axis_its_first_sensors_verdicts() {
+    let fitted = several_sensor_model();
+    let a = fitted.axes[0].clone();
     // Through the file, as `compensate` and Python load it.
     let dir = std::env::temp_dir().join(format!("gyrotherm-unit-coverage-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("unit.json");
-    several_sensor_model().save(&path).unwrap();
+    fitted.save(&path).unwrap();
     let model = Model::load(&path).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let test = run(3, None);
@@ -89,22 +95,46 @@ fn coverage_log_gives_a_several_sensor_axis_a_verdict_on_every_sample() {
     assert!(notes.is_empty(), "{notes:?}");
     let cov = &axes[0];
     assert_eq!(cov.codes.len(), test.len());
-    // Every sample once the flight compensator's filters have run has a verdict and a finite,
-    // positive σ (°/h).
-    let first_verdict = cov
-        .codes
+    // The independent path: the fallback's compensator on the first sensor's column.
+    let one = a.fallback.as_ref().unwrap();
+    let map = one.coverage.as_ref().unwrap().to_core().unwrap();
+    let ratio = a
+        .model
+        .coverage
+        .as_ref()
+        .unwrap()
+        .sigma_dph
         .iter()
-        .position(|&c| c != NO_COVERAGE)
-        .expect("some verdict");
-    assert!(
-        first_verdict < 10,
-        "first verdict at sample {first_verdict}"
-    );
-    for (c, s) in cov.codes[first_verdict..]
-        .iter()
-        .zip(&cov.sigma_dph[first_verdict..])
-    {
-        assert_ne!(*c, NO_COVERAGE);
-        assert!(s.is_finite() && *s > 0.0, "{s}");
+        .zip(&one.coverage.as_ref().unwrap().sigma_dph)
+        .find(|(_, s1)| **s1 > 0.0)
+        .map(|(s, s1)| s / s1)
+        .unwrap();
+    let t = test.temp.iter().position(|c| c.name == a.temps[0]).unwrap();
+    let mut comp = gyrotherm::compensate::compensator(one).unwrap();
+    let mut judged = 0;
+    for i in 0..test.len() {
+        comp.step(
+            test.time_s[i],
+            test.gyro[0].values[i],
+            test.temp[t].values[i],
+        );
+        match map.verdict_of(comp.features()) {
+            Some(v) => {
+                judged += 1;
+                assert_eq!(cov.codes[i], v.coverage as u8, "sample {i}");
+                let want = v.sigma_dph * ratio;
+                assert!(
+                    (cov.sigma_dph[i] - want).abs() <= 1e-12 * want,
+                    "sample {i}: {} vs {want}",
+                    cov.sigma_dph[i]
+                );
+            }
+            None => assert_eq!(cov.codes[i], NO_COVERAGE, "sample {i}"),
+        }
     }
+    assert!(
+        judged > test.len() / 2,
+        "{judged} of {} samples judged",
+        test.len()
+    );
 }
