@@ -100,7 +100,6 @@ impl ImuLinesSummary {
         if self.malformed > 0 {
             s.push_str(&format!(" ({} malformed)", self.malformed));
         }
-        let none = [0; 3];
         for (k, (g, [ok, held, degraded, invalid, fallback])) in
             gyro_cols.iter().zip(&self.per_axis).enumerate()
         {
@@ -110,12 +109,20 @@ impl ImuLinesSummary {
             if *fallback > 0 {
                 s.push_str(&format!(", fallback {fallback}"));
             }
-            let [i, e, o] = self.coverage.get(k).unwrap_or(&none);
-            if i + e + o > 0 {
-                s.push_str(&format!(", coverage: inside {i}, edge {e}, outside {o}"));
-            }
+            s.push_str(&self.coverage_counts(k));
         }
         s
+    }
+
+    /// `, coverage: inside i, edge j, outside k` for axis `k`, or nothing when it had no
+    /// verdict.
+    pub(crate) fn coverage_counts(&self, k: usize) -> String {
+        match self.coverage.get(k) {
+            Some([i, e, o]) if i + e + o > 0 => {
+                format!(", coverage: inside {i}, edge {e}, outside {o}")
+            }
+            _ => String::new(),
+        }
     }
 }
 

@@ -633,16 +633,15 @@ fn several_sensor_coverage(
             return;
         }
     };
-    if let Some(c) = model.coverage.take() {
-        model.coverage = Some(c.rescaled(ratio, c.growth_per_cell));
-    }
-    shrink_by_lstm(model, lstm_ratio);
+    shrink_map(model, Some(ratio));
+    shrink_map(model, lstm_ratio);
 }
 
-/// The map's σ times a kept LSTM's held-out ratio (`auto`'s LSTM candidate and `thermal-lstm`
-/// by name shrink the same map in the same steps, so both write the same numbers).
-fn shrink_by_lstm(model: &mut ModelFile, lstm_ratio: Option<f64>) {
-    if let (Some(r), Some(c)) = (lstm_ratio, model.coverage.as_mut()) {
+/// The map's σ times `ratio`, where both are there. A kept LSTM's held-out ratio is applied by
+/// itself, after the sensors' (`auto`'s LSTM candidate and `thermal-lstm` by name shrink the
+/// same map in the same steps, so both write the same numbers).
+fn shrink_map(model: &mut ModelFile, ratio: Option<f64>) {
+    if let (Some(r), Some(c)) = (ratio, model.coverage.as_mut()) {
         *c = c.rescaled(r, c.growth_per_cell);
     }
 }
@@ -962,7 +961,7 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
             lstm_on_several(first, sets(&thermal.temps[0]), &further, &lstm_cfg)
                 .map_err(fit_err)?;
         let mut axis = thermal.clone();
-        shrink_by_lstm(&mut axis.model, lstm_ratio);
+        shrink_map(&mut axis.model, lstm_ratio);
         axis.model.method = crate::fit::thermal_lstm::label(
             Method::ThermalLstm,
             Some(&bias),

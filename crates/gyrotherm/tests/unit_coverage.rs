@@ -122,6 +122,8 @@ fn coverage_log_gives_a_several_sensor_axis_its_first_sensors_verdicts() {
             Some(v) => {
                 judged += 1;
                 assert_eq!(cov.codes[i], v.coverage as u8, "sample {i}");
+                // σ·(1 + g·d) of the scaled map against the unscaled one's times the ratio: the
+                // same product in another order, equal to rounding.
                 let want = v.sigma_dph * ratio;
                 assert!(
                     (cov.sigma_dph[i] - want).abs() <= 1e-12 * want,
@@ -132,6 +134,7 @@ fn coverage_log_gives_a_several_sensor_axis_its_first_sensors_verdicts() {
             None => assert_eq!(cov.codes[i], NO_COVERAGE, "sample {i}"),
         }
     }
+    // The comparison ran: the compensator gives features on all but its first steps.
     assert!(
         judged > test.len() / 2,
         "{judged} of {} samples judged",

@@ -540,12 +540,7 @@ impl Compensation {
                             } else {
                                 String::new()
                             };
-                            let coverage = match s.coverage.get(k) {
-                                Some([i, e, o]) if i + e + o > 0 => {
-                                    format!(", coverage: inside {i}, edge {e}, outside {o}")
-                                }
-                                _ => String::new(),
-                            };
+                            let coverage = s.coverage_counts(k);
                             format!(
                                 "{g}: {} ok, {} held, {} degraded, {} invalid{fallback}{coverage}",
                                 n[0], n[1], n[2], n[3]
