@@ -86,6 +86,7 @@ use gyrotherm::sim::imu::{
     imu_from_family, simulate_imu, truth_col, ImuConfig, ImuUnit, AXIS_NAMES, CASE_SENSOR_COL,
 };
 use gyrotherm::sim::{Profile, SimConfig};
+use gyrotherm::unit_model::{AxisCoverage, Model, NO_COVERAGE};
 use gyrotherm_core::baseline::BaselineModel;
 use gyrotherm_core::features::{FeatureKind, FeaturePipeline, FeatureSpec, MAX_FEATURES};
 
@@ -240,42 +241,21 @@ struct SigmaWindow {
     sigma_dph: f64,
 }
 
-/// The 100 s windows of axis `a`'s compensated output `comp` on the static run `log`, with the
-/// verdicts of the axis's map stepped on its first sensor's temperature, as
-/// `Model::coverage_log` steps them (an axis without a map, or a window with a sample without
-/// a verdict, gives none).
-fn sigma_windows(
-    a: &gyrotherm::imu_model::ImuAxis,
-    log: &ImuLog,
-    comp: &[f64],
-) -> Result<Vec<SigmaWindow>, String> {
-    let Some(map) = a.model.coverage.as_ref() else {
-        return Ok(Vec::new());
-    };
-    let map = map.to_core().map_err(|e| e.to_string())?;
-    let g = log
-        .gyro
-        .iter()
-        .position(|s| s.name == a.gyro)
-        .ok_or("gyro")?;
-    let t = log
-        .temp
-        .iter()
-        .position(|s| s.name == a.temps[0])
-        .ok_or("temp")?;
-    let mut c = gyrotherm::compensate::compensator(&a.model).map_err(|e| e.to_string())?;
+/// The 100 s windows of an axis's compensated output `comp` on a static run, with the
+/// verdicts `Model::coverage_log` gives that axis on the run (`cov`; a window with a sample
+/// without a verdict gives none, so an axis without a map gives none).
+fn sigma_windows(cov: &AxisCoverage, comp: &[f64]) -> Vec<SigmaWindow> {
     let mut out = Vec::new();
     let mut w: Option<(u8, f64, f64, usize)> = None;
-    for (i, out_dps) in comp.iter().enumerate() {
-        c.step(log.time_s[i], log.gyro[g].values[i], log.temp[t].values[i]);
-        let Some(v) = map.verdict_of(c.features()) else {
+    for ((out_dps, code), sigma_dph) in comp.iter().zip(&cov.codes).zip(&cov.sigma_dph) {
+        if *code == NO_COVERAGE {
             w = None;
             continue;
-        };
+        }
         let x = w.get_or_insert((0, 0.0, 0.0, 0));
-        x.0 = x.0.max(v.coverage as u8);
+        x.0 = x.0.max(*code);
         x.1 += out_dps * 3600.0;
-        x.2 += v.sigma_dph;
+        x.2 += sigma_dph;
         x.3 += 1;
         if x.3 == 100 {
             out.push(SigmaWindow {
@@ -286,7 +266,7 @@ fn sigma_windows(
             w = None;
         }
     }
-    Ok(out)
+    out
 }
 
 struct Job<'a> {
@@ -897,6 +877,14 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             };
             for (profile, st, tabs, floors) in &tests {
                 let cs = apply(st)?;
+                let coverage = if job.sigma && hold == "none" {
+                    Model::from_unit(model.clone())
+                        .coverage_log(st)
+                        .map_err(|e| e.to_string())?
+                        .0
+                } else {
+                    Vec::new()
+                };
                 if job.replica && hold == "none" {
                     // The replica must be compensate_imu exactly.
                     let reference = compensate_imu(&model, st).map_err(|e| e.to_string())?;
@@ -946,11 +934,9 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                         },
                         outside: cs[k].1,
                         lstm: axis.model.bias.as_ref().is_some_and(|b| b.lstm().is_some()),
-                        windows: if job.sigma && hold == "none" {
-                            sigma_windows(axis, st, &cs[k].0)?
-                        } else {
-                            Vec::new()
-                        },
+                        windows: coverage
+                            .get(k)
+                            .map_or_else(Vec::new, |c| sigma_windows(c, &cs[k].0)),
                     });
                 }
             }

@@ -160,7 +160,7 @@ impl Model {
     }
 
     /// An inertial unit's model (sealed: it was made, not read).
-    pub(crate) fn from_unit(m: ImuModel) -> Model {
+    pub fn from_unit(m: ImuModel) -> Model {
         Model {
             form: Form::Unit(m),
             seal: Seal::Verified,
