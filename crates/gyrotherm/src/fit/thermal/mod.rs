@@ -620,15 +620,15 @@ fn identify_runs(
     })
 }
 
-/// Fit one target on training sets whose features are the identified spec's: ridge over
-/// [`basis`], strength by blocked cross-validation (or the fallback), per-run offsets
-/// averaged into the constant.
-pub fn fit_target(
+/// The basis [`fit_target`] fits a target with: the configured one (the scale basis, or the
+/// bias basis identified), degraded one step at a time while the training runs hold fewer
+/// than 100 labelled steps per term.
+pub(crate) fn target_basis(
     sets: &[TargetSet],
     cfg: &ThermalConfig,
     id: &Identified,
     scale: bool,
-) -> Result<(SubModel, ThermalReport), ThermalError> {
+) -> Basis {
     let lags = id.report.lags_s.len();
     let mut kind = if scale { cfg.scale_basis } else { id.basis };
     let labelled: usize = sets.iter().map(|s| s.labelled()).sum();
@@ -640,6 +640,20 @@ pub fn fit_target(
             _ => Basis::Minimal,
         };
     }
+    kind
+}
+
+/// Fit one target on training sets whose features are the identified spec's: ridge over
+/// [`basis`], strength by blocked cross-validation (or the fallback), per-run offsets
+/// averaged into the constant.
+pub fn fit_target(
+    sets: &[TargetSet],
+    cfg: &ThermalConfig,
+    id: &Identified,
+    scale: bool,
+) -> Result<(SubModel, ThermalReport), ThermalError> {
+    let lags = id.report.lags_s.len();
+    let kind = target_basis(sets, cfg, id, scale);
     let terms = basis(kind, lags);
     let nc = terms.len() - 1;
     let mut d = Design {
@@ -669,6 +683,7 @@ pub fn fit_target(
         d.n_steps.push(s.table.n_rows());
     }
     let needed = nc + 1 + sets.len();
+    let labelled: usize = sets.iter().map(|s| s.labelled()).sum();
     if labelled < needed {
         return Err(ThermalError::TooFewSteps {
             steps: labelled,

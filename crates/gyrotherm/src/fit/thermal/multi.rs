@@ -86,25 +86,14 @@ pub(crate) fn extra_terms(lags: usize, kind: ExtraTerms) -> Terms {
 }
 
 /// The first sensor's terms for a target, degraded on few labelled steps exactly as
-/// [`fit_target`] does.
+/// [`fit_target`] does ([`target_basis`]).
 pub(crate) fn first_terms(
     sets: &[TargetSet],
     cfg: &ThermalConfig,
     id: &Identified,
     scale: bool,
 ) -> Terms {
-    let lags = id.report.lags_s.len();
-    let mut kind = if scale { cfg.scale_basis } else { id.basis };
-    let labelled: usize = sets.iter().map(|s| s.labelled()).sum();
-    while kind != Basis::Minimal && labelled < 100 * basis(kind, lags).len() {
-        kind = match kind {
-            Basis::Full => Basis::Small,
-            Basis::Small => Basis::Linear,
-            Basis::Linear => Basis::Lean,
-            _ => Basis::Minimal,
-        };
-    }
-    basis(kind, lags)
+    basis(target_basis(sets, cfg, id, scale), id.report.lags_s.len())
 }
 
 /// The terms of one target on the sensors `order`: the first sensor's (its constant first)
