@@ -242,7 +242,7 @@ fn stream_in_process(
         text.push('\n');
     }
     let mut out = Vec::new();
-    gyrotherm::compensate_imu_lines::compensate_imu_lines(
+    gyrotherm::compensate_lines::unit::compensate_imu_lines(
         model,
         text.as_bytes(),
         Path::new("generated"),
@@ -437,7 +437,7 @@ fn generated_unit_c_equals_the_unit_stream() {
             assert_eq!(want.len(), s.len(), "unit {u}: one line out per line in");
             // The coverage verdicts: the core unit stepped here, each axis's map on its
             // features (C: 0 inside, 1 edge, 2 outside, 3 no verdict yet, 4 no map).
-            let mut unit = gyrotherm::compensate_imu_lines::flight_unit(m).unwrap();
+            let mut unit = gyrotherm::compensate_lines::unit::flight_unit(m).unwrap();
             // An axis on its fallback: the fallback's map on the fallback's features.
             let map_of =
                 |f: &gyrotherm::model::ModelFile| f.coverage.as_ref().map(|c| c.to_core().unwrap());

@@ -51,9 +51,8 @@
 //! - [`spec`]: spec sheets: limits on the standard figures, and a run's verdict.
 //! - `imu_error`: why an inertial-unit model cannot be fitted, read, written or applied.
 //! - [`compensate_lines`](mod@compensate_lines): a CSV stream compensated line by line, with a
-//!   status per line.
+//!   status per line, for one gyro or each axis of a unit ([`compensate_lines::unit`](mod@compensate_lines::unit)).
 //! - [`imu_model`]: one model file for an inertial unit: a model per gyro axis.
-//! - [`compensate_imu_lines`]: an inertial unit's CSV stream compensated line by line.
 //! - [`imu_judge`]: the standard figures and verdicts of an inertial unit, axis by axis.
 //! - [`plan`]: what the training logs cover of a flight's envelope, and the runs still needed.
 //! - [`report`]: the figures and the HTML report.
@@ -87,7 +86,6 @@ pub mod atomic_file;
 pub mod baseline;
 pub mod compare;
 pub mod compensate;
-pub mod compensate_imu_lines;
 pub mod compensate_lines;
 pub mod coverage;
 pub mod coverage_track;

@@ -11,7 +11,7 @@
 #[path = "../../gyrotherm-core/examples/imu_flight/gyrotherm_model.rs"]
 mod gyrotherm_model;
 
-use gyrotherm::compensate_imu_lines::compensate_imu_lines;
+use gyrotherm::compensate_lines::unit::compensate_imu_lines;
 use gyrotherm::compensate_lines::Mode;
 use gyrotherm::imu_model::ImuModel;
 use gyrotherm::sim::imu::{imu_from_family, simulate_imu, ImuConfig};

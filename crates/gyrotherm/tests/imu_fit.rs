@@ -218,7 +218,7 @@ fn the_stream_runs_an_axis_on_several_sensors_as_compensate_imu_does() {
     let want = compensate_imu(&model, &test).unwrap();
     assert_eq!(want[0].status[5000], Status::Held);
     let mut out = Vec::new();
-    gyrotherm::compensate_imu_lines::compensate_imu_lines(
+    gyrotherm::compensate_lines::unit::compensate_imu_lines(
         &model,
         std::io::BufReader::new(std::fs::File::open(&path).unwrap()),
         &path,

@@ -8,7 +8,7 @@
 //! The files are the `imu_flight` example's model (`gyrotherm train` of three gyros and four
 //! sensors, every axis reading several), hand-edited as a hostile probe would.
 
-use gyrotherm::compensate_imu_lines::{compensate_imu_lines, MAX_STREAM_AXES};
+use gyrotherm::compensate_lines::unit::{compensate_imu_lines, MAX_STREAM_AXES};
 use gyrotherm::compensate_lines::Mode;
 use gyrotherm::csvlog::ReadOptions;
 use gyrotherm::imu_model::{compensate_imu, ImuError, ImuModel};

@@ -9,7 +9,7 @@ use std::borrow::Cow;
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
-use crate::compensate_imu_lines::{compensate_imu_file, compensate_imu_lines, ImuLinesSummary};
+use crate::compensate_lines::unit::{compensate_imu_file, compensate_imu_lines, ImuLinesSummary};
 use crate::compensate_lines::{
     compensate_file, compensate_lines, FileError, LinesError, LinesSummary, Mode,
 };

@@ -26,6 +26,9 @@
 //! may use a decimal comma, and the output uses the same separator (numbers with a decimal
 //! point, which the reader accepts beside the comma). A line longer than [`MAX_LINE_BYTES`] is
 //! malformed (its bytes are skipped, not kept).
+//!
+//! An inertial unit's model runs the same line loop (`run_lines`) in [`unit`](mod@unit), with the
+//! columns of each of its axes.
 
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -39,6 +42,8 @@ use crate::model::ModelFile;
 /// malformed: in [`Mode::Stream`] it gives one `invalid` output line and its bytes are skipped
 /// without being kept, so one endless line cannot take the memory of a flight computer.
 pub use crate::csvlog::MAX_LINE_BYTES;
+
+pub mod unit;
 
 /// Columns appended to every row, in order.
 pub(crate) const OUTPUT_COLUMNS: [&str; 6] = [

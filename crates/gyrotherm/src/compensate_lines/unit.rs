@@ -34,7 +34,7 @@ use std::path::Path;
 
 use gyrotherm_core::compensator::{Corrected, Status};
 
-use crate::compensate_lines::{
+use super::{
     gyro_not_a_number, lines_to_file, parse_number, push_corrected, push_invalid, push_verdict,
     read_header, run_lines, Cadence, Fields, FileError, LineCheck, LineModel, LinesError, Mode,
 };
