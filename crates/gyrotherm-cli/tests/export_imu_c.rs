@@ -224,7 +224,7 @@ fn unit_stream(u: usize, axes: usize, temps: usize) -> Vec<Vec<f64>> {
 type StreamAxis = ((usize, f64, f64, f64), (usize, f64));
 
 fn stream_in_process(
-    model: &gyrotherm::imu_model::ImuModel,
+    model: &gyrotherm::model::unit::ImuModel,
     rows: &[Vec<f64>],
 ) -> Vec<Vec<StreamAxis>> {
     let mut text = String::from("time_s,");
@@ -331,7 +331,7 @@ fn generated_unit_c_equals_the_unit_stream() {
         let mut units = Vec::new();
         for &u in &ids {
             let (json, axes, temps) = unit_model(u);
-            let m = gyrotherm::imu_model::ImuModel::from_json(&json.to_string())
+            let m = gyrotherm::model::unit::ImuModel::from_json(&json.to_string())
                 .unwrap_or_else(|e| panic!("generated unit {u}: {e}"));
             if m.hidden_size().unwrap().units() == 32 {
                 wide_units += 1;

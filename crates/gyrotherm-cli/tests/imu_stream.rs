@@ -190,10 +190,10 @@ fn batch_and_stream_write_the_same_file_and_a_sensor_fault_stays_on_its_axis() {
     let input = d.join("finite.csv");
     std::fs::write(&input, &finite).unwrap();
     let streamed = stream(&model, &input, &[]);
-    let m = gyrotherm::imu_model::ImuModel::load(&model).unwrap();
+    let m = gyrotherm::model::unit::ImuModel::load(&model).unwrap();
     let opts = m.read_options(&gyrotherm::ReadOptions::default());
     let (log, _) = gyrotherm::csvlog::read_imu_log(&input, &opts, None).unwrap();
-    let want = gyrotherm::imu_model::compensate_imu(&m, &log).unwrap();
+    let want = gyrotherm::compensate::unit::compensate_imu(&m, &log).unwrap();
     let (mut n, mut differ) = (0, 0);
     for (k, g) in GYROS.iter().enumerate() {
         let get = |suffix: &str| {

@@ -71,7 +71,7 @@ fn model_check_and_seal_take_a_unit_model() {
         out.contains("ok, sealed") && !err.contains(UNSEALED),
         "{out}{err}"
     );
-    let digest = gyrotherm::imu_model::ImuModel::load(&model)
+    let digest = gyrotherm::model::unit::ImuModel::load(&model)
         .unwrap()
         .content_digest()
         .unwrap();

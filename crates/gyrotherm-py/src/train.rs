@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use gyrotherm::imu_model::ImuFitEvent;
+use gyrotherm::fit::unit::ImuFitEvent;
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::told::Told;
 use gyrotherm::train::{train, TrainEvent};

@@ -23,12 +23,12 @@ use crate::compare::{
     compare, performance, CompareConfig, CompareError, Comparison, ComparisonSummary,
     ComparisonTable, Performance, TableFigure,
 };
+use crate::compensate::unit::compensate_imu;
 use crate::csvlog::{ExtraColumn, ImuLog, TestLog, GYRO_COL};
+use crate::fit::unit::{fit_imu_with_events, ImuEvents, UnitFitError};
 use crate::fit::{NamedLog, Target};
-use crate::imu_model::{
-    compensate_imu, fit_imu_with_events, ImuAxis, ImuError, ImuEvents, ImuModel,
-};
 use crate::metrics::Evaluation;
+use crate::model::unit::{ImuAxis, ImuError, ImuModel};
 use crate::model::TempSensorDef;
 use crate::settings::evaluate::{EvaluateError, EvaluateSettings, ResolvedTau};
 use crate::spec::{self, MeasureOptions, Spec, SpecError, Verdict};
@@ -58,8 +58,10 @@ pub enum ImuJudgeError {
         output: &'static str,
         source: Box<SpecError>,
     },
-    /// The unit model (fitting it, or compensating with it).
+    /// The unit model (compensating with it).
     Unit(ImuError),
+    /// Fitting the unit model.
+    Fit(UnitFitError),
     /// The logs or settings do not fit together (the message says what to do).
     Layout(String),
 }
@@ -77,7 +79,7 @@ impl std::fmt::Display for ImuJudgeError {
             ImuJudgeError::Spec { gyro, output, .. } => {
                 write!(f, "axis {gyro} ({output} output) against the spec sheet")
             }
-            ImuJudgeError::Unit(_) => write!(f, "the unit model"),
+            ImuJudgeError::Unit(_) | ImuJudgeError::Fit(_) => write!(f, "the unit model"),
             ImuJudgeError::Layout(m) => write!(f, "{m}"),
         }
     }
@@ -91,6 +93,7 @@ impl std::error::Error for ImuJudgeError {
             ImuJudgeError::UnitFit { source, .. } => Some(source),
             ImuJudgeError::Spec { source, .. } => Some(source.as_ref()),
             ImuJudgeError::Unit(e) => Some(e),
+            ImuJudgeError::Fit(e) => Some(e),
             ImuJudgeError::Layout(_) => None,
         }
     }
@@ -628,7 +631,7 @@ pub(crate) fn compare_imu(
     } else {
         Some(
             fit_imu_with_events(train, &cfg.fit, temp_sensor, &|_, _, _, _, _| {}, events)
-                .map_err(ImuJudgeError::Unit)?,
+                .map_err(ImuJudgeError::Fit)?,
         )
     };
     let sensors: Vec<usize> = unit

@@ -39,20 +39,19 @@
 //! - [`settings`]: what a user can choose for each job, with every default, list of values
 //!   and check defined once (the command line and Python only translate).
 //! - [`model`]: the model file ([`ModelFile::save`], [`ModelFile::load`]), with the coverage
-//!   map it carries.
+//!   map it carries; an inertial unit's file, a model per gyro axis, in
+//!   [`model::unit`](mod@model::unit).
 //! - [`compensate`]: the flight compensator (`gyrotherm-core`) run over a log
-//!   ([`compensate_log`]).
+//!   ([`compensate_log`]; a unit's, axis by axis, [`compensate::unit`](mod@compensate::unit)).
 //! - [`coverage`]: what training covered: the cross-validated coverage map, and a log's
 //!   shares inside it.
 //! - [`coverage_track`]: a log's path through a model's coverage map, sample by sample.
 //! - [`fit`]: fitting a compensation model from training logs ([`fit_model`], [`FitConfig`],
-//!   [`RecipeSettings`]).
+//!   [`RecipeSettings`]; a unit's, axis by axis, [`fit::unit`](mod@fit::unit)).
 //! - [`compare`]: held-out comparison of methods: the numbers of the results table.
 //! - [`spec`]: spec sheets: limits on the standard figures, and a run's verdict.
-//! - `imu_error`: why an inertial-unit model cannot be fitted, read, written or applied.
 //! - [`compensate_lines`](mod@compensate_lines): a CSV stream compensated line by line, with a
 //!   status per line, for one gyro or each axis of a unit ([`compensate_lines::unit`](mod@compensate_lines::unit)).
-//! - [`imu_model`]: one model file for an inertial unit: a model per gyro axis.
 //! - [`imu_judge`]: the standard figures and verdicts of an inertial unit, axis by axis.
 //! - [`plan`]: what the training logs cover of a flight's envelope, and the runs still needed.
 //! - [`report`]: the figures and the HTML report.
@@ -97,9 +96,7 @@ pub mod export;
 pub mod features;
 pub mod fit;
 pub mod flight_size;
-pub(crate) mod imu_error;
 pub mod imu_judge;
-pub mod imu_model;
 pub mod input_file;
 pub mod json_keys;
 pub mod judge;

@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use crate::csvlog::{ImuLog, LogSet, LogSetForm, ReadOptions};
+use crate::fit::unit::{fit_imu_with_events, ImuFitEvent, UnitFitError};
 use crate::fit::{fit_model, FitConfig, FitError, NamedLog, Target};
-use crate::imu_error::ImuError;
-use crate::imu_model::{fit_imu_with_events, ImuFitEvent, ImuModel};
+use crate::model::unit::ImuModel;
 use crate::model::{ColumnsDef, TempSensorDef};
 use crate::told::Told;
 use crate::unit_model::Model;
@@ -48,7 +48,7 @@ pub enum TrainError {
     /// A single gyro's fit.
     Single(FitError),
     /// An inertial unit's fit.
-    Unit(ImuError),
+    Unit(UnitFitError),
 }
 
 impl std::fmt::Display for TrainError {

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use gyrotherm::export::autopilot::{self, ModelRef};
 use gyrotherm::export::ExportTarget;
-use gyrotherm::imu_model::ImuModel;
+use gyrotherm::model::unit::ImuModel;
 use gyrotherm::model::ModelFile;
 use gyrotherm::settings::autopilot::{AutopilotSettings, GyroAxis};
 

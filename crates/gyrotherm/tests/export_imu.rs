@@ -13,7 +13,7 @@ mod gyrotherm_model;
 
 use gyrotherm::compensate_lines::unit::compensate_imu_lines;
 use gyrotherm::compensate_lines::Mode;
-use gyrotherm::imu_model::ImuModel;
+use gyrotherm::model::unit::ImuModel;
 use gyrotherm::sim::imu::{imu_from_family, simulate_imu, ImuConfig};
 use gyrotherm::sim::{Profile, SimConfig};
 use gyrotherm_core::unit::Unit;

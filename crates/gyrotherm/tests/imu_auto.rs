@@ -5,8 +5,9 @@
 //! method fits by name, and the file round-trips through its checks.
 
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
+use gyrotherm::fit::unit::fit_imu;
 use gyrotherm::fit::FitConfig;
-use gyrotherm::imu_model::{fit_imu, ImuAxis, ImuModel, IMU_FORMAT_VERSION};
+use gyrotherm::model::unit::{ImuAxis, ImuModel, IMU_FORMAT_VERSION};
 use gyrotherm::model::{TempSensorDef, Validation};
 use gyrotherm::settings::{FitSettings, Method};
 use gyrotherm::told::Told;

@@ -7,10 +7,12 @@
 //!
 //! Either way the file round-trips with its checks and the unit's flight compensator runs it.
 
+use gyrotherm::compensate::unit::compensate_imu;
 use gyrotherm::csvlog::TRUE_BIAS_COL;
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
+use gyrotherm::fit::unit::fit_imu;
 use gyrotherm::imu_judge::axis_test_log;
-use gyrotherm::imu_model::{compensate_imu, fit_imu, ImuAxis, ImuModel};
+use gyrotherm::model::unit::{ImuAxis, ImuModel};
 use gyrotherm::model::{MethodChoice, SubModel, TempSensorDef, Validation};
 use gyrotherm::plan::{propose, resolve_envelope};
 use gyrotherm::settings::plan::PlanSettings;

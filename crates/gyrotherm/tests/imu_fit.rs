@@ -4,10 +4,9 @@
 //! that read it.
 
 use gyrotherm::compensate::compensate_log;
-use gyrotherm::imu_model::{
-    compensate_imu, fit_imu_with, ImuFitSettings, ImuModel, ImuSensors, IMU_FORMAT_VERSION,
-    IMU_FORMAT_VERSION_ONE_SENSOR,
-};
+use gyrotherm::compensate::unit::compensate_imu;
+use gyrotherm::fit::unit::{fit_imu_with, ImuFitSettings, ImuSensors};
+use gyrotherm::model::unit::{ImuModel, IMU_FORMAT_VERSION, IMU_FORMAT_VERSION_ONE_SENSOR};
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::{FitSettings, Method};
 use gyrotherm_core::compensator::Status;
@@ -101,7 +100,7 @@ fn every_sensor_when_cross_validation_keeps_it() {
         p[i] = q;
         p
     };
-    let further_terms = |a: &gyrotherm::imu_model::ImuAxis, cubic: bool| {
+    let further_terms = |a: &gyrotherm::model::unit::ImuAxis, cubic: bool| {
         let lags = a.more[0].lags_s.len();
         let n = 2 + lags;
         let mut want = vec![power(n, 0, 1)];

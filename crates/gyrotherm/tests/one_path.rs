@@ -149,7 +149,7 @@ fn train_on_a_unit_s_set_tells_each_axis_step_with_its_names() {
     }
     // The unit fit called directly gives the same file.
     let (log, _) = gyrotherm::csvlog::read_imu_log(&path, &opts, None).unwrap();
-    let want = gyrotherm::imu_model::fit_imu(
+    let want = gyrotherm::fit::unit::fit_imu(
         &[(path.display().to_string(), log)],
         &cfg,
         &TempSensorDef::default(),

@@ -5,7 +5,8 @@
 //! the file (`multi_cv_rms`, `scores`). `Model::coverage_log` gives a verdict on every sample
 //! of such an axis once its filters have run.
 
-use gyrotherm::imu_model::{fit_imu_with, ImuFitSettings, ImuModel, ImuSensors};
+use gyrotherm::fit::unit::{fit_imu_with, ImuFitSettings, ImuSensors};
+use gyrotherm::model::unit::ImuModel;
 use gyrotherm::model::TempSensorDef;
 use gyrotherm::settings::{FitSettings, Method};
 use gyrotherm::unit_model::{Model, NO_COVERAGE};

@@ -8,10 +8,11 @@
 //! The files are the `imu_flight` example's model (`gyrotherm train` of three gyros and four
 //! sensors, every axis reading several), hand-edited as a hostile probe would.
 
+use gyrotherm::compensate::unit::compensate_imu;
 use gyrotherm::compensate_lines::unit::{compensate_imu_lines, MAX_STREAM_AXES};
 use gyrotherm::compensate_lines::Mode;
 use gyrotherm::csvlog::ReadOptions;
-use gyrotherm::imu_model::{compensate_imu, ImuError, ImuModel};
+use gyrotherm::model::unit::{ImuError, ImuModel};
 use gyrotherm::model::Seal;
 use gyrotherm::sim::imu::{imu_from_family, simulate_imu, ImuConfig};
 use gyrotherm::sim::{Profile, SimConfig};

@@ -73,13 +73,13 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
+use gyrotherm::compensate::unit::{compensate_imu, imu_axis_compensators};
 use gyrotherm::csvlog::{ImuLog, NamedSeries};
+use gyrotherm::fit::unit::{fit_imu_with, ImuFitSettings, ImuSensors};
 use gyrotherm::fit::{FitConfig, RecipeSettings};
-use gyrotherm::imu_model::{
-    compensate_imu, fit_imu_with, imu_axis_compensators, ImuFitSettings, ImuModel, ImuSensors,
-};
 use gyrotherm::metrics::bias_stability_dph;
 use gyrotherm::metrics::scale_factor::{scale_factor, ScaleFactorOptions};
+use gyrotherm::model::unit::ImuModel;
 use gyrotherm::model::SubModel;
 use gyrotherm::model::{Method, TempSensorDef};
 use gyrotherm::sim::imu::{

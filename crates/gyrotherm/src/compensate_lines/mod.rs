@@ -120,7 +120,7 @@ pub enum LinesError {
     Model(crate::compensate::CompensateError),
     /// An inertial-unit model cannot be turned into the flight unit, or the log lacks one of
     /// its columns.
-    Unit(crate::imu_error::ImuError),
+    Unit(crate::model::unit::ImuError),
     /// The input (header, or a malformed line in [`Mode::Strict`]): file, line, column, fix.
     Log(LogError),
     /// Reading the input or writing the output failed.

@@ -1,5 +1,5 @@
 //! Compensate an inertial unit's CSV log line by line: what `gyrotherm compensate --stream`
-//! runs with a unit model ([`crate::imu_model`]).
+//! runs with a unit model ([`crate::model::unit`]).
 //!
 //! The line loop is the single-axis stream's ([`compensate_lines`](mod@crate::compensate_lines)):
 //! the header (comments and blank lines before it), the line cap
@@ -38,9 +38,10 @@ use super::{
     gyro_not_a_number, lines_to_file, parse_number, push_corrected, push_invalid, push_verdict,
     read_header, run_lines, Cadence, Fields, FileError, LineCheck, LineModel, LinesError, Mode,
 };
+use crate::compensate::unit::imu_axis_compensators;
 use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
-pub use crate::imu_model::MAX_STREAM_AXES;
-use crate::imu_model::{imu_axis_compensators, ImuError, ImuModel};
+pub use crate::model::unit::MAX_STREAM_AXES;
+use crate::model::unit::{ImuError, ImuModel};
 use gyrotherm_core::coverage::CoverageMap;
 
 pub use crate::flight_size::StreamUnit;
@@ -61,7 +62,7 @@ pub(crate) fn output_columns(model: &ImuModel) -> Vec<String> {
 
 /// The flight unit of `model`: axis `i` runs axis `i`'s model on its sensors' indices among
 /// the model's temperature columns (the first sensor's compensator and any further sensors'
-/// parts, [`imu_axis_compensators`]), the same axes as batch [`crate::imu_model::compensate_imu`].
+/// parts, [`imu_axis_compensators`]), the same axes as batch [`crate::compensate::unit::compensate_imu`].
 pub fn flight_unit(model: &ImuModel) -> Result<Box<StreamUnit>, ImuError> {
     let comps = imu_axis_compensators(model)?;
     // Boxed: a unit of 16 axes, each with its fallback, is some 370 KB (more with larger

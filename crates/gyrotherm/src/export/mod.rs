@@ -41,7 +41,7 @@ pub enum ExportError {
     /// The model cannot be turned into flight form.
     Flight(CompensateError),
     /// An inertial-unit model fails its checks, or one of its axes cannot be exported.
-    Unit(crate::imu_model::ImuError),
+    Unit(crate::model::unit::ImuError),
     /// The model cannot be written as autopilot parameters.
     Autopilot(autopilot::AutopilotError),
     /// Writing an output file failed.

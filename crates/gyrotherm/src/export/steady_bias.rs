@@ -29,7 +29,7 @@ use std::fmt::Write as _;
 use gyrotherm_core::features::FeatureKind;
 
 use super::{ExportError, ExportTarget};
-use crate::imu_model::ImuModel;
+use crate::model::unit::ImuModel;
 use crate::model::{ModelFile, SubModel};
 use crate::settings::autopilot::AutopilotSettings;
 use crate::settings::SettingError;

@@ -26,7 +26,7 @@
 //! reading, the pipelines pushed together, the parts added in order, every pipeline restarted
 //! on a new time base. So each axis computes exactly what the
 //! core's [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last
-//! bit. An axis with a fallback model ([`crate::imu_model::ImuAxis::fallback`]) also gets the
+//! bit. An axis with a fallback model ([`crate::model::unit::ImuAxis::fallback`]) also gets the
 //! single-axis port of that model, suffixed `_a<i>f`, stepped on its first sensor alongside,
 //! and the unit function makes the core's choice between the two outputs
 //! ([`gyrotherm_core::multi`]: status `GT_FALLBACK`).
@@ -52,7 +52,7 @@ use gyrotherm_core::static_model::{StaticBaseline, StaticModel, StaticTarget};
 use super::{
     c, describe, rust, sized_static_model, static_baseline, write_files, ExportError, Lang,
 };
-use crate::imu_model::{ImuError, ImuModel};
+use crate::model::unit::{ImuError, ImuModel};
 use crate::model::CHECKSUM_KEY;
 
 /// The model-independent helpers of the C port, written once for the unit: the text from

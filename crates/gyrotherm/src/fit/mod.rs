@@ -33,6 +33,7 @@ pub mod select;
 pub mod terms;
 pub mod thermal;
 pub mod thermal_lstm;
+pub mod unit;
 
 use crate::baseline::{self, PolyDegrees, Terms};
 use crate::csvlog::TestLog;

@@ -5,9 +5,39 @@ use super::*;
 
 use crate::flight_size::HiddenSize;
 use gyrotherm_core::compensator::ModelError as FlightModelError;
-use gyrotherm_core::compensator::{TargetModel, LSTM_INPUTS};
+use gyrotherm_core::compensator::{Compensator, TargetModel, LSTM_INPUTS};
 use gyrotherm_core::features::MAX_FEATURES;
 use gyrotherm_core::static_model::{StaticBaseline, StaticLstm, StaticTarget};
+
+/// [`sized_compensator`], boxed in a frame of its own (see [`crate::flight_size`]).
+#[inline(never)]
+pub(crate) fn boxed_compensator<const H: usize>(
+    model: &ModelFile,
+) -> Result<Box<Compensator<H>>, CompensateError> {
+    sized_compensator::<H>(model).map(Box::new)
+}
+
+/// The flight compensator of a model file (bias 0 °/s and K = 1 where a target is absent) at
+/// `H` hidden units (an LSTM of the model larger than `H` is refused).
+pub(crate) fn sized_compensator<const H: usize>(
+    model: &ModelFile,
+) -> Result<Compensator<H>, CompensateError> {
+    let spec = model.feature_spec().map_err(CompensateError::Model)?;
+    let in_target = |target| {
+        move |e| CompensateError::InTarget {
+            target,
+            source: Box::new(e),
+        }
+    };
+    let bias = target_model(model.bias.as_ref(), 0.0).map_err(in_target(Target::Bias))?;
+    let scale = target_model(model.scale.as_ref(), 1.0).map_err(in_target(Target::Scale))?;
+    let limits = model
+        .features
+        .temp_sensor
+        .to_core()
+        .map_err(CompensateError::Model)?;
+    Compensator::with_limits(spec, bias, scale, limits).map_err(CompensateError::Flight)
+}
 
 /// Widen an LSTM to the flight input count and `H` hidden units: input columns beyond
 /// `input_size` get weight 0, and so do hidden units beyond `hidden_size` (their state stays

@@ -676,9 +676,11 @@ mod flight;
 mod ground;
 mod method_choice;
 mod seal;
+pub mod unit;
 
 pub use checks::SubModelError;
 pub use coverage_map::CoverageDef;
+pub(crate) use flight::{boxed_compensator, sized_compensator};
 pub use flight::{
     hidden_size, padded_core_lstm, static_baseline, static_target, target_model, CompensateError,
 };

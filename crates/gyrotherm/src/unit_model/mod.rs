@@ -17,10 +17,10 @@ use crate::csvlog::ReadOptions;
 use crate::export::autopilot::{self, AutopilotExport, ModelRef};
 use crate::export::unit::{column_map, export_imu};
 use crate::export::{export, ExportError, ExportTarget, Lang};
-use crate::imu_model::{
+use crate::input_file::{read_capped_to_string, InputKind};
+use crate::model::unit::{
     is_imu_model_text, ImuAxis, ImuError, ImuModel, SensorScore, IMU_FORMAT_VERSION_ONE_SENSOR,
 };
-use crate::input_file::{read_capped_to_string, InputKind};
 use crate::model::{GivenColumns, ModelFile, ModelFileError, Seal};
 use crate::settings::autopilot::AutopilotSettings;
 pub use crate::told::Told;

@@ -3,10 +3,10 @@
 //! writes for the same samples, and per sample the coverage verdict and σ.
 
 use super::{Form, Model};
+use crate::compensate::unit::{compensate_imu, AxisCompensated};
 use crate::compensate::{compensator, extrapolation_warnings, CompensateError};
 use crate::csvlog::{ImuLog, ReadOptions, TestLog};
-use crate::imu_error::ImuError;
-use crate::imu_model::{compensate_imu, AxisCompensated};
+use crate::model::unit::ImuError;
 
 /// Why samples could not be compensated.
 #[derive(Debug)]

@@ -1,6 +1,6 @@
 //! Reading and checking the choice `auto` records on an inertial unit's axis.
 
-use gyrotherm::imu_model::ImuAxis;
+use gyrotherm::model::unit::ImuAxis;
 use gyrotherm::model::{MethodChoice, Validation};
 use gyrotherm::settings::Method;
 

@@ -1,23 +1,15 @@
-//! Why an inertial-unit model ([`crate::imu_model`]) cannot be fitted, read, written or
-//! applied: defined apart from the model so that the line-by-line compensation, which
-//! carries it, need not import the model.
+//! Why an inertial-unit model ([`super::ImuModel`]) cannot be read, written or applied. Its
+//! fit's own errors are [`crate::fit::unit::UnitFitError`].
 
 use std::path::PathBuf;
 
-use crate::fit::FitError;
 use crate::json_keys::DuplicateKey;
 use crate::model::{CompensateError, ModelFileError, SubModelError, Target, CHECKSUM_KEY};
 
-/// Why an inertial-unit model cannot be fitted, read, written or applied.
+/// Why an inertial-unit model cannot be read, written or applied.
 #[derive(Debug)]
 #[non_exhaustive]
 pub enum ImuError {
-    /// Fitting axis `gyro` on sensor `temp` failed.
-    Fit {
-        gyro: String,
-        temp: String,
-        source: Box<FitError>,
-    },
     /// The model of axis `gyro` is not valid.
     Axis {
         gyro: String,
@@ -57,9 +49,6 @@ pub enum ImuError {
 impl std::fmt::Display for ImuError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            ImuError::Fit { gyro, temp, .. } => {
-                write!(f, "fitting axis {gyro} on sensor {temp} failed")
-            }
             ImuError::Axis { gyro, .. } => write!(f, "the model of axis {gyro}"),
             ImuError::Layout(m) => write!(f, "{m}"),
             ImuError::FurtherSensor {
@@ -86,7 +75,6 @@ impl std::fmt::Display for ImuError {
 impl std::error::Error for ImuError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            ImuError::Fit { source, .. } => Some(source.as_ref()),
             ImuError::Axis { source, .. } => Some(source.as_ref()),
             ImuError::FurtherSensor { source, .. } => Some(source.as_ref()),
             ImuError::Json(e) => Some(e),

@@ -1,13 +1,12 @@
-//! One model file for an inertial unit: per gyro axis a bias and a scale-factor model, the
-//! gyro columns and the temperature sensors the unit's log must hold, and which sensors each
-//! axis reads.
+//! Fitting an inertial unit's model ([`ImuModel`]): per gyro axis a bias and a scale-factor
+//! model, on the temperature sensors it reads.
 //!
 //! By default ([`ImuSensors::All`]) every axis may read every listed sensor: with the
 //! `thermal` method each sensor's lags are identified on its own, the sensor whose one-sensor
 //! fit has the lowest cross-validated RMS comes first, and the others join while they lower
 //! the cross-validated RMS ([`crate::fit::thermal::multi`]); the axis's model is then the first
 //! sensor's model plus each further sensor's linear part ([`SensorModel`]), run by the flight
-//! [`AxisCompensator`]. With [`ImuSensors::ChooseOne`] (and for methods without
+//! [`AxisCompensator`](gyrotherm_core::multi::AxisCompensator). With [`ImuSensors::ChooseOne`] (and for methods without
 //! cross-validation, which keep the first sensor) each axis reads one sensor, an ordinary
 //! single-sensor [`ModelFile`]. The axes fit on their own threads. A fault in one sensor
 //! reaches only the axes that read it. An axis with further sensors also keeps its first
@@ -22,126 +21,61 @@
 //! builds it, whichever scores lower on held-out validation of the training runs (as `auto`
 //! scores one gyro, [`crate::fit::auto`]); the axis's model records both scores and the
 //! choice ([`ModelFile::method_choice`]).
-//!
-//! The file is JSON with `imu_format_version` (which tells it from a single-axis file, whose
-//! format is unchanged): 1 when every axis reads one sensor (as older builds wrote), 2 when
-//! an axis reads several; sealed with `content_sha256` like a single-axis file. It is read
-//! with a single-axis file's checks ([`crate::model`]): a key named twice is refused, a file
-//! without its seal is read with a warning for the caller to tell ([`Seal::warning`]), every
-//! axis's model is checked as a single-axis model, each further sensor's parts as least-squares
-//! sub-models (plausible coefficients, one per term), and B and K of the whole axis, further
-//! sensors included, must stay plausible over the training range. A unit has 1 to
-//! [`MAX_STREAM_AXES`] axes, each on a gyro column of its own.
 
-use serde::{Deserialize, Serialize};
-use std::path::Path;
-
-use gyrotherm_core::compensator::Status;
-use gyrotherm_core::features::LagOutputs;
-use gyrotherm_core::multi::{AxisCompensator, MAX_SENSORS};
-
-use crate::compensate::{hidden_size, sized_compensator};
-use crate::csvlog::{ImuLog, ReadOptions, TestLog};
+use crate::csvlog::{ImuLog, TestLog};
 use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
 use crate::fit::thermal::Identified;
 use crate::fit::{
     chooses_method, fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog,
 };
-use crate::flight_size::build_sized;
-use crate::flight_size::{FlightAxis, HiddenSize};
-pub use crate::imu_error::ImuError;
-use crate::model::{
-    content_digest_of, parse_sealed, ModelFile, Seal, SealedTextError, SubModel, Target,
-    TempSensorDef, CHECKSUM_KEY,
+use crate::model::unit::{
+    axis_checks, check_axis_count, ImuAxis, ImuError, ImuModel, SensorModel, SensorScore,
+    IMU_FORMAT_VERSION, IMU_FORMAT_VERSION_ONE_SENSOR,
 };
+use crate::model::{ModelFile, SubModel, TempSensorDef};
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets::{self, TargetSet};
 
-pub use crate::flight_size::MAX_STREAM_AXES;
-
-/// Version of the inertial-unit file layout when an axis reads several sensors.
-pub const IMU_FORMAT_VERSION: u32 = 2;
-/// Version of the layout when every axis reads one sensor (the first layout; such files are
-/// written as before).
-pub const IMU_FORMAT_VERSION_ONE_SENSOR: u32 = 1;
-/// The key that marks an inertial-unit model file.
-pub(crate) const IMU_VERSION_KEY: &str = "imu_format_version";
-
-/// A sensor tried for an axis and its score.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SensorScore {
-    /// The temperature column.
-    pub temp: String,
-    /// Cross-validated RMS of the fit on this sensor (bias °/s, or K for a scale-only
-    /// axis); None when the method has no cross-validation.
-    pub cv_rms: Option<f64>,
+/// Why an inertial unit's model cannot be fitted.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum UnitFitError {
+    /// Fitting axis `gyro` on sensor `temp` failed.
+    Fit {
+        gyro: String,
+        temp: String,
+        source: Box<FitError>,
+    },
+    /// The logs do not make a unit, or the model fitted is not valid.
+    Model(ImuError),
 }
 
-/// A further sensor an axis reads (`temps[i + 1]` for `more[i]`): its lags and its parts of
-/// the bias and the scale factor, each a baseline over that sensor's features (`T, dT,
-/// T − lag_j(T)`, the first sensor's step period and rate lag) without a constant.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SensorModel {
-    /// Time constants of this sensor's lags, s, fastest first.
-    pub lags_s: Vec<f64>,
-    /// Its part of the bias, °/s.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bias: Option<SubModel>,
-    /// Its part of the scale factor.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub scale: Option<SubModel>,
+impl From<ImuError> for UnitFitError {
+    fn from(e: ImuError) -> Self {
+        UnitFitError::Model(e)
+    }
 }
 
-/// One gyro axis of the unit.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ImuAxis {
-    /// The gyro column.
-    pub gyro: String,
-    /// The temperature columns this axis's model reads, the first sensor first.
-    pub temps: Vec<String>,
-    /// Every sensor tried, in column order, with its one-sensor score.
-    pub scores: Vec<SensorScore>,
-    /// The first sensor's bias and scale-factor model (the whole model with one sensor).
-    pub model: ModelFile,
-    /// The further sensors' parts, in the order of `temps[1..]` (empty: one sensor).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub more: Vec<SensorModel>,
-    /// Cross-validated RMS of the bias on all the sensors read (with several).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub multi_cv_rms: Option<f64>,
-    /// With further sensors: the one-sensor model on the first sensor alone (its `thermal`
-    /// fit), which the axis runs on while a further sensor is given up on (status
-    /// `fallback`, [`gyrotherm_core::multi`]). Files written before it have none: such an
-    /// axis stays held and then degraded while a further sensor is lost.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fallback: Option<ModelFile>,
+impl std::fmt::Display for UnitFitError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            UnitFitError::Fit { gyro, temp, .. } => {
+                write!(f, "fitting axis {gyro} on sensor {temp} failed")
+            }
+            // Transparent: the model's error is this error's own.
+            UnitFitError::Model(e) => e.fmt(f),
+        }
+    }
 }
 
-/// An inertial unit's model.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ImuModel {
-    /// [`IMU_FORMAT_VERSION`].
-    pub imu_format_version: u32,
-    /// The gyro columns, in the order of the axes (and of the exported `gyro[]`).
-    pub gyro_cols: Vec<String>,
-    /// The temperature columns, in the order of the exported `temp[]`.
-    pub temp_cols: Vec<String>,
-    /// One entry per gyro column, same order.
-    pub axes: Vec<ImuAxis>,
-}
-
-/// Whether model-file text is an inertial unit's (it has [`IMU_VERSION_KEY`]): the one place
-/// the two file forms are told apart (by `unit_model::Model::load`).
-pub(crate) fn is_imu_model_text(text: &str) -> bool {
-    serde_json::from_str::<serde_json::Value>(text.strip_prefix('\u{feff}').unwrap_or(text))
-        .ok()
-        .and_then(|v| v.get(IMU_VERSION_KEY).cloned())
-        .is_some()
+impl std::error::Error for UnitFitError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            UnitFitError::Fit { source, .. } => Some(source.as_ref()),
+            UnitFitError::Model(e) => e.source(),
+        }
+    }
 }
 
 /// Progress of an inertial-unit fit: axis index, sensor index, and the fit's own progress
@@ -182,7 +116,7 @@ pub fn fit_imu(
     cfg: &FitConfig,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
-) -> Result<ImuModel, ImuError> {
+) -> Result<ImuModel, UnitFitError> {
     fit_imu_with(logs, cfg, &ImuFitSettings::default(), temp_sensor, progress)
 }
 
@@ -193,7 +127,7 @@ pub(crate) fn fit_imu_with_events(
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
     events: &ImuEvents,
-) -> Result<ImuModel, ImuError> {
+) -> Result<ImuModel, UnitFitError> {
     fit_imu_full(
         logs,
         cfg,
@@ -212,7 +146,7 @@ pub fn fit_imu_with(
     settings: &ImuFitSettings,
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
-) -> Result<ImuModel, ImuError> {
+) -> Result<ImuModel, UnitFitError> {
     fit_imu_full(logs, cfg, settings, temp_sensor, progress, &|_| {})
 }
 
@@ -224,7 +158,7 @@ pub(crate) fn fit_imu_full(
     temp_sensor: &TempSensorDef,
     progress: &ImuProgress,
     events: &ImuEvents,
-) -> Result<ImuModel, ImuError> {
+) -> Result<ImuModel, UnitFitError> {
     let (gyro_cols, temp_cols) = ImuLog::shared_columns(logs)
         .map_err(|name| {
             ImuError::Layout(format!(
@@ -272,7 +206,7 @@ pub(crate) fn fit_imu_full(
         events,
     };
     type Checked = (ImuAxis, Result<(), ImuError>);
-    let axes: Vec<Result<Checked, ImuError>> = std::thread::scope(|scope| {
+    let axes: Vec<Result<Checked, UnitFitError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..gyro_cols.len())
             .map(|k| {
                 scope.spawn(move || {
@@ -335,7 +269,7 @@ struct UnitJob<'a> {
 }
 
 /// Axis `k` on the sensor whose one-sensor fit cross-validates best.
-fn fit_axis(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
+fn fit_axis(job: &UnitJob, k: usize) -> Result<ImuAxis, UnitFitError> {
     let UnitJob {
         logs,
         gyro_cols,
@@ -361,7 +295,7 @@ fn fit_axis(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
             .collect();
         let outcome =
             fit_model(&named, cfg, &|t, e, loss| progress(k, j, t, e, loss)).map_err(|source| {
-                ImuError::Fit {
+                UnitFitError::Fit {
                     gyro: gyro_cols[k].clone(),
                     temp: temp.clone(),
                     source: Box::new(source),
@@ -492,7 +426,7 @@ fn prepare_axis(
     k: usize,
     cfg: &FitConfig,
     events: &ImuEvents,
-) -> Result<AxisRuns, ImuError> {
+) -> Result<AxisRuns, UnitFitError> {
     let UnitJob {
         logs,
         shared,
@@ -699,8 +633,8 @@ fn lstm_on_multi(
 }
 
 /// Why axis `gyro`'s fit on sensor `temp` failed.
-fn fit_error(gyro: &str, temp: &str, source: FitError) -> ImuError {
-    ImuError::Fit {
+fn fit_error(gyro: &str, temp: &str, source: FitError) -> UnitFitError {
+    UnitFitError::Fit {
         gyro: gyro.to_owned(),
         temp: temp.to_owned(),
         source: Box::new(source),
@@ -710,7 +644,7 @@ fn fit_error(gyro: &str, temp: &str, source: FitError) -> ImuError {
 /// One axis on every sensor (see the module doc): each sensor's lags identified on its own,
 /// the sensors chosen by cross-validation, one fit over the chosen sensors; `shared` the
 /// temperature columns' search features per sensor and run (the job's `shared`).
-fn fit_axis_multi(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
+fn fit_axis_multi(job: &UnitJob, k: usize) -> Result<ImuAxis, UnitFitError> {
     let events = job.events;
     events(ImuFitEvent::AxisStarted { axis: k });
     let all: Vec<usize> = (0..job.logs.len()).collect();
@@ -733,7 +667,7 @@ fn thermal_axis(
     runs: &mut AxisRuns,
     k: usize,
     cfg: &FitConfig,
-) -> Result<(ImuAxis, usize), ImuError> {
+) -> Result<(ImuAxis, usize), UnitFitError> {
     let UnitJob {
         logs,
         gyro_cols,
@@ -886,7 +820,7 @@ fn thermal_axis(
 /// LSTM's held-out blocks of the static run. Both are scored on the same rows by the same
 /// prediction ([`axis_bias_on`]); the lower RMS wins, `thermal` on a tie. The axis's model
 /// records the scores and the choice ([`ModelFile::method_choice`]).
-fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
+fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, UnitFitError> {
     let UnitJob {
         logs,
         gyro_cols,
@@ -919,7 +853,7 @@ fn fit_axis_auto(job: &UnitJob, k: usize) -> Result<ImuAxis, ImuError> {
     // fit. On one sensor that is `thermal-lstm` on it, as the single-gyro path fits it (its
     // lags and training sets the ones made for the selection); on several, the LSTM on the
     // several-sensor fit's residual, as `--method thermal-lstm` fits the axis.
-    let lstm_fit = |thermal: &ImuAxis| -> Result<ImuAxis, ImuError> {
+    let lstm_fit = |thermal: &ImuAxis| -> Result<ImuAxis, UnitFitError> {
         events(ImuFitEvent::LstmTraining {
             axis: k,
             sensor: j0,
@@ -1059,7 +993,7 @@ fn leave_one_run_out(
     k: usize,
     thermal_cfg: &FitConfig,
     lstm_cfg: &FitConfig,
-) -> Result<[f64; 2], ImuError> {
+) -> Result<[f64; 2], UnitFitError> {
     let UnitJob {
         logs,
         gyro_cols,
@@ -1222,471 +1156,4 @@ fn blend_with_one(mut b: multi::MultiFit, one: Option<&SubModel>, w: f64) -> mul
         }
     }
     b
-}
-
-/// One axis's checks in [`ImuModel::validate`]: its sensors among `temp_cols`, its model, and
-/// the flight compensator its further sensors build.
-fn axis_checks(temp_cols: &[String], a: &ImuAxis) -> Result<(), ImuError> {
-    let distinct = a
-        .temps
-        .iter()
-        .enumerate()
-        .all(|(i, t)| !a.temps[..i].contains(t));
-    if a.temps.is_empty()
-        || a.temps.len() > MAX_SENSORS
-        || !distinct
-        || !a.temps.iter().all(|t| temp_cols.contains(t))
-    {
-        return Err(ImuError::Layout(format!(
-            "axis {} must read 1 to {MAX_SENSORS} distinct temperature columns among \
-             {}",
-            a.gyro,
-            temp_cols.join(", ")
-        )));
-    }
-    if a.more.len() + 1 != a.temps.len() {
-        return Err(ImuError::Layout(format!(
-            "axis {}: `more` must hold one entry per further sensor ({} of them)",
-            a.gyro,
-            a.temps.len() - 1
-        )));
-    }
-    a.model.validate().map_err(|source| ImuError::Axis {
-        gyro: a.gyro.clone(),
-        source: Box::new(source),
-    })?;
-    if let Some(f) = &a.fallback {
-        if a.more.is_empty() {
-            return Err(ImuError::Layout(format!(
-                "axis {}: a `fallback` model is only for an axis that reads further sensors \
-                 (remove it: this axis's model already reads its one sensor alone)",
-                a.gyro
-            )));
-        }
-        f.validate().map_err(|source| ImuError::Axis {
-            gyro: a.gyro.clone(),
-            source: Box::new(source),
-        })?;
-    }
-    if !a.more.is_empty() {
-        // The further sensors' parts must build a flight compensator, and with the first
-        // sensor's model keep B and K plausible over the training range, as a single-axis
-        // model must.
-        let size = axes_hidden_size(std::slice::from_ref(a))?;
-        let comp = build_sized!(FlightAxis, size, H => boxed_axis::<H>(temp_cols, a)?);
-        let further: Vec<_> = comp
-            .further()
-            .into_iter()
-            .map(|(_, s, b, k)| (s, b, k))
-            .collect();
-        a.model
-            .check_outputs_with_further(comp.first().spec(), &further)
-            .map_err(|source| ImuError::Axis {
-                gyro: a.gyro.clone(),
-                source: Box::new(source),
-            })?;
-    }
-    Ok(())
-}
-
-/// Refuse more gyro axes than a unit model may have: the capacity of the flight unit that
-/// compensates it ([`MAX_STREAM_AXES`]).
-fn check_axis_count(n: usize) -> Result<(), ImuError> {
-    if n > MAX_STREAM_AXES {
-        return Err(ImuError::Layout(format!(
-            "{n} gyro columns: a unit model has at most {MAX_STREAM_AXES} axes (what \
-             `compensate` runs); split the unit into models of at most {MAX_STREAM_AXES} gyro \
-             columns"
-        )));
-    }
-    Ok(())
-}
-
-/// The first name listed twice in `names`, with both positions (1-based).
-fn repeated(names: &[String]) -> Option<(&str, usize, usize)> {
-    names.iter().enumerate().find_map(|(i, n)| {
-        names[..i]
-            .iter()
-            .position(|m| m == n)
-            .map(|j| (n.as_str(), j + 1, i + 1))
-    })
-}
-
-/// `check` of each axis, on a thread per axis when there are several, in axis order.
-fn each_axis<T: Send>(axes: &[ImuAxis], check: impl Fn(&ImuAxis) -> T + Sync) -> Vec<T> {
-    if axes.len() < 2 {
-        return axes.iter().map(check).collect();
-    }
-    let check = &check;
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = axes.iter().map(|a| scope.spawn(move || check(a))).collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    })
-}
-
-/// The LSTM size a unit of `axes` runs at: the largest LSTM of any axis's model or fallback
-/// (8 without one); see [`crate::flight_size`].
-fn axes_hidden_size(axes: &[ImuAxis]) -> Result<HiddenSize, ImuError> {
-    let mut size = HiddenSize::H8;
-    for a in axes {
-        for m in std::iter::once(&a.model).chain(a.fallback.as_ref()) {
-            let s = hidden_size([m.bias.as_ref(), m.scale.as_ref()]).map_err(|source| {
-                ImuError::Compensate {
-                    gyro: a.gyro.clone(),
-                    source: Box::new(source),
-                }
-            })?;
-            size = size.max(s);
-        }
-    }
-    Ok(size)
-}
-
-/// [`axis_compensator_in`], boxed in a frame of its own (see [`crate::flight_size`]).
-#[inline(never)]
-fn boxed_axis<const H: usize>(
-    temp_cols: &[String],
-    a: &ImuAxis,
-) -> Result<Box<AxisCompensator<H>>, ImuError> {
-    axis_compensator_in::<H>(temp_cols, a).map(Box::new)
-}
-
-/// [`ImuModel::axis_compensator`] with the model's temperature columns `temp_cols`, at `H`
-/// hidden units.
-fn axis_compensator_in<const H: usize>(
-    temp_cols: &[String],
-    a: &ImuAxis,
-) -> Result<AxisCompensator<H>, ImuError> {
-    let index = |t: &String| {
-        temp_cols
-            .iter()
-            .position(|c| c == t)
-            .ok_or_else(|| ImuError::Layout(format!("axis {} reads unknown sensor {t}", a.gyro)))
-    };
-    let layout = |what: String| ImuError::Layout(format!("axis {}: {what}", a.gyro));
-    let first = sized_compensator::<H>(&a.model).map_err(|source| ImuError::Compensate {
-        gyro: a.gyro.clone(),
-        source: Box::new(source),
-    })?;
-    let spec0 = *first.spec();
-    let mut axis = AxisCompensator::new(first, index(&a.temps[0])?);
-    for (t, m) in a.temps.iter().skip(1).zip(&a.more) {
-        let spec = spec0
-            .with_lags(&m.lags_s, LagOutputs::DiffFromT)
-            .map_err(|e| layout(format!("sensor {t}: {e}")))?;
-        let part = |sub: &Option<SubModel>, what: Target| match sub {
-            None => Ok(None),
-            Some(
-                sub @ SubModel::Baseline {
-                    terms,
-                    coefficients,
-                },
-            ) => {
-                // A single-axis file's checks of a least-squares part: its terms, one
-                // coefficient per term, each finite and plausible.
-                sub.validate(spec.n_features())
-                    .map_err(|source| ImuError::FurtherSensor {
-                        gyro: a.gyro.clone(),
-                        temp: t.clone(),
-                        part: what,
-                        source: Box::new(source),
-                    })?;
-                crate::baseline::to_core(terms, coefficients)
-                    .map(Some)
-                    .map_err(|e| layout(format!("sensor {t}, {}: {e}", what.as_str())))
-            }
-            Some(_) => Err(layout(format!(
-                "sensor {t}, {}: a further sensor's part must be a baseline",
-                what.as_str()
-            ))),
-        };
-        axis = axis
-            .with_sensor(
-                index(t)?,
-                spec,
-                part(&m.bias, Target::Bias)?,
-                part(&m.scale, Target::Scale)?,
-            )
-            .map_err(|e| layout(format!("sensor {t}: {e}")))?;
-    }
-    if let Some(f) = &a.fallback {
-        let f = sized_compensator::<H>(f).map_err(|source| ImuError::Compensate {
-            gyro: a.gyro.clone(),
-            source: Box::new(source),
-        })?;
-        axis = axis.with_fallback(f);
-    }
-    Ok(axis)
-}
-
-impl ImuModel {
-    /// Checks the layout (one axis per gyro column, in order; each axis's sensors among the
-    /// temperature columns) and every axis's model.
-    pub fn validate(&self) -> Result<(), ImuError> {
-        self.validate_columns()?;
-        // The axes' checks (each runs its models over the training range) on a thread per
-        // axis; the first axis in order that fails is told, as checking in turn would.
-        each_axis(&self.axes, |a| axis_checks(&self.temp_cols, a))
-            .into_iter()
-            .collect()
-    }
-
-    /// [`ImuModel::validate`]'s checks of the file's version and gyro columns.
-    fn validate_columns(&self) -> Result<(), ImuError> {
-        // What is wrong with the axes is said before the version: the version expected
-        // follows from them.
-        if self.axes.is_empty() || self.gyro_cols.is_empty() {
-            return Err(ImuError::Layout(
-                "the model has no gyro axes (`axes` and `gyro_cols` must list at least one); \
-                 re-train"
-                    .into(),
-            ));
-        }
-        check_axis_count(self.axes.len().max(self.gyro_cols.len()))?;
-        if let Some((g, i, j)) = repeated(&self.gyro_cols) {
-            return Err(ImuError::Layout(format!(
-                "gyro column {g:?} is listed twice in `gyro_cols` (axes {i} and {j}): each axis \
-                 reads a gyro column of its own; re-train, or check a hand edit"
-            )));
-        }
-        if let Some((t, i, j)) = repeated(&self.temp_cols) {
-            return Err(ImuError::Layout(format!(
-                "temperature column {t:?} is listed twice in `temp_cols` (entries {i} and {j}); \
-                 re-train, or check a hand edit"
-            )));
-        }
-        let several = self.axes.iter().any(|a| a.temps.len() > 1);
-        let expected = if several {
-            IMU_FORMAT_VERSION
-        } else {
-            IMU_FORMAT_VERSION_ONE_SENSOR
-        };
-        if self.imu_format_version != expected {
-            return Err(ImuError::Layout(format!(
-                "{IMU_VERSION_KEY} {} is not supported here (this build reads \
-                 {IMU_FORMAT_VERSION_ONE_SENSOR} when every axis reads one sensor, \
-                 {IMU_FORMAT_VERSION} when an axis reads several)",
-                self.imu_format_version
-            )));
-        }
-        let gyros: Vec<&String> = self.axes.iter().map(|a| &a.gyro).collect();
-        if gyros != self.gyro_cols.iter().collect::<Vec<_>>() || gyros.is_empty() {
-            return Err(ImuError::Layout(
-                "the axes must list the gyro columns, in order".into(),
-            ));
-        }
-        Ok(())
-    }
-
-    /// The flight compensator of one axis: its first sensor's
-    /// [`Compensator`](gyrotherm_core::compensator::Compensator) and each further sensor's
-    /// pipeline and parts, reading the indices of its sensors among
-    /// [`ImuModel::temp_cols`], at the unit's LSTM size ([`ImuModel::hidden_size`]).
-    pub(crate) fn axis_compensator(&self, a: &ImuAxis) -> Result<FlightAxis, ImuError> {
-        let size = self.hidden_size()?;
-        Ok(build_sized!(FlightAxis, size, H => boxed_axis::<H>(&self.temp_cols, a)?))
-    }
-
-    /// The LSTM size every axis of the unit runs at: the largest LSTM of any axis's model or
-    /// fallback (8 without one). An LSTM of a size flight code is not built for is refused,
-    /// naming the axis and the size.
-    pub fn hidden_size(&self) -> Result<HiddenSize, ImuError> {
-        axes_hidden_size(&self.axes)
-    }
-
-    /// The sealed JSON text (pretty; `content_sha256` of the compact content last).
-    pub fn to_json(&self) -> Result<String, ImuError> {
-        self.validate()?;
-        let text = serde_json::to_string_pretty(self).map_err(ImuError::Json)?;
-        let body = text.strip_suffix("\n}").unwrap_or(&text);
-        Ok(format!(
-            "{body},\n  \"{CHECKSUM_KEY}\": \"{}\"\n}}\n",
-            self.content_digest()?
-        ))
-    }
-
-    /// The `content_sha256` of the model: SHA-256 of its compact JSON content (how the file
-    /// is formatted does not change it).
-    pub fn content_digest(&self) -> Result<String, ImuError> {
-        content_digest_of(self).map_err(ImuError::Json)
-    }
-
-    /// Parse and check the text (the checksum, when present, must match).
-    pub fn from_json(text: &str) -> Result<ImuModel, ImuError> {
-        Self::from_json_sealed(text).map(|(m, _)| m)
-    }
-
-    /// [`from_json`](Self::from_json), also saying whether the text was sealed (a caller
-    /// warns on [`Seal::Absent`], see [`Seal::warning`]). Read as a single-axis file is: a
-    /// key named twice in any object is refused.
-    pub fn from_json_sealed(text: &str) -> Result<(ImuModel, Seal), ImuError> {
-        let (m, sealed) = Self::parse(text, true)?;
-        Ok((m, if sealed { Seal::Verified } else { Seal::Absent }))
-    }
-
-    /// The model and whether the text held a checksum (checked only when `verify`).
-    fn parse(text: &str, verify: bool) -> Result<(ImuModel, bool), ImuError> {
-        let (m, sealed): (ImuModel, bool) =
-            parse_sealed(text, verify, |_| Ok::<(), std::convert::Infallible>(())).map_err(
-                |e| match e {
-                    SealedTextError::DuplicateKey(d) => ImuError::DuplicateKey(d),
-                    SealedTextError::NotJson(e) | SealedTextError::Fields(e) => ImuError::Json(e),
-                    SealedTextError::Refused(never) => match never {},
-                    SealedTextError::Checksum { found, computed } => {
-                        ImuError::Checksum { found, computed }
-                    }
-                },
-            )?;
-        m.validate()?;
-        Ok((m, sealed))
-    }
-
-    /// Re-seal a unit model file after a deliberate hand edit, as [`ModelFile::seal`]: read
-    /// it without checking its `content_sha256`, check everything else, and write it back
-    /// with a new one. Returns the model and its new digest.
-    pub fn seal(path: &Path) -> Result<(ImuModel, String), ImuError> {
-        let text = read_text(path)?;
-        let (m, _) = Self::parse(&text, false)?;
-        m.save(path)?;
-        let digest = m.content_digest()?;
-        Ok((m, digest))
-    }
-
-    /// Write atomically.
-    pub fn save(&self, path: &Path) -> Result<(), ImuError> {
-        let text = self.to_json()?;
-        crate::atomic_file::write_bytes_atomically(path, text.as_bytes()).map_err(|source| {
-            ImuError::Io {
-                path: path.to_path_buf(),
-                source,
-            }
-        })
-    }
-
-    /// Read and check a file.
-    pub fn load(path: &Path) -> Result<ImuModel, ImuError> {
-        Self::load_sealed(path).map(|(m, _)| m)
-    }
-
-    /// [`load`](Self::load), also saying whether the file was sealed (a caller warns on
-    /// [`Seal::Absent`]; see [`Seal::warning`]).
-    pub fn load_sealed(path: &Path) -> Result<(ImuModel, Seal), ImuError> {
-        Self::from_json_sealed(&read_text(path)?)
-    }
-
-    /// Read options naming the model's columns (the rest of `base` kept): its gyro columns
-    /// and the temperature columns its axes read ([`ImuModel::temps_read`]).
-    pub fn read_options(&self, base: &ReadOptions) -> ReadOptions {
-        ReadOptions {
-            gyro_col: self.gyro_cols.join(","),
-            temp_col: self.temps_read().join(","),
-            ..base.clone()
-        }
-    }
-
-    /// The temperature columns some axis reads, in the order of [`ImuModel::temp_cols`]: the
-    /// ones a log must hold (a column no axis reads changes no output).
-    pub fn temps_read(&self) -> Vec<&str> {
-        self.temp_cols
-            .iter()
-            .filter(|t| self.axes.iter().any(|a| a.temps.contains(t)))
-            .map(String::as_str)
-            .collect()
-    }
-
-    /// Index of each axis's first (or only) sensor in the temperature columns.
-    pub(crate) fn sensor_index(&self) -> Vec<usize> {
-        self.axes
-            .iter()
-            .map(|a| {
-                self.temp_cols
-                    .iter()
-                    .position(|t| *t == a.temps[0])
-                    .unwrap_or(0)
-            })
-            .collect()
-    }
-}
-
-/// The text of the file `path`.
-fn read_text(path: &Path) -> Result<String, ImuError> {
-    crate::input_file::read_capped_to_string(path, crate::input_file::InputKind::Model).map_err(
-        |source| ImuError::Io {
-            path: path.to_path_buf(),
-            source,
-        },
-    )
-}
-
-/// The compensated series of one axis.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct AxisCompensated {
-    pub bias_dps: Vec<f64>,
-    pub scale: Vec<f64>,
-    pub gyro_comp_dps: Vec<f64>,
-    pub status: Vec<Status>,
-}
-
-/// The flight compensators of every axis, in axis order, each reading its own sensors
-/// among `temps[]` in the order of [`ImuModel::temp_cols`].
-pub fn imu_axis_compensators(model: &ImuModel) -> Result<Vec<FlightAxis>, ImuError> {
-    model
-        .axes
-        .iter()
-        .map(|a| model.axis_compensator(a))
-        .collect()
-}
-
-/// Compensate an inertial unit's log: each axis's flight compensator fed, sample by sample,
-/// with its gyro column and the model's temperature columns. The log must hold the model's
-/// gyro columns and the temperature columns its axes read (the error names the first one
-/// missing); a column no axis reads is not looked for.
-pub fn compensate_imu(model: &ImuModel, log: &ImuLog) -> Result<Vec<AxisCompensated>, ImuError> {
-    let find = |list: &[crate::csvlog::NamedSeries], name: &str, role| {
-        list.iter()
-            .position(|s| s.name == name)
-            .ok_or_else(|| ImuError::MissingColumn {
-                column: name.to_owned(),
-                role,
-            })
-    };
-    let mut comps = imu_axis_compensators(model)?;
-    let read = model.temps_read();
-    let temps: Vec<Option<&[f64]>> = model
-        .temp_cols
-        .iter()
-        .map(|t| {
-            if !read.contains(&t.as_str()) {
-                return Ok(None);
-            }
-            find(&log.temp, t, "temperature").map(|i| Some(log.temp[i].values.as_slice()))
-        })
-        .collect::<Result<_, _>>()?;
-    let n = log.len();
-    let mut out = Vec::with_capacity(model.axes.len());
-    let mut row = vec![0.0; temps.len()];
-    for (a, comp) in model.axes.iter().zip(&mut comps) {
-        let g = &log.gyro[find(&log.gyro, &a.gyro, "gyro")?].values;
-        let mut r = AxisCompensated {
-            bias_dps: Vec::with_capacity(n),
-            scale: Vec::with_capacity(n),
-            gyro_comp_dps: Vec::with_capacity(n),
-            status: Vec::with_capacity(n),
-        };
-        for i in 0..n {
-            for (v, t) in row.iter_mut().zip(&temps) {
-                *v = t.map_or(f64::NAN, |t| t[i]);
-            }
-            let c = comp.step(log.time_s[i], g[i], &row);
-            r.bias_dps.push(c.bias_dps);
-            r.scale.push(c.scale);
-            r.gyro_comp_dps.push(c.rate_dps);
-            r.status.push(c.status);
-        }
-        out.push(r);
-    }
-    Ok(out)
 }

@@ -1,17 +1,17 @@
-//! Apply a fitted model to a log: the ground side of the flight [`Compensator`].
+//! Apply a fitted model to a log: the ground side of the flight [`Compensator`](gyrotherm_core::compensator::Compensator).
 //!
 //! Batch compensation runs the same `gyrotherm-core` compensator sample by sample that
 //! `compensate --stream` and flight code run, so the numbers are identical by construction.
-
-use gyrotherm_core::compensator::Compensator;
 
 use crate::flight_size::build_sized;
 use crate::flight_size::FlightCompensator;
 
 use crate::csvlog::TestLog;
+use crate::model::boxed_compensator;
 use crate::model::ModelFile;
-use crate::model::Target;
 pub use crate::model::{hidden_size, padded_core_lstm, target_model, CompensateError};
+
+pub mod unit;
 
 /// Compensated series of one log, one value per sample.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -25,39 +25,10 @@ pub struct Compensated {
 }
 
 /// The flight compensator of a model file (bias 0 °/s and K = 1 where a target is absent), at
-/// the size of its LSTMs ([`hidden_size`]).
+/// the size of its LSTMs ([`hidden_size`]). An inertial unit's: [`unit`](mod@unit).
 pub fn compensator(model: &ModelFile) -> Result<FlightCompensator, CompensateError> {
     let size = hidden_size([model.bias.as_ref(), model.scale.as_ref()])?;
     Ok(build_sized!(FlightCompensator, size, H => boxed_compensator::<H>(model)?))
-}
-
-/// [`sized_compensator`], boxed in a frame of its own (see [`crate::flight_size`]).
-#[inline(never)]
-pub(crate) fn boxed_compensator<const H: usize>(
-    model: &ModelFile,
-) -> Result<Box<Compensator<H>>, CompensateError> {
-    sized_compensator::<H>(model).map(Box::new)
-}
-
-/// [`compensator`] at `H` hidden units (an LSTM of the model larger than `H` is refused).
-pub(crate) fn sized_compensator<const H: usize>(
-    model: &ModelFile,
-) -> Result<Compensator<H>, CompensateError> {
-    let spec = model.feature_spec().map_err(CompensateError::Model)?;
-    let in_target = |target| {
-        move |e| CompensateError::InTarget {
-            target,
-            source: Box::new(e),
-        }
-    };
-    let bias = target_model(model.bias.as_ref(), 0.0).map_err(in_target(Target::Bias))?;
-    let scale = target_model(model.scale.as_ref(), 1.0).map_err(in_target(Target::Scale))?;
-    let limits = model
-        .features
-        .temp_sensor
-        .to_core()
-        .map_err(CompensateError::Model)?;
-    Compensator::with_limits(spec, bias, scale, limits).map_err(CompensateError::Flight)
 }
 
 /// Compensate a whole log with the flight compensator. The error names the sample.
