@@ -104,7 +104,7 @@ fn read_log<'py>(
             .map_err(|e| LogError::new_err(gyrotherm::error_chain(&e)))?;
         // As the single-axis reader states it: the first axis's view.
         let period = match (log.gyro.is_empty(), log.temp.is_empty()) {
-            (false, false) => gyrotherm::imu_judge::axis_test_log(&log, 0, 0).sample_period_s(),
+            (false, false) => gyrotherm::compare::unit::axis_test_log(&log, 0, 0).sample_period_s(),
             _ => f64::NAN,
         };
         unit_columns(&cols, &rep, log)?;

@@ -6,13 +6,14 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::compare::unit::{self as compare_unit, ImuComparison};
 use crate::compare::{compare_with_stages, CompareConfig, CompareError, Comparison, Stage};
 use crate::csvlog::{ImuLog, LogSet, LogSetForm, TestLog};
 use crate::export::ExportTarget;
 use crate::fit::{NamedLog, Target};
-use crate::imu_judge::{self, AxisVerdicts, ImuComparison, ImuJudgeError};
 use crate::model::TempSensorDef;
 use crate::report::ReportError;
+use crate::spec::unit::{self as spec_unit, AxisVerdicts, ImuJudgeError};
 use crate::spec::{ColumnVerdict, Spec, SpecError};
 use crate::told::Told;
 
@@ -118,7 +119,7 @@ pub fn tau_s(test: &LogSet, given: Option<f64>) -> (f64, Option<Told>) {
     }
     let (t, adjusted_to) = match test.form() {
         LogSetForm::Single(logs) => crate::compare::default_tau_s(&named(logs)),
-        LogSetForm::Unit(logs) => imu_judge::default_tau_s(logs),
+        LogSetForm::Unit(logs) => compare_unit::default_tau_s(logs),
     };
     let told = adjusted_to.map(|period| {
         Told::Line(format!(
@@ -273,7 +274,7 @@ fn judge_unit<'a>(
     let step = |s: crate::train::AxisStep| events(JudgeEvent::Told(Told::Line(s.line)));
     let steps = crate::train::step_lines(started, train, &step);
     let gyro = gyro_names(train);
-    let cmp = imu_judge::compare_imu(
+    let cmp = compare_unit::compare_imu(
         train,
         test,
         cfg,
@@ -290,9 +291,9 @@ fn judge_unit<'a>(
         },
         &steps,
     )
-    .map_err(JudgeError::Unit)?;
+    .map_err(|e| JudgeError::Unit(e.into()))?;
     let verdicts = spec
-        .map(|s| imu_judge::judge_unit_comparison(s, &cmp, cfg))
+        .map(|s| spec_unit::judge_unit_comparison(s, &cmp, cfg))
         .transpose()
         .map_err(JudgeError::Unit)?;
     Ok(Judged::Unit { cmp, verdicts })
@@ -493,7 +494,7 @@ fn write_unit_tables(
         writeln!(w)?;
     }
     writeln!(w, "across axes:")?;
-    imu_judge::write_text_table(w, &cmp.across_axes(cfg))
+    compare_unit::write_text_table(w, &cmp.across_axes(cfg))
 }
 
 /// Each axis's verdicts (every column, then the unit's own fit), then the unit's verdict of
@@ -512,7 +513,7 @@ fn write_unit_verdicts(
         }
     }
     writeln!(w, "\nspec {} across the axes:", spec.name.escape_debug())?;
-    for line in imu_judge::verdicts_across_axes(spec, verdicts) {
+    for line in spec_unit::verdicts_across_axes(spec, verdicts) {
         writeln!(w, "  {line}")?;
     }
     Ok(())

@@ -48,11 +48,12 @@
 //! - [`coverage_track`]: a log's path through a model's coverage map, sample by sample.
 //! - [`fit`]: fitting a compensation model from training logs ([`fit_model`], [`FitConfig`],
 //!   [`RecipeSettings`]; a unit's, axis by axis, [`fit::unit`](mod@fit::unit)).
-//! - [`compare`]: held-out comparison of methods: the numbers of the results table.
-//! - [`spec`]: spec sheets: limits on the standard figures, and a run's verdict.
+//! - [`compare`]: held-out comparison of methods: the numbers of the results table (a unit's,
+//!   axis by axis, and its table across axes: [`compare::unit`](mod@compare::unit)).
+//! - [`spec`]: spec sheets: limits on the standard figures, and a run's verdict (a unit's,
+//!   axis by axis: [`spec::unit`](mod@spec::unit)).
 //! - [`compensate_lines`](mod@compensate_lines): a CSV stream compensated line by line, with a
 //!   status per line, for one gyro or each axis of a unit ([`compensate_lines::unit`](mod@compensate_lines::unit)).
-//! - [`imu_judge`]: the standard figures and verdicts of an inertial unit, axis by axis.
 //! - [`plan`]: what the training logs cover of a flight's envelope, and the runs still needed.
 //! - [`report`]: the figures and the HTML report.
 //! - [`export`]: a model as flight code (C, Rust) or autopilot parameters.
@@ -96,7 +97,6 @@ pub mod export;
 pub mod features;
 pub mod fit;
 pub mod flight_size;
-pub mod imu_judge;
 pub mod input_file;
 pub mod json_keys;
 pub mod judge;

@@ -7,11 +7,11 @@
 //!
 //! Either way the file round-trips with its checks and the unit's flight compensator runs it.
 
+use gyrotherm::compare::unit::axis_test_log;
 use gyrotherm::compensate::unit::compensate_imu;
 use gyrotherm::csvlog::TRUE_BIAS_COL;
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
 use gyrotherm::fit::unit::fit_imu;
-use gyrotherm::imu_judge::axis_test_log;
 use gyrotherm::model::unit::{ImuAxis, ImuModel};
 use gyrotherm::model::{MethodChoice, SubModel, TempSensorDef, Validation};
 use gyrotherm::plan::{propose, resolve_envelope};

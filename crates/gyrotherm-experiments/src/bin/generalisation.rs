@@ -10,7 +10,8 @@
 //!   `seed-shock` runs identifies, as `gyrotherm plan --train` sizes it; setting `planned`: `seed-shock`
 //!   static + table plus static + table on the chamber profile `gyrotherm plan` proposes for
 //!   the unit (`gyrotherm::plan::propose`, envelope from the unit's own airborne run with a
-//!   seed other than the held-out one's), methods `linear` and `thermal` only;
+//!   seed other than the held-out one's), methods `linear`, `thermal` and those holding a
+//!   larger LSTM only, unless `--methods` names others;
 //! - held out: `slow-ramp`, `shock-5` (5 °C/min) and `airborne`, static + table each.
 //!
 //! Per setting and method it prints the median and worst bias stability (τ = 100 s) as a
@@ -257,6 +258,8 @@ fn table_figures(log: &TestLog, out: &[f64]) -> Result<(f64, f64), String> {
 struct Job<'a> {
     methods: &'a [String],
     settings: &'a [String],
+    /// `--methods` was given: every method named runs on every setting.
+    methods_named: bool,
 }
 
 fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
@@ -335,9 +338,15 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
         for m in job.methods {
             let capacity =
                 m.starts_with("tlstm") || m.starts_with("auto") || m.starts_with("dlstm");
-            if setting.starts_with("planned") && m != "linear" && m != "thermal" && !capacity {
+            if setting.starts_with("planned")
+                && m != "linear"
+                && m != "thermal"
+                && !capacity
+                && !job.methods_named
+            {
                 // The planned setting asks whether the chamber profile helps the default
-                // method; linear stays for the 0.7 × linear share.
+                // method; linear stays for the 0.7 × linear share. Methods named with
+                // `--methods` run there too.
                 continue;
             }
             if m == "published" && setting == "two" {
@@ -486,6 +495,7 @@ fn run() -> Result<(), String> {
     let job = Job {
         methods: &methods,
         settings: &settings,
+        methods_named: get("--methods").is_some(),
     };
     eprintln!(
         "{family} family: {} units (seeds {}..{}), settings {settings:?}, methods {methods:?}, {threads} threads",

@@ -15,6 +15,7 @@
 
 mod summary;
 mod table;
+pub mod unit;
 
 pub use summary::{ComparisonSummary, ModelSummary, TestSummary};
 pub use table::{ComparisonTable, TableBlock, TableFigure, TableRow, FAILED_CELL, NOT_FITTED_CELL};

@@ -31,10 +31,10 @@ use sha2::{Digest, Sha256};
 use crate::compensate::compensate_log;
 use crate::csvlog::{ImuLog, LogSet, LogSetForm, TestLog};
 use crate::fit::NamedLog;
-use crate::imu_judge::{ImuJudgeError, UnitVerdict};
 use crate::metrics::EvaluationOptions;
 use crate::model::unit::ImuModel;
 use crate::model::ModelFile;
+use crate::spec::unit::{ImuJudgeError, UnitVerdict};
 use crate::spec::{self, MeasureOptions, Spec};
 use crate::unit_model::Model;
 
@@ -534,7 +534,7 @@ pub struct UnitInputs<'a, L = (String, TestLog)> {
     pub tests: &'a [L],
     pub spec: Option<&'a Spec>,
     /// Bias-stability τ, s (None: `compare`'s default for these logs; for an inertial unit
-    /// `crate::imu_judge::default_tau_s`).
+    /// `crate::compare::unit::default_tau_s`).
     pub tau_s: Option<f64>,
     /// Settle time at each table segment start, s.
     pub settle_s: f64,
@@ -734,16 +734,16 @@ pub struct ImuRunVerdict {
 }
 
 /// Judge an inertial unit: compensate each held-out log with the unit's model, measure every
-/// figure of each axis (`crate::imu_judge::measure_unit`, as `evaluate --model` measures
+/// figure of each axis (`crate::spec::unit::measure_unit`, as `evaluate --model` measures
 /// it), judge each axis and the unit against the spec
-/// (`crate::imu_judge::judge_unit_figures`); the [`Run`] to record (dated now, a row per
+/// (`crate::spec::unit::judge_unit_figures`); the [`Run`] to record (dated now, a row per
 /// axis in [`Run::axes`], each figure with its axis) and the verdicts when a spec is given.
 pub(crate) fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVerdict>), LotError> {
     check_unit_name(u.unit.trim())?;
     let (text, model_sha256) = u.model_text()?;
     let model = ImuModel::from_json(&text).map_err(|e| u.model_err(e.into()))?;
     let content = model.content_digest().map_err(|e| u.model_err(e.into()))?;
-    let opts = u.measure_options(|| crate::imu_judge::default_tau_s(u.tests).0);
+    let opts = u.measure_options(|| crate::compare::unit::default_tau_s(u.tests).0);
     let mut inputs = Vec::with_capacity(u.tests.len());
     for (i, (path, log)) in u.tests.iter().enumerate() {
         inputs.push(Input {
@@ -758,11 +758,11 @@ pub(crate) fn judge_imu_unit(u: &ImuUnitInputs) -> Result<(Run, Option<ImuRunVer
         });
     }
     let measured =
-        crate::imu_judge::measure_unit(&model, u.tests, &opts).map_err(LotError::Unit)?;
+        crate::spec::unit::measure_unit(&model, u.tests, &opts).map_err(LotError::Unit)?;
     let verdict = match u.spec {
         Some(s) => {
             let (axes, unit) =
-                crate::imu_judge::judge_unit_figures(s, &measured).map_err(LotError::Unit)?;
+                crate::spec::unit::judge_unit_figures(s, &measured).map_err(LotError::Unit)?;
             Some(ImuRunVerdict {
                 axes: measured.iter().map(|a| a.gyro.clone()).zip(axes).collect(),
                 unit,

@@ -11,8 +11,9 @@ use std::path::{Path, PathBuf};
 use super::html::{escape, push_table, Table, CSS};
 use super::{grouped_warnings, results_table, write_full_report_with, ReportError};
 use crate::atomic_file::write_bytes_atomically;
+use crate::compare::unit::ImuComparison;
 use crate::compare::CompareConfig;
-use crate::imu_judge::{unit_verdicts, AxisVerdicts, ImuComparison, UNIT_FIT_COLUMN};
+use crate::spec::unit::{unit_verdicts, AxisVerdicts, UNIT_FIT_COLUMN};
 use crate::spec::{Spec, Verdict};
 
 /// The figures of each axis's page that the unit page shows in the axis's section, with
@@ -98,7 +99,7 @@ pub(crate) fn axis_verdict_table(a: &AxisVerdicts) -> Table {
 
 /// Write every axis's full report, then `dir/index.html`; returns the unit page's path.
 /// `extra_warnings` (e.g. gaps filled on reading) are listed after the axes' findings. With
-/// `judged` (a spec sheet and [`crate::imu_judge::judge_unit_comparison`]'s verdicts), the
+/// `judged` (a spec sheet and [`crate::spec::unit::judge_unit_comparison`]'s verdicts), the
 /// page shows the unit's verdict of each column across the axes and, in each axis's section,
 /// the axis's verdicts.
 pub(crate) fn write_unit_report(

@@ -21,6 +21,7 @@
 
 mod columns;
 mod figures;
+pub mod unit;
 mod verdict;
 
 pub use columns::{judge_comparison, ColumnVerdict};

@@ -1,6 +1,5 @@
-//! The standard figures of an inertial unit, axis by axis: `evaluate` (each gyro column, raw
-//! and with a unit model compensated), `compare` (every method fitted and judged per axis)
-//! and the table across axes that `report` and `compare` show.
+//! `compare` on an inertial unit, axis by axis: every method fitted and judged per axis, and
+//! the table across axes that `report` and `compare` show.
 //!
 //! Each axis is judged as a single-axis log ([`axis_test_log`]): its gyro, the sensor its
 //! model reads, the table rate only in the runs where the table turns this axis (in the
@@ -21,42 +20,27 @@ use serde::Serialize;
 
 use crate::compare::{
     compare, performance, CompareConfig, CompareError, Comparison, ComparisonSummary,
-    ComparisonTable, Performance, TableFigure,
+    ComparisonTable, Performance, PerformanceError, TableFigure,
 };
 use crate::compensate::unit::compensate_imu;
-use crate::csvlog::{ExtraColumn, ImuLog, TestLog, GYRO_COL};
+use crate::csvlog::{ExtraColumn, ImuLog, TestLog};
 use crate::fit::unit::{fit_imu_with_events, ImuEvents, UnitFitError};
 use crate::fit::{NamedLog, Target};
-use crate::metrics::Evaluation;
 use crate::model::unit::{ImuAxis, ImuError, ImuModel};
 use crate::model::TempSensorDef;
-use crate::settings::evaluate::{EvaluateError, EvaluateSettings, ResolvedTau};
-use crate::spec::{self, MeasureOptions, Spec, SpecError, Verdict};
 use crate::string_table::Table;
 
-/// Why a unit's figures could not be computed.
+/// Why a unit comparison could not be made (told as
+/// [`UnitCompareError`](crate::spec::unit::UnitCompareError), variant for variant).
 #[derive(Debug)]
-#[non_exhaustive]
-pub enum ImuJudgeError {
-    /// The figures of axis `gyro` (`output`: raw or compensated).
-    Evaluate {
-        gyro: String,
-        output: &'static str,
-        source: EvaluateError,
-    },
+pub(crate) enum UnitCompareError {
     /// The comparison of axis `gyro`.
     Compare { gyro: String, source: CompareError },
     /// The unit fit's figures of axis `gyro` on held-out log `log`.
     UnitFit {
         gyro: String,
         log: String,
-        source: crate::compare::PerformanceError,
-    },
-    /// The spec-sheet verdict of axis `gyro` (`output`: raw or compensated).
-    Spec {
-        gyro: String,
-        output: &'static str,
-        source: Box<SpecError>,
+        source: PerformanceError,
     },
     /// The unit model (compensating with it).
     Unit(ImuError),
@@ -64,39 +48,6 @@ pub enum ImuJudgeError {
     Fit(UnitFitError),
     /// The logs or settings do not fit together (the message says what to do).
     Layout(String),
-}
-
-impl std::fmt::Display for ImuJudgeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ImuJudgeError::Evaluate { gyro, output, .. } => {
-                write!(f, "axis {gyro} ({output} output)")
-            }
-            ImuJudgeError::Compare { gyro, .. } => write!(f, "axis {gyro}"),
-            ImuJudgeError::UnitFit { gyro, log, .. } => {
-                write!(f, "axis {gyro}, the unit's fit on held-out log {log}")
-            }
-            ImuJudgeError::Spec { gyro, output, .. } => {
-                write!(f, "axis {gyro} ({output} output) against the spec sheet")
-            }
-            ImuJudgeError::Unit(_) | ImuJudgeError::Fit(_) => write!(f, "the unit model"),
-            ImuJudgeError::Layout(m) => write!(f, "{m}"),
-        }
-    }
-}
-
-impl std::error::Error for ImuJudgeError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            ImuJudgeError::Evaluate { source, .. } => Some(source),
-            ImuJudgeError::Compare { source, .. } => Some(source),
-            ImuJudgeError::UnitFit { source, .. } => Some(source),
-            ImuJudgeError::Spec { source, .. } => Some(source.as_ref()),
-            ImuJudgeError::Unit(e) => Some(e),
-            ImuJudgeError::Fit(e) => Some(e),
-            ImuJudgeError::Layout(_) => None,
-        }
-    }
 }
 
 /// Axis `axis` of a unit log as a single-axis log for judging (see the module doc):
@@ -125,110 +76,6 @@ pub fn axis_test_log(log: &ImuLog, axis: usize, temp: usize) -> TestLog {
     out
 }
 
-/// The figures of one axis: of the raw gyro column, and of its compensated output when a
-/// unit model was given.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub(crate) struct AxisEvaluation {
-    /// The gyro column.
-    pub gyro: String,
-    /// The temperature columns its model reads (empty without a model).
-    pub temps: Vec<String>,
-    pub raw: Evaluation,
-    pub compensated: Option<Evaluation>,
-    /// The axis's verdict against a spec sheet ([`evaluate_imu_spec`]): of the compensated
-    /// output when a unit model was given, else of the raw column.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub verdict: Option<Verdict>,
-}
-
-/// The unit's verdict against a spec sheet: it passes only when every axis passes.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct UnitVerdict {
-    /// The spec sheet's name and SHA-256.
-    pub spec: String,
-    pub spec_sha256: String,
-    /// Which output was judged: `compensated` (with a unit model) or `raw`.
-    pub judged: &'static str,
-    /// True when every limited figure of every axis passes.
-    pub pass: bool,
-    /// The gyro columns of the axes that missed a limit, in column order.
-    pub failed_axes: Vec<String>,
-}
-
-impl UnitVerdict {
-    /// The one rule of a unit's verdict: it passes only when every axis passes. `axes`: each
-    /// axis's gyro column and whether it passed, in column order; `judged`: which output
-    /// (`compensated` or `raw`).
-    pub(crate) fn from_axes<'a>(
-        spec: &str,
-        spec_sha256: &str,
-        judged: &'static str,
-        axes: impl IntoIterator<Item = (&'a str, bool)>,
-    ) -> UnitVerdict {
-        let failed_axes: Vec<String> = axes
-            .into_iter()
-            .filter(|(_, pass)| !pass)
-            .map(|(g, _)| g.to_owned())
-            .collect();
-        UnitVerdict {
-            spec: spec.to_owned(),
-            spec_sha256: spec_sha256.to_owned(),
-            judged,
-            pass: failed_axes.is_empty(),
-            failed_axes,
-        }
-    }
-
-    /// `PASS` or `FAIL`.
-    pub fn word(&self) -> &'static str {
-        if self.pass {
-            "PASS"
-        } else {
-            "FAIL"
-        }
-    }
-
-    /// The verdict as one text line.
-    pub fn line(&self, axes: usize) -> String {
-        let mut s = format!(
-            "unit verdict: {} (spec {}, {axes} axes, {} output",
-            self.word(),
-            self.spec,
-            self.judged
-        );
-        if !self.failed_axes.is_empty() {
-            s.push_str(&format!("; failed: {}", self.failed_axes.join(", ")));
-        }
-        s.push(')');
-        s
-    }
-}
-
-/// What [`evaluate_imu_spec`] returns: the axes' figures (each with its verdict when a spec
-/// sheet was given), the τ used, and the unit's verdict.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct UnitEvaluation {
-    pub axes: Vec<AxisEvaluation>,
-    pub tau: ResolvedTau,
-    pub verdict: Option<UnitVerdict>,
-}
-
-impl UnitEvaluation {
-    /// The form `gyrotherm evaluate --json` prints for a unit (and Python returns): `tau_s`,
-    /// `axes` (each with its `verdict` when judged, in the single-axis verdict's form) and,
-    /// when judged, the unit's `verdict` beside them.
-    pub fn to_json(&self) -> serde_json::Value {
-        let mut j = serde_json::json!({ "tau_s": self.tau.tau_s, "axes": self.axes });
-        if let (Some(v), Some(o)) = (&self.verdict, j.as_object_mut()) {
-            o.insert(
-                "verdict".into(),
-                serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
-            );
-        }
-        j
-    }
-}
-
 /// The bias-stability τ of a unit comparison when none was asked for: the single-axis rule
 /// ([`crate::compare::default_tau_s`]) on the first axis's view of the held-out logs (every
 /// axis shares the time column). Returns τ and, when it is not 100 s, the sample period it
@@ -244,248 +91,6 @@ pub(crate) fn default_tau_s(test: &[(String, ImuLog)]) -> (f64, Option<f64>) {
         .map(|(n, l)| NamedLog { name: n, log: l })
         .collect();
     crate::compare::default_tau_s(&named)
-}
-
-/// `evaluate` on a unit log: the figures of each gyro column (raw, in °/s as read), and with
-/// `model` of each axis's compensated output (`G_comp`, the flight compensator's output as
-/// `compensate` writes it); `settings.column` must be the default (the gyro columns are
-/// named by the log's column list). With `spec`, each axis judged against the spec sheet as the
-/// single-axis `evaluate --spec` judges one column (the same figures, measured on the axis's
-/// single-axis log, [`axis_test_log`]): the compensated output when `model` is given (the
-/// unit as it is flown), else the raw gyro column. `log_name` names the log in the
-/// verdicts' lines. The unit passes only when every axis passes.
-pub(crate) fn evaluate_imu_spec(
-    log: &ImuLog,
-    model: Option<&ImuModel>,
-    settings: &EvaluateSettings,
-    spec: Option<&Spec>,
-    log_name: &str,
-) -> Result<UnitEvaluation, ImuJudgeError> {
-    if settings.column != GYRO_COL {
-        return Err(ImuJudgeError::Layout(format!(
-            "column {:?}: a unit log is judged per gyro column (--gyro-col lists them); leave \
-             the column at its default {GYRO_COL}",
-            settings.column
-        )));
-    }
-    if log.gyro.is_empty() || log.temp.is_empty() {
-        return Err(ImuJudgeError::Layout(
-            "the log has no gyro or no temperature column".into(),
-        ));
-    }
-    let comp = model
-        .map(|m| compensate_imu(m, log))
-        .transpose()
-        .map_err(ImuJudgeError::Unit)?;
-    let mut axes = Vec::with_capacity(log.gyro.len());
-    let mut tau = None;
-    for (k, g) in log.gyro.iter().enumerate() {
-        let axis_log = axis_test_log(log, k, 0);
-        let tau0_s = axis_log.sample_period_s();
-        if !(tau0_s.is_finite() && tau0_s > 0.0) {
-            return Err(ImuJudgeError::Layout(
-                "cannot tell the sample period (need at least two samples with increasing time)"
-                    .into(),
-            ));
-        }
-        let judge = |values: &[f64], output: &'static str, name: String| {
-            let (mut e, t) = settings
-                .evaluate(&axis_log, values, tau0_s)
-                .map_err(|source| ImuJudgeError::Evaluate {
-                    gyro: g.name.clone(),
-                    output,
-                    source,
-                })?;
-            e.column = name;
-            Ok::<_, ImuJudgeError>((e, t))
-        };
-        let (raw, t) = judge(&g.values, "raw", g.name.clone())?;
-        tau.get_or_insert(t);
-        // The axis's compensated output and sensors (compensate_imu returns the model's axes
-        // in order; this column's is found by name), or none without a model.
-        let comp_axis = match (&comp, model) {
-            (Some(c), Some(m)) => {
-                let i = m
-                    .axes
-                    .iter()
-                    .position(|a| a.gyro == g.name)
-                    .ok_or_else(|| {
-                        ImuJudgeError::Layout(format!("the model has no axis {}", g.name))
-                    })?;
-                Some((c[i].gyro_comp_dps.as_slice(), &m.axes[i].temps))
-            }
-            _ => None,
-        };
-        let (compensated, temps) = match comp_axis {
-            Some((values, temps)) => {
-                let (e, _) = judge(values, "compensated", format!("{}_comp", g.name))?;
-                (Some(e), temps.clone())
-            }
-            None => (None, Vec::new()),
-        };
-        let verdict = match spec {
-            Some(sp) => {
-                let (values, output) = match comp_axis {
-                    Some((values, _)) => (values, "compensated"),
-                    None => (g.values.as_slice(), "raw"),
-                };
-                Some(judge_axis(
-                    sp, &axis_log, values, settings, tau0_s, log_name, &g.name, output,
-                )?)
-            }
-            None => None,
-        };
-        axes.push(AxisEvaluation {
-            gyro: g.name.clone(),
-            temps,
-            raw,
-            compensated,
-            verdict,
-        });
-    }
-    let tau = tau.ok_or_else(|| ImuJudgeError::Layout("no gyro column".into()))?;
-    let verdict = spec.map(|sp| {
-        UnitVerdict::from_axes(
-            &sp.name,
-            &sp.sha256,
-            if model.is_some() {
-                "compensated"
-            } else {
-                "raw"
-            },
-            axes.iter()
-                .map(|a| (a.gyro.as_str(), a.verdict.as_ref().is_none_or(|v| v.pass))),
-        )
-    });
-    Ok(UnitEvaluation { axes, tau, verdict })
-}
-
-/// Every figure of one axis of a unit's compensated output on each held-out log.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct AxisFigures {
-    /// The gyro column.
-    pub gyro: String,
-    /// The temperature columns the axis's model reads, the first sensor first.
-    pub temps: Vec<String>,
-    /// Per held-out log, in order: its name and the figures measured on it.
-    pub measured: Vec<(String, spec::Figures)>,
-}
-
-/// Every figure ([`spec::measure`] with `opts`) of each axis's compensated output (the flight
-/// compensator's, as `compensate` writes it) on each held-out log, each axis measured on its
-/// single-axis view of the log ([`axis_test_log`]) as `evaluate --model` measures it. The
-/// logs must be read with the model's columns ([`ImuModel::read_options`]). Axes in the
-/// model's order.
-pub(crate) fn measure_unit(
-    model: &ImuModel,
-    tests: &[(String, ImuLog)],
-    opts: &MeasureOptions,
-) -> Result<Vec<AxisFigures>, ImuJudgeError> {
-    let mut axes: Vec<AxisFigures> = model
-        .axes
-        .iter()
-        .map(|a| AxisFigures {
-            gyro: a.gyro.clone(),
-            temps: a.temps.clone(),
-            measured: Vec::with_capacity(tests.len()),
-        })
-        .collect();
-    for (name, log) in tests {
-        let comp = compensate_imu(model, log).map_err(ImuJudgeError::Unit)?;
-        for (i, a) in axes.iter_mut().enumerate() {
-            let k = log
-                .gyro
-                .iter()
-                .position(|g| g.name == a.gyro)
-                .ok_or_else(|| {
-                    ImuJudgeError::Layout(format!(
-                        "{name}: no gyro column {} (the model's axis {}); read the log with \
-                         the model's columns",
-                        a.gyro,
-                        i + 1
-                    ))
-                })?;
-            let axis_log = axis_test_log(log, k, 0);
-            let f = spec::measure(&axis_log, &comp[i].gyro_comp_dps, opts).map_err(|source| {
-                ImuJudgeError::Spec {
-                    gyro: a.gyro.clone(),
-                    output: "compensated",
-                    source: Box::new(SpecError::Measure {
-                        log: name.clone(),
-                        source,
-                    }),
-                }
-            })?;
-            a.measured.push((name.clone(), f));
-        }
-    }
-    Ok(axes)
-}
-
-/// Each axis of [`measure_unit`] judged against `spec` on all its held-out logs (as the
-/// single-axis [`spec::judge`] judges one column), and the unit's verdict
-/// ([`UnitVerdict::from_axes`]: compensated output).
-pub(crate) fn judge_unit_figures(
-    spec: &Spec,
-    axes: &[AxisFigures],
-) -> Result<(Vec<Verdict>, UnitVerdict), ImuJudgeError> {
-    let verdicts = axes
-        .iter()
-        .map(|a| {
-            spec::judge(spec, &a.measured).map_err(|source| ImuJudgeError::Spec {
-                gyro: a.gyro.clone(),
-                output: "compensated",
-                source: Box::new(source),
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let unit = UnitVerdict::from_axes(
-        &spec.name,
-        &spec.sha256,
-        "compensated",
-        axes.iter()
-            .zip(&verdicts)
-            .map(|(a, v)| (a.gyro.as_str(), v.pass)),
-    );
-    Ok((verdicts, unit))
-}
-
-/// One axis's output judged against `spec`, as `evaluate --spec` judges one column.
-#[allow(clippy::too_many_arguments)]
-fn judge_axis(
-    spec: &Spec,
-    axis_log: &TestLog,
-    values: &[f64],
-    settings: &EvaluateSettings,
-    tau0_s: f64,
-    log_name: &str,
-    gyro: &str,
-    output: &'static str,
-) -> Result<Verdict, ImuJudgeError> {
-    let (rate_dps, evaluation, _) =
-        settings
-            .prepare(values, tau0_s)
-            .map_err(|source| ImuJudgeError::Evaluate {
-                gyro: gyro.to_owned(),
-                output,
-                source,
-            })?;
-    let opts = MeasureOptions {
-        evaluation,
-        noise_terms: spec.needs_noise_terms(),
-    };
-    let spec_err = |source| ImuJudgeError::Spec {
-        gyro: gyro.to_owned(),
-        output,
-        source: Box::new(source),
-    };
-    let f = spec::measure(axis_log, &rate_dps, &opts).map_err(|source| {
-        spec_err(SpecError::Measure {
-            log: log_name.to_owned(),
-            source,
-        })
-    })?;
-    spec::judge(spec, &[(log_name.to_owned(), f)]).map_err(spec_err)
 }
 
 /// The unit's own fit of one axis in a comparison: the model `train` with the same lists
@@ -615,13 +220,13 @@ pub(crate) fn compare_imu(
     temp_sensor: &TempSensorDef,
     progress: &ImuCompareProgress,
     events: &ImuEvents,
-) -> Result<ImuComparison, ImuJudgeError> {
+) -> Result<ImuComparison, UnitCompareError> {
     if train.is_empty() {
-        return Err(ImuJudgeError::Layout("no training logs".into()));
+        return Err(UnitCompareError::Layout("no training logs".into()));
     }
     let (gyro_cols, temp_cols) = ImuLog::shared_columns(train.iter().chain(test))
         .map_err(|n| {
-            ImuJudgeError::Layout(format!(
+            UnitCompareError::Layout(format!(
                 "{n}: every log must be read with the same gyro and temperature columns"
             ))
         })?
@@ -631,7 +236,7 @@ pub(crate) fn compare_imu(
     } else {
         Some(
             fit_imu_with_events(train, &cfg.fit, temp_sensor, &|_, _, _, _, _| {}, events)
-                .map_err(ImuJudgeError::Fit)?,
+                .map_err(UnitCompareError::Fit)?,
         )
     };
     let sensors: Vec<usize> = unit
@@ -646,8 +251,8 @@ pub(crate) fn compare_imu(
                 .collect::<Result<Vec<_>, _>>()
         })
         .transpose()
-        .map_err(ImuJudgeError::Unit)?;
-    let axes: Vec<Result<AxisComparison, ImuJudgeError>> = std::thread::scope(|scope| {
+        .map_err(UnitCompareError::Unit)?;
+    let axes: Vec<Result<AxisComparison, UnitCompareError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..gyro_cols.len())
             .map(|k| {
                 let (gyro_cols, temp_cols, sensors) = (&gyro_cols, &temp_cols, &sensors);
@@ -670,7 +275,7 @@ pub(crate) fn compare_imu(
                             .map(|(n, l)| NamedLog { name: n, log: l })
                             .collect();
                         compare(&tr, &te, cfg, &|key, t, e, l| progress(k, key, t, e, l)).map_err(
-                            |source| ImuJudgeError::Compare {
+                            |source| UnitCompareError::Compare {
                                 gyro: gyro_cols[k].clone(),
                                 source,
                             },
@@ -683,7 +288,7 @@ pub(crate) fn compare_imu(
                                 .zip(outs)
                                 .map(|((name, l), out)| {
                                     performance(l, &out[k].gyro_comp_dps, cfg.tau_s, cfg.settle_s)
-                                        .map_err(|source| ImuJudgeError::UnitFit {
+                                        .map_err(|source| UnitCompareError::UnitFit {
                                             gyro: gyro_cols[k].clone(),
                                             log: name.clone(),
                                             source,
@@ -719,134 +324,6 @@ pub(crate) fn compare_imu(
     })
 }
 
-/// One axis of a unit comparison judged against a spec sheet: each method's column and the
-/// unit's own fit, on the axis's held-out logs.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub(crate) struct AxisVerdicts {
-    pub gyro: String,
-    /// The one-sensor methods' columns, as `compare --spec` judges a single axis.
-    pub columns: Vec<spec::ColumnVerdict>,
-    /// The unit's own fit (its label and verdict), when the unit reads several sensors.
-    pub unit_fit: Option<(String, Verdict)>,
-}
-
-impl AxisVerdicts {
-    /// Whether every judged column of the axis meets every limit.
-    pub fn pass(&self) -> bool {
-        self.columns.iter().all(|c| c.verdict.pass)
-            && self.unit_fit.as_ref().is_none_or(|(_, v)| v.pass)
-    }
-}
-
-/// The name of the unit fit's column in [`unit_verdicts`] and [`verdicts_across_axes`].
-pub(crate) const UNIT_FIT_COLUMN: &str = "unit fit";
-
-/// The unit's verdict of each judged column across the axes ([`UnitVerdict::from_axes`]: a
-/// column passes for the unit only when it passes on every axis), the columns in the order
-/// of the tables, the unit's own fit ([`UNIT_FIT_COLUMN`]) last.
-pub(crate) fn unit_verdicts(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<(String, UnitVerdict)> {
-    let mut names: Vec<String> = Vec::new();
-    let mut per: Vec<Vec<(&str, bool)>> = Vec::new();
-    for a in axes {
-        let mut cols: Vec<(String, bool)> = a
-            .columns
-            .iter()
-            .map(|c| (c.label.to_owned(), c.verdict.pass))
-            .collect();
-        if let Some((_, v)) = &a.unit_fit {
-            cols.push((UNIT_FIT_COLUMN.to_owned(), v.pass));
-        }
-        for (name, pass) in cols {
-            let i = match names.iter().position(|n| *n == name) {
-                Some(i) => i,
-                None => {
-                    names.push(name);
-                    per.push(Vec::new());
-                    names.len() - 1
-                }
-            };
-            per[i].push((a.gyro.as_str(), pass));
-        }
-    }
-    names
-        .into_iter()
-        .zip(per)
-        .map(|(n, axes)| {
-            let v = UnitVerdict::from_axes(&spec.name, &spec.sha256, "compensated", axes);
-            (n, v)
-        })
-        .collect()
-}
-
-/// One line per judged column across the axes (`unit_verdicts`): `linear: FAIL on
-/// gyro_x_dps, gyro_z_dps`, `unit fit: PASS on every axis`.
-pub(crate) fn verdicts_across_axes(spec: &Spec, axes: &[AxisVerdicts]) -> Vec<String> {
-    unit_verdicts(spec, axes)
-        .into_iter()
-        .map(|(n, v)| {
-            if v.pass {
-                format!("{n}: PASS on every axis")
-            } else {
-                format!("{n}: FAIL on {}", v.failed_axes.join(", "))
-            }
-        })
-        .collect()
-}
-
-/// Every axis of a unit comparison judged against `spec`: each column's compensated output on
-/// each held-out log, with the comparison's τ and settle time (the single-axis rule,
-/// [`spec::judge_comparison`]).
-pub(crate) fn judge_unit_comparison(
-    spec: &Spec,
-    cmp: &ImuComparison,
-    cfg: &CompareConfig,
-) -> Result<Vec<AxisVerdicts>, ImuJudgeError> {
-    let opts = MeasureOptions {
-        evaluation: crate::metrics::EvaluationOptions {
-            tau_s: cfg.tau_s,
-            settle_s: cfg.settle_s,
-            reference_scale: None,
-        },
-        noise_terms: spec.needs_noise_terms(),
-    };
-    let mut out = Vec::with_capacity(cmp.axes.len());
-    for a in &cmp.axes {
-        let spec_err = |output: &'static str, source| ImuJudgeError::Spec {
-            gyro: a.gyro.clone(),
-            output,
-            source: Box::new(source),
-        };
-        let columns = spec::judge_comparison(spec, &a.comparison, &a.test_named(), cfg)
-            .map_err(|e| spec_err("compensated", e))?;
-        let unit_fit = match &a.unit_fit {
-            Some(u) => {
-                let mut measured = Vec::with_capacity(a.test.len());
-                for ((name, log), rate) in a.test.iter().zip(&u.compensated_dps) {
-                    let f = spec::measure(log, rate, &opts).map_err(|source| {
-                        spec_err(
-                            "compensated",
-                            SpecError::Measure {
-                                log: name.clone(),
-                                source,
-                            },
-                        )
-                    })?;
-                    measured.push((name.clone(), f));
-                }
-                let v = spec::judge(spec, &measured).map_err(|e| spec_err("compensated", e))?;
-                Some((u.label.clone(), v))
-            }
-            None => None,
-        };
-        out.push(AxisVerdicts {
-            gyro: a.gyro.clone(),
-            columns,
-            unit_fit,
-        });
-    }
-    Ok(out)
-}
-
 /// The header of the unit fit's column in the table across axes.
 pub(crate) const UNIT_FIT_HEADER: &str = "unit fit (axis's sensors)";
 
@@ -880,12 +357,13 @@ pub(crate) struct AcrossAxes {
 
 impl ImuComparison {
     /// `gyrotherm compare --json` of the unit (and Python's `compare`): the
-    /// [`summary`](Self::summary), with `verdicts` (each axis's, [`judge_unit_comparison`])
+    /// [`summary`](Self::summary), with `verdicts` (each axis's,
+    /// [`judge_unit_comparison`](crate::spec::unit::judge_unit_comparison))
     /// when it was judged against a spec.
-    pub(crate) fn summary_json(
+    pub(crate) fn summary_json<V: Serialize>(
         &self,
         cfg: &CompareConfig,
-        verdicts: Option<&[AxisVerdicts]>,
+        verdicts: Option<&[V]>,
     ) -> Result<serde_json::Value, serde_json::Error> {
         let mut j = serde_json::to_value(self.summary(cfg))?;
         if let (Some(v), Some(o)) = (verdicts, j.as_object_mut()) {
@@ -1103,23 +581,5 @@ mod tests {
         assert_eq!(lines[0], "held-out log  figure  axis  raw");
         assert_eq!(lines[1], "-".repeat(31));
         assert_eq!(lines[2], "a.csv         bias    gx    0.5");
-    }
-
-    #[test]
-    fn evaluate_refuses_a_column_other_than_the_gyros() {
-        let log = ImuLog {
-            time_s: vec![0.0, 1.0],
-            gyro: vec![series("gx", &[1.0, 2.0])],
-            temp: vec![series("t", &[20.0, 21.0])],
-            ..Default::default()
-        };
-        let s = EvaluateSettings {
-            column: "other_dps".into(),
-            ..Default::default()
-        };
-        let e = evaluate_imu_spec(&log, None, &s, None, "")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("judged per gyro column"), "{e}");
     }
 }

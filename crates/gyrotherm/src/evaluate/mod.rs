@@ -7,13 +7,16 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::csvlog::{read_imu_log, read_log, ColumnError, LogError, ReadOptions};
-use crate::imu_judge::{evaluate_imu_spec, ImuJudgeError, UnitEvaluation};
 use crate::metrics::{Evaluation, EvaluationError};
 use crate::settings::evaluate::EvaluateError;
 use crate::settings::EvaluateSettings;
+use crate::spec::unit::ImuJudgeError;
 use crate::spec::{MeasureOptions, Spec, SpecError, Verdict};
 use crate::told::Told;
 use crate::unit_model::Model;
+use unit::{evaluate_imu_spec, UnitEvaluation};
+
+pub mod unit;
 
 /// What to evaluate and how.
 #[derive(Debug, Clone, Copy)]
