@@ -24,6 +24,7 @@
 //! - [`told`]: a line a job tells the user (what it read, did or warns of).
 //! - [`moving_average`]: the one centred moving average on a time axis.
 //! - [`table_segments`]: the one segmentation of a rate-table log by commanded rate.
+//! - [`flight_size`]: the flight LSTM's hidden size, read from a model file at run time.
 //! - [`allan`]: Allan-family deviations of rate data, with confidence intervals.
 //! - [`nn`]: the LSTM network on the ground: parameters, training, evaluation.
 //! - [`csvlog`]: the test logs (CSV, ULog, DataFlash; read, validate, write): [`read_log`] →
