@@ -29,7 +29,7 @@ mod dataflash;
 mod error;
 mod format;
 mod gaps;
-mod imu;
+mod unit;
 mod log_set;
 mod number;
 mod reader;
@@ -44,8 +44,8 @@ pub use column_list::{
 pub use error::{LogError, LogErrorKind};
 pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
-pub(crate) use imu::write_imu_csv;
-pub use imu::{read_imu_log, read_imu_logs, write_imu_log};
+pub(crate) use unit::write_imu_csv;
+pub use unit::{read_imu_log, read_imu_logs, write_imu_log};
 pub(crate) use log_set::{read_in_form, LogSetForm};
 pub use log_set::{read_log_set, read_log_sets, FileRead, LogSet, LogSetError, SetRead};
 pub(crate) use number::parse_f64_decimal_comma;
@@ -239,7 +239,7 @@ pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<(TestLog, ReadReport)
 }
 
 /// [`read_log`], the pass-through columns named in `numbers` (the first of each name) parsed
-/// as they are read ([`imu::NumberColumn`]) instead of kept as text: such a column stays in
+/// as they are read ([`unit::NumberColumn`]) instead of kept as text: such a column stays in
 /// [`TestLog::extra`] by name only (no values), its numbers at the same index of the list
 /// returned. A log read with several gyro or temperature columns parses them without holding
 /// every field as a string first.
@@ -247,7 +247,7 @@ pub(crate) fn read_log_numbers(
     path: &Path,
     opts: &ReadOptions,
     numbers: &[&str],
-) -> Result<(TestLog, ReadReport, Vec<Option<imu::NumberColumn>>), LogError> {
+) -> Result<(TestLog, ReadReport, Vec<Option<unit::NumberColumn>>), LogError> {
     let decimal_comma = opts.delimiter != b',';
     let file = File::open(path).map_err(|e| {
         LogError::new(
@@ -264,12 +264,12 @@ pub(crate) fn read_log_numbers(
     let mut table: Vec<f64> = Vec::new();
     let mut extra: Vec<Vec<String>> = vec![Vec::new(); rdr.extra_count()];
     let names: Vec<&str> = rdr.extra_names().collect();
-    let mut parsed: Vec<Option<imu::NumberColumn>> = names
+    let mut parsed: Vec<Option<unit::NumberColumn>> = names
         .iter()
         .enumerate()
         .map(|(k, n)| {
             let first = names.iter().position(|m| m == n) == Some(k);
-            (first && numbers.contains(n)).then(imu::NumberColumn::default)
+            (first && numbers.contains(n)).then(unit::NumberColumn::default)
         })
         .collect();
     drop(names);
