@@ -388,6 +388,7 @@ pub struct FitArgs {
     epochs: Option<usize>,
     seed: u64,
     hidden: Option<usize>,
+    windows: Option<usize>,
     bias_window_s: f64,
     settle_s: f64,
     poly_temp_degree: u8,
@@ -409,6 +410,7 @@ impl FitArgs {
             epochs: self.epochs,
             seed: self.seed,
             hidden: self.hidden,
+            windows: self.windows,
             bias_window_s: self.bias_window_s,
             settle_s: self.settle_s,
             poly_temp_degree: self.poly_temp_degree,
@@ -441,6 +443,7 @@ pub fn fit_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("epochs", d.epochs)?;
     out.set_item("seed", d.seed)?;
     out.set_item("hidden", d.hidden)?;
+    out.set_item("windows", d.windows)?;
     out.set_item("bias_window_s", d.bias_window_s)?;
     out.set_item("settle_s", d.settle_s)?;
     out.set_item("poly_temp_degree", d.poly_temp_degree)?;

@@ -10,6 +10,10 @@ use std::fmt;
 /// epochs stays a few megabytes.
 pub const MAX_EPOCHS: usize = 1_000_000;
 
+/// Most training windows per Adam step one may ask for: four times the largest batch of the
+/// outside recipe (256), and at 64 hidden units a step's activations stay under a gigabyte.
+pub const MAX_WINDOWS: usize = 1024;
+
 /// Absolute zero, °C: no envelope temperature below it.
 pub const ABSOLUTE_ZERO_C: f64 = -273.15;
 /// Hottest envelope temperature accepted, °C: far above any flight (and any chamber's
@@ -28,6 +32,8 @@ pub enum Rule {
     AtLeastOne,
     /// A number of training epochs: an integer from 1 to [`MAX_EPOCHS`].
     Epochs,
+    /// Training windows per Adam step: an integer from 1 to [`MAX_WINDOWS`].
+    Windows,
     /// A scale factor: finite and > 0 (gyro output over table rate, about 1).
     PositiveScaleFactor,
     /// A power-law noise exponent α: an integer from -4 to 2.
@@ -62,6 +68,8 @@ impl Rule {
             Rule::AtLeastOne => "must be at least 1",
             // Stated here as text; a test holds it equal to MAX_EPOCHS.
             Rule::Epochs => "must be a whole number from 1 to 1000000",
+            // Stated here as text; a test holds it equal to MAX_WINDOWS.
+            Rule::Windows => "must be a whole number from 1 to 1024",
             Rule::PositiveScaleFactor => {
                 "is not a scale factor: give a positive number (gyro output over table rate, \
                  about 1)"
@@ -107,6 +115,7 @@ impl Rule {
             Rule::NonNegativeSeconds => v.is_finite() && v >= 0.0,
             Rule::AtLeastOne => v >= 1.0,
             Rule::Epochs => v.fract() == 0.0 && (1.0..=MAX_EPOCHS as f64).contains(&v),
+            Rule::Windows => v.fract() == 0.0 && (1.0..=MAX_WINDOWS as f64).contains(&v),
             Rule::NoiseAlpha => v.fract() == 0.0 && (-4.0..=2.0).contains(&v),
             Rule::Number
             | Rule::ColumnList
@@ -202,7 +211,7 @@ impl fmt::Display for SettingError {
                 setting,
                 value,
                 rule,
-            } if matches!(rule, Rule::AtLeastOne | Rule::Epochs) => {
+            } if matches!(rule, Rule::AtLeastOne | Rule::Epochs | Rule::Windows) => {
                 write!(f, "{setting} {}, not {value}", rule.text())
             }
             SettingError::Invalid {

@@ -48,6 +48,10 @@ pub struct FitArgs {
     pub seed: u64,
     #[arg(long, help = fit::hidden_help())]
     pub hidden: Option<usize>,
+    /// Training windows per Adam step of an LSTM trained in minibatches (`thermal-lstm`,
+    /// `auto`'s LSTM; default: the method's own, 32).
+    #[arg(long)]
+    pub windows: Option<usize>,
     /// Bias target smoothing window, s (centred moving average; 100 s as published).
     #[arg(long, default_value_t = fit::DEFAULT_BIAS_WINDOW_S,
           value_parser = seconds("bias_window_s", Rule::PositiveSeconds))]
@@ -80,6 +84,7 @@ impl FitArgs {
             epochs: self.epochs,
             seed: self.seed,
             hidden: self.hidden,
+            windows: self.windows,
             bias_window_s: self.bias_window_s,
             settle_s: self.settle_s,
             poly_temp_degree: self.poly_temp_degree,

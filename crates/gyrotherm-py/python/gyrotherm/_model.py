@@ -377,6 +377,7 @@ def fit(
     epochs: Optional[int] = _FIT["epochs"],
     seed: int = _FIT["seed"],
     hidden: Optional[int] = _FIT["hidden"],
+    windows: Optional[int] = _FIT["windows"],
     bias_window_s: float = _FIT["bias_window_s"],
     settle_s: float = _FIT["settle_s"],
     poly_temp_degree: int = _FIT["poly_temp_degree"],
@@ -414,7 +415,7 @@ def fit(
     if not static_paths and not table_paths:
         raise _g.FitError("no training logs given; pass static=[...] and/or table=[...]")
     settings = _fit_settings(
-        method, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
+        method, epochs, seed, hidden, windows, bias_window_s, settle_s, poly_temp_degree,
         poly_rate_degree, cross, validate_on_runs,
     )
     options = read_options(log_options)
@@ -494,7 +495,7 @@ def evaluate(
 
 
 def _fit_settings(
-    method, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
+    method, epochs, seed, hidden, windows, bias_window_s, settle_s, poly_temp_degree,
     poly_rate_degree, cross, validate_on_runs,
 ) -> Dict[str, Any]:
     """The fit keywords of :func:`fit` and :func:`compare` as the binding's settings."""
@@ -503,6 +504,7 @@ def _fit_settings(
         "epochs": None if epochs is None else int(epochs),
         "seed": int(seed),
         "hidden": None if hidden is None else int(hidden),
+        "windows": None if windows is None else int(windows),
         "bias_window_s": float(bias_window_s),
         "settle_s": float(settle_s),
         "poly_temp_degree": int(poly_temp_degree),
@@ -523,6 +525,7 @@ def compare(
     epochs: Optional[int] = _FIT["epochs"],
     seed: int = _FIT["seed"],
     hidden: Optional[int] = _FIT["hidden"],
+    windows: Optional[int] = _FIT["windows"],
     bias_window_s: float = _FIT["bias_window_s"],
     settle_s: float = _FIT["settle_s"],
     poly_temp_degree: int = _FIT["poly_temp_degree"],
@@ -553,7 +556,7 @@ def compare(
     if not train_paths or not test_paths:
         raise _g.FitError("give training logs (train=[...]) and held-out logs (test=[...])")
     settings = _fit_settings(
-        method, epochs, seed, hidden, bias_window_s, settle_s, poly_temp_degree,
+        method, epochs, seed, hidden, windows, bias_window_s, settle_s, poly_temp_degree,
         poly_rate_degree, cross, validate_on_runs,
     )
     text, notes = _g.compare(

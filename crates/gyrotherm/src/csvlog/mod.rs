@@ -29,13 +29,13 @@ mod dataflash;
 mod error;
 mod format;
 mod gaps;
-mod unit;
 mod log_set;
 mod number;
 mod reader;
 pub mod repr;
 mod step_means;
 mod ulog;
+mod unit;
 pub(crate) mod writer;
 
 pub use column_list::{
@@ -44,8 +44,6 @@ pub use column_list::{
 pub use error::{LogError, LogErrorKind};
 pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
-pub(crate) use unit::write_imu_csv;
-pub use unit::{read_imu_log, read_imu_logs, write_imu_log};
 pub(crate) use log_set::{read_in_form, LogSetForm};
 pub use log_set::{read_log_set, read_log_sets, FileRead, LogSet, LogSetError, SetRead};
 pub(crate) use number::parse_f64_decimal_comma;
@@ -57,6 +55,8 @@ pub use repr::{
     TEMP_COL, TIME_COL, TRUE_BIAS_COL, TRUE_SCALE_COL,
 };
 pub use step_means::{SAMPLES_COL, SENSOR_GYRO_COLS, STEP_S};
+pub(crate) use unit::write_imu_csv;
+pub use unit::{read_imu_log, read_imu_logs, write_imu_log};
 pub(crate) use writer::short_f64;
 pub use writer::{format_f64, LogWriter};
 

@@ -114,6 +114,10 @@ impl FitSettings {
         if let Some(h) = self.hidden {
             r.hidden = h;
         }
+        // Only a recipe that draws windows at random takes a batch of them per Adam step.
+        if let (Some(w), true) = (self.windows, r.sampled_windows) {
+            r.batch = w;
+        }
         r
     }
 
@@ -779,5 +783,29 @@ mod tests {
         assert_eq!(size(Method::ThermalLstm, Some(8)), 8);
         assert_eq!(size(Method::ThermalLstm, Some(64)), 64);
         assert_eq!(size(Method::Published, Some(16)), 16);
+    }
+
+    /// The windows per Adam step reach the LSTM of the methods that draw windows at random
+    /// (`thermal-lstm`, `auto`'s candidate), whose own is 32; the others train on every
+    /// window in turn and keep theirs.
+    #[test]
+    fn given_windows_reach_the_minibatch_methods_only() {
+        let recipe = |method, windows| {
+            FitSettings {
+                method,
+                windows,
+                ..FitSettings::default()
+            }
+            .fit_config()
+            .unwrap()
+            .recipe
+        };
+        for m in [Method::ThermalLstm, Method::Auto] {
+            assert_eq!(recipe(m, None).batch, 32, "{m:?}");
+            assert_eq!(recipe(m, Some(128)).batch, 128, "{m:?}");
+        }
+        let own = recipe(Method::Residual, None).batch;
+        assert!(!recipe(Method::Residual, None).sampled_windows);
+        assert_eq!(recipe(Method::Residual, Some(128)).batch, own);
     }
 }

@@ -91,6 +91,7 @@ pub(crate) fn fit_options() -> Vec<OptionSpec> {
         opt("epochs", d.epochs.map(|e| e.to_string())),
         opt("seed", Some(d.seed.to_string())),
         opt("hidden", d.hidden.map(|h| h.to_string())),
+        opt("windows", d.windows.map(|w| w.to_string())),
         opt("bias_window_s", Some(d.bias_window_s.to_string())),
         opt("settle_s", Some(d.settle_s.to_string())),
         opt("poly_temp_degree", Some(d.poly_temp_degree.to_string())),

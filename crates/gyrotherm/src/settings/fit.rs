@@ -7,8 +7,8 @@
 //! [`crate::compare`]).
 
 use super::method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
-pub use crate::setting_rule::MAX_EPOCHS;
 use crate::setting_rule::{check, Rule, SettingError};
+pub use crate::setting_rule::{MAX_EPOCHS, MAX_WINDOWS};
 use crate::targets;
 
 /// Default random seed of the LSTM initialisation and window order.
@@ -192,6 +192,10 @@ pub struct FitSettings {
     /// [`gyrotherm_core::compensator::HIDDEN_SIZES`]: [`FitSettings::validate`] accepts
     /// those only.
     pub hidden: Option<usize>,
+    /// Training windows per Adam step of an LSTM trained in minibatches (`thermal-lstm`, and
+    /// `auto`'s LSTM candidate; None: the method's own, 32). Methods that train on every
+    /// window in turn do not read it.
+    pub windows: Option<usize>,
     /// Bias target smoothing window, s (centred moving average).
     pub bias_window_s: f64,
     /// Time dropped at the start of each rate-table segment, s.
@@ -214,6 +218,7 @@ impl Default for FitSettings {
             epochs: None,
             seed: DEFAULT_SEED,
             hidden: None,
+            windows: None,
             bias_window_s: DEFAULT_BIAS_WINDOW_S,
             settle_s: DEFAULT_SETTLE_S,
             poly_temp_degree: DEFAULT_POLY_TEMP_DEGREE,
@@ -236,6 +241,13 @@ impl FitSettings {
         }
         if let Some(h) = self.hidden {
             check("hidden", h as f64, Rule::HiddenUnits)?;
+        }
+        if let Some(w) = self.windows.filter(|w| !(1..=MAX_WINDOWS).contains(w)) {
+            return Err(SettingError::Invalid {
+                setting: "windows",
+                value: w.to_string(),
+                rule: Rule::Windows,
+            });
         }
         check("bias_window_s", self.bias_window_s, Rule::PositiveSeconds)?;
         check("settle_s", self.settle_s, Rule::NonNegativeSeconds)?;
@@ -281,5 +293,31 @@ mod tests {
             assert!(s.validate().is_ok(), "{e}");
         }
         assert!(Rule::Epochs.holds(MAX_EPOCHS as f64) && !Rule::Epochs.holds(0.5));
+    }
+
+    /// The windows per Adam step are refused outside 1 to the bound, by name, with the bound
+    /// the message states equal to the one checked.
+    #[test]
+    fn windows_outside_the_bound_are_refused_by_name() {
+        for w in [0, MAX_WINDOWS + 1, usize::MAX] {
+            let s = FitSettings {
+                windows: Some(w),
+                ..FitSettings::default()
+            };
+            let err = s.validate().unwrap_err();
+            assert_eq!(err.setting(), "windows");
+            assert_eq!(
+                err.to_string(),
+                format!("windows must be a whole number from 1 to {MAX_WINDOWS}, not {w}")
+            );
+        }
+        for w in [1, 128, MAX_WINDOWS] {
+            let s = FitSettings {
+                windows: Some(w),
+                ..FitSettings::default()
+            };
+            assert!(s.validate().is_ok(), "{w}");
+        }
+        assert!(Rule::Windows.holds(MAX_WINDOWS as f64) && !Rule::Windows.holds(0.5));
     }
 }
