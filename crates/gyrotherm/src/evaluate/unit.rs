@@ -211,10 +211,10 @@ mod tests {
     use super::*;
     use crate::csvlog::NamedSeries;
 
-    fn series(name: &str, v: &[f64]) -> NamedSeries {
+    fn series(name: &str, v: [f64; 2]) -> NamedSeries {
         NamedSeries {
             name: name.into(),
-            values: v.to_vec(),
+            values: v.into(),
         }
     }
 
@@ -222,8 +222,8 @@ mod tests {
     fn evaluate_refuses_a_column_other_than_the_gyros() {
         let log = ImuLog {
             time_s: vec![0.0, 1.0],
-            gyro: vec![series("gx", &[1.0, 2.0])],
-            temp: vec![series("t", &[20.0, 21.0])],
+            gyro: vec![series("gx", [1.0, 2.0])],
+            temp: vec![series("t", [20.0, 21.0])],
             ..Default::default()
         };
         let s = EvaluateSettings {
