@@ -22,6 +22,7 @@
 //! - [`json_keys`]: a JSON object that names a key twice.
 //! - `string_table`: a table of strings, as results are printed.
 //! - [`told`]: a line a job tells the user (what it read, did or warns of).
+//! - `per_thread`: work split over threads, one per item.
 //! - [`moving_average`]: the one centred moving average on a time axis.
 //! - [`table_segments`]: the one segmentation of a rate-table log by commanded rate.
 //! - [`flight_size`]: the flight LSTM's hidden size, read from a model file at run time.
@@ -107,6 +108,7 @@ pub mod model;
 pub mod moving_average;
 pub mod nn;
 mod number_text;
+mod per_thread;
 pub mod plan;
 pub mod report;
 pub mod setting_rule;

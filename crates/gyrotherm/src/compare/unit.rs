@@ -28,6 +28,7 @@ use crate::fit::unit::{fit_imu_with_events, ImuEvents, UnitFitError};
 use crate::fit::{NamedLog, Target};
 use crate::model::unit::{ImuAxis, ImuError, ImuModel};
 use crate::model::TempSensorDef;
+use crate::per_thread::on_threads;
 use crate::string_table::Table;
 
 /// Why a unit comparison could not be made (told as
@@ -252,72 +253,58 @@ pub(crate) fn compare_imu(
         })
         .transpose()
         .map_err(UnitCompareError::Unit)?;
-    let axes: Vec<Result<AxisComparison, UnitCompareError>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..gyro_cols.len())
-            .map(|k| {
-                let (gyro_cols, temp_cols, sensors) = (&gyro_cols, &temp_cols, &sensors);
-                let (unit, unit_out) = (&unit, &unit_out);
-                scope.spawn(move || {
-                    let j = sensors[k];
-                    let per_axis = |logs: &[(String, ImuLog)]| -> Vec<(String, TestLog)> {
-                        logs.iter()
-                            .map(|(n, l)| (n.clone(), axis_test_log(l, k, j)))
-                            .collect()
-                    };
-                    let (train, test) = (per_axis(train), per_axis(test));
-                    let comparison = {
-                        let tr: Vec<NamedLog> = train
-                            .iter()
-                            .map(|(n, l)| NamedLog { name: n, log: l })
-                            .collect();
-                        let te: Vec<NamedLog> = test
-                            .iter()
-                            .map(|(n, l)| NamedLog { name: n, log: l })
-                            .collect();
-                        compare(&tr, &te, cfg, &|key, t, e, l| progress(k, key, t, e, l)).map_err(
-                            |source| UnitCompareError::Compare {
+    let axes: Vec<Result<AxisComparison, UnitCompareError>> = on_threads(gyro_cols.len(), |k| {
+        let j = sensors[k];
+        let per_axis = |logs: &[(String, ImuLog)]| -> Vec<(String, TestLog)> {
+            logs.iter()
+                .map(|(n, l)| (n.clone(), axis_test_log(l, k, j)))
+                .collect()
+        };
+        let (train, test) = (per_axis(train), per_axis(test));
+        let comparison = {
+            let tr: Vec<NamedLog> = train
+                .iter()
+                .map(|(n, l)| NamedLog { name: n, log: l })
+                .collect();
+            let te: Vec<NamedLog> = test
+                .iter()
+                .map(|(n, l)| NamedLog { name: n, log: l })
+                .collect();
+            compare(&tr, &te, cfg, &|key, t, e, l| progress(k, key, t, e, l)).map_err(|source| {
+                UnitCompareError::Compare {
+                    gyro: gyro_cols[k].clone(),
+                    source,
+                }
+            })?
+        };
+        let unit_fit = match (unit.as_ref(), unit_out.as_ref()) {
+            (Some(m), Some(outs)) => {
+                let perf = test
+                    .iter()
+                    .zip(outs)
+                    .map(|((name, l), out)| {
+                        performance(l, &out[k].gyro_comp_dps, cfg.tau_s, cfg.settle_s).map_err(
+                            |source| UnitCompareError::UnitFit {
                                 gyro: gyro_cols[k].clone(),
+                                log: name.clone(),
                                 source,
                             },
-                        )?
-                    };
-                    let unit_fit = match (unit.as_ref(), unit_out.as_ref()) {
-                        (Some(m), Some(outs)) => {
-                            let perf = test
-                                .iter()
-                                .zip(outs)
-                                .map(|((name, l), out)| {
-                                    performance(l, &out[k].gyro_comp_dps, cfg.tau_s, cfg.settle_s)
-                                        .map_err(|source| UnitCompareError::UnitFit {
-                                            gyro: gyro_cols[k].clone(),
-                                            log: name.clone(),
-                                            source,
-                                        })
-                                })
-                                .collect::<Result<Vec<_>, _>>()?;
-                            let comp = outs.iter().map(|o| o[k].gyro_comp_dps.clone()).collect();
-                            Some(UnitFitColumn::new(&m.axes[k], perf, comp))
-                        }
-                        _ => None,
-                    };
-                    Ok(AxisComparison {
-                        gyro: gyro_cols[k].clone(),
-                        temp: temp_cols[j].clone(),
-                        unit_fit,
-                        train,
-                        test,
-                        comparison,
+                        )
                     })
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| match h.join() {
-                Ok(r) => r,
-                Err(p) => std::panic::resume_unwind(p),
-            })
-            .collect()
+                    .collect::<Result<Vec<_>, _>>()?;
+                let comp = outs.iter().map(|o| o[k].gyro_comp_dps.clone()).collect();
+                Some(UnitFitColumn::new(&m.axes[k], perf, comp))
+            }
+            _ => None,
+        };
+        Ok(AxisComparison {
+            gyro: gyro_cols[k].clone(),
+            temp: temp_cols[j].clone(),
+            unit_fit,
+            train,
+            test,
+            comparison,
+        })
     });
     Ok(ImuComparison {
         axes: axes.into_iter().collect::<Result<Vec<_>, _>>()?,

@@ -33,6 +33,7 @@ use crate::model::unit::{
     IMU_FORMAT_VERSION, IMU_FORMAT_VERSION_ONE_SENSOR,
 };
 use crate::model::{ModelFile, SubModel, TempSensorDef};
+use crate::per_thread::on_threads;
 use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
 use crate::targets::{self, TargetSet};
@@ -174,22 +175,10 @@ pub(crate) fn fit_imu_full(
     // What the lag search takes of each temperature column depends on no axis: made once per
     // sensor and run (a thread per sensor) for all the axes that read it.
     let shared: Vec<Vec<Option<SharedTables>>> = if multi_path {
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = (0..temp_cols.len())
-                .map(|j| {
-                    scope.spawn(move || {
-                        logs.iter()
-                            .map(|(_, l)| {
-                                crate::fit::thermal::shared_tables(&l.time_s, &l.temp[j].values)
-                            })
-                            .collect::<Vec<_>>()
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                .collect()
+        on_threads(temp_cols.len(), |j| {
+            logs.iter()
+                .map(|(_, l)| crate::fit::thermal::shared_tables(&l.time_s, &l.temp[j].values))
+                .collect::<Vec<_>>()
         })
     } else {
         Vec::new()
@@ -206,30 +195,17 @@ pub(crate) fn fit_imu_full(
         events,
     };
     type Checked = (ImuAxis, Result<(), ImuError>);
-    let axes: Vec<Result<Checked, UnitFitError>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..gyro_cols.len())
-            .map(|k| {
-                scope.spawn(move || {
-                    let axis = if auto {
-                        fit_axis_auto(&job, k)
-                    } else if multi_path {
-                        fit_axis_multi(&job, k)
-                    } else {
-                        fit_axis(&job, k)
-                    }?;
-                    // The axis's part of the model's checks, here while other axes still fit.
-                    let checked = axis_checks(job.temp_cols, &axis);
-                    Ok((axis, checked))
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| match h.join() {
-                Ok(r) => r,
-                Err(p) => std::panic::resume_unwind(p),
-            })
-            .collect()
+    let axes: Vec<Result<Checked, UnitFitError>> = on_threads(gyro_cols.len(), |k| {
+        let axis = if auto {
+            fit_axis_auto(&job, k)
+        } else if multi_path {
+            fit_axis_multi(&job, k)
+        } else {
+            fit_axis(&job, k)
+        }?;
+        // The axis's part of the model's checks, here while other axes still fit.
+        let checked = axis_checks(job.temp_cols, &axis);
+        Ok((axis, checked))
     });
     let (axes, checks): (Vec<ImuAxis>, Vec<_>) = axes
         .into_iter()

@@ -102,14 +102,7 @@ pub(crate) fn each_axis<T: Send>(axes: &[ImuAxis], check: impl Fn(&ImuAxis) -> T
     if axes.len() < 2 {
         return axes.iter().map(check).collect();
     }
-    let check = &check;
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = axes.iter().map(|a| scope.spawn(move || check(a))).collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    })
+    crate::per_thread::on_threads(axes.len(), |k| check(&axes[k]))
 }
 
 /// The LSTM size a unit of `axes` runs at: the largest LSTM of any axis's model or fallback
