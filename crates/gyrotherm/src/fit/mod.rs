@@ -800,8 +800,10 @@ mod tests {
             .unwrap()
             .recipe
         };
+        // The methods' own: `thermal-lstm`'s recipe, which `auto`'s candidate trains with.
+        let own_sampled = super::RecipeSettings::thermal_lstm().batch;
         for m in [Method::ThermalLstm, Method::Auto] {
-            assert_eq!(recipe(m, None).batch, 32, "{m:?}");
+            assert_eq!(recipe(m, None).batch, own_sampled, "{m:?}");
             assert_eq!(recipe(m, Some(128)).batch, 128, "{m:?}");
         }
         let own = recipe(Method::Residual, None).batch;
