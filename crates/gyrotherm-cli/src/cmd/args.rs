@@ -48,9 +48,7 @@ pub struct FitArgs {
     pub seed: u64,
     #[arg(long, help = fit::hidden_help())]
     pub hidden: Option<usize>,
-    /// Training windows per Adam step of an LSTM trained in minibatches (`thermal-lstm`,
-    /// `auto`'s LSTM; default: the method's own, 32).
-    #[arg(long)]
+    #[arg(long, help = fit::windows_help())]
     pub windows: Option<usize>,
     /// Bias target smoothing window, s (centred moving average; 100 s as published).
     #[arg(long, default_value_t = fit::DEFAULT_BIAS_WINDOW_S,

@@ -14,7 +14,7 @@
 use super::recipe::RecipeSettings;
 use crate::model::SubModel;
 use crate::nn::LrSchedule;
-use crate::settings::fit::THERMAL_LSTM_HIDDEN;
+use crate::settings::fit::{THERMAL_LSTM_HIDDEN, THERMAL_LSTM_WINDOWS};
 use crate::settings::method::Method;
 
 impl RecipeSettings {
@@ -29,7 +29,7 @@ impl RecipeSettings {
             hidden: THERMAL_LSTM_HIDDEN,
             window: 768,
             burn_in: 256,
-            batch: 32,
+            batch: THERMAL_LSTM_WINDOWS,
             // Long enough for several window starts per block after the burn-in.
             block_steps: 2048,
             validation_every: 4,

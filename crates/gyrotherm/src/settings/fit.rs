@@ -26,6 +26,10 @@ pub(crate) const DEFAULT_HIDDEN: usize = 8;
 /// Hidden units of `thermal-lstm`'s LSTM: 32, chosen against 16 on the design family
 /// (docs/experiments/lstm-capacity.md). A `hidden` setting, when given, overrides it.
 pub(crate) const THERMAL_LSTM_HIDDEN: usize = 32;
+/// Training windows per Adam step of `thermal-lstm`'s LSTM (and `auto`'s candidate): 32, kept
+/// against 128 on the design family (docs/experiments/lstm-capacity.md). A `windows` setting,
+/// when given, overrides it.
+pub(crate) const THERMAL_LSTM_WINDOWS: usize = 32;
 
 /// The hidden sizes flight code and its exports are built for, as text: "8, 16, 32 or 64".
 pub(crate) fn hidden_sizes_text() -> String {
@@ -37,6 +41,16 @@ pub(crate) fn hidden_sizes_text() -> String {
         Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
         _ => n.join(""),
     }
+}
+
+/// What the windows setting does, with its bound and default: the help of every front end's
+/// option.
+pub fn windows_help() -> String {
+    format!(
+        "Training windows per Adam step of an LSTM trained in minibatches (thermal-lstm, \
+         auto's LSTM candidate), 1 to {MAX_WINDOWS} (default: {THERMAL_LSTM_WINDOWS}); other \
+         methods do not read it"
+    )
 }
 
 /// What the hidden-size setting does, with the sizes it takes and its defaults: the help
@@ -193,7 +207,7 @@ pub struct FitSettings {
     /// those only.
     pub hidden: Option<usize>,
     /// Training windows per Adam step of an LSTM trained in minibatches (`thermal-lstm`, and
-    /// `auto`'s LSTM candidate; None: the method's own, 32). Methods that train on every
+    /// `auto`'s LSTM candidate; None: the method's own, [`THERMAL_LSTM_WINDOWS`]). Methods that train on every
     /// window in turn do not read it.
     pub windows: Option<usize>,
     /// Bias target smoothing window, s (centred moving average).
