@@ -207,7 +207,7 @@ pub struct FitSettings {
     /// those only.
     pub hidden: Option<usize>,
     /// Training windows per Adam step of an LSTM trained in minibatches (`thermal-lstm`, and
-    /// `auto`'s LSTM candidate; None: the method's own, [`THERMAL_LSTM_WINDOWS`]). Methods that train on every
+    /// `auto`'s LSTM candidate; None: the method's own, 32). Methods that train on every
     /// window in turn do not read it.
     pub windows: Option<usize>,
     /// Bias target smoothing window, s (centred moving average).
