@@ -2,7 +2,7 @@
 //! ([`gyrotherm_core::features::FeaturePipeline`]) run sample by sample, so training and
 //! flight see bit-identical numbers. The centred moving average that smooths the bias target
 //! (100 s in He et al. 2024, DOI 10.19452/j.issn1007-5453.2024.02.004) lives in
-//! [`crate::moving_average`] and is re-exported here.
+//! `crate::moving_average` and is re-exported here.
 
 use crate::csvlog::TestLog;
 use crate::moving_average::windowed_mean;
@@ -237,7 +237,7 @@ const TEMP_RATE_HALF_SPAN_S: f64 = 5.0;
 /// Gyro temperature rate, °C/min: the `TEMP_RATE_SMOOTHING_S` centred moving average
 /// ([`centred_moving_average`]) differentiated
 /// by a central difference over ±`TEMP_RATE_HALF_SPAN_S` (one-sided at the ends).
-pub fn temperature_rate_c_per_min(time_s: &[f64], temp_c: &[f64]) -> Vec<f64> {
+pub(crate) fn temperature_rate_c_per_min(time_s: &[f64], temp_c: &[f64]) -> Vec<f64> {
     let n = time_s.len().min(temp_c.len());
     // The symmetric shrinking window keeps a ramp unbiased up to the ends; a log it refuses
     // (non-finite or non-increasing samples) gets the plain windowed mean.

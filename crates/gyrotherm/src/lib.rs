@@ -19,12 +19,12 @@
 //! - [`setting_rule`]: the rules a setting's value may break, and [`SettingError`].
 //! - [`atomic_file`]: writing an output so that nothing is lost (temporary file, then rename).
 //! - [`input_file`]: reading the small input files (models, spec sheets, profiles).
-//! - [`json_keys`]: a JSON object that names a key twice.
+//! - `json_keys`: a JSON object that names a key twice.
 //! - `string_table`: a table of strings, as results are printed.
 //! - [`told`]: a line a job tells the user (what it read, did or warns of).
 //! - `per_thread`: work split over threads, one per item.
-//! - [`moving_average`]: the one centred moving average on a time axis.
-//! - [`table_segments`]: the one segmentation of a rate-table log by commanded rate.
+//! - `moving_average`: the one centred moving average on a time axis.
+//! - `table_segments`: the one segmentation of a rate-table log by commanded rate.
 //! - [`flight_size`]: the flight LSTM's hidden size, read from a model file at run time.
 //! - [`allan`]: Allan-family deviations of rate data, with confidence intervals.
 //! - [`nn`]: the LSTM network on the ground: parameters, training, evaluation.
@@ -100,12 +100,12 @@ pub mod features;
 pub mod fit;
 pub mod flight_size;
 pub mod input_file;
-pub mod json_keys;
+pub(crate) mod json_keys;
 pub mod judge;
 pub mod lot;
 pub mod metrics;
 pub mod model;
-pub mod moving_average;
+pub(crate) mod moving_average;
 pub mod nn;
 mod number_text;
 mod per_thread;
@@ -116,7 +116,7 @@ pub mod settings;
 pub mod sim;
 pub mod spec;
 pub(crate) mod string_table;
-pub mod table_segments;
+pub(crate) mod table_segments;
 pub mod targets;
 pub mod told;
 pub mod train;

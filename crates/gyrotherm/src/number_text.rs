@@ -5,7 +5,7 @@ use std::io::Write as _;
 
 /// Shortest round-trip decimal text of `v` (see the module doc).
 #[inline]
-pub fn format_f64(buf: &mut Vec<u8>, v: f64) {
+pub(crate) fn format_f64(buf: &mut Vec<u8>, v: f64) {
     let a = v.abs();
     // Writing into a Vec cannot fail.
     let _ = if a != 0.0 && !(1e-5..1e16).contains(&a) {

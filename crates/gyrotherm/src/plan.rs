@@ -112,7 +112,7 @@ impl std::error::Error for PlanError {
 
 /// The envelope of a flight log: its sensor temperature's extremes and the largest |rate|
 /// of the report's temperature rate (100 s smoothing, so the sensor's 0.0625 °C steps do not
-/// read as rates; [`crate::features::temperature_rate_c_per_min`]).
+/// read as rates; `crate::features::temperature_rate_c_per_min`).
 pub fn envelope_of(log: &TestLog) -> Result<Envelope, PlanError> {
     let finite = || log.temp_c.iter().copied().filter(|t| t.is_finite());
     let lo = finite().fold(f64::INFINITY, f64::min);

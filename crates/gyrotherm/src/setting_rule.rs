@@ -245,7 +245,7 @@ pub fn check(setting: &'static str, v: f64, rule: Rule) -> Result<f64, SettingEr
 }
 
 /// [`check`] for an optional value (None passes).
-pub fn check_opt(
+pub(crate) fn check_opt(
     setting: &'static str,
     v: Option<f64>,
     rule: Rule,

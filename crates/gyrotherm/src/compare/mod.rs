@@ -18,7 +18,7 @@ mod table;
 pub mod unit;
 
 pub use summary::{ComparisonSummary, ModelSummary, TestSummary};
-pub use table::{ComparisonTable, TableBlock, TableFigure, TableRow, FAILED_CELL, NOT_FITTED_CELL};
+pub use table::{ComparisonTable, TableBlock, TableFigure, TableRow};
 
 use std::fmt;
 

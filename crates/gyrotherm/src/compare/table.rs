@@ -186,9 +186,9 @@ impl Comparison {
 type FigureOf = fn(&Performance) -> Option<f64>;
 
 /// The cell of a column whose fit on the training logs failed.
-pub const NOT_FITTED_CELL: &str = "not fitted";
+pub(crate) const NOT_FITTED_CELL: &str = "not fitted";
 /// The cell of a fitted column that could not compensate or be judged on a held-out log.
-pub const FAILED_CELL: &str = "failed";
+pub(crate) const FAILED_CELL: &str = "failed";
 
 fn cell(v: Option<f64>, digits: usize) -> String {
     match v {

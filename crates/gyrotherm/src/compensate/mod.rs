@@ -9,7 +9,7 @@ use crate::flight_size::FlightCompensator;
 use crate::csvlog::TestLog;
 use crate::model::boxed_compensator;
 use crate::model::ModelFile;
-pub use crate::model::{hidden_size, padded_core_lstm, target_model, CompensateError};
+pub use crate::model::{hidden_size, CompensateError};
 
 pub mod unit;
 

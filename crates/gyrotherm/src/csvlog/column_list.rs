@@ -15,15 +15,15 @@ use super::{ReadOptions, DEFAULT_TABLE_COL, GYRO_COL, TEMP_COL, TIME_COL};
 use crate::setting_rule::{Rule, SettingError};
 
 /// Separator of the names in a column list.
-pub const COLUMN_LIST_SEPARATOR: char = ',';
+pub(crate) const COLUMN_LIST_SEPARATOR: char = ',';
 
 /// Slope of a gyro's output on the table rate that marks the axis the table turns: a scale
 /// factor near 1 (He et al. 2024 eq. (1): Ĝ = B + K·G, K ≈ 1); the other axes read ≈ 0.
-pub const TABLE_AXIS_SLOPE_RANGE: (f64, f64) = (0.5, 2.0);
+pub(crate) const TABLE_AXIS_SLOPE_RANGE: (f64, f64) = (0.5, 2.0);
 
 /// Split a column list into its names: non-empty (spaces around a name are dropped) and
 /// distinct; the error names `setting`.
-pub fn split_columns(setting: &'static str, s: &str) -> Result<Vec<String>, SettingError> {
+pub(crate) fn split_columns(setting: &'static str, s: &str) -> Result<Vec<String>, SettingError> {
     let names: Vec<String> = s
         .split(COLUMN_LIST_SEPARATOR)
         .map(|n| n.trim().to_owned())
@@ -45,7 +45,7 @@ pub fn split_columns(setting: &'static str, s: &str) -> Result<Vec<String>, Sett
 }
 
 /// Check `--table-axis`: one of the gyro columns.
-pub fn parse_table_axis(s: &str, gyro_cols: &[String]) -> Result<usize, SettingError> {
+pub(crate) fn parse_table_axis(s: &str, gyro_cols: &[String]) -> Result<usize, SettingError> {
     gyro_cols
         .iter()
         .position(|g| g == s.trim())

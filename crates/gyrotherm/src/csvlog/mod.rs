@@ -38,9 +38,6 @@ mod ulog;
 mod unit;
 pub(crate) mod writer;
 
-pub use column_list::{
-    parse_table_axis, split_columns, COLUMN_LIST_SEPARATOR, TABLE_AXIS_SLOPE_RANGE,
-};
 pub use error::{LogError, LogErrorKind};
 pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
@@ -54,11 +51,11 @@ pub use repr::{
     ColumnError, ExtraColumn, ImuLog, NamedSeries, TestLog, DEFAULT_TABLE_COL, GYRO_COL, NOISE_COL,
     TEMP_COL, TIME_COL, TRUE_BIAS_COL, TRUE_SCALE_COL,
 };
-pub use step_means::{SAMPLES_COL, SENSOR_GYRO_COLS, STEP_S};
+pub use step_means::{SAMPLES_COL, SENSOR_GYRO_COLS};
 pub(crate) use unit::write_imu_csv;
 pub use unit::{read_imu_log, read_imu_logs, write_imu_log};
 pub(crate) use writer::short_f64;
-pub use writer::{format_f64, LogWriter};
+pub use writer::LogWriter;
 
 use std::fs::File;
 use std::path::Path;
@@ -128,7 +125,7 @@ pub struct ReadOptions {
     /// Header of the time column (s).
     pub time_col: String,
     /// Header of the gyro column (unit: `gyro_unit`), or of several, comma-separated (an
-    /// inertial unit's log: [`read_imu_log`]; see [`split_columns`]).
+    /// inertial unit's log: [`read_imu_log`]; see `split_columns`).
     pub gyro_col: String,
     /// Header of the temperature column (°C), or of several, comma-separated.
     pub temp_col: String,

@@ -13,7 +13,7 @@ use super::error::{LogError, LogErrorKind as Kind};
 use super::{ExtraColumn, GyroUnit, ImuLog, NamedSeries, ReadReport, TEMP_COL};
 
 /// The model's step, s: the length of the time slice one row of a reduced log averages.
-pub const STEP_S: f64 = 1.0;
+pub(crate) const STEP_S: f64 = 1.0;
 
 /// The gyro columns of an autopilot's three-axis sensor, as a unit's CSV names its axes.
 pub const SENSOR_GYRO_COLS: [&str; 3] = ["gyro_x_dps", "gyro_y_dps", "gyro_z_dps"];

@@ -7,7 +7,7 @@
 
 use std::io::{self, Write};
 
-pub use crate::number_text::format_f64;
+pub(crate) use crate::number_text::format_f64;
 pub(crate) use crate::number_text::short_f64;
 
 /// Rows are handed to the inner writer once this many bytes are buffered (unless flushing

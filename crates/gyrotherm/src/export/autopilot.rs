@@ -6,9 +6,10 @@
 use std::path::{Path, PathBuf};
 
 pub use super::steady_bias::{
-    cubic, fit_cubic, steady_bias, AutopilotError, AutopilotExport, FitError, ModelRef, SteadyBias,
-    GRID_POINTS, MIN_RANGE_C, RAD_PER_DEG,
+    cubic, steady_bias, AutopilotError, AutopilotExport, FitError, ModelRef, SteadyBias,
+    GRID_POINTS, MIN_RANGE_C,
 };
+
 use super::{ExportError, ExportTarget};
 use crate::compare::{
     performance, Column, CompareConfig, CompareError, Comparison, FailedColumn, MethodResult,

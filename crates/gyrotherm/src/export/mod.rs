@@ -19,7 +19,7 @@ pub mod steady_bias;
 pub mod target;
 pub mod unit;
 
-pub use target::{ExportTarget, EXPORT_TARGETS, EXPORT_TARGET_NAMES};
+pub use target::{ExportTarget, EXPORT_TARGETS};
 
 use std::path::{Path, PathBuf};
 

@@ -361,7 +361,7 @@ pub fn steady_bias(
 
 /// Least squares `y ≈ c0 + c1·x + c2·x² + c3·x³`; the columns are built on x scaled to
 /// [-1, 1] (well conditioned for any range) and the coefficients turned back to powers of x.
-pub fn fit_cubic(x: &[f64], y: &[f64]) -> Option<[f64; 4]> {
+pub(crate) fn fit_cubic(x: &[f64], y: &[f64]) -> Option<[f64; 4]> {
     if x.len() != y.len() || x.len() < 4 {
         return None;
     }
@@ -444,7 +444,7 @@ impl FitError {
 }
 
 /// °/s to rad/s.
-pub const RAD_PER_DEG: f64 = std::f64::consts::PI / 180.0;
+pub(crate) const RAD_PER_DEG: f64 = std::f64::consts::PI / 180.0;
 
 /// What an autopilot target wrote (or would write).
 #[derive(Debug, Clone, PartialEq)]

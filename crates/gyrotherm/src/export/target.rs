@@ -2,7 +2,7 @@
 //! each full-model target writes.
 
 use super::Lang;
-pub use crate::settings::export::{ExportTarget, EXPORT_TARGETS, EXPORT_TARGET_NAMES};
+pub use crate::settings::export::{ExportTarget, EXPORT_TARGETS};
 
 impl ExportTarget {
     /// The flight-code language, for the targets that write the full model.

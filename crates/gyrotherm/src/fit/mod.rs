@@ -32,7 +32,7 @@ pub mod residual;
 pub mod select;
 pub mod terms;
 pub mod thermal;
-pub mod thermal_lstm;
+pub(crate) mod thermal_lstm;
 pub mod unit;
 
 use crate::baseline::{self, PolyDegrees, Terms};

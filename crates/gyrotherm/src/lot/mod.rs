@@ -5,8 +5,8 @@
 //! [`crate::spec::FIGURES`] on each, judges them against the spec sheet when
 //! one is given, and returns a [`Run`]: the unit, the time, the gyrotherm version, the
 //! SHA-256 of every input and the model's `content_sha256`, each figure and verdict, and
-//! the spec. A [`LotStore`] keeps runs: [`SqliteStore`] (one file, the default) or
-//! [`PgStore`] (PostgreSQL, for several stations on separate machines), with the same schema
+//! the spec. A [`LotStore`] keeps runs: `SqliteStore` (one file, the default) or
+//! `PgStore` (PostgreSQL, for several stations on separate machines), with the same schema
 //! ([`schema`], docs/lot-schema.md). [`report`] writes the lot's HTML page and CSV.
 //!
 //! Nothing is lost: each run is written in one transaction; a unit added again keeps both
@@ -18,9 +18,10 @@ pub mod schema;
 mod sqlite;
 mod time;
 
-pub use pg::PgStore;
-pub use sqlite::SqliteStore;
-pub use time::{now_unix_ms, rfc3339_utc};
+pub(crate) use pg::PgStore;
+pub(crate) use sqlite::SqliteStore;
+pub use time::now_unix_ms;
+pub(crate) use time::rfc3339_utc;
 
 use std::fmt;
 use std::path::{Path, PathBuf};

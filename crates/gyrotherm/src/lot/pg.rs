@@ -17,7 +17,7 @@ use super::{
 const SCHEMA_LOCK: i64 = 0x6779_726f;
 
 /// A lot in a PostgreSQL database.
-pub struct PgStore {
+pub(crate) struct PgStore {
     client: Client,
     /// The URL without its password, for messages.
     db: String,

@@ -18,7 +18,7 @@ use super::{
 };
 
 /// A lot in an SQLite file.
-pub struct SqliteStore {
+pub(crate) struct SqliteStore {
     conn: Connection,
     path: PathBuf,
     busy_timeout_ms: u64,

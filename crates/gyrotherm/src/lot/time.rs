@@ -9,7 +9,7 @@ pub fn now_unix_ms() -> i64 {
 }
 
 /// `unix_ms` as RFC 3339 UTC with milliseconds.
-pub fn rfc3339_utc(unix_ms: i64) -> String {
+pub(crate) fn rfc3339_utc(unix_ms: i64) -> String {
     let secs = unix_ms.div_euclid(1000);
     let ms = unix_ms.rem_euclid(1000);
     let days = secs.div_euclid(86_400);

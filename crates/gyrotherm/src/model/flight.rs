@@ -42,7 +42,7 @@ pub(crate) fn sized_compensator<const H: usize>(
 /// Widen an LSTM to the flight input count and `H` hidden units: input columns beyond
 /// `input_size` get weight 0, and so do hidden units beyond `hidden_size` (their state stays
 /// 0 and they add nothing to the output; see [`crate::flight_size`]).
-pub fn padded_core_lstm<const H: usize>(
+pub(crate) fn padded_core_lstm<const H: usize>(
     params: &LstmParams,
 ) -> Result<gyrotherm_core::lstm::LstmWeights<LSTM_INPUTS, H>, CompensateError> {
     let i = params.input_size;
@@ -89,7 +89,7 @@ pub fn hidden_size<'a>(
 /// The flight model of one target (`None`: the constant `absent`) at `H` hidden units: the
 /// compensator's own conversion of its flight form ([`static_target`]), so that what runs on
 /// the ground is what an export carries.
-pub fn target_model<const H: usize>(
+pub(crate) fn target_model<const H: usize>(
     sub: Option<&SubModel>,
     absent: f64,
 ) -> Result<TargetModel<H>, CompensateError> {
@@ -102,7 +102,7 @@ pub fn target_model<const H: usize>(
 /// data: its baseline's terms, and its LSTM widened to `H` units and the flight input count
 /// ([`padded_core_lstm`]) with its normalisation. Both the compensator ([`target_model`]) and
 /// the exports are made from it.
-pub fn static_target<const H: usize>(
+pub(crate) fn static_target<const H: usize>(
     sub: Option<&SubModel>,
     absent: f64,
 ) -> Result<StaticTarget<H>, CompensateError> {
@@ -150,7 +150,7 @@ pub fn static_target<const H: usize>(
 }
 
 /// A core baseline as plain data.
-pub fn static_baseline(b: &gyrotherm_core::baseline::BaselineModel) -> StaticBaseline {
+pub(crate) fn static_baseline(b: &gyrotherm_core::baseline::BaselineModel) -> StaticBaseline {
     let mut s = StaticBaseline {
         n_features: b.n_features() as u8,
         n_terms: b.n_terms() as u8,

@@ -8,7 +8,7 @@ use crate::nn::{predict, TrainError};
 
 /// Why a sub-model could not be run over a table: its LSTM's shapes do not fit the table's
 /// features.
-pub type GroundPredictError = TrainError;
+pub(crate) type GroundPredictError = TrainError;
 
 impl SubModel {
     /// The sub-model's output (bias °/s, or scale factor) at every row of `table`.

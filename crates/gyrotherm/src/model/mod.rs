@@ -19,7 +19,7 @@
 //! shortest round-trip form, so save → load is bit-exact. [`ModelFile::load`] checks the
 //! version first, then the fields (unknown fields are refused), then shapes and finiteness.
 //! A key named twice in one object is refused anywhere in the file (see
-//! [`crate::json_keys`]).
+//! `crate::json_keys`).
 
 use crate::atomic_file::write_bytes_atomically;
 use crate::baseline::TermsError;
@@ -681,10 +681,8 @@ pub mod unit;
 pub use checks::SubModelError;
 pub use coverage_map::CoverageDef;
 pub(crate) use flight::{boxed_compensator, sized_compensator};
-pub use flight::{
-    hidden_size, padded_core_lstm, static_baseline, static_target, target_model, CompensateError,
-};
-pub use ground::GroundPredictError;
+pub use flight::{hidden_size, CompensateError};
+pub(crate) use flight::{static_baseline, static_target, target_model};
 pub use method_choice::{CandidateScore, MethodChoice, Validation};
 use seal::supported_list;
 pub(crate) use seal::{content_digest_of, parse_sealed, SealedTextError};

@@ -1,7 +1,7 @@
 //! The named figures of the report (after the figures of He et al. 2024,
 //! DOI 10.19452/j.issn1007-5453.2024.02.004), each a function over plain data, and the Allan
 //! figure that `gyrotherm allan --plot` reuses. Every function takes a path (with or
-//! without `.png`/`.svg`, see [`figure_paths`](super::plot::figure_paths)) and writes the
+//! without `.png`/`.svg`, see `figure_paths`) and writes the
 //! PNG and the SVG.
 //!
 //! Units: time s, temperature °C, temperature rate °C/min, gyro output °/h, rate-table rate

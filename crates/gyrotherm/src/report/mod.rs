@@ -38,15 +38,13 @@ pub use figures::{
 };
 pub use html::{write_report, ReportContent, ReportFigure, Table};
 pub use job::{
-    allan_curve, comparison_table, grouped_warnings, input_names, model_table, noise_lines,
-    results_table, scale_factor_points, shared_settings, temperature_rate_c_per_min,
-    write_full_report, write_full_report_with, ScalePoints, FIGURE_STEMS, FIGURE_WINDOW_S,
-    NOT_APPLICABLE, TEMP_RATE_SMOOTHING_S,
+    allan_curve, input_names, noise_lines, scale_factor_points, write_full_report, ScalePoints,
+    FIGURE_STEMS, TEMP_RATE_SMOOTHING_S,
 };
+pub(crate) use job::{grouped_warnings, results_table, write_full_report_with};
 pub use plot::{
-    figure_layout, figure_paths, write_figure, Figure, FigureFiles, Panel, PanelLayout, PixelRect,
-    Series, SeriesStyle, FIGURE_HEIGHT_2_PANELS_PX, FIGURE_HEIGHT_PX, FIGURE_WIDTH_PX,
-    LEGEND_BORDER_RGB,
+    figure_layout, write_figure, Figure, FigureFiles, Panel, PanelLayout, PixelRect, Series,
+    SeriesStyle, FIGURE_HEIGHT_PX, FIGURE_WIDTH_PX, LEGEND_BORDER_RGB,
 };
 
 /// Why a figure or report could not be written.

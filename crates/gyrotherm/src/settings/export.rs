@@ -26,7 +26,7 @@ pub const EXPORT_TARGETS: [ExportTarget; 4] = [
 ];
 
 /// The names of [`EXPORT_TARGETS`], in its order (made from it, so the two cannot differ).
-pub const EXPORT_TARGET_NAMES: [&str; EXPORT_TARGETS.len()] = {
+pub(crate) const EXPORT_TARGET_NAMES: [&str; EXPORT_TARGETS.len()] = {
     let mut names = [""; EXPORT_TARGETS.len()];
     let mut i = 0;
     while i < names.len() {

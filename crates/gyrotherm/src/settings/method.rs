@@ -83,7 +83,7 @@ registry! {
          LSTM (fast: under a second); degrades on short or coarse logs and says how";
     /// `Thermal`'s model plus an LSTM of real capacity on its residual, reading the thermal
     /// states and `Thermal`'s prediction; kept only where it beats `Thermal` on held-out
-    /// blocks, else the model is `Thermal` alone ([`crate::fit::thermal_lstm`]).
+    /// blocks, else the model is `Thermal` alone (`crate::fit::thermal_lstm`).
     ThermalLstm = "thermal-lstm", Recipe, None,
         "`thermal` plus a 32-unit LSTM on its residual (reading the thermal states and \
          thermal's prediction, minibatch training), kept only where it beats `thermal` on \

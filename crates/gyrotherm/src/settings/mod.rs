@@ -50,4 +50,5 @@ pub use describe::{describe, OptionSpec};
 pub use evaluate::EvaluateSettings;
 pub use fit::FitSettings;
 pub use method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
-pub use rule::{check, check_opt, parse_number, Rule, SettingError};
+pub(crate) use rule::check_opt;
+pub use rule::{check, parse_number, Rule, SettingError};

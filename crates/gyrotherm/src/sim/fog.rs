@@ -392,7 +392,7 @@ pub(crate) fn lag_alpha(h_s: f64, tau_s: f64) -> f64 {
 
 /// Thermal state of the unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ThermalState {
+pub(crate) struct ThermalState {
     /// Mounting-node temperature, °C (follows the chamber air when the unit has none).
     pub mount_c: f64,
     /// Case temperature, °C.

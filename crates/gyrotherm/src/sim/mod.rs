@@ -38,7 +38,8 @@ use std::path::PathBuf;
 pub use chamber::ChamberParams;
 pub use family::{random_unit, UnitRanges};
 pub use fault::FaultParams;
-pub use fog::{FogUnit, SensorNode, ThermalState, EARTH_RATE_DPH};
+pub(crate) use fog::ThermalState;
+pub use fog::{FogUnit, SensorNode, EARTH_RATE_DPH};
 pub use profile::{Profile, Segment, BUILTIN_PROFILES};
 
 use crate::csvlog::{ExtraColumn, TestLog, NOISE_COL, TRUE_BIAS_COL, TRUE_SCALE_COL};

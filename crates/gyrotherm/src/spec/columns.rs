@@ -9,7 +9,7 @@ use crate::metrics::EvaluationOptions;
 
 /// The verdict of one column of a comparison.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ColumnVerdict {
+pub(crate) struct ColumnVerdict {
     /// The column's key (`linear`, `poly`, `lstm`, `published`).
     pub key: &'static str,
     /// Its name in the table.
@@ -19,7 +19,7 @@ pub struct ColumnVerdict {
 
 /// Judge the compensated output of every column of `cmp` (run on `test`) against `spec`,
 /// with the comparison's τ and settle time.
-pub fn judge_comparison(
+pub(crate) fn judge_comparison(
     spec: &Spec,
     cmp: &Comparison,
     test: &[NamedLog],

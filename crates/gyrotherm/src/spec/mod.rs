@@ -24,7 +24,7 @@ mod figures;
 pub mod unit;
 mod verdict;
 
-pub use columns::{judge_comparison, ColumnVerdict};
+pub(crate) use columns::{judge_comparison, ColumnVerdict};
 pub use figures::{figure, measure, FigureDef, Figures, LogKind, MeasureOptions, FIGURES};
 pub use verdict::{judge, FigureVerdict, Verdict};
 

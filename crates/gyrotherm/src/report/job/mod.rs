@@ -20,10 +20,9 @@ mod warnings;
 
 pub use allan_figure::{allan_curve, noise_lines};
 pub use rate_table::{scale_factor_points, ScalePoints};
-pub use tables::{
-    comparison_table, input_names, model_table, results_table, shared_settings, NOT_APPLICABLE,
-};
-pub use warnings::grouped_warnings;
+pub use tables::input_names;
+pub(crate) use tables::{model_table, results_table, shared_settings};
+pub(crate) use warnings::grouped_warnings;
 
 use allan_figure::allan_report_figure;
 use rate_table::rate_table_figures;
@@ -39,14 +38,15 @@ use super::html::{write_report, ReportContent, ReportFigure};
 use super::plot::FigureFiles;
 use super::ReportError;
 use crate::compare::{CompareConfig, Comparison, MethodResult, TestResult};
-pub use crate::features::{temperature_rate_c_per_min, TEMP_RATE_SMOOTHING_S};
+pub(crate) use crate::features::temperature_rate_c_per_min;
+pub use crate::features::TEMP_RATE_SMOOTHING_S;
 use crate::fit::NamedLog;
 use crate::metrics::DPS_TO_DPH;
 use crate::moving_average::centred_moving_average;
 use crate::sim::CHAMBER_TEMP_COL;
 
 /// Averaging window of the raw-output and compensation figures, s (He et al. 2024 use 100 s).
-pub const FIGURE_WINDOW_S: f64 = 100.0;
+pub(crate) const FIGURE_WINDOW_S: f64 = 100.0;
 
 /// File stems of the figures, in report order.
 pub const FIGURE_STEMS: [&str; 10] = [
@@ -62,7 +62,7 @@ pub const FIGURE_STEMS: [&str; 10] = [
     "fig10_sigma",
 ];
 
-/// [`write_full_report_with`] without extra warnings.
+/// `write_full_report_with` without extra warnings.
 pub fn write_full_report(
     dir: &Path,
     train: &[NamedLog],
@@ -78,7 +78,7 @@ pub fn write_full_report(
 /// training logs (named on the page). `extra_warnings` (e.g. gaps filled on reading) are
 /// listed after the extrapolation warnings of `cmp` (each finding once per held-out log,
 /// naming the models it concerns).
-pub fn write_full_report_with(
+pub(crate) fn write_full_report_with(
     dir: &Path,
     train: &[NamedLog],
     test: &[NamedLog],

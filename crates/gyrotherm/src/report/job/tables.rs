@@ -8,15 +8,9 @@ use crate::fit::{FitOutcome, NamedLog, TrainSummary};
 use crate::model::{Method, ModelFile, SubModel};
 use crate::report::html::Table;
 
-/// The comparison table of `gyrotherm compare` ([`Comparison::table`]) as the report's HTML
-/// table: one row per figure, the held-out log named on its first row, a noise-floor column.
-pub fn comparison_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
-    results_table(&cmp.table(cfg))
-}
-
 /// A results table (a comparison's, or a unit axis's with its unit-fit column) as the
 /// report's HTML table: held-out log, figure, the output columns, the noise floor.
-pub fn results_table(t: &crate::compare::ComparisonTable) -> Table {
+pub(crate) fn results_table(t: &crate::compare::ComparisonTable) -> Table {
     let mut headers = vec!["held-out log".to_owned(), "figure".to_owned()];
     headers.extend(t.columns.iter().cloned());
     headers.push("noise floor".to_owned());
@@ -38,7 +32,7 @@ pub fn results_table(t: &crate::compare::ComparisonTable) -> Table {
 /// Settings shared by every model of the comparison, key then value: the training logs and
 /// the comparison's windows, then the provenance fields (data digest, training inputs,
 /// writer) when every model carries the same value; [`model_table`] shows them otherwise.
-pub fn shared_settings(
+pub(crate) fn shared_settings(
     train: &[NamedLog],
     cmp: &Comparison,
     cfg: &CompareConfig,
@@ -72,7 +66,7 @@ pub fn shared_settings(
 /// The models side by side: a header row naming each model, then one row per field.
 /// A cell whose field does not apply to that model (epochs of a least-squares fit, the
 /// recipe of a method without one) holds "—"; a field that applies to no model has no row.
-pub fn model_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
+pub(crate) fn model_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
     let n = cmp.fits.len().min(cmp.columns.len());
     let mut headers = vec!["field".to_owned()];
     headers.extend(cmp.columns[..n].iter().map(|c| c.label.to_owned()));
@@ -105,7 +99,7 @@ pub fn model_table(cmp: &Comparison, cfg: &CompareConfig) -> Table {
 }
 
 /// The cell of a field that does not apply to a model.
-pub const NOT_APPLICABLE: &str = "—";
+pub(crate) const NOT_APPLICABLE: &str = "—";
 
 /// The rows of [`model_table`], in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -13,7 +13,7 @@ const EXTRAPOLATES: &str = "; the model extrapolates there";
 /// One line per distinct finding on each held-out log, in the order first found: the
 /// finding, then the models it concerns. A warning of `cmp` that is not an extrapolation
 /// finding of one of its models is kept as it is.
-pub fn grouped_warnings(test: &[NamedLog], cmp: &Comparison) -> Vec<String> {
+pub(crate) fn grouped_warnings(test: &[NamedLog], cmp: &Comparison) -> Vec<String> {
     let mut out = Vec::new();
     for (log, result) in test.iter().zip(&cmp.tests) {
         // (finding, labels of the models it concerns)

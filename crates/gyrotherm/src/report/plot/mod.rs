@@ -30,7 +30,7 @@ pub const FIGURE_WIDTH_PX: u32 = 1000;
 /// Default height of a one-panel figure.
 pub const FIGURE_HEIGHT_PX: u32 = 600;
 /// Default height of a two-panel figure.
-pub const FIGURE_HEIGHT_2_PANELS_PX: u32 = 800;
+pub(crate) const FIGURE_HEIGHT_2_PANELS_PX: u32 = 800;
 
 const LEGEND_FONT_PX: u32 = 15;
 const TICK_FONT_PX: u32 = 15;
@@ -174,7 +174,7 @@ pub struct FigureFiles {
 /// The PNG and SVG paths for `path`: a trailing `.png` or `.svg` is replaced, any other name
 /// gets the extensions appended (`out/fig1` and `out/fig1.png` both give `out/fig1.png` and
 /// `out/fig1.svg`).
-pub fn figure_paths(path: &Path) -> (PathBuf, PathBuf) {
+pub(crate) fn figure_paths(path: &Path) -> (PathBuf, PathBuf) {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
@@ -189,7 +189,7 @@ pub fn figure_paths(path: &Path) -> (PathBuf, PathBuf) {
     (PathBuf::from(png), PathBuf::from(svg))
 }
 
-/// Draw `fig` and write it as PNG and SVG beside each other (see [`figure_paths`]); the
+/// Draw `fig` and write it as PNG and SVG beside each other (see `figure_paths`); the
 /// folder must exist. Lines longer than twice the plot width are decimated to min/max per
 /// pixel column first. Errors: series with x, y (or bars) of different lengths, a figure
 /// without panels or with a zero size, and any I/O failure, each naming the file or series.
