@@ -1,59 +1,13 @@
-//! Export an inertial-unit model ([`ImuModel`]): the unit's flight code, in C or Rust.
-//!
-//! **C.** `gyrotherm_model.h` defines `GT_AXES` and `GT_TEMPS` and declares
-//!
-//! ```c
-//! void gt_init(gt_state *s);
-//! void gt_step_imu(gt_state *s, double t, const double gyro[GT_AXES],
-//!                  const double temp[GT_TEMPS], double rate[GT_AXES],
-//!                  gt_status status[GT_AXES]);
-//! void gt_step_imu_bk(gt_state *s, double t, const double gyro[GT_AXES],
-//!                     const double temp[GT_TEMPS], double rate[GT_AXES],
-//!                     gt_status status[GT_AXES], double bias[GT_AXES], double scale[GT_AXES]);
-//! gt_coverage gt_coverage_of_axis(const gt_state *s, int axis, double *sigma_dph);
-//! ```
-//!
-//! `gyrotherm_model.c` holds, per axis, the single-axis port of [`super::c`] for that axis's
-//! model, its file-scope names suffixed `_a<i>` (comments untouched), the model-independent
-//! helpers (`expm1`, `exp`, bit casts) once; then the unit functions, which call axis `i`'s
-//! `gt_step` with `gyro[i]` and the temperature of the first sensor it reads. An axis that
-//! reads further sensors ([`gyrotherm_core::multi`]) gets, per further sensor, the feature
-//! pipeline and baseline code of the same port (the port of a model on that sensor's features
-//! whose B and K are its parts), suffixed `_a<i>s<j>`, with a state of only what the core's
-//! further sensor holds (that pipeline and its latest accepted reading, not a whole
-//! single-axis state), and the port's hooks (`@MORE_*@`) call the `more_*` functions, a port
-//! of the core's further-sensor handling: plausibility against each sensor's own last good
-//! reading, the pipelines pushed together, the parts added in order, every pipeline restarted
-//! on a new time base. So each axis computes exactly what the
-//! core's [`Unit`](gyrotherm_core::unit::Unit) computes: `compensate --stream` to the last
-//! bit. An axis with a fallback model ([`crate::model::unit::ImuAxis::fallback`]) also gets the
-//! single-axis port of that model, suffixed `_a<i>f`, stepped on its first sensor alongside,
-//! and the unit function makes the core's choice between the two outputs
-//! ([`gyrotherm_core::multi`]: status `GT_FALLBACK`).
-//!
-//! **Rust.** `gyrotherm_model.rs` holds `AXES`, `TEMPS`, `CHANNELS` (the first sensor each
-//! axis reads), `MODELS` (one [`StaticModel`] per axis), `SENSORS` (each axis's further
-//! sensors) and `FALLBACKS` (each axis's fallback model, if any), for
-//! [`Unit::from_static_fallbacks`](gyrotherm_core::unit::Unit::from_static_fallbacks).
-//!
-//! **Column names.** Generated source holds only generator text and numbers: the column
-//! names, which come from the model file, are never written into it (a name could close a
-//! comment and add code). The files give the order by index (`gyro[i]` is the model's i-th
-//! gyro column, `temp[j]` its j-th temperature column, and which `temp[]` each axis reads)
-//! with the model's content hash; `column_map` gives the names for that order, which
-//! `gyrotherm export` prints on stderr.
+//! An inertial unit's C export: per axis, the single-axis port of [`crate::export::c`] with
+//! its file-scope names suffixed, the further sensors' pipelines and the unit functions (see
+//! the parent module).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 use gyrotherm_core::features::HISTORY_STEPS;
-use gyrotherm_core::static_model::{StaticBaseline, StaticModel, StaticTarget};
 
-use super::{
-    c, describe, rust, sized_static_model, static_baseline, write_files, ExportError, Lang,
-};
-use crate::model::unit::{ImuError, ImuModel};
-use crate::model::CHECKSUM_KEY;
+use super::{AxisExport, Layout, SensorExport};
+use crate::export::c;
 
 /// The model-independent helpers of the C port, written once for the unit: the text from
 /// the first of them up to (not including) the first model-dependent function.
@@ -78,238 +32,6 @@ const PER_AXIS_HEADER: [&str; 6] = [
     "GT_N_FEATURES",
     "GT_LAG_SLOTS",
 ];
-
-/// `1st`, `2nd`, `3rd`, `4th`, ...
-fn ordinal(n: usize) -> String {
-    let suffix = match (n % 10, n % 100) {
-        (_, 11..=13) => "th",
-        (1, _) => "st",
-        (2, _) => "nd",
-        (3, _) => "rd",
-        _ => "th",
-    };
-    format!("{n}{suffix}")
-}
-
-/// The unit's name-to-index map, one line each, for the user (stderr): the names come from
-/// the model file and go nowhere into generated source.
-pub(crate) fn column_map(model: &ImuModel) -> Vec<String> {
-    let mut out = Vec::new();
-    for (i, (g, a)) in model.gyro_cols.iter().zip(&model.axes).enumerate() {
-        let reads: Vec<String> = a
-            .temps
-            .iter()
-            .map(|t| {
-                let j = model.temp_cols.iter().position(|c| c == t).unwrap_or(0);
-                format!("temp[{j}]")
-            })
-            .collect();
-        out.push(format!(
-            "gyro[{i}] = {g} (axis {i}, reads {})",
-            reads.join(", ")
-        ));
-    }
-    for (j, t) in model.temp_cols.iter().enumerate() {
-        out.push(format!("temp[{j}] = {t}"));
-    }
-    out
-}
-
-/// The generated files of a unit model for `lang`, as `(file name, text)`, without writing
-/// anything; like [`super::generate`], every byte is the generator's.
-pub fn generate_imu(
-    model: &ImuModel,
-    lang: Lang,
-) -> Result<Vec<(&'static str, String)>, ExportError> {
-    model.validate().map_err(ExportError::Unit)?;
-    let size = model.hidden_size().map_err(ExportError::Unit)?;
-    crate::flight_size::with_hidden!(size, H => generate_imu_sized::<H>(model, lang))
-}
-
-/// [`generate_imu`] with every axis's LSTMs at `H` hidden units.
-fn generate_imu_sized<const H: usize>(
-    model: &ImuModel,
-    lang: Lang,
-) -> Result<Vec<(&'static str, String)>, ExportError> {
-    let compact = serde_json::to_string(model).map_err(|e| ExportError::Unit(ImuError::Json(e)))?;
-    let digest = crate::model::sha256_hex(compact.as_bytes());
-    let mut axes = Vec::with_capacity(model.axes.len());
-    for a in &model.axes {
-        let err = |e: ExportError| match e {
-            ExportError::Model(source) => ExportError::Unit(ImuError::Axis {
-                gyro: a.gyro.clone(),
-                source: Box::new(source),
-            }),
-            other => other,
-        };
-        let first = sized_static_model::<H>(&a.model).map_err(err)?;
-        // The further sensors as the core axis holds them (what the stream runs).
-        let core = model.axis_compensator(a).map_err(ExportError::Unit)?;
-        let sensors = core
-            .further()
-            .into_iter()
-            .map(|(channel, spec, bias, scale)| {
-                let bias = bias.map(static_baseline);
-                let scale = scale.map(static_baseline);
-                let part = |b: &Option<StaticBaseline>| StaticTarget {
-                    offset: 0.0,
-                    baseline: *b,
-                    lstm: None,
-                    lstm_reads_base: false,
-                };
-                SensorExport {
-                    channel,
-                    model: StaticModel {
-                        spec: *spec,
-                        limits: first.limits,
-                        bias: part(&bias),
-                        scale: part(&scale),
-                        coverage: None,
-                    },
-                    bias,
-                    scale,
-                }
-            })
-            .collect();
-        let fallback = match &a.fallback {
-            Some(f) => Some((
-                sized_static_model::<H>(f).map_err(err)?,
-                describe(f).map_err(err)?,
-            )),
-            None => None,
-        };
-        axes.push(AxisExport {
-            channel: core.first().channel(),
-            about: describe(&a.model).map_err(err)?,
-            model: first,
-            sensors,
-            fallback,
-        });
-    }
-    let layout = Layout {
-        n_temps: model.temp_cols.len(),
-        digest: &digest,
-    };
-    Ok(match lang {
-        Lang::C => {
-            let (h, c) = generate_c(&axes, &layout);
-            vec![("gyrotherm_model.h", h), ("gyrotherm_model.c", c)]
-        }
-        Lang::Rust => vec![("gyrotherm_model.rs", generate_rust(&axes, &layout))],
-    })
-}
-
-/// One axis to export: its first sensor's model and channel, its further sensors, and its
-/// fallback model on the first sensor alone (with its description).
-struct AxisExport<const H: usize> {
-    model: StaticModel<H>,
-    about: String,
-    channel: usize,
-    sensors: Vec<SensorExport<H>>,
-    fallback: Option<(StaticModel<H>, String)>,
-}
-
-impl<const H: usize> AxisExport<H> {
-    /// The `temp[]` entries the axis reads, first sensor first.
-    fn channels(&self) -> Vec<usize> {
-        std::iter::once(self.channel)
-            .chain(self.sensors.iter().map(|s| s.channel))
-            .collect()
-    }
-}
-
-/// A further sensor of an axis: its `temp[]` entry, its features, its parts of B and K, and
-/// the single-axis model whose port gives its pipeline and baseline code (the axis's limits,
-/// the parts as baselines without offset).
-struct SensorExport<const H: usize> {
-    channel: usize,
-    model: StaticModel<H>,
-    bias: Option<StaticBaseline>,
-    scale: Option<StaticBaseline>,
-}
-
-/// Write the export of a unit model for `lang` into `dir` (created if missing), each file
-/// atomically; returns the files written.
-pub fn export_imu(model: &ImuModel, lang: Lang, dir: &Path) -> Result<Vec<PathBuf>, ExportError> {
-    write_files(generate_imu(model, lang)?, dir)
-}
-
-/// What the files say about the unit besides the axes' models.
-struct Layout<'a> {
-    n_temps: usize,
-    digest: &'a str,
-}
-
-impl Layout<'_> {
-    /// The comment lines (without comment markers) on the model and the column order.
-    fn about<const H: usize>(&self, axes: &[AxisExport<H>], gyro: &str, temp: &str) -> Vec<String> {
-        let n = axes.len();
-        let mut out = vec![
-            format!(
-                "Unit model: {n} gyro axes, {} temperature columns;",
-                self.n_temps
-            ),
-            format!("{CHECKSUM_KEY} {}.", self.digest),
-        ];
-        for (i, a) in axes.iter().enumerate() {
-            out.push(format!("Axis {i}: {}.", a.about));
-            for (j, s) in a.sensors.iter().enumerate() {
-                let spec = &s.model.spec;
-                let lags: Vec<String> = spec.lags().iter().map(|t| format!("{t} s")).collect();
-                out.push(format!(
-                    "  further sensor {}: {temp}[{}], lags [{}] (T - lag outputs), parts of {};",
-                    j + 1,
-                    s.channel,
-                    lags.join(", "),
-                    match (s.bias.is_some(), s.scale.is_some()) {
-                        (true, true) => "B and K",
-                        (true, false) => "B",
-                        (false, true) => "K",
-                        (false, false) => "neither B nor K",
-                    }
-                ));
-            }
-            if let Some((_, about)) = &a.fallback {
-                out.push(format!(
-                    "  fallback on {temp}[{}] alone, while a further sensor is given up on: {about};",
-                    a.channel
-                ));
-            }
-        }
-        out.push(
-            "Column order. The model's column names are not copied into generated source;".into(),
-        );
-        out.push(
-            "`gyrotherm export` prints them on stderr, and the model file lists them \
-             (gyro_cols, temp_cols):"
-                .into(),
-        );
-        for (i, a) in axes.iter().enumerate() {
-            let reads: Vec<String> = a
-                .channels()
-                .iter()
-                .map(|c| format!("{temp}[{c}]"))
-                .collect();
-            out.push(format!(
-                "  {gyro}[{i}] is the model's {} gyro column; axis {i} reads {}{};",
-                ordinal(i + 1),
-                reads.join(", "),
-                if reads.len() > 1 {
-                    " (first sensor first)"
-                } else {
-                    ""
-                }
-            ));
-        }
-        for j in 0..self.n_temps {
-            out.push(format!(
-                "  {temp}[{j}] is the model's {} temperature column.",
-                ordinal(j + 1)
-            ));
-        }
-        out
-    }
-}
 
 /// Whether `b` may continue an identifier.
 fn ident_byte(b: u8) -> bool {
@@ -637,7 +359,10 @@ fn further_sensors<const H: usize>(
 }
 
 /// `(header, source)` of the unit.
-fn generate_c<const H: usize>(axes: &[AxisExport<H>], layout: &Layout) -> (String, String) {
+pub(super) fn generate_c<const H: usize>(
+    axes: &[AxisExport<H>],
+    layout: &Layout,
+) -> (String, String) {
     let n = axes.len();
     let mut h = String::new();
     h.push_str(
@@ -898,118 +623,6 @@ gt_coverage gt_coverage_of_axis(const gt_state *s, int axis, double *sigma_dph);
 #endif /* GYROTHERM_MODEL_H */
 ";
 
-/// The Rust module of the unit.
-fn generate_rust<const H: usize>(axes: &[AxisExport<H>], layout: &Layout) -> String {
-    let n = axes.len();
-    let mut out = String::from(
-        "//! Inertial-unit compensation model for gyrotherm-core, generated by\n\
-         //! `gyrotherm export --target rust`.\n",
-    );
-    for line in layout.about(axes, "gyro", "temps") {
-        let _ = writeln!(out, "//! {line}");
-    }
-    let unit_type = if H == gyrotherm_core::compensator::HIDDEN {
-        "Unit::<AXES>".to_owned()
-    } else {
-        format!("Unit::<AXES, {H}>")
-    };
-    out.push_str(&format!(
-        "//! Use: `let mut unit = gyrotherm_core::unit::{unit_type}::from_static_fallbacks(&MODELS, \
-         &CHANNELS, &SENSORS, &FALLBACKS, TEMPS)?;`\n\
-         //! then `unit.step(time_s, &gyro, &temps)` per sample: entry i is axis i's corrected\n\
-         //! sample (axis i runs MODELS[i] on temps[CHANNELS[i]], and SENSORS[i] on the further\n\
-         //! sensors it reads, with FALLBACKS[i] on temps[CHANNELS[i]] alone while a further\n\
-         //! sensor is given up on; with no fallback `Unit::from_static_sensors(&MODELS, \
-         &CHANNELS, &SENSORS, TEMPS)`\n\
-         //! is the same, with no further sensor `Unit::from_static(&MODELS, &CHANNELS, TEMPS)`).\n\
-         //! Do not edit: re-export instead.\n\n\
-         use gyrotherm_core::compensator::TempLimits;\n\
-         #[allow(unused_imports)]\n\
-         use gyrotherm_core::coverage::Grid;\n\
-         use gyrotherm_core::features::{{FeatureSpec, LagOutputs}};\n\
-         #[allow(unused_imports)]\n\
-         use gyrotherm_core::static_model::{{\n    \
-         StaticBaseline, StaticCoverage, StaticLstm, StaticModel, StaticSensor, StaticTarget,\n\
-         }};\n\n",
-    ));
-    let _ = writeln!(
-        out,
-        "/// Gyro axes (gyro[] entries).\npub const AXES: usize = {n};"
-    );
-    let _ = writeln!(
-        out,
-        "/// Temperature columns (temps[] entries).\npub const TEMPS: usize = {};",
-        layout.n_temps
-    );
-    let _ = writeln!(
-        out,
-        "/// The temps[] entry each axis reads first.\npub static CHANNELS: [u8; AXES] = [{}];\n",
-        axes.iter()
-            .map(|a| a.channel.to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    out.push_str("/// Each axis's model, in axis order.\n");
-    out.push_str("#[rustfmt::skip]\n#[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n");
-    let _ = writeln!(
-        out,
-        "pub static MODELS: [{}; AXES] = [",
-        rust::sized_type("StaticModel", H)
-    );
-    for a in axes {
-        out.push_str(&rust::model_expr(&a.model));
-        out.push_str(",\n");
-    }
-    out.push_str("];\n");
-    for (i, a) in axes.iter().enumerate() {
-        let _ = writeln!(
-            out,
-            "\n/// Axis {i}'s further sensors, in order.\n#[rustfmt::skip]\n\
-             #[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n\
-             pub static SENSORS_A{i}: [StaticSensor; {}] = [",
-            a.sensors.len()
-        );
-        for s in &a.sensors {
-            out.push_str(&rust::sensor_expr(
-                s.channel,
-                &s.model.spec,
-                &s.bias,
-                &s.scale,
-            ));
-            out.push_str(",\n");
-        }
-        out.push_str("];\n");
-    }
-    let _ = writeln!(
-        out,
-        "\n/// Each axis's further sensors (none: the axis reads CHANNELS[i] alone).\n\
-         pub static SENSORS: [&[StaticSensor]; AXES] = [{}];",
-        (0..n)
-            .map(|i| format!("&SENSORS_A{i}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    out.push_str(&format!(
-        "\n/// Each axis's fallback on its first sensor alone (None: the axis has none).\n\
-         #[rustfmt::skip]\n\
-         #[allow(clippy::excessive_precision, clippy::unreadable_literal, clippy::approx_constant)]\n\
-         pub static FALLBACKS: [Option<{}>; AXES] = [\n",
-        rust::sized_type("StaticModel", H)
-    ));
-    for a in axes {
-        match &a.fallback {
-            Some((m, _)) => {
-                out.push_str("Some(");
-                out.push_str(&rust::model_expr(m));
-                out.push_str("),\n");
-            }
-            None => out.push_str("None,\n"),
-        }
-    }
-    out.push_str("];\n");
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1029,7 +642,7 @@ mod tests {
     /// reference: the template text, read here line by line).
     #[test]
     fn a_further_sensors_state_is_the_templates_fields() {
-        let template = include_str!("templates/gyrotherm_model.h.in");
+        let template = include_str!("../templates/gyrotherm_model.h.in");
         let header = template.replace("@MORE_STATE@", "");
         let got = sensor_state(&header);
         let decls: Vec<&str> = got.lines().filter(|l| l.ends_with(';')).collect();
@@ -1057,14 +670,5 @@ mod tests {
         for f in ["base_s", "lstm_h", "cov_temp_c", "has_held", "unplaced"] {
             assert!(!got.contains(f), "{f} in {got}");
         }
-    }
-
-    #[test]
-    fn ordinals() {
-        let got: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22].map(ordinal).to_vec();
-        assert_eq!(
-            got,
-            ["1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd"]
-        );
     }
 }
