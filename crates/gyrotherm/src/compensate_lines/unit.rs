@@ -35,11 +35,11 @@ use std::path::Path;
 use gyrotherm_core::compensator::{Corrected, Status};
 
 use super::{
-    gyro_not_a_number, lines_to_file, parse_number, push_corrected, push_invalid, push_verdict,
-    read_header, run_lines, Cadence, Fields, FileError, LineCheck, LineModel, LinesError, Mode,
+    gyro_not_a_number, lines_to_file, push_corrected, push_invalid, push_verdict, read_header,
+    run_lines, Cadence, FileError, LineCheck, LineModel, LinesError, Mode,
 };
 use crate::compensate::unit::imu_axis_compensators;
-use crate::csvlog::{LogError, LogErrorKind, LogWriter, ReadOptions};
+use crate::csvlog::{parse_number, Fields, LogError, LogErrorKind, LogWriter, ReadOptions};
 pub use crate::model::unit::MAX_STREAM_AXES;
 use crate::model::unit::{ImuError, ImuModel};
 use gyrotherm_core::coverage::CoverageMap;
