@@ -1,22 +1,25 @@
 //! Held-out comparison of compensation methods: the paper's results table for the user's logs.
 //!
 //! Fits one model per [`Candidate`] on the training logs (by default linear, polynomial, the
-//! default `lstm` recipe and the published recipe of He et al. 2024, each its own column),
+//! default method and the published recipe of He et al. 2024, each its own column),
 //! compensates each held-out log with the flight compensator, and judges it with the standard figures: bias stability
 //! (1σ of τ-means, °/h) for static logs; for rate-table logs the scale factor K(t) per segment
 //! against the ideal K = 1 (ppm) and the compensated output range at each table rate. When a
 //! held-out log carries simulator truth (`noise_dps`), the bias stability of the noise alone is
 //! the physical floor no compensation can beat.
-
 //!
 //! The results serialise as [`ComparisonSummary`] (`gyrotherm compare --json`) and tabulate as
 //! one [`ComparisonTable`], written as text ([`ComparisonTable::write_text`]) and turned into
-//! the report's HTML table (`report::comparison_table`).
+//! the report's HTML table (`report::results_table`).
 
+mod column;
+mod performance;
 mod summary;
 mod table;
 pub mod unit;
 
+pub use column::{Candidate, ColumnName};
+pub use performance::{performance, Performance, PerformanceError, RateRange};
 pub use summary::{ComparisonSummary, ModelSummary, TestSummary};
 pub use table::{ComparisonTable, TableBlock, TableFigure, TableRow};
 
@@ -35,216 +38,6 @@ use crate::settings::rule::{check, Rule, SettingError};
 use crate::targets;
 
 pub use crate::metrics::BIAS_STABILITY_TAU_S;
-
-/// One column of the comparison: a method and, for a recipe method, the recipe it trains.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Candidate {
-    pub method: Method,
-    /// The recipe (recipe methods only; None: the comparison's [`FitConfig::recipe`] when
-    /// it is this method's, else the method's own).
-    pub recipe: Option<RecipeSettings>,
-}
-
-impl Candidate {
-    /// A column fitting `method` with the comparison's settings.
-    pub fn of(method: Method) -> Self {
-        Candidate {
-            method,
-            recipe: None,
-        }
-    }
-
-    /// The `linear` fit.
-    pub fn linear() -> Self {
-        Self::of(Method::Linear)
-    }
-
-    /// The `poly` fit.
-    pub fn poly() -> Self {
-        Self::of(Method::Poly)
-    }
-
-    /// The `published` method (He et al. 2024 as published), `epochs` Adam steps (None: the
-    /// published 1000).
-    pub fn published(epochs: Option<usize>) -> Self {
-        let mut recipe = RecipeSettings::published();
-        if let Some(e) = epochs {
-            recipe.epochs = e;
-        }
-        Candidate {
-            method: Method::Published,
-            recipe: Some(recipe),
-        }
-    }
-
-    /// The fit settings of this column: `base` with its method and recipe.
-    pub fn fit_config(&self, base: &FitConfig) -> FitConfig {
-        let recipe = match &self.recipe {
-            Some(r) => r.clone(),
-            None if self.method.is_own_recipe() && self.method != base.recipe.kind => {
-                RecipeSettings::of_kind(self.method)
-            }
-            None => base.recipe.clone(),
-        };
-        FitConfig {
-            method: self.method,
-            recipe,
-            ..base.clone()
-        }
-    }
-
-    /// The column's own label, if its method has one ([`Method::column_label`]: the
-    /// published recipe's names its authors); otherwise the column is labelled by its model.
-    pub(crate) fn column_label(&self, base: &FitConfig) -> Option<&'static str> {
-        self.fit_config(base).model_method().column_label()
-    }
-
-    /// The column's key in `gyrotherm compare --json` and `--methods`: the method's name.
-    pub fn key(&self, base: &FitConfig) -> &'static str {
-        self.fit_config(base).model_method().as_str()
-    }
-
-    /// Whether fitting this column trains an LSTM (and reports its epochs).
-    pub(crate) fn trains_lstm(&self, base: &FitConfig) -> bool {
-        let c = self.fit_config(base);
-        c.method.is_recipe()
-            && c.recipe.epochs > 0
-            && (c.recipe.kind != Method::Thermal || c.thermal.residual_lstm)
-    }
-}
-
-/// A column asked for by name (`compare --methods`, Python's `methods=`): a method, fitted on
-/// the training logs, or an autopilot's polynomial ([`ExportTarget::is_autopilot`]) fitted to
-/// the steady-state bias of the comparison's own method's model, as `export --target` writes
-/// it and the firmware computes it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ColumnName {
-    Method(Method),
-    Autopilot(ExportTarget),
-}
-
-impl ColumnName {
-    /// Every name a column may be asked for by, with its help line: the methods a fit can
-    /// use, then the autopilot targets.
-    pub fn all() -> Vec<(&'static str, &'static str)> {
-        METHODS
-            .iter()
-            .map(|m| (m.as_str(), m.help()))
-            .chain(
-                EXPORT_TARGETS
-                    .iter()
-                    .filter(|t| t.is_autopilot())
-                    .map(|t| (t.as_str(), autopilot_column_help(*t))),
-            )
-            .collect()
-    }
-}
-
-fn autopilot_column_help(t: ExportTarget) -> &'static str {
-    match t {
-        ExportTarget::Px4 => {
-            "PX4's TC_G cubic in temperature, fitted to the steady-state bias of --method's \
-             model (what `export --target px4` writes), as the firmware computes it"
-        }
-        _ => {
-            "ArduPilot's INS_TCAL cubic in temperature, fitted to the steady-state bias of \
-             --method's model (what `export --target ardupilot` writes), as the firmware \
-             computes it"
-        }
-    }
-}
-
-impl std::str::FromStr for ColumnName {
-    type Err = SettingError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        if let Some(m) = METHODS.iter().find(|m| m.as_str() == s) {
-            return Ok(ColumnName::Method(*m));
-        }
-        match EXPORT_TARGETS
-            .iter()
-            .find(|t| t.is_autopilot() && t.as_str() == s)
-        {
-            Some(t) => Ok(ColumnName::Autopilot(*t)),
-            None => Err(SettingError::Unknown {
-                setting: "methods",
-                value: s.to_owned(),
-                expected: column_names(),
-            }),
-        }
-    }
-}
-
-/// The names [`ColumnName`] parses, for error messages.
-fn column_names() -> &'static [&'static str] {
-    static NAMES: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
-    NAMES.get_or_init(|| ColumnName::all().into_iter().map(|(n, _)| n).collect())
-}
-
-/// The comparison's side of the user's settings: the settings sit below the comparison and
-/// know nothing of it, so the comparison builds its configuration from them here.
-impl FitSettings {
-    /// The comparison of `methods` (None: `linear`, `poly`, this settings' method and
-    /// `published`, once) with these settings, bias stability over `tau_s`.
-    pub fn compare_config(
-        &self,
-        columns: Option<&[ColumnName]>,
-        tau_s: f64,
-    ) -> Result<CompareConfig, SettingError> {
-        check("tau_s", tau_s, Rule::PositiveSeconds)?;
-        let fit = self.fit_config()?;
-        let main = fit.model_method();
-        let methods: Option<Vec<Method>> = columns.map(|c| {
-            c.iter()
-                .filter_map(|c| match c {
-                    ColumnName::Method(m) => Some(*m),
-                    ColumnName::Autopilot(_) => None,
-                })
-                .collect()
-        });
-        let autopilot: Vec<ExportTarget> = columns
-            .into_iter()
-            .flatten()
-            .filter_map(|c| match c {
-                ColumnName::Autopilot(t) => Some(*t),
-                ColumnName::Method(_) => None,
-            })
-            .collect();
-        let wanted: Vec<Method> = match methods.as_deref() {
-            Some(m) => {
-                // `lstm`, which older model files record, is no method a fit can use.
-                if let Some(old) = m.iter().find(|m| !METHODS.contains(m)) {
-                    return Err(SettingError::unknown(
-                        "methods",
-                        old.as_str(),
-                        &METHOD_NAMES,
-                    ));
-                }
-                m.to_vec()
-            }
-            None => {
-                let mut all = vec![Method::Linear, Method::Poly, main];
-                if main != Method::Published {
-                    all.push(Method::Published);
-                }
-                all
-            }
-        };
-        let candidates = wanted
-            .into_iter()
-            .map(|m| Candidate {
-                method: m,
-                recipe: m.is_own_recipe().then(|| self.recipe_for(m)),
-            })
-            .collect();
-        Ok(CompareConfig {
-            candidates,
-            autopilot,
-            fit,
-            tau_s,
-            settle_s: self.settle_s,
-        })
-    }
-}
 
 /// The bias-stability smoothing time for held-out logs when none was asked for:
 /// [`BIAS_STABILITY_TAU_S`] when it is a whole number of sample periods of every static log
@@ -302,29 +95,6 @@ impl Default for CompareConfig {
             settle_s: targets::SETTLE_S,
         }
     }
-}
-
-/// Output range at one table rate: min and max of the segment means, °/s.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct RateRange {
-    pub table_dps: f64,
-    pub min_dps: f64,
-    pub max_dps: f64,
-}
-
-/// The performance figures (numbers, not pictures) of one output column, raw or compensated,
-/// of one held-out log.
-#[derive(Debug, Clone, PartialEq, Default, Serialize)]
-pub struct Performance {
-    /// Static logs: bias stability, °/h.
-    pub bias_stability_dph: Option<f64>,
-    /// Rate-table logs: max |K(t) − 1| over the rate segments, ppm.
-    pub sf_error_ppm: Option<f64>,
-    /// Rate-table logs: max |K(t) − K(first segment)|, ppm (the thermal error as defined by
-    /// the scale-factor figures).
-    pub sf_thermal_error_ppm: Option<f64>,
-    /// Rate-table logs: output range per table rate.
-    pub rate_ranges: Vec<RateRange>,
 }
 
 /// One column's result on one held-out log.
@@ -454,95 +224,6 @@ impl std::error::Error for CompareError {
             | CompareError::NoColumnFitted { .. } => None,
         }
     }
-}
-
-/// Why the figures of an output column could not be computed.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub enum PerformanceError {
-    /// Bias stability of a static log.
-    BiasStability(MetricsError),
-    /// Scale factor of a rate-table log.
-    ScaleFactor(ScaleFactorError),
-}
-
-impl fmt::Display for PerformanceError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PerformanceError::BiasStability(e) => write!(f, "{e}"),
-            PerformanceError::ScaleFactor(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-impl std::error::Error for PerformanceError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            // Transparent: the inner error's message is this error's own.
-            PerformanceError::BiasStability(e) => e.source(),
-            PerformanceError::ScaleFactor(e) => e.source(),
-        }
-    }
-}
-
-/// Performance of `output_dps` on `log` (its table column decides static or rate-table).
-pub fn performance(
-    log: &TestLog,
-    output_dps: &[f64],
-    tau_s: f64,
-    settle_s: f64,
-) -> Result<Performance, PerformanceError> {
-    let mut f = Performance::default();
-    if log.is_static() {
-        let period = log.sample_period_s();
-        f.bias_stability_dph = Some(
-            metrics::bias_stability_dph(output_dps, period, tau_s)
-                .map_err(PerformanceError::BiasStability)?
-                .bias_stability_dph,
-        );
-        return Ok(f);
-    }
-    let table = log.table_dps.as_deref().unwrap_or_default();
-    let opts = ScaleFactorOptions {
-        settle_s,
-        ..Default::default()
-    };
-    let r = metrics::scale_factor(&log.time_s, output_dps, table, &opts)
-        .map_err(PerformanceError::ScaleFactor)?;
-    let ks: Vec<f64> = r
-        .scale_over_time
-        .iter()
-        .map(|s| s.scale)
-        .filter(|k| k.is_finite())
-        .collect();
-    f.sf_error_ppm = ks.iter().map(|k| (k - 1.0).abs() * 1e6).reduce(f64::max);
-    f.sf_thermal_error_ppm = Some(r.sf_thermal_error_ppm).filter(|v| v.is_finite());
-    let mut rates: Vec<f64> = r
-        .segments
-        .iter()
-        .map(|s| s.table_dps)
-        .filter(|w| *w != 0.0)
-        .collect();
-    rates.sort_by(f64::total_cmp);
-    rates.dedup();
-    for w in rates {
-        let means = r
-            .segments
-            .iter()
-            .filter(|s| s.table_dps == w && s.mean_output_dps.is_finite())
-            .map(|s| s.mean_output_dps);
-        let (lo, hi) = means.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), m| {
-            (a.min(m), b.max(m))
-        });
-        if lo.is_finite() {
-            f.rate_ranges.push(RateRange {
-                table_dps: w,
-                min_dps: lo,
-                max_dps: hi,
-            });
-        }
-    }
-    Ok(f)
 }
 
 /// Fit every configured column on `train` and judge each on every log of `test`.
