@@ -67,132 +67,6 @@ pub enum Seal {
 
 pub use crate::settings::Method;
 
-/// [`LagOutputs`] in the file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LagOutputsDef {
-    /// Lag outputs y_j.
-    Level,
-    /// T - y_j.
-    DiffFromT,
-    /// Both.
-    Both,
-}
-
-/// The feature definition in the file (the core's [`FeatureSpec`], with the lags as a list).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FeatureDef {
-    /// Model step period, s.
-    pub step_period_s: f64,
-    /// Rate lag, s (dT = (T(t) - T(t - lag)) / lag).
-    pub rate_lag_s: f64,
-    /// Moving-average window of T, s (0: none).
-    pub smoothing_window_s: f64,
-    /// Thermal-state lag time constants, s.
-    pub lag_tau_s: Vec<f64>,
-    /// Which lag outputs are features.
-    pub lag_outputs: LagOutputsDef,
-    /// Which temperature readings are believed (absent in older files: the defaults).
-    #[serde(default)]
-    pub temp_sensor: TempSensorDef,
-}
-
-/// Temperature-sensor fault limits in the file (the core's [`TempLimits`]): a reading outside
-/// `min_c..=max_c`, or changing faster than `max_rate_c_per_s` (plus `step_allowance_c`)
-/// since the last good one, is held; held longer than `degraded_after_s` is degraded.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct TempSensorDef {
-    /// Lowest plausible reading, °C.
-    pub min_c: f64,
-    /// Highest plausible reading, °C.
-    pub max_c: f64,
-    /// Fastest plausible change, °C/s.
-    pub max_rate_c_per_s: f64,
-    /// Change always allowed between readings, °C.
-    pub step_allowance_c: f64,
-    /// Seconds without a good reading before the output is degraded.
-    pub degraded_after_s: f64,
-}
-
-impl Default for TempSensorDef {
-    fn default() -> Self {
-        Self::from_core(&TempLimits::DEFAULT)
-    }
-}
-
-impl TempSensorDef {
-    /// The file form of core limits.
-    pub(crate) fn from_core(l: &TempLimits) -> Self {
-        TempSensorDef {
-            min_c: l.min_c,
-            max_c: l.max_c,
-            max_rate_c_per_s: l.max_rate_c_per_s,
-            step_allowance_c: l.step_allowance_c,
-            degraded_after_s: l.degraded_after_s,
-        }
-    }
-
-    /// The core limits, checked (the error names `features.temp_sensor`).
-    pub fn to_core(&self) -> Result<TempLimits, ModelFileError> {
-        let l = TempLimits {
-            min_c: self.min_c,
-            max_c: self.max_c,
-            max_rate_c_per_s: self.max_rate_c_per_s,
-            step_allowance_c: self.step_allowance_c,
-            degraded_after_s: self.degraded_after_s,
-        };
-        l.validate()
-            .map_err(|e| ModelFileError::invalid("features.temp_sensor", e.to_string()))?;
-        Ok(l)
-    }
-}
-
-impl FeatureDef {
-    /// The file form of `spec`.
-    pub fn from_spec(spec: &FeatureSpec) -> FeatureDef {
-        FeatureDef {
-            step_period_s: spec.step_period_s,
-            rate_lag_s: spec.rate_lag_s,
-            smoothing_window_s: spec.smoothing_window_s,
-            lag_tau_s: spec.lags().to_vec(),
-            lag_outputs: match spec.lag_outputs {
-                LagOutputs::Level => LagOutputsDef::Level,
-                LagOutputs::DiffFromT => LagOutputsDef::DiffFromT,
-                LagOutputs::Both => LagOutputsDef::Both,
-            },
-            temp_sensor: TempSensorDef::default(),
-        }
-    }
-
-    /// The core spec, checked.
-    pub fn to_spec(&self) -> Result<FeatureSpec, ModelFileError> {
-        if self.lag_tau_s.len() > MAX_LAGS {
-            return Err(ModelFileError::invalid(
-                "features",
-                format!(
-                    "{} lag time constants, at most {MAX_LAGS} supported",
-                    self.lag_tau_s.len()
-                ),
-            ));
-        }
-        let base = FeatureSpec {
-            step_period_s: self.step_period_s,
-            rate_lag_s: self.rate_lag_s,
-            smoothing_window_s: self.smoothing_window_s,
-            ..FeatureSpec::PUBLISHED
-        };
-        let outputs = match self.lag_outputs {
-            LagOutputsDef::Level => LagOutputs::Level,
-            LagOutputsDef::DiffFromT => LagOutputs::DiffFromT,
-            LagOutputsDef::Both => LagOutputs::Both,
-        };
-        base.with_lags(&self.lag_tau_s, outputs)
-            .map_err(ModelFileError::Features)
-    }
-}
-
 /// One target's model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
@@ -222,72 +96,6 @@ pub enum SubModel {
         #[serde(default)]
         lstm_reads_base: bool,
     },
-}
-
-/// A closed range.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Range {
-    pub min: f64,
-    pub max: f64,
-}
-
-impl Range {
-    /// (min, max) of `x` (None if empty).
-    pub fn of(x: &[f64]) -> Option<Range> {
-        if x.is_empty() {
-            return None;
-        }
-        let (min, max) = x
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                (a.min(v), b.max(v))
-            });
-        Some(Range { min, max })
-    }
-    /// True when `v` lies inside.
-    pub fn contains(&self, v: f64) -> bool {
-        v >= self.min && v <= self.max
-    }
-}
-
-/// Training temperature range (feature 0, °C) and rate range (feature 1, °C/s) over the
-/// steps of `tables` (None if there are no steps).
-pub fn training_ranges(tables: &[&FeatureTable]) -> Option<(Range, Range)> {
-    let mut t = Vec::new();
-    let mut r = Vec::new();
-    for tab in tables {
-        if tab.n_features >= 2 {
-            t.extend(tab.column(0));
-            r.extend(tab.column(1));
-        }
-    }
-    Some((Range::of(&t)?, Range::of(&r)?))
-}
-
-/// How the model was trained.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TrainingInfo {
-    /// Temperature range seen in training, °C.
-    pub temp_range_c: Range,
-    /// Temperature-rate (dT) range seen in training, °C/s.
-    pub rate_range_c_per_s: Range,
-    /// SHA-256 (lower-case hex) of the training inputs, see [`data_digest`].
-    pub data_digest_sha256: String,
-    /// Training epochs (None for a least-squares fit).
-    #[serde(default)]
-    pub epochs: Option<u64>,
-    /// Final training loss (normalised MSE for LSTMs; RMS residual for baselines).
-    #[serde(default)]
-    pub final_loss: Option<f64>,
-    /// Random seed (None when nothing was random).
-    #[serde(default)]
-    pub seed: Option<u64>,
-    /// Program and version that wrote the file, e.g. `gyrotherm 0.1.0`.
-    pub created_by: String,
-    /// Names of the training input files.
-    pub inputs: Vec<String>,
 }
 
 /// A model file.
@@ -328,86 +136,6 @@ pub struct ModelFile {
     pub method_choice: Option<MethodChoice>,
 }
 
-/// The columns of the logs a model was trained on: the header names of time, gyro output,
-/// temperature and rate table, and the unit of the gyro column (see [`ReadOptions`]).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ColumnsDef {
-    pub time_col: String,
-    pub gyro_col: String,
-    pub temp_col: String,
-    pub table_col: String,
-    /// `dps`, `dph` or `rad/s`.
-    pub gyro_unit: String,
-}
-
-/// Which column options a user named (each one named overrides the model's
-/// [`ColumnsDef`]; the others come from the model).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct GivenColumns {
-    pub time_col: bool,
-    pub gyro_col: bool,
-    pub temp_col: bool,
-    pub table_col: bool,
-    pub gyro_unit: bool,
-}
-
-impl ColumnsDef {
-    /// The columns `opts` reads.
-    pub fn of(opts: &ReadOptions) -> ColumnsDef {
-        ColumnsDef {
-            time_col: opts.time_col.clone(),
-            gyro_col: opts.gyro_col.clone(),
-            temp_col: opts.temp_col.clone(),
-            table_col: opts.table_col.clone(),
-            gyro_unit: opts.gyro_unit.as_str().to_owned(),
-        }
-    }
-
-    /// `base` with these columns, except those `given` says the user named.
-    pub fn read_options(
-        &self,
-        base: &ReadOptions,
-        given: GivenColumns,
-    ) -> Result<ReadOptions, ModelFileError> {
-        let pick = |given: bool, flag: &String, mine: &String| {
-            if given {
-                flag.clone()
-            } else {
-                mine.clone()
-            }
-        };
-        let gyro_unit = if given.gyro_unit {
-            base.gyro_unit
-        } else {
-            self.gyro_unit
-                .parse()
-                .map_err(|e: String| ModelFileError::invalid("columns.gyro_unit", e))?
-        };
-        Ok(ReadOptions {
-            time_col: pick(given.time_col, &base.time_col, &self.time_col),
-            gyro_col: pick(given.gyro_col, &base.gyro_col, &self.gyro_col),
-            temp_col: pick(given.temp_col, &base.temp_col, &self.temp_col),
-            table_col: pick(given.table_col, &base.table_col, &self.table_col),
-            gyro_unit,
-            ..base.clone()
-        })
-    }
-
-    /// Checked: one column each, names a log can hold, a known gyro unit.
-    pub fn validate(&self) -> Result<(), ModelFileError> {
-        let opts = self.read_options(&ReadOptions::default(), GivenColumns::default())?;
-        if opts.is_multi_column() {
-            return Err(ModelFileError::invalid(
-                "columns",
-                "a single-axis model reads one gyro and one temperature column".to_owned(),
-            ));
-        }
-        opts.validate()
-            .map_err(|e| ModelFileError::invalid("columns", e.to_string()))
-    }
-}
-
 /// Which of the two sub-models of a model file (and which target a fit is for).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Target {
@@ -426,40 +154,10 @@ impl Target {
     }
 }
 
-/// `gyrotherm <version>`, for [`TrainingInfo::created_by`].
-pub fn created_by() -> String {
-    format!("gyrotherm {}", env!("CARGO_PKG_VERSION"))
-}
-
 /// SHA-256 hex of `bytes`.
 pub fn sha256_hex(bytes: &[u8]) -> String {
     let d = Sha256::digest(bytes);
     d.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// Digest of training logs: SHA-256 over, per log in order, the sample count (u64 LE), then
-/// `time_s`, `gyro_dps`, `temp_c` as f64 LE bytes, then a table flag byte and `table_dps` if
-/// present. Pass-through columns are not included. Same numbers, same digest.
-pub fn data_digest(logs: &[&TestLog]) -> String {
-    let mut h = Sha256::new();
-    for log in logs {
-        h.update((log.len() as u64).to_le_bytes());
-        for col in [&log.time_s, &log.gyro_dps, &log.temp_c] {
-            for v in col.iter() {
-                h.update(v.to_le_bytes());
-            }
-        }
-        match &log.table_dps {
-            Some(t) => {
-                h.update([1u8]);
-                for v in t {
-                    h.update(v.to_le_bytes());
-                }
-            }
-            None => h.update([0u8]),
-        }
-    }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
 impl ModelFile {
@@ -562,20 +260,26 @@ pub fn missing_coverage_note(model: &ModelFile) -> Option<String> {
 }
 
 mod checks;
+mod columns;
 mod coverage_map;
 mod error;
 mod flight;
 mod ground;
+mod inputs;
 mod method_choice;
 mod seal;
+mod training;
 pub mod unit;
 
 pub use checks::SubModelError;
+pub use columns::{ColumnsDef, GivenColumns};
 pub use coverage_map::CoverageDef;
 pub use error::ModelFileError;
 pub(crate) use flight::{boxed_compensator, sized_compensator};
 pub use flight::{hidden_size, CompensateError};
 pub(crate) use flight::{static_baseline, static_target, target_model};
+pub use inputs::{FeatureDef, LagOutputsDef, TempSensorDef};
 pub use method_choice::{CandidateScore, MethodChoice, Validation};
 use seal::supported_list;
 pub(crate) use seal::{content_digest_of, parse_sealed, SealedTextError};
+pub use training::{created_by, data_digest, training_ranges, Range, TrainingInfo};
