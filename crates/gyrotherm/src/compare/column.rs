@@ -1,7 +1,12 @@
 //! The comparison's columns: a [`Candidate`] (a method and, for a recipe method, its recipe)
 //! and the column names `--methods` takes.
 
-use super::*;
+use super::CompareConfig;
+use crate::fit::{FitConfig, RecipeSettings};
+use crate::settings::export::{ExportTarget, EXPORT_TARGETS};
+use crate::settings::fit::FitSettings;
+use crate::settings::method::{Method, METHODS, METHOD_NAMES};
+use crate::settings::rule::{check, Rule, SettingError};
 
 /// One column of the comparison: a method and, for a recipe method, the recipe it trains.
 #[derive(Debug, Clone, PartialEq)]

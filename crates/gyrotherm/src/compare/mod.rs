@@ -28,13 +28,11 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::compensate::{compensate_log, extrapolation_warnings, Compensated};
-use crate::csvlog::{TestLog, NOISE_COL};
-use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, RecipeSettings, Target};
-use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
-use crate::settings::export::{ExportTarget, EXPORT_TARGETS};
-use crate::settings::fit::FitSettings;
-use crate::settings::method::{Method, DEFAULT_METHOD, METHODS, METHOD_NAMES};
-use crate::settings::rule::{check, Rule, SettingError};
+use crate::csvlog::NOISE_COL;
+use crate::fit::{fit_model, FitConfig, FitOutcome, NamedLog, Target};
+use crate::metrics;
+use crate::settings::export::ExportTarget;
+use crate::settings::method::{Method, DEFAULT_METHOD};
 use crate::targets;
 
 pub use crate::metrics::BIAS_STABILITY_TAU_S;

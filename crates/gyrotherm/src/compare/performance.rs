@@ -1,6 +1,11 @@
 //! One held-out log's figures for one model's output: [`performance`].
 
-use super::*;
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::csvlog::TestLog;
+use crate::metrics::{self, MetricsError, ScaleFactorError, ScaleFactorOptions};
 
 /// Output range at one table rate: min and max of the segment means, °/s.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

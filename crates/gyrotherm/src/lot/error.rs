@@ -1,6 +1,10 @@
 //! Why a lot cannot be read, written or judged.
 
-use super::*;
+use std::fmt;
+use std::path::PathBuf;
+
+use crate::spec;
+use crate::spec::unit::ImuJudgeError;
 
 /// Why a lot could not be read or written, or a unit judged.
 #[derive(Debug)]

@@ -1,7 +1,21 @@
 //! Judging a unit for the lot: its held-out logs compensated with its model, every figure
 //! measured and judged against the spec sheet.
 
-use super::*;
+use std::path::Path;
+
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+
+use super::{now_unix_ms, AxisRecord, FigureRow, Input, LotError, Run, RunVerdict};
+use crate::compensate::compensate_log;
+use crate::csvlog::{ImuLog, LogSet, LogSetForm, TestLog};
+use crate::fit::NamedLog;
+use crate::metrics::EvaluationOptions;
+use crate::model::unit::ImuModel;
+use crate::model::ModelFile;
+use crate::spec::unit::UnitVerdict;
+use crate::spec::{self, MeasureOptions, Spec};
+use crate::unit_model::Model;
 
 /// What `judge_unit` needs besides the logs; for an inertial unit (several gyro axes,
 /// `judge_imu_unit`) the same with its logs (`ImuUnitInputs`).

@@ -33,21 +33,5 @@ pub use store::{open_store, LotStore};
 pub use time::now_unix_ms;
 pub(crate) use time::rfc3339_utc;
 
-use std::fmt;
-use std::path::{Path, PathBuf};
-
-use serde::Serialize;
-use sha2::{Digest, Sha256};
-
-use crate::compensate::compensate_log;
-use crate::csvlog::{ImuLog, LogSet, LogSetForm, TestLog};
-use crate::fit::NamedLog;
-use crate::metrics::EvaluationOptions;
-use crate::model::unit::ImuModel;
-use crate::model::ModelFile;
-use crate::spec::unit::{ImuJudgeError, UnitVerdict};
-use crate::spec::{self, MeasureOptions, Spec};
-use crate::unit_model::Model;
-
 #[cfg(test)]
 mod tests;

@@ -1,7 +1,11 @@
 //! A run: what the station recorded of one unit judged (its inputs, figures, verdicts and
 //! axes), and the lot's view of the latest run of each unit.
 
-use super::*;
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+
+use super::rfc3339_utc;
+use crate::spec::unit::UnitVerdict;
 
 /// One input file of a run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -25,7 +29,7 @@ pub struct FigureRow {
     pub axis: Option<u32>,
     /// The [`Input::position`] of the log it was measured on.
     pub position: u32,
-    /// The figure's key ([`spec::FIGURES`]).
+    /// The figure's key ([`spec::FIGURES`](crate::spec::FIGURES)).
     pub figure: String,
     pub value: f64,
     /// The spec's limits on it, if any.

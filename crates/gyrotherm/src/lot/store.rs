@@ -1,7 +1,9 @@
 //! Where runs are kept: the [`LotStore`] trait, opening a store from its address, and the
 //! address with its password hidden for messages.
 
-use super::*;
+use std::path::Path;
+
+use super::{LotError, PgStore, Run, SqliteStore};
 
 /// A place runs are kept: the same schema in SQLite or PostgreSQL.
 pub trait LotStore {

@@ -1,7 +1,10 @@
 //! The log columns a model file was trained on: the names given and the reading options they
 //! imply.
 
-use super::*;
+use serde::{Deserialize, Serialize};
+
+use super::ModelFileError;
+use crate::csvlog::ReadOptions;
 
 /// The columns of the logs a model was trained on: the header names of time, gyro output,
 /// temperature and rate table, and the unit of the gyro column (see [`ReadOptions`]).

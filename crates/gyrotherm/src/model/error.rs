@@ -1,6 +1,10 @@
 //! Why a single gyro's model file cannot be read, checked or written.
 
-use super::*;
+use std::path::PathBuf;
+
+use super::seal::supported_list;
+use super::{SubModelError, Target, CHECKSUM_KEY};
+use crate::json_keys::DuplicateKey;
 
 /// A model that cannot be read, checked or written: the file, the field and the value at
 /// fault.

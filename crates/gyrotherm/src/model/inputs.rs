@@ -1,7 +1,11 @@
 //! What a model reads: its features (lags and their outputs) and its temperature sensor's
 //! plausibility limits.
 
-use super::*;
+use gyrotherm_core::compensator::TempLimits;
+use gyrotherm_core::features::{FeatureSpec, LagOutputs, MAX_LAGS};
+use serde::{Deserialize, Serialize};
+
+use super::ModelFileError;
 
 /// [`LagOutputs`] in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -24,17 +24,16 @@
 use crate::atomic_file::write_bytes_atomically;
 use crate::baseline::TermsError;
 use crate::baseline::{self, Terms};
-use crate::csvlog::{ReadOptions, TestLog};
+use crate::csvlog::ReadOptions;
 use crate::features::FeatureTable;
 use crate::json_keys::{check_unique_keys, DuplicateKey, KeyCheckError};
 use crate::nn::params::{LstmParams, ParamsError};
 use crate::nn::zscore::ZScore;
 use gyrotherm_core::baseline::{BaselineError, BaselineModel};
-use gyrotherm_core::compensator::TempLimits;
-use gyrotherm_core::features::{FeatureKind, FeatureSpec, LagOutputs, MAX_LAGS};
+use gyrotherm_core::features::{FeatureKind, FeatureSpec};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The format version this build writes.
 pub(crate) const FORMAT_VERSION: u32 = 1;
@@ -280,6 +279,5 @@ pub use flight::{hidden_size, CompensateError};
 pub(crate) use flight::{static_baseline, static_target, target_model};
 pub use inputs::{FeatureDef, LagOutputsDef, TempSensorDef};
 pub use method_choice::{CandidateScore, MethodChoice, Validation};
-use seal::supported_list;
 pub(crate) use seal::{content_digest_of, parse_sealed, SealedTextError};
 pub use training::{created_by, data_digest, training_ranges, Range, TrainingInfo};

@@ -1,6 +1,10 @@
 //! What a model file records of its training: the data's ranges and digest, and who made it.
 
-use super::*;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::csvlog::TestLog;
+use crate::features::FeatureTable;
 
 /// A closed range.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

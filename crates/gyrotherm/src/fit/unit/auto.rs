@@ -5,7 +5,12 @@ use super::several::{
     axis_bias_on, lstm_on_multi, lstm_on_several, multi_settings, prepare_axis,
     several_sensor_bias, shrink_map, thermal_axis,
 };
-use super::*;
+use super::{fit_error, ImuFitEvent, UnitFitError, UnitJob};
+use crate::fit::thermal::multi;
+use crate::fit::{FitConfig, FitError};
+use crate::model::unit::ImuAxis;
+use crate::model::SubModel;
+use crate::targets::{self, TargetSet};
 
 /// One axis with `auto`: its `thermal` fit ([`thermal_axis`], as `--method thermal` builds
 /// it, on one sensor or several) against `thermal-lstm` on that fit (as `--method

@@ -21,22 +21,22 @@
 //! builds it, whichever scores lower on held-out validation of the training runs (as `auto`
 //! scores one gyro, [`crate::fit::auto`]); the axis's model records both scores and the
 //! choice ([`ModelFile::method_choice`]).
+//!
+//! [`SensorModel`]: crate::model::unit::SensorModel
+//! [`ModelFile`]: crate::model::ModelFile
+//! [`ModelFile::method_choice`]: crate::model::ModelFile::method_choice
 
 use crate::csvlog::{ImuLog, TestLog};
-use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
-use crate::fit::thermal::Identified;
 use crate::fit::{
     chooses_method, fit_model, uses_identification, FitConfig, FitError, FitOutcome, NamedLog,
 };
 use crate::model::unit::{
-    axis_checks, check_axis_count, ImuAxis, ImuError, ImuModel, SensorModel, SensorScore,
-    IMU_FORMAT_VERSION, IMU_FORMAT_VERSION_ONE_SENSOR,
+    axis_checks, check_axis_count, ImuAxis, ImuError, ImuModel, SensorScore, IMU_FORMAT_VERSION,
+    IMU_FORMAT_VERSION_ONE_SENSOR,
 };
-use crate::model::{ModelFile, SubModel, TempSensorDef};
+use crate::model::TempSensorDef;
 use crate::per_thread::on_threads;
-use crate::settings::fit::IMU_IDENTIFY_EVERY;
 pub use crate::settings::fit::{ImuFitSettings, ImuSensors};
-use crate::targets::{self, TargetSet};
 
 mod auto;
 mod several;

@@ -2,7 +2,15 @@
 //! sensors chosen by cross-validation, one fit over the chosen ones, its coverage map and its
 //! residual LSTM (see the parent module).
 
-use super::*;
+use super::{fit_error, ImuEvents, ImuFitEvent, ImuFitSettings, UnitFitError, UnitJob};
+use crate::csvlog::{ImuLog, TestLog};
+use crate::fit::thermal::multi::{self, MultiConfig, SensorData};
+use crate::fit::thermal::Identified;
+use crate::fit::{FitConfig, FitError, NamedLog};
+use crate::model::unit::{ImuAxis, SensorModel, SensorScore};
+use crate::model::{ModelFile, SubModel};
+use crate::settings::fit::IMU_IDENTIFY_EVERY;
+use crate::targets::{self, TargetSet};
 
 /// One axis's training data on every sensor, each sensor's lags identified on the runs given
 /// (all of them, or all but one for a fold of `auto`'s validation).
