@@ -12,7 +12,7 @@
 use memchr::memchr;
 
 use super::gaps::Sample;
-use super::number::{parse_decimal_prefix, parse_f64, parse_f64_decimal_comma};
+use super::number::{parse_decimal_prefix, parse_number};
 
 /// Blocks at least this long are split in two and parsed on two threads.
 pub(super) const PARALLEL_MIN_BYTES: usize = 256 * 1024;
@@ -292,10 +292,7 @@ fn number_at(text: &[u8], pos: usize, d: u8, decimal_comma: bool) -> Option<(f64
     if memchr::memchr2(b'"', b'\r', field).is_some() {
         return None;
     }
-    let v = match parse_f64(field) {
-        None if decimal_comma => parse_f64_decimal_comma(field),
-        v => v,
-    };
+    let v = parse_number(field, decimal_comma);
     v.filter(|v| v.is_finite()).map(|v| (v, end))
 }
 

@@ -82,16 +82,6 @@ impl Fields {
     }
 }
 
-/// A numeric field (ASCII spaces around it allowed), as the log reader parses it: with a
-/// separator other than the comma, a decimal comma (`0,5`) is accepted too.
-pub(crate) fn parse_number(raw: &[u8], decimal_comma: bool) -> Option<f64> {
-    let dotted = std::str::from_utf8(raw.trim_ascii()).ok()?.parse().ok();
-    match dotted {
-        None if decimal_comma => crate::csvlog::parse_f64_decimal_comma(raw),
-        v => v,
-    }
-}
-
 /// What [`read_line_capped`] found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum LineRead {

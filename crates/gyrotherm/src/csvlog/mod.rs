@@ -42,10 +42,10 @@ pub(crate) mod writer;
 pub use error::{LogError, LogErrorKind};
 pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
-pub(crate) use line::{parse_number, read_line_capped, record, Fields, LineRead};
+pub(crate) use line::{read_line_capped, record, Fields, LineRead};
 pub(crate) use log_set::{read_in_form, LogSetForm};
 pub use log_set::{read_log_set, read_log_sets, FileRead, LogSet, LogSetError, SetRead};
-pub(crate) use number::parse_f64_decimal_comma;
+pub(crate) use number::parse_number;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
 };

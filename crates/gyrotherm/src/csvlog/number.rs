@@ -11,6 +11,16 @@ pub(super) fn parse_f64(raw: &[u8]) -> Option<f64> {
     }
 }
 
+/// A numeric field as every log reader parses it ([`parse_f64`]); with a separator other than
+/// the comma, a decimal comma (`0,5`) is accepted too.
+#[inline(always)]
+pub(crate) fn parse_number(raw: &[u8], decimal_comma: bool) -> Option<f64> {
+    match parse_f64(raw) {
+        None if decimal_comma => parse_f64_decimal_comma(raw),
+        v => v,
+    }
+}
+
 /// A number written with a decimal comma (`-0,25`, `1,5e-3`): one comma and no point.
 #[cold]
 pub(crate) fn parse_f64_decimal_comma(raw: &[u8]) -> Option<f64> {

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use super::column_list::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
 use super::error::{LogError, LogErrorKind as Kind};
-use super::number::{parse_f64, parse_f64_decimal_comma};
+use super::number::parse_number;
 use super::{ExtraColumn, ImuLog, LogWriter, NamedSeries, ReadOptions, ReadReport, TIME_COL};
 
 /// The gyro the table turns: the one whose output has a slope on the table rate within
@@ -230,11 +230,7 @@ impl NumberColumn {
             return;
         }
         let raw = text.as_bytes();
-        let v = parse_f64(raw).or_else(|| {
-            decimal_comma
-                .then(|| parse_f64_decimal_comma(raw))
-                .flatten()
-        });
+        let v = parse_number(raw, decimal_comma);
         let v = match v {
             Some(v) if v.is_finite() => v,
             Some(_) => {

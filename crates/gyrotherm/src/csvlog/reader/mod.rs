@@ -29,7 +29,7 @@ use super::chunk::{self, parse_lines, Layout, Row, MAX_BLOCK_BYTES, PARALLEL_MIN
 use super::columns::{check_options, map_columns, Columns};
 use super::error::{quoted_field, LogError, LogErrorKind as Kind};
 use super::gaps::{gap_verdict, Fill, GapVerdict, Sample, MAX_FILL_SAMPLES_PER_GAP};
-use super::number::{parse_f64, parse_f64_decimal_comma};
+use super::number::parse_number;
 use super::MAX_LINE_BYTES;
 use super::{ReadOptions, ReadReport};
 

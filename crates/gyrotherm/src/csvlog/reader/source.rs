@@ -256,11 +256,7 @@ impl<R: Read> Source<R> {
         i: usize,
         line: u64,
     ) -> Result<f64, Box<LogError>> {
-        let parsed = match parse_f64(&rec[i]) {
-            None if self.decimal_comma => parse_f64_decimal_comma(&rec[i]),
-            v => v,
-        };
-        match parsed {
+        match parse_number(&rec[i], self.decimal_comma) {
             Some(v) if v.is_finite() => Ok(v),
             _ => Err(Box::new(self.number_error(&rec[i], i, line))),
         }
@@ -270,8 +266,7 @@ impl<R: Read> Source<R> {
     pub(super) fn number_error(&self, raw: &[u8], i: usize, line: u64) -> LogError {
         let text = String::from_utf8_lossy(raw);
         let quoted = quoted_field(raw);
-        let parses = parse_f64(raw).is_some()
-            || (self.decimal_comma && parse_f64_decimal_comma(raw).is_some());
+        let parses = parse_number(raw, self.decimal_comma).is_some();
         let (kind, message) = if parses {
             (
                 Kind::NonFinite,
