@@ -13,14 +13,13 @@ use gyrotherm::csvlog::TRUE_BIAS_COL;
 use gyrotherm::csvlog::{ImuLog, LogSet, ReadOptions};
 use gyrotherm::fit::unit::fit_imu;
 use gyrotherm::model::unit::{ImuAxis, ImuModel};
-use gyrotherm::model::{MethodChoice, SubModel, TempSensorDef, Validation};
+use gyrotherm::model::{MethodChoice, ModelFile, SubModel, TempSensorDef, Validation};
 use gyrotherm::plan::{propose, resolve_envelope};
 use gyrotherm::settings::plan::PlanSettings;
 use gyrotherm::settings::{FitSettings, Method};
 use gyrotherm::sim::imu::{imu_from_family, simulate_imu, truth_col, ImuConfig};
 use gyrotherm::sim::{simulate, Profile, SimConfig};
 use gyrotherm::train::train;
-use gyrotherm::unit_model::Form;
 
 #[path = "support/unit_choice.rs"]
 mod unit_choice;
@@ -95,9 +94,9 @@ fn auto_unit(logs: &[(String, ImuLog)]) -> ImuModel {
         &|_| {},
     )
     .unwrap();
-    let Form::Unit(model) = trained.model.into_form() else {
-        panic!("a unit's logs gave a single-gyro model");
-    };
+    // A unit's logs give a unit's file: its text reads as a unit model.
+    let model = ImuModel::from_json(&trained.model.to_json().unwrap())
+        .expect("a unit's logs gave a unit's model file");
     model
 }
 
@@ -150,9 +149,9 @@ fn an_axis_whose_lstm_wins_and_is_kept_flies_thermal_lstm_as_the_single_gyro_pat
         &|_| {},
     )
     .unwrap();
-    let Form::Single(one) = one.model.into_form() else {
-        panic!("single-gyro logs gave a unit model");
-    };
+    // A single gyro's logs give a single-gyro file (format version 1).
+    let one = ModelFile::from_json(&one.model.to_json().unwrap())
+        .expect("single-gyro logs gave a single-gyro model file");
     assert_eq!(one.method, Method::ThermalLstm);
     assert_eq!(a.model.bias, one.bias);
     assert_eq!(a.model.scale, one.scale);

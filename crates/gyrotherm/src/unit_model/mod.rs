@@ -36,10 +36,11 @@ pub struct Model {
     seal: Seal,
 }
 
-/// The file form a [`Model`] was read from (and is written back in): for a binding that keeps
-/// a class per form ([`Model::into_form`]); everything else goes through [`Model`].
+/// The file form a [`Model`] was read from and is written back in: the two wire formats of
+/// one model (a single gyro's file is a unit of one axis). Only the library's own code
+/// chooses between them (for the bytes each form writes); callers see [`Model`].
 #[derive(Debug, Clone)]
-pub enum Form {
+pub(crate) enum Form {
     Single(Box<ModelFile>),
     Unit(ImuModel),
 }
@@ -165,11 +166,6 @@ impl Model {
             form: Form::Unit(m),
             seal: Seal::Verified,
         }
-    }
-
-    /// The model in the form it was read from.
-    pub fn into_form(self) -> Form {
-        self.form
     }
 
     /// Whether the model has the form of an inertial unit's file (for the library's own
