@@ -250,6 +250,15 @@ impl std::str::FromStr for Method {
 mod tests {
     use super::*;
 
+    /// The help of `thermal-lstm` names the LSTM size its fit uses: the registry holds
+    /// string literals, so this keeps the text and the setting one number.
+    #[test]
+    fn thermal_lstm_help_names_its_default_size() {
+        let hidden = crate::settings::fit::THERMAL_LSTM_HIDDEN;
+        let help = Method::ThermalLstm.info().help;
+        assert!(help.contains(&format!(" {hidden}-unit ")), "{help}");
+    }
+
     /// Each variant indexes its own entry, and a model file writes the entry's name.
     #[test]
     fn every_entry_is_its_variant_and_serialises_by_its_name() {
