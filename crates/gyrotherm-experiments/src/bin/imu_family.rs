@@ -50,7 +50,9 @@
 //! `--sigma FILE` (docs/experiments/coverage.md): per 100 s window of each held-out static
 //! run and axis, the window's coverage (its worst sample's), the mean compensated output
 //! (the residual bias, °/h) and the mean σ the model gives there, as `compensate` gives it
-//! (axes without a map give none); one line a window.
+//! (axes without a map give none), then the same mean σ with the maps' growth per cell set
+//! to 0 and to 1 (σ is linear in the growth, so any growth g gives σ0 + g·(σ1 − σ0): how
+//! the growth is calibrated); one line a window.
 //!
 //! `--dump DIR` (experiment, docs/experiments/imu-worst-case.md): for setting `all`, per
 //! axis, the 100 s means of the bias error and of each simulator bias term on the training
@@ -239,34 +241,55 @@ struct SigmaWindow {
     coverage: u8,
     resid_dph: f64,
     sigma_dph: f64,
+    /// The mean σ with the maps' growth per cell set to 0 and to 1.
+    sigma_g0_dph: f64,
+    sigma_g1_dph: f64,
 }
 
 /// The 100 s windows of an axis's compensated output `comp` on a static run, with the
 /// verdicts `Model::coverage_log` gives that axis on the run (`cov`; a window with a sample
 /// without a verdict gives none, so an axis without a map gives none).
-fn sigma_windows(cov: &AxisCoverage, comp: &[f64]) -> Vec<SigmaWindow> {
+fn sigma_windows(cov: &[&AxisCoverage; 3], comp: &[f64]) -> Vec<SigmaWindow> {
     let mut out = Vec::new();
-    let mut w: Option<(u8, f64, f64, usize)> = None;
-    for ((out_dps, code), sigma_dph) in comp.iter().zip(&cov.codes).zip(&cov.sigma_dph) {
+    let mut w: Option<(u8, [f64; 4], usize)> = None;
+    for (i, (out_dps, code)) in comp.iter().zip(&cov[0].codes).enumerate() {
         if *code == NO_COVERAGE {
             w = None;
             continue;
         }
-        let x = w.get_or_insert((0, 0.0, 0.0, 0));
+        let x = w.get_or_insert((0, [0.0; 4], 0));
         x.0 = x.0.max(*code);
-        x.1 += out_dps * 3600.0;
-        x.2 += sigma_dph;
-        x.3 += 1;
-        if x.3 == 100 {
+        x.1[0] += out_dps * 3600.0;
+        for (sum, c) in x.1[1..].iter_mut().zip(cov) {
+            *sum += c.sigma_dph[i];
+        }
+        x.2 += 1;
+        if x.2 == 100 {
+            let [r, s, s0, s1] = x.1.map(|v| v / 100.0);
             out.push(SigmaWindow {
                 coverage: x.0,
-                resid_dph: x.1 / 100.0,
-                sigma_dph: x.2 / 100.0,
+                resid_dph: r,
+                sigma_dph: s,
+                sigma_g0_dph: s0,
+                sigma_g1_dph: s1,
             });
             w = None;
         }
     }
     out
+}
+
+/// `model` with every map's growth per cell (each axis's and each fallback's) set to `growth`.
+fn with_growth(model: &ImuModel, growth: f64) -> ImuModel {
+    let mut m = model.clone();
+    for a in &mut m.axes {
+        for f in std::iter::once(&mut a.model).chain(a.fallback.as_mut()) {
+            if let Some(c) = &mut f.coverage {
+                *c = c.rescaled(1.0, growth);
+            }
+        }
+    }
+    m
 }
 
 struct Job<'a> {
@@ -878,10 +901,17 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
             for (profile, st, tabs, floors) in &tests {
                 let cs = apply(st)?;
                 let coverage = if job.sigma && hold == "none" {
-                    Model::from_unit(model.clone())
-                        .coverage_log(st)
-                        .map_err(|e| e.to_string())?
-                        .0
+                    let log = |m: ImuModel| {
+                        Model::from_unit(m)
+                            .coverage_log(st)
+                            .map(|c| c.0)
+                            .map_err(|e| e.to_string())
+                    };
+                    vec![
+                        log(model.clone())?,
+                        log(with_growth(&model, 0.0))?,
+                        log(with_growth(&model, 1.0))?,
+                    ]
                 } else {
                     Vec::new()
                 };
@@ -934,9 +964,13 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                         },
                         outside: cs[k].1,
                         lstm: axis.model.bias.as_ref().is_some_and(|b| b.lstm().is_some()),
-                        windows: coverage
-                            .get(k)
-                            .map_or_else(Vec::new, |c| sigma_windows(c, &cs[k].0)),
+                        windows: match coverage.as_slice() {
+                            [a, b, c] => match (a.get(k), b.get(k), c.get(k)) {
+                                (Some(a), Some(b), Some(c)) => sigma_windows(&[a, b, c], &cs[k].0),
+                                _ => Vec::new(),
+                            },
+                            _ => Vec::new(),
+                        },
                     });
                 }
             }
@@ -1190,13 +1224,14 @@ fn run() -> Result<(), String> {
     if let Some(path) = get("--sigma") {
         // One line per 100 s window of each held-out static run and axis.
         let mut text = String::from(
-            "unit_seed\tsetting\taxis\tprofile\tsensors\tlstm\tcoverage\tresid_dph\tsigma_dph\n",
+            "unit_seed\tsetting\taxis\tprofile\tsensors\tlstm\tcoverage\tresid_dph\tsigma_dph\t\
+             sigma_g0_dph\tsigma_g1_dph\n",
         );
         for c in &cases {
             let sensors = c.temps.split(' ').next().unwrap_or("").split('+').count();
             for w in &c.windows {
                 text.push_str(&format!(
-                    "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.6}\t{:.6}\n",
+                    "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\n",
                     c.unit_seed,
                     c.setting,
                     AXIS_NAMES[c.axis],
@@ -1205,7 +1240,9 @@ fn run() -> Result<(), String> {
                     u8::from(c.lstm),
                     w.coverage,
                     w.resid_dph,
-                    w.sigma_dph
+                    w.sigma_dph,
+                    w.sigma_g0_dph,
+                    w.sigma_g1_dph
                 ));
             }
         }
