@@ -7,7 +7,7 @@
 //! "coverage": {"temp_min_c": -45.0, "temp_cell_c": 6.5, "n_temp": 16,
 //!              "rate_min_c_per_s": -0.06, "rate_cell_c_per_s": 0.01, "n_rate": 12,
 //!              "folds": 5, "count": [...], "rms_dph": [...], "sigma_dph": [...],
-//!              "growth_per_cell": 0.5}
+//!              "growth_per_cell": 1.5}
 //! ```
 //! with one value per cell, row-major by temperature.
 
