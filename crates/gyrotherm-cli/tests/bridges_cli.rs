@@ -1,6 +1,7 @@
 //! The bridges to autopilots and ROS, through the real binary: `export --target ardupilot|px4`
 //! (the fit printed, what the polynomial leaves out, the file written atomically into
-//! `--out`), the removed `--lang` refused in favour of `--target`, flags refused where they
+//! `--out`), the deprecated `--lang` still writing what `--target` writes (with a warning) for
+//! one release, flags refused where they
 //! mean nothing, and `allan --kalibr` (the file written with the figures the library reads,
 //! bounds printed, a bad topic refused).
 
@@ -89,21 +90,39 @@ fn export_writes_autopilot_parameters_with_the_fit_printed() {
 }
 
 #[test]
-fn lang_is_refused_and_autopilot_flags_are_refused_for_code() {
+fn lang_is_deprecated_and_autopilot_flags_are_refused_for_code() {
     let dir = tempfile::tempdir().unwrap();
     let model = thermal_model(dir.path());
-    let out = dir.path().join("c");
+    let old = dir.path().join("lang");
+    let r = run_ok(
+        gyrotherm()
+            .args(["export", "--lang", "c", "--model"])
+            .arg(&model)
+            .arg("--out")
+            .arg(&old),
+    );
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("--lang is deprecated and will be removed: use --target c"),
+        "{err}"
+    );
     let r = gyrotherm()
-        .args(["export", "--lang", "c", "--model"])
+        .args(["export", "--lang", "px4", "--model"])
         .arg(&model)
         .arg("--out")
-        .arg(&out)
+        .arg(dir.path().join("px4"))
         .output()
         .unwrap();
     assert_exit(&r, 2);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert!(err.contains("unexpected argument '--lang'"), "{err}");
-    assert!(!out.exists(), "nothing written");
+    let r = gyrotherm()
+        .args(["export", "--lang", "c", "--target", "rust", "--model"])
+        .arg(&model)
+        .arg("--out")
+        .arg(dir.path().join("both"))
+        .output()
+        .unwrap();
+    assert_exit(&r, 2);
+    let out = dir.path().join("c");
     run_ok(
         gyrotherm()
             .args(["export", "--target", "c", "--model"])
@@ -111,7 +130,13 @@ fn lang_is_refused_and_autopilot_flags_are_refused_for_code() {
             .arg("--out")
             .arg(&out),
     );
-    assert!(out.join("gyrotherm_model.c").exists());
+    for f in ["gyrotherm_model.c", "gyrotherm_model.h"] {
+        assert_eq!(
+            std::fs::read(out.join(f)).unwrap(),
+            std::fs::read(old.join(f)).unwrap(),
+            "{f}: --lang c writes what --target c writes"
+        );
+    }
     let r = gyrotherm()
         .args(["export", "--target", "c", "--axis", "y", "--model"])
         .arg(&model)
@@ -126,7 +151,7 @@ fn lang_is_refused_and_autopilot_flags_are_refused_for_code() {
     for t in ["ardupilot", "px4", "rust"] {
         assert!(help.contains(t), "{help}");
     }
-    assert!(!help.contains("--lang"), "removed\n{help}");
+    assert!(!help.contains("--lang"), "hidden\n{help}");
 }
 
 /// Standard normal pairs: SplitMix64 (Steele, Lea & Flood 2014) and the Box–Muller

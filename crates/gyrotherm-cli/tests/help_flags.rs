@@ -73,7 +73,12 @@ fn named_flags(dir: &Path, out: &mut Vec<(String, usize, String)>) {
                 break; // the test module tests the aliases themselves
             }
             let code = line.trim_start();
-            if code.starts_with("//") || code.starts_with("#[arg(") || code.contains("alias") {
+            // A deprecation warning names the hidden spelling it replaces.
+            if code.starts_with("//")
+                || code.starts_with("#[arg(")
+                || code.contains("alias")
+                || code.contains("is deprecated")
+            {
                 continue;
             }
             for f in flags_in(code) {

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context as _};
-use gyrotherm::export::{ExportError, ExportTarget, EXPORT_TARGETS};
+use gyrotherm::export::{ExportError, ExportTarget, Lang, EXPORT_TARGETS};
 use gyrotherm::settings::autopilot::{self as ap, AutopilotSettings, GyroAxis, GYRO_AXES};
 use gyrotherm::unit_model::Model;
 
@@ -19,9 +19,13 @@ pub struct ExportArgs {
     #[arg(long)]
     pub model: PathBuf,
     /// What to write.
-    #[arg(long,
+    #[arg(long, required_unless_present = "lang", conflicts_with = "lang",
           value_parser = choice::<ExportTarget>(EXPORT_TARGETS.map(|t| (t.as_str(), t.help()))))]
-    pub target: ExportTarget,
+    pub target: Option<ExportTarget>,
+    /// Deprecated spelling of `--target c|rust`, kept for one release.
+    #[arg(long, hide = true,
+          value_parser = choice::<Lang>([Lang::C, Lang::Rust].map(|l| (l.as_str(), l.help()))))]
+    pub lang: Option<Lang>,
     /// Output directory (created if missing).
     #[arg(long)]
     pub out: PathBuf,
@@ -52,7 +56,16 @@ impl ExportArgs {
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<ExitCode> {
-    let target = args.target;
+    let target = match (args.target, args.lang) {
+        (Some(t), _) => t,
+        (None, Some(l)) => {
+            eprintln!(
+                "gyrotherm: warning: --lang is deprecated and will be removed: use --target {l}"
+            );
+            ExportTarget::from(l)
+        }
+        (None, None) => bail!("give --target"),
+    };
     if target.lang().is_some() {
         for (given, flag) in [
             (args.instance.is_some(), "--instance"),
