@@ -394,6 +394,19 @@ fn report_has_a_page_across_axes_and_one_per_axis() {
         assert!(folder.join("index.html").is_file(), "{}", folder.display());
         assert!(folder.join("fig7_compensation.png").is_file());
         assert!(page.contains(&format!("src=\"axis{}/fig7_compensation.png\"", k + 1)));
+        // The axis's coverage figures are of the unit's own fit (what the unit's `compensate`
+        // writes σ from), named by its label with its sensors, not of a one-sensor column.
+        let axis_page = std::fs::read_to_string(folder.join("index.html")).unwrap();
+        for caption in ["Coverage map of the ", "after the "] {
+            let at = axis_page
+                .find(caption)
+                .unwrap_or_else(|| panic!("{caption}: {g}"));
+            let named = &axis_page[at..at + 200.min(axis_page.len() - at)];
+            assert!(
+                named.contains(" sensors: temp_") || named.contains(" sensor: temp_"),
+                "{g}: {named}"
+            );
+        }
     }
 }
 

@@ -418,9 +418,15 @@ impl Judgement<'_> {
                 cmp,
                 gap_warnings,
                 ..
-            } => {
-                crate::report::write_full_report_with(dir, train, test, cmp, self.cfg, gap_warnings)
-            }
+            } => crate::report::write_full_report_with(
+                dir,
+                train,
+                test,
+                cmp,
+                self.cfg,
+                gap_warnings,
+                None,
+            ),
             Judged::Unit { cmp, verdicts } => {
                 let judged = self.spec.zip(verdicts.as_deref());
                 crate::report::unit::write_unit_report(dir, cmp, self.cfg, &[], judged)

@@ -27,7 +27,7 @@ use crate::csvlog::{ExtraColumn, ImuLog, TestLog};
 use crate::fit::unit::{fit_imu_with_events, ImuEvents, UnitFitError};
 use crate::fit::{NamedLog, Target};
 use crate::model::unit::{ImuAxis, ImuError, ImuModel};
-use crate::model::TempSensorDef;
+use crate::model::{ModelFile, TempSensorDef};
 use crate::per_thread::on_threads;
 use crate::string_table::Table;
 
@@ -109,10 +109,15 @@ pub(crate) struct UnitFitColumn {
     pub temps: Vec<String>,
     /// Its figures on each held-out log, in order.
     pub performance: Vec<Performance>,
-    /// Its compensated rate, °/s, on each held-out log, in order (for a spec verdict; not in
-    /// the JSON summary).
+    /// Its compensated rate, °/s, on each held-out log, in order (for a spec verdict and the
+    /// report's σ figure; not in the JSON summary).
     #[serde(skip)]
     pub compensated_dps: Vec<Vec<f64>>,
+    /// The axis's first-sensor model, which carries the axis's coverage map (its first
+    /// sensor's cells, σ scaled to the several-sensor fit): what the report's coverage figures
+    /// draw for this axis. Not in the JSON summary.
+    #[serde(skip)]
+    pub coverage_model: ModelFile,
 }
 
 impl UnitFitColumn {
@@ -137,6 +142,7 @@ impl UnitFitColumn {
             temps: axis.temps.clone(),
             performance,
             compensated_dps,
+            coverage_model: axis.model.clone(),
         }
     }
 }

@@ -41,7 +41,7 @@ pub use job::{
     allan_curve, input_names, noise_lines, scale_factor_points, write_full_report, ScalePoints,
     FIGURE_STEMS, TEMP_RATE_SMOOTHING_S,
 };
-pub(crate) use job::{grouped_warnings, results_table, write_full_report_with};
+pub(crate) use job::{grouped_warnings, results_table, write_full_report_with, CoverageModel};
 pub use plot::{
     figure_layout, write_figure, Figure, FigureFiles, Panel, PanelLayout, PixelRect, Series,
     SeriesStyle, FIGURE_HEIGHT_PX, FIGURE_WIDTH_PX, LEGEND_BORDER_RGB,

@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::html::{escape, push_table, Table, CSS};
-use super::{grouped_warnings, results_table, write_full_report_with, ReportError};
+use super::{grouped_warnings, results_table, write_full_report_with, CoverageModel, ReportError};
 use crate::atomic_file::write_bytes_atomically;
 use crate::compare::unit::ImuComparison;
 use crate::compare::CompareConfig;
@@ -117,6 +117,13 @@ pub(crate) fn write_unit_report(
     for (k, a) in cmp.axes.iter().enumerate() {
         let train = a.train_named();
         let test = a.test_named();
+        // An axis on several sensors: its coverage figures are of the unit's own fit (the
+        // map and σ the unit's `compensate` writes), not of a one-sensor column.
+        let unit_fit = a.unit_fit.as_ref().map(|u| CoverageModel {
+            label: &u.label,
+            model: &u.coverage_model,
+            compensated_dps: &u.compensated_dps,
+        });
         write_full_report_with(
             &dir.join(axis_folder(k)),
             &train,
@@ -124,6 +131,7 @@ pub(crate) fn write_unit_report(
             &a.comparison,
             cfg,
             &[],
+            unit_fit.as_ref(),
         )?;
         for w in grouped_warnings(&test, &a.comparison) {
             warnings.push(format!("{}: {w}", a.gyro));

@@ -1,11 +1,13 @@
-//! Figures 9 and 10: the coverage map of the model the report is about (the column of
-//! [`compensated_result`], else the first model with a map) with the main held-out log's
-//! path over it, and that model's σ beside the residual of the first static held-out log.
+//! Figures 9 and 10: the coverage map of the model the report is about (a unit axis's own fit
+//! where one is given, else the column of [`compensated_result`], else the first model with a
+//! map) with the main held-out log's path over it, and that model's σ beside the residual of
+//! the first static held-out log.
 
-use super::{compensated_result, fmt_num, sig, to_dph, Builder, FIGURE_WINDOW_S};
+use super::{compensated_result, fmt_num, sig, to_dph, Builder, CoverageModel, FIGURE_WINDOW_S};
 use crate::compare::{Comparison, TestResult};
 use crate::coverage_track::{covered_cells, track};
-use crate::fit::{FitOutcome, NamedLog};
+use crate::fit::NamedLog;
+use crate::model::ModelFile;
 use crate::report::coverage_figures::{
     coverage_map_figure, sigma_figure, CellRect, CoverageMapData, SigmaData,
 };
@@ -15,7 +17,7 @@ use crate::report::ReportError;
 const MAP_INDEX: usize = 8;
 
 /// The model with a coverage map the report is about, and its column label.
-fn mapped_model<'a>(r: &TestResult, cmp: &'a Comparison) -> Option<(&'a FitOutcome, &'a str)> {
+fn mapped_model<'a>(r: &TestResult, cmp: &'a Comparison) -> Option<(&'a ModelFile, &'a str)> {
     let with_map = |key: &str| {
         cmp.fits
             .iter()
@@ -30,29 +32,38 @@ fn mapped_model<'a>(r: &TestResult, cmp: &'a Comparison) -> Option<(&'a FitOutco
                 .zip(&cmp.columns)
                 .find(|(f, _)| f.model.coverage.is_some())
         })
-        .map(|(f, c)| (f, c.label))
+        .map(|(f, c)| (&f.model, c.label))
 }
 
+/// `static_pair` comes with its index among the held-out logs (for `shipped`'s output).
 pub(super) fn coverage_figures(
     b: &mut Builder,
     main_pair: Option<(&NamedLog, &TestResult)>,
-    static_pair: Option<(&NamedLog, &TestResult)>,
+    static_pair: Option<((&NamedLog, &TestResult), usize)>,
     cmp: &Comparison,
+    shipped: Option<&CoverageModel>,
 ) -> Result<(), ReportError> {
     const NO_MAP: &str = "no model in this comparison carries a coverage map (only models with \
                           a least-squares bias get one)";
+    let model_of = |r: &TestResult| match shipped {
+        Some(s) => Some((s.model, s.label)),
+        None => mapped_model(r, cmp),
+    };
     match main_pair {
         None => b.note(MAP_INDEX + 1, "no held-out log given"),
-        Some((l, r)) => match mapped_model(r, cmp) {
+        Some((l, r)) => match model_of(r) {
             None => b.note(MAP_INDEX + 1, NO_MAP),
-            Some((fit, label)) => map_figure(b, l, fit, label)?,
+            Some((model, label)) => map_figure(b, l, model, label)?,
         },
     }
     match static_pair {
         None => b.note(MAP_INDEX + 2, "no static held-out log given"),
-        Some((l, r)) => match mapped_model(r, cmp) {
+        Some(((l, r), i)) => match model_of(r) {
             None => b.note(MAP_INDEX + 2, NO_MAP),
-            Some((fit, label)) => sigma_fig(b, l, fit, label)?,
+            Some((model, label)) => {
+                let given = shipped.and_then(|s| s.compensated_dps.get(i));
+                sigma_fig(b, l, model, label, given.map(Vec::as_slice))?
+            }
         },
     }
     Ok(())
@@ -60,9 +71,9 @@ pub(super) fn coverage_figures(
 
 fn track_of(
     l: &NamedLog,
-    fit: &FitOutcome,
+    model: &ModelFile,
 ) -> Result<Option<crate::coverage_track::CoverageTrack>, ReportError> {
-    track(&fit.model, l.log).map_err(|e| ReportError::Data {
+    track(model, l.log).map_err(|e| ReportError::Data {
         what: format!("coverage of {}: {e}", l.name),
     })
 }
@@ -70,10 +81,10 @@ fn track_of(
 fn map_figure(
     b: &mut Builder,
     l: &NamedLog,
-    fit: &FitOutcome,
+    model: &ModelFile,
     label: &str,
 ) -> Result<(), ReportError> {
-    let (Some(def), Some(t)) = (fit.model.coverage.as_ref(), track_of(l, fit)?) else {
+    let (Some(def), Some(t)) = (model.coverage.as_ref(), track_of(l, model)?) else {
         b.note(MAP_INDEX + 1, "the coverage map does not apply");
         return Ok(());
     };
@@ -116,23 +127,31 @@ fn map_figure(
     Ok(())
 }
 
+/// `compensated`: the model's output on `l` where the caller has it (a unit axis's own fit,
+/// which runs on several sensors); else `model` compensates `l`.
 fn sigma_fig(
     b: &mut Builder,
     l: &NamedLog,
-    fit: &FitOutcome,
+    model: &ModelFile,
     label: &str,
+    compensated: Option<&[f64]>,
 ) -> Result<(), ReportError> {
-    let Some(t) = track_of(l, fit)? else {
+    let Some(t) = track_of(l, model)? else {
         b.note(MAP_INDEX + 2, "the coverage map does not apply");
         return Ok(());
     };
-    let comp =
-        crate::compensate::compensate_log(&fit.model, l.log).map_err(|e| ReportError::Data {
-            what: format!("compensating {}: {e}", l.name),
-        })?;
     // A static log's true rate is taken as 0 (the simulator's; a real log still holds the
     // Earth rate's component, which shows as an offset).
-    let residual = to_dph(&comp.gyro_comp_dps);
+    let residual = match compensated {
+        Some(c) => to_dph(c),
+        None => {
+            let comp =
+                crate::compensate::compensate_log(model, l.log).map_err(|e| ReportError::Data {
+                    what: format!("compensating {}: {e}", l.name),
+                })?;
+            to_dph(&comp.gyro_comp_dps)
+        }
+    };
     let files = sigma_figure(
         &b.path(MAP_INDEX + 1),
         &SigmaData {

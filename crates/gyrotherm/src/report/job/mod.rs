@@ -70,14 +70,25 @@ pub fn write_full_report(
     cmp: &Comparison,
     cfg: &CompareConfig,
 ) -> Result<PathBuf, ReportError> {
-    write_full_report_with(dir, train, test, cmp, cfg, &[])
+    write_full_report_with(dir, train, test, cmp, cfg, &[], None)
+}
+
+/// The model a report's coverage figures (9 and 10) are about when it is not one of the
+/// comparison's columns: an inertial unit's axis fitted on several sensors, whose map is its
+/// first sensor's cells with σ scaled to the several-sensor fit, and its compensated output
+/// on each held-out log (in the comparison's order).
+pub(crate) struct CoverageModel<'a> {
+    pub label: &'a str,
+    pub model: &'a crate::model::ModelFile,
+    pub compensated_dps: &'a [Vec<f64>],
 }
 
 /// Write the figures, then `dir/index.html` (creating `dir`), and return the page's path.
 /// `test` must be the held-out logs `cmp` was computed on, in the same order; `train` the
 /// training logs (named on the page). `extra_warnings` (e.g. gaps filled on reading) are
 /// listed after the extrapolation warnings of `cmp` (each finding once per held-out log,
-/// naming the models it concerns).
+/// naming the models it concerns). With `coverage_model`, figures 9 and 10 draw it instead of
+/// a column of `cmp`.
 pub(crate) fn write_full_report_with(
     dir: &Path,
     train: &[NamedLog],
@@ -85,6 +96,7 @@ pub(crate) fn write_full_report_with(
     cmp: &Comparison,
     cfg: &CompareConfig,
     extra_warnings: &[String],
+    coverage_model: Option<&CoverageModel>,
 ) -> Result<PathBuf, ReportError> {
     if test.len() != cmp.tests.len() {
         return Err(ReportError::Data {
@@ -117,7 +129,14 @@ pub(crate) fn write_full_report_with(
     fig_rate_table(&mut b, table_pair, cfg)?;
     fig_before_after(&mut b, main_pair)?;
     fig_allan(&mut b, static_pair)?;
-    coverage::coverage_figures(&mut b, main_pair, static_pair, cmp)?;
+    let static_index = cmp.tests.iter().position(|r| r.is_static);
+    coverage::coverage_figures(
+        &mut b,
+        main_pair,
+        static_pair.zip(static_index),
+        cmp,
+        coverage_model,
+    )?;
 
     let mut warnings = grouped_warnings(test, cmp);
     warnings.extend(extra_warnings.iter().cloned());
