@@ -95,9 +95,8 @@ fn auto_unit(logs: &[(String, ImuLog)]) -> ImuModel {
     )
     .unwrap();
     // A unit's logs give a unit's file: its text reads as a unit model.
-    let model = ImuModel::from_json(&trained.model.to_json().unwrap())
-        .expect("a unit's logs gave a unit's model file");
-    model
+    ImuModel::from_json(&trained.model.to_json().unwrap())
+        .expect("a unit's logs gave a unit's model file")
 }
 
 /// The file round-trips with its checks, and the flight compensator gives every sample of
