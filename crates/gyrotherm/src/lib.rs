@@ -69,6 +69,32 @@
 //!   verdict ([`evaluate::evaluate`]).
 //! - [`lot`]: the test station's record of units judged against their spec sheet.
 //!
+//! One path serves a single gyro and an inertial unit: the logs are read as a set
+//! ([`csvlog::read_log_set`]; column lists in [`ReadOptions`] make it a unit's), [`train`]
+//! fits the set, and a [`Model`] is what every job loads, saves, compensates with and exports,
+//! whichever file form it holds (a single gyro is a unit of one axis):
+//!
+//! ```no_run
+//! use gyrotherm::model::{GivenColumns, TempSensorDef};
+//! use gyrotherm::{csvlog::read_log_set, train::train, FitConfig, Method, Model, ReadOptions};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! // "gyro_x,gyro_y,gyro_z" and "temp_case,temp_x" would read a unit's logs the same way.
+//! let opts = ReadOptions::default();
+//! let logs = read_log_set(&["static.csv".into(), "table.csv".into()], &opts, None).set?;
+//! let cfg = FitConfig::new(Method::Thermal);
+//! let trained = train(&logs, &cfg, &TempSensorDef::default(), &opts, &|_| {})?;
+//! trained.model.save("model.json".as_ref())?;
+//!
+//! let model = Model::load("model.json".as_ref())?;
+//! let columns = model.read_options(&opts, GivenColumns::default())?;
+//! let run = model.compensate_file("flight.csv".as_ref(), "out.csv".as_ref(), &columns)?;
+//! println!("{} lines compensated", run.rows());
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! The single gyro's own types remain for analysis code that wants one log in memory:
+//!
 //! ```no_run
 //! use gyrotherm::{compensate_log, fit_model, read_log, FitConfig, Method, ModelFile, NamedLog};
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -131,3 +157,4 @@ pub use model::{Method, ModelFile, ModelFileError, SubModel, Target};
 pub use settings::{FitSettings, SettingError};
 pub use sim::{simulate, SimConfig};
 pub use targets::TargetSet;
+pub use unit_model::{Model, ModelError};
