@@ -281,3 +281,56 @@ fn compensate_writes_each_axis_coverage_and_sigma_as_the_model_gives_them() {
         assert!(err.contains(&want_line), "{want_line}: {err}");
     }
 }
+
+/// `plan` with column lists plans for the unit: every axis on every sensor listed gets the
+/// single gyro's coverage lines, prefixed with its columns, and the first soaks are sized by
+/// the slowest lag of any pair (the soak line names that lag).
+#[test]
+fn plan_with_lists_covers_every_axis_on_every_sensor() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = simulate_args(
+        dir.path(),
+        "s.csv",
+        &[&UNIT[..], &["--profile", "seed-shock", "--seed", "1"]].concat(),
+    );
+    let out = run_ok(
+        gyrotherm()
+            .args([
+                "plan",
+                "--gyro-col",
+                GYROS,
+                "--temp-col",
+                "temp_case_c,temp_x_c",
+            ])
+            .args(["--temp-min-c", "-40", "--temp-max-c", "50"])
+            .args(["--max-rate-c-per-min", "8", "--input"])
+            .arg(&s),
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut lags = Vec::new();
+    for g in GYROS.split(',') {
+        for t in ["temp_case_c", "temp_x_c"] {
+            let pair = format!("{g} on {t}: ");
+            assert!(
+                text.contains(&format!("{pair}training covers ")),
+                "{pair}\n{text}"
+            );
+            let lag = text
+                .lines()
+                .find_map(|l| l.strip_prefix(&format!("{pair}slowest thermal lag identified: ")))
+                .and_then(|l| l.split(' ').next())
+                .and_then(|v| v.parse::<f64>().ok())
+                .unwrap_or_else(|| panic!("{pair}: no lag\n{text}"));
+            lags.push(lag);
+        }
+    }
+    let slowest = lags.iter().copied().fold(f64::NAN, f64::max);
+    assert!(
+        text.contains(&format!(
+            "slowest thermal lag of the unit: {slowest:.0} s ("
+        )),
+        "{text}"
+    );
+    let soak = text.lines().find(|l| l.starts_with("soaks: ")).unwrap();
+    assert!(soak.contains(&format!("({slowest:.0} s)")), "{soak}");
+}

@@ -23,11 +23,16 @@
 //! ([`crate::settings::plan`]), so that its state settles at a constant temperature, where it
 //! can be told from the faster ones. The other soaks, and every soak without training logs,
 //! last `SOAK_S`. [`Plan::soak`] says which length was chosen and why.
+//!
+//! **Units.** An inertial unit's logs ([`set_coverage`]) are planned for pair by pair: every
+//! gyro axis on every temperature sensor, each as a single gyro's logs; the soaks follow the
+//! slowest lag of any pair ([`slowest_lag`]), and a unit's flight envelope is the union over
+//! its sensors ([`resolve_set_envelope`]).
 
 use std::fmt;
 
 use crate::coverage_track::track;
-use crate::csvlog::TestLog;
+use crate::csvlog::{LogSet, LogSetForm, ReadOptions, TestLog};
 use crate::fit::{fit_model, FitConfig, FitError, NamedLog};
 use crate::settings::coverage::TEMP_CELLS;
 use crate::settings::plan::{
@@ -258,6 +263,136 @@ pub fn training_coverage(
         slowest_lag_s,
         lag_at_bound,
     }))
+}
+
+/// What the training logs cover on one gyro column read with one temperature column.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairCoverage {
+    pub gyro: String,
+    pub temp: String,
+    /// What they cover, or why there is no coverage map (the fit's note).
+    pub coverage: Result<CoverageSummary, String>,
+}
+
+/// What a job's training logs cover ([`training_coverage`] per pair): a single gyro's one
+/// gyro and temperature column (named by `opts`), or every gyro axis of an inertial unit on
+/// every temperature sensor, since an axis's bias follows each sensor with lags of its own.
+/// A unit's `flight` is its own log, each pair seen on the same columns; the envelope `env`
+/// is the one of [`resolve_set_envelope`].
+pub fn set_coverage(
+    train: &LogSet,
+    flight: Option<&LogSet>,
+    env: &Envelope,
+    opts: &ReadOptions,
+) -> Result<Vec<PairCoverage>, PlanError> {
+    let pairs = pair_views(train, opts);
+    let flights = flight.map(|f| pair_views(f, opts));
+    let mut out = Vec::with_capacity(pairs.len());
+    for (gyro, temp, logs) in pairs {
+        let named: Vec<NamedLog> = logs
+            .iter()
+            .map(|(n, l)| NamedLog { name: n, log: l })
+            .collect();
+        // The flight's view on the same columns (its first log).
+        let flight = flights.as_ref().and_then(|f| {
+            f.iter()
+                .find(|(g, t, _)| *g == gyro && *t == temp)
+                .and_then(|(_, _, l)| l.first().map(|(_, l)| l))
+        });
+        out.push(PairCoverage {
+            coverage: training_coverage(&named, flight, env)?,
+            gyro,
+            temp,
+        });
+    }
+    Ok(out)
+}
+
+/// The slowest lag any pair's fit identified, with the pair: what sizes the soaks.
+pub fn slowest_lag(pairs: &[PairCoverage]) -> Option<(&PairCoverage, f64)> {
+    pairs
+        .iter()
+        .filter_map(|p| {
+            let c = p.coverage.as_ref().ok()?;
+            Some((p, c.slowest_lag_s?))
+        })
+        .reduce(|a, b| if b.1 > a.1 { b } else { a })
+}
+
+/// A gyro column, a temperature column, and the set's logs seen on them.
+type PairView = (String, String, Vec<(String, TestLog)>);
+
+/// Every (gyro, temperature) pair of a set, each with its logs seen as single-axis logs
+/// (gyro column, temperature column, the table rate where the table turns that gyro).
+fn pair_views(set: &LogSet, opts: &ReadOptions) -> Vec<PairView> {
+    match set.form() {
+        LogSetForm::Single(logs) => {
+            vec![(opts.gyro_col.clone(), opts.temp_col.clone(), logs.clone())]
+        }
+        LogSetForm::Unit(logs) => {
+            let Some((_, first)) = logs.first() else {
+                return Vec::new();
+            };
+            let mut out = Vec::new();
+            for (k, g) in first.gyro.iter().enumerate() {
+                for (j, t) in first.temp.iter().enumerate() {
+                    let views = logs
+                        .iter()
+                        .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
+                        .collect();
+                    out.push((g.name.clone(), t.name.clone(), views));
+                }
+            }
+            out
+        }
+    }
+}
+
+/// [`resolve_envelope`] for a flight read as a set: a single gyro's log as it is; an inertial
+/// unit's the union over its temperature columns (the coldest and hottest reading of any
+/// sensor, the fastest rate of any).
+pub fn resolve_set_envelope(
+    flight: Option<&LogSet>,
+    s: &PlanSettings,
+) -> Result<Envelope, PlanError> {
+    let logs = match flight.map(LogSet::form) {
+        None => return resolve_envelope(None, s),
+        Some(LogSetForm::Single(logs)) => return resolve_envelope(logs.first().map(|(_, l)| l), s),
+        Some(LogSetForm::Unit(logs)) => logs,
+    };
+    let Some((_, log)) = logs.first() else {
+        return resolve_envelope(None, s);
+    };
+    let views: Vec<TestLog> = (0..log.temp.len())
+        .filter(|_| !log.gyro.is_empty())
+        .map(|j| log.axis_data(0, j))
+        .collect();
+    // A sensor whose reading never changes gives no envelope of its own; the others do.
+    let mut env: Option<Envelope> = None;
+    let mut first_error = None;
+    for v in &views {
+        let e = match resolve_envelope(Some(v), s) {
+            Ok(e) => e,
+            Err(e @ (PlanError::FlatFlight { .. } | PlanError::EmptyFlight)) => {
+                first_error.get_or_insert(e);
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        env = Some(match env {
+            None => e,
+            Some(a) => Envelope {
+                temp_min_c: a.temp_min_c.min(e.temp_min_c),
+                temp_max_c: a.temp_max_c.max(e.temp_max_c),
+                max_rate_c_per_min: a.max_rate_c_per_min.max(e.max_rate_c_per_min),
+            },
+        });
+    }
+    match (env, first_error) {
+        (Some(e), _) => Ok(e),
+        (None, Some(e)) => Err(e),
+        (None, None) => resolve_envelope(None, s),
+    }
 }
 
 /// What a segment of the proposed profile does.

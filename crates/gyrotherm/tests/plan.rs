@@ -139,3 +139,78 @@ fn the_first_soak_at_each_extreme_separates_the_slowest_identified_lag() {
     // Still a profile `simulate --profile-file` reads.
     Profile::parse(&plan.profile_text(), "plan.txt").unwrap();
 }
+
+/// An inertial unit's training logs: every gyro axis on every temperature sensor is one pair,
+/// each pair's coverage is `training_coverage` of that axis's view on that sensor (computed
+/// here on the views directly), and the soaks follow the slowest lag of any pair. The flight
+/// envelope of a unit is the union over its sensors.
+#[test]
+fn a_unit_plans_every_axis_on_every_sensor_and_soaks_for_the_slowest() {
+    use gyrotherm::csvlog::{LogSet, ReadOptions};
+    use gyrotherm::plan::{resolve_set_envelope, set_coverage, slowest_lag};
+    use gyrotherm::sim::imu::{imu_from_family, simulate_imu, ImuConfig};
+
+    let run = |profile: &str, seed: u64| {
+        let mut r = SimConfig::new(Profile::builtin(profile).unwrap());
+        r.seed = seed;
+        simulate_imu(&ImuConfig {
+            run: r,
+            unit: imu_from_family(1000),
+            table_axis: 0,
+        })
+        .unwrap()
+    };
+    let mut shock = run("seed-shock", 1);
+    let mut flight = run("airborne", 2);
+    // Two axes and two sensors keep the test short: four pairs.
+    for l in [&mut shock, &mut flight] {
+        l.gyro.truncate(2);
+        l.temp.truncate(2);
+    }
+    let train = LogSet::of_unit_logs(vec![("shock".to_owned(), shock.clone())]);
+    let flight_set = LogSet::of_unit_logs(vec![("flight".to_owned(), flight.clone())]);
+    let s = PlanSettings::default();
+    let env = resolve_set_envelope(Some(&flight_set), &s).unwrap();
+    // The union of each sensor's envelope.
+    let per_sensor: Vec<_> = (0..2)
+        .map(|j| resolve_envelope(Some(&flight.axis_data(0, j)), &s).unwrap())
+        .collect();
+    assert_eq!(
+        env.temp_min_c,
+        per_sensor[0].temp_min_c.min(per_sensor[1].temp_min_c)
+    );
+    assert_eq!(
+        env.temp_max_c,
+        per_sensor[0].temp_max_c.max(per_sensor[1].temp_max_c)
+    );
+    assert_eq!(
+        env.max_rate_c_per_min,
+        per_sensor[0]
+            .max_rate_c_per_min
+            .max(per_sensor[1].max_rate_c_per_min)
+    );
+
+    let pairs = set_coverage(&train, Some(&flight_set), &env, &ReadOptions::default()).unwrap();
+    assert_eq!(pairs.len(), 4, "two axes × two sensors");
+    let mut lags = Vec::new();
+    for (i, p) in pairs.iter().enumerate() {
+        let (k, j) = (i / 2, i % 2);
+        assert_eq!(p.gyro, shock.gyro[k].name);
+        assert_eq!(p.temp, shock.temp[j].name);
+        let view = shock.axis_data(k, j);
+        let want = training_coverage(
+            &[NamedLog {
+                name: "shock",
+                log: &view,
+            }],
+            Some(&flight.axis_data(k, j)),
+            &env,
+        )
+        .unwrap();
+        assert_eq!(p.coverage, want, "{} on {}", p.gyro, p.temp);
+        lags.extend(want.ok().and_then(|c| c.slowest_lag_s));
+    }
+    let (p, tau) = slowest_lag(&pairs).expect("a thermal fit identifies lags");
+    assert_eq!(tau, lags.iter().copied().fold(f64::NAN, f64::max));
+    assert_eq!(p.coverage.as_ref().unwrap().slowest_lag_s, Some(tau));
+}

@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 use clap::Args;
 use gyrotherm::csvlog::{self, GyroUnit, LogFormat, ReadOptions, TestLog, LOG_FORMATS};
-use gyrotherm::fit::NamedLog;
 use gyrotherm::model::GivenColumns;
 use gyrotherm::settings::{read, Rule};
 
@@ -161,44 +160,6 @@ pub fn read_log_with(path: &Path, opts: &ReadOptions) -> anyhow::Result<(TestLog
     Ok((log, warning))
 }
 
-/// Read every log, reporting each failure, then stop if any failed. Gap-filling warnings are
-/// added to `warnings`.
-pub fn read_logs(
-    paths: &[PathBuf],
-    args: &LogArgs,
-    warnings: &mut Vec<String>,
-) -> anyhow::Result<Vec<(String, TestLog)>> {
-    read_logs_with(paths, &args.read_options(), warnings)
-}
-
-/// [`read_logs`] with read options `opts`.
-pub fn read_logs_with(
-    paths: &[PathBuf],
-    opts: &ReadOptions,
-    warnings: &mut Vec<String>,
-) -> anyhow::Result<Vec<(String, TestLog)>> {
-    let mut out = Vec::new();
-    let mut failed = 0;
-    for p in paths {
-        match read_log_with(p, opts) {
-            Ok((log, warning)) => {
-                warnings.extend(warning);
-                out.push((p.display().to_string(), log));
-            }
-            Err(e) => {
-                eprintln!("gyrotherm: {}", error_message(&e));
-                failed += 1;
-            }
-        }
-    }
-    anyhow::ensure!(
-        failed == 0,
-        "{failed} of {} input logs could not be read (see above)",
-        paths.len()
-    );
-    Ok(out)
-}
-
 /// Read a job's logs through the library's one entry point, telling what reading did for
 /// each file and each failure, then stop if any failed.
 pub fn read_log_set(
@@ -248,13 +209,6 @@ pub fn refuse_outputs_over_inputs<'a>(
     let inputs: Vec<&Path> = inputs.into_iter().collect();
     gyrotherm::atomic_file::refuse_outputs_over_inputs(&outputs, &inputs)?;
     Ok(())
-}
-
-/// The library's view of read logs: name and data.
-pub fn named(logs: &[(String, TestLog)]) -> Vec<NamedLog<'_>> {
-    logs.iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect()
 }
 
 /// Values of the options that name a built-in chamber profile (`gyrotherm::sim`'s list,

@@ -6,10 +6,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use gyrotherm::plan::{propose, resolve_envelope, training_coverage, Step};
+use gyrotherm::plan::{
+    propose, resolve_set_envelope, set_coverage, slowest_lag, CoverageSummary, Step,
+};
 use gyrotherm::settings::plan::{self as defaults, PlanSettings};
 
-use super::common::{named, read_log_reporting, read_logs, LogArgs};
+use super::common::{read_log_set, read_log_sets, LogArgs};
 
 #[derive(Debug, clap::Args)]
 pub struct PlanArgs {
@@ -64,12 +66,21 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
         chamber_max_rate_c_per_min: args.chamber_max_rate_c_per_min,
         slowest_lag_s: None,
     };
-    let flight = args
-        .flight
-        .as_deref()
-        .map(|p| read_log_reporting(p, &args.log))
-        .transpose()?;
-    let env = resolve_envelope(flight.as_ref(), &s)?;
+    // The flight and the training logs are read through the one entry, alike: a single
+    // gyro's, or an inertial unit's when the columns are lists.
+    let opts = args.log.read_options();
+    let table_axis = args.log.table_axis.as_deref();
+    let flight_paths: Vec<PathBuf> = args.flight.iter().cloned().collect();
+    let (flight, train) = match (flight_paths.is_empty(), args.input.is_empty()) {
+        (false, false) => {
+            let [f, t] = read_log_sets([&flight_paths[..], &args.input[..]], &args.log)?;
+            (Some(f), Some(t))
+        }
+        (false, true) => (Some(read_log_set(&flight_paths, &opts, table_axis)?), None),
+        (true, false) => (None, Some(read_log_set(&args.input, &opts, table_axis)?)),
+        (true, true) => (None, None),
+    };
+    let env = resolve_set_envelope(flight.as_ref(), &s)?;
     writeln!(
         w,
         "envelope: {:.1} to {:.1} °C, |dT| up to {:.2} °C/min{}",
@@ -92,50 +103,26 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
         "chamber: {} to {} °C, ramps up to {} °C/min",
         s.chamber_min_c, s.chamber_max_c, s.chamber_max_rate_c_per_min
     )?;
-    if !args.input.is_empty() {
-        let mut warnings = Vec::new();
-        let train = read_logs(&args.input, &args.log, &mut warnings)?;
-        match training_coverage(&named(&train), flight.as_ref(), &env)? {
-            Err(why) => writeln!(w, "training coverage: none: {why}")?,
-            Ok(c) => {
+    if let Some(train) = &train {
+        let pairs = set_coverage(train, flight.as_ref(), &env, &opts)?;
+        for p in &pairs {
+            // A unit's lines name the gyro and the sensor; a single gyro's are as they were.
+            let pair = if pairs.len() > 1 {
+                format!("{} on {}: ", p.gyro, p.temp)
+            } else {
+                String::new()
+            };
+            write_coverage(&mut w, &pair, &p.coverage)?;
+        }
+        if let Some((p, tau)) = slowest_lag(&pairs) {
+            if pairs.len() > 1 {
                 writeln!(
                     w,
-                    "training covers {} of {} (T, dT) cells: {:.1} to {:.1} °C, {:.2} to {:.2} \
-                     °C/min",
-                    c.covered_cells,
-                    c.cells,
-                    c.temp_span_c.0,
-                    c.temp_span_c.1,
-                    c.rate_span_c_per_min.0,
-                    c.rate_span_c_per_min.1
+                    "slowest thermal lag of the unit: {tau:.0} s ({} on {})",
+                    p.gyro, p.temp
                 )?;
-                if let Some([inside, edge, outside]) = c.flight_shares {
-                    writeln!(
-                        w,
-                        "flight: {:.1} % of samples inside, {:.1} % at the edge, {:.1} % outside",
-                        100.0 * inside,
-                        100.0 * edge,
-                        100.0 * outside
-                    )?;
-                }
-                writeln!(
-                    w,
-                    "envelope (temperature × ±rate): {:.1} % outside",
-                    100.0 * c.envelope_outside
-                )?;
-                if let Some(tau) = c.slowest_lag_s {
-                    writeln!(
-                        w,
-                        "slowest thermal lag identified: {tau:.0} s{}",
-                        if c.lag_at_bound {
-                            " (at the lag search's upper bound: the true lag may be longer)"
-                        } else {
-                            ""
-                        }
-                    )?;
-                }
-                s.slowest_lag_s = c.slowest_lag_s;
             }
+            s.slowest_lag_s = Some(tau);
         }
     }
     let plan = propose(&env, &s)?;
@@ -191,4 +178,54 @@ pub fn run(args: PlanArgs) -> anyhow::Result<ExitCode> {
         writeln!(w, "wrote {}", out.display())?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What the training logs cover on one pair of columns, each line after `pair` (empty for a
+/// single gyro).
+fn write_coverage(
+    w: &mut impl std::io::Write,
+    pair: &str,
+    coverage: &Result<CoverageSummary, String>,
+) -> std::io::Result<()> {
+    let c = match coverage {
+        Err(why) => return writeln!(w, "{pair}training coverage: none: {why}"),
+        Ok(c) => c,
+    };
+    writeln!(
+        w,
+        "{pair}training covers {} of {} (T, dT) cells: {:.1} to {:.1} °C, {:.2} to {:.2} \
+         °C/min",
+        c.covered_cells,
+        c.cells,
+        c.temp_span_c.0,
+        c.temp_span_c.1,
+        c.rate_span_c_per_min.0,
+        c.rate_span_c_per_min.1
+    )?;
+    if let Some([inside, edge, outside]) = c.flight_shares {
+        writeln!(
+            w,
+            "{pair}flight: {:.1} % of samples inside, {:.1} % at the edge, {:.1} % outside",
+            100.0 * inside,
+            100.0 * edge,
+            100.0 * outside
+        )?;
+    }
+    writeln!(
+        w,
+        "{pair}envelope (temperature × ±rate): {:.1} % outside",
+        100.0 * c.envelope_outside
+    )?;
+    if let Some(tau) = c.slowest_lag_s {
+        writeln!(
+            w,
+            "{pair}slowest thermal lag identified: {tau:.0} s{}",
+            if c.lag_at_bound {
+                " (at the lag search's upper bound: the true lag may be longer)"
+            } else {
+                ""
+            }
+        )?;
+    }
+    Ok(())
 }

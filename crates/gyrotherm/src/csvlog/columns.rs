@@ -38,7 +38,8 @@ pub(super) fn check_options(path: &Path, opts: &ReadOptions) -> Result<(), LogEr
             None,
             format!(
                 "this reads one gyro and one temperature column, not the lists {:?} and {:?}; \
-                 name one of each (lists are for train and compensate of an inertial unit)",
+                 name one of each (column lists are for the jobs on an inertial unit: train, \
+                 compensate, evaluate, compare, report, plan and lot)",
                 opts.gyro_col, opts.temp_col
             ),
         ));
