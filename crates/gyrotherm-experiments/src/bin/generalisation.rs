@@ -260,6 +260,13 @@ struct Job<'a> {
     settings: &'a [String],
     /// `--methods` was given: every method named runs on every setting.
     methods_named: bool,
+    /// `--blend-grid W,…`: with `thermal` and a `tlstm…` method among the methods, also the
+    /// compensated outputs `(1 − W)·thermal + W·tlstm` of each held-out run, as method
+    /// `blendW`. Both models share the scale-factor model (`thermal-lstm`'s LSTM is on the bias
+    /// only), so this is the output of the bias blend `(1 − W)·B_thermal + W·B_tlstm`. Judged
+    /// with every W on the held-out runs themselves, the best W is a bound on what any blend
+    /// chosen on training data could give, not a method.
+    blend_grid: Vec<f64>,
 }
 
 fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
@@ -335,6 +342,9 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                 log: &train_all[i].1,
             })
             .collect();
+        // Per method, per held-out profile: the static and table runs' compensated outputs
+        // (for `--blend-grid`).
+        let mut outputs: Vec<(String, &str, Vec<f64>, Vec<f64>)> = Vec::new();
         for m in job.methods {
             let capacity =
                 m.starts_with("tlstm") || m.starts_with("auto") || m.starts_with("dlstm");
@@ -410,6 +420,14 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                     .map_err(|e| e.to_string())?
                     .bias_stability_dph;
                 let (sf_ppm, out20_err_dps) = table_figures(&tab.log, &ct.gyro_comp_dps)?;
+                if !job.blend_grid.is_empty() {
+                    outputs.push((
+                        m.clone(),
+                        profile,
+                        cs.gyro_comp_dps.clone(),
+                        ct.gyro_comp_dps.clone(),
+                    ));
+                }
                 out.push(Case {
                     unit_seed,
                     setting: setting.clone(),
@@ -420,6 +438,42 @@ fn run_unit(unit_seed: u64, job: &Job) -> Result<Vec<Case>, String> {
                     out20_err_dps,
                     fit_s: fit_s / TEST_PROFILES.len() as f64,
                     note: note.clone(),
+                });
+            }
+        }
+        let of = |name: &dyn Fn(&str) -> bool, profile: &str| {
+            outputs.iter().find(|(m, p, _, _)| name(m) && *p == profile)
+        };
+        for (profile, st, tab) in &tests {
+            let (Some(t), Some(l)) = (
+                of(&|m| m == "thermal", profile),
+                of(&|m| m.starts_with("tlstm"), profile),
+            ) else {
+                continue;
+            };
+            for &w in &job.blend_grid {
+                let mix = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                    a.iter()
+                        .zip(b)
+                        .map(|(a, b)| (1.0 - w) * a + w * b)
+                        .collect()
+                };
+                let cs = mix(&t.2, &l.2);
+                let ct = mix(&t.3, &l.3);
+                let b = bias_stability_dph(&cs, 1.0, TAU_S)
+                    .map_err(|e| e.to_string())?
+                    .bias_stability_dph;
+                let (sf_ppm, out20_err_dps) = table_figures(&tab.log, &ct)?;
+                out.push(Case {
+                    unit_seed,
+                    setting: setting.clone(),
+                    method: format!("blend{w}"),
+                    profile,
+                    x_floor: b / st.floor_dph.unwrap_or(f64::NAN),
+                    sf_ppm,
+                    out20_err_dps,
+                    fit_s: 0.0,
+                    note: String::new(),
                 });
             }
         }
@@ -496,6 +550,13 @@ fn run() -> Result<(), String> {
         methods: &methods,
         settings: &settings,
         methods_named: get("--methods").is_some(),
+        blend_grid: match get("--blend-grid") {
+            None => Vec::new(),
+            Some(v) => v
+                .split(',')
+                .map(|w| w.parse().map_err(|e| format!("--blend-grid {w:?}: {e}")))
+                .collect::<Result<_, String>>()?,
+        },
     };
     eprintln!(
         "{family} family: {} units (seeds {}..{}), settings {settings:?}, methods {methods:?}, {threads} threads",
