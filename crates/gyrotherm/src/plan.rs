@@ -29,6 +29,7 @@
 //! slowest lag of any pair ([`slowest_lag`]), and a unit's flight envelope is the union over
 //! its sensors ([`resolve_set_envelope`]).
 
+use std::borrow::Cow;
 use std::fmt;
 
 use crate::coverage_track::track;
@@ -285,22 +286,17 @@ pub fn set_coverage(
     env: &Envelope,
     opts: &ReadOptions,
 ) -> Result<Vec<PairCoverage>, PlanError> {
-    let pairs = pair_views(train, opts);
-    let flights = flight.map(|f| pair_views(f, opts));
-    let mut out = Vec::with_capacity(pairs.len());
-    for (gyro, temp, logs) in pairs {
+    let mut out = Vec::new();
+    for (gyro, temp) in column_pairs(train, opts) {
+        let logs = views_on(train, &gyro, &temp);
         let named: Vec<NamedLog> = logs
             .iter()
             .map(|(n, l)| NamedLog { name: n, log: l })
             .collect();
-        // The flight's view on the same columns (its first log).
-        let flight = flights.as_ref().and_then(|f| {
-            f.iter()
-                .find(|(g, t, _)| *g == gyro && *t == temp)
-                .and_then(|(_, _, l)| l.first().map(|(_, l)| l))
-        });
+        // The flight's view on the same columns (its first log), made for this pair only.
+        let flight = flight.and_then(|f| views_on(f, &gyro, &temp).into_iter().next());
         out.push(PairCoverage {
-            coverage: training_coverage(&named, flight, env)?,
+            coverage: training_coverage(&named, flight.as_ref().map(|(_, l)| &**l), env)?,
             gyro,
             temp,
         });
@@ -319,32 +315,37 @@ pub fn slowest_lag(pairs: &[PairCoverage]) -> Option<(&PairCoverage, f64)> {
         .reduce(|a, b| if b.1 > a.1 { b } else { a })
 }
 
-/// A gyro column, a temperature column, and the set's logs seen on them.
-type PairView = (String, String, Vec<(String, TestLog)>);
-
-/// Every (gyro, temperature) pair of a set, each with its logs seen as single-axis logs
-/// (gyro column, temperature column, the table rate where the table turns that gyro).
-fn pair_views(set: &LogSet, opts: &ReadOptions) -> Vec<PairView> {
+/// Every (gyro, temperature) pair of a set: a single gyro's one (its columns named by
+/// `opts`), a unit's every gyro column with every temperature column of its first log.
+fn column_pairs(set: &LogSet, opts: &ReadOptions) -> Vec<(String, String)> {
     match set.form() {
-        LogSetForm::Single(logs) => {
-            vec![(opts.gyro_col.clone(), opts.temp_col.clone(), logs.clone())]
-        }
-        LogSetForm::Unit(logs) => {
-            let Some((_, first)) = logs.first() else {
-                return Vec::new();
-            };
-            let mut out = Vec::new();
-            for (k, g) in first.gyro.iter().enumerate() {
-                for (j, t) in first.temp.iter().enumerate() {
-                    let views = logs
-                        .iter()
-                        .map(|(n, l)| (n.clone(), l.axis_data(k, j)))
-                        .collect();
-                    out.push((g.name.clone(), t.name.clone(), views));
-                }
-            }
-            out
-        }
+        LogSetForm::Single(_) => vec![(opts.gyro_col.clone(), opts.temp_col.clone())],
+        LogSetForm::Unit(logs) => logs.first().map_or_else(Vec::new, |(_, l)| {
+            l.gyro
+                .iter()
+                .flat_map(|g| l.temp.iter().map(|t| (g.name.clone(), t.name.clone())))
+                .collect()
+        }),
+    }
+}
+
+/// The set's logs seen on one pair of columns as single-axis logs (the gyro column, the
+/// temperature column, the table rate where the table turns that gyro): a single gyro's as
+/// they are, a unit's each log that holds both columns.
+fn views_on<'a>(set: &'a LogSet, gyro: &str, temp: &str) -> Vec<(&'a str, Cow<'a, TestLog>)> {
+    match set.form() {
+        LogSetForm::Single(logs) => logs
+            .iter()
+            .map(|(n, l)| (n.as_str(), Cow::Borrowed(l)))
+            .collect(),
+        LogSetForm::Unit(logs) => logs
+            .iter()
+            .filter_map(|(n, l)| {
+                let k = l.gyro.iter().position(|g| g.name == gyro)?;
+                let j = l.temp.iter().position(|t| t.name == temp)?;
+                Some((n.as_str(), Cow::Owned(l.axis_data(k, j))))
+            })
+            .collect(),
     }
 }
 
@@ -363,10 +364,10 @@ pub fn resolve_set_envelope(
     let Some((_, log)) = logs.first() else {
         return resolve_envelope(None, s);
     };
-    let views: Vec<TestLog> = (0..log.temp.len())
-        .filter(|_| !log.gyro.is_empty())
-        .map(|j| log.axis_data(0, j))
-        .collect();
+    if log.gyro.is_empty() {
+        return resolve_envelope(None, s);
+    }
+    let views: Vec<TestLog> = (0..log.temp.len()).map(|j| log.axis_data(0, j)).collect();
     // A sensor whose reading never changes gives no envelope of its own; the others do.
     let mut env: Option<Envelope> = None;
     let mut first_error = None;
