@@ -225,4 +225,8 @@ impl LogSet {
     pub(crate) fn form(&self) -> &LogSetForm {
         &self.form
     }
+
+    pub(crate) fn into_form(self) -> LogSetForm {
+        self.form
+    }
 }

@@ -6,7 +6,9 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::csvlog::{read_imu_log, read_log, ColumnError, LogError, ReadOptions};
+use crate::csvlog::{
+    read_in_form, ColumnError, ImuLog, LogError, LogSet, LogSetForm, ReadOptions, TestLog,
+};
 use crate::metrics::{Evaluation, EvaluationError};
 use crate::settings::evaluate::EvaluateError;
 use crate::settings::EvaluateSettings;
@@ -44,6 +46,8 @@ pub enum EvaluateJobError {
     Column { path: PathBuf, source: ColumnError },
     /// The log at `path` has no sample period.
     Period { path: PathBuf },
+    /// Reading gave no log and no error (a reader's fault, not the file's).
+    NoLog,
     /// The figures could not be computed.
     Evaluate(EvaluateError),
     /// The figures the spec sheet needs could not be measured on the log named `log`.
@@ -71,6 +75,9 @@ impl std::fmt::Display for EvaluateJobError {
                  time_s)",
                 path.display()
             ),
+            EvaluateJobError::NoLog => f.write_str(
+                "internal: reading the log gave neither the log nor an error; please report it",
+            ),
             EvaluateJobError::Evaluate(e) => e.fmt(f),
             EvaluateJobError::Measure { log, .. } | EvaluateJobError::Unit { log, .. } => {
                 f.write_str(log)
@@ -90,7 +97,7 @@ impl std::error::Error for EvaluateJobError {
             // Transparent: these errors' own messages are this one's.
             EvaluateJobError::Evaluate(e) => e.source(),
             EvaluateJobError::Spec(e) => e.source(),
-            EvaluateJobError::Period { .. } => None,
+            EvaluateJobError::Period { .. } | EvaluateJobError::NoLog => None,
         }
     }
 }
@@ -114,39 +121,48 @@ enum Form {
 
 /// The figures of the log: a single gyro's column, or each gyro axis of a unit's log (a
 /// unit's when the options name several columns, the file's format holds a unit, or a model
-/// is given, whose columns are read and whose output is judged beside the raw one).
+/// is given, whose columns are read and whose output is judged beside the raw one). The log
+/// is read through the one entry every job reads through ([`read_in_form`]).
 pub fn evaluate(job: &EvaluateJob) -> Result<Evaluated, EvaluateJobError> {
-    if job.model.is_some() || job.read.reads_unit(&[job.input]) {
-        evaluate_unit(job)
-    } else {
-        evaluate_single(job)
-    }
-}
-
-fn read_told(path: &Path, report: &crate::csvlog::ReadReport, jitter: bool) -> Vec<Told> {
-    let mut told = Vec::new();
-    if report.filled_gaps > 0 {
-        told.push(Told::Line(format!(
-            "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps-max-s)",
-            path.display(),
-            report.filled_gaps,
-            report.filled_samples
-        )));
-    }
-    if jitter {
-        told.extend(report.jitter_warning(path).map(Told::Warning));
-    }
-    told.extend(report.truncation_warning(path).map(Told::Warning));
-    told
-}
-
-fn evaluate_single(job: &EvaluateJob) -> Result<Evaluated, EvaluateJobError> {
     let path = job.input;
-    let (mut log, report) = read_log(path, job.read).map_err(|source| EvaluateJobError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut told = read_told(path, &report, true);
+    let model = job.model.map(|m| m.to_unit(job.read));
+    let opts = match &model {
+        Some(m) => m.read_options(job.read),
+        None => job.read.clone(),
+    };
+    let unit = model.is_some() || job.read.reads_unit(&[path]);
+    let read = read_in_form(&[path.to_path_buf()], &opts, job.table_axis, unit);
+    // One path, so one file read: its error, or the set of its one log.
+    let mut told = Vec::new();
+    for f in read.files {
+        told.extend(f.told);
+        if let Some(source) = f.error {
+            return Err(EvaluateJobError::Read {
+                path: f.path,
+                source,
+            });
+        }
+    }
+    let form = read.set.map(LogSet::into_form);
+    match form {
+        Ok(LogSetForm::Single(logs)) => match logs.into_iter().next() {
+            Some((_, log)) => evaluate_single(job, log, told),
+            None => Err(EvaluateJobError::NoLog),
+        },
+        Ok(LogSetForm::Unit(logs)) => match logs.first() {
+            Some((_, log)) => evaluate_unit(job, model.as_deref(), log, told),
+            None => Err(EvaluateJobError::NoLog),
+        },
+        Err(_) => Err(EvaluateJobError::NoLog),
+    }
+}
+
+fn evaluate_single(
+    job: &EvaluateJob,
+    mut log: TestLog,
+    mut told: Vec<Told>,
+) -> Result<Evaluated, EvaluateJobError> {
+    let path = job.input;
     let log_name = job.read.log_column(&job.settings.column).to_owned();
     let values = log
         .take_column(&log_name)
@@ -196,26 +212,19 @@ fn evaluate_single(job: &EvaluateJob) -> Result<Evaluated, EvaluateJobError> {
     })
 }
 
-fn evaluate_unit(job: &EvaluateJob) -> Result<Evaluated, EvaluateJobError> {
-    let path = job.input;
-    let model = job.model.map(|m| m.to_unit(job.read));
-    let opts = match &model {
-        Some(m) => m.read_options(job.read),
-        None => job.read.clone(),
-    };
-    let (log, report) =
-        read_imu_log(path, &opts, job.table_axis).map_err(|source| EvaluateJobError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    let mut told = read_told(path, &report, false);
-    let name = path.display().to_string();
-    let unit = evaluate_imu_spec(&log, model.as_deref(), job.settings, job.spec, &name).map_err(
-        |source| EvaluateJobError::Unit {
+fn evaluate_unit(
+    job: &EvaluateJob,
+    model: Option<&crate::model::unit::ImuModel>,
+    log: &ImuLog,
+    mut told: Vec<Told>,
+) -> Result<Evaluated, EvaluateJobError> {
+    let name = job.input.display().to_string();
+    let unit = evaluate_imu_spec(log, model, job.settings, job.spec, &name).map_err(|source| {
+        EvaluateJobError::Unit {
             log: name.clone(),
             source: Box::new(source),
-        },
-    )?;
+        }
+    })?;
     told.extend(
         unit.tau
             .note(unit.axes[0].raw.sample_period_s)
