@@ -1,8 +1,8 @@
 //! Test logs: reading with the CLI's column mapping, unit and gap options.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use gyrotherm::csvlog::{self, GyroUnit, ImuLog, ReadOptions, TestLog};
+use gyrotherm::csvlog::{self, ColumnValues, GyroUnit, ReadOptions};
 use gyrotherm::settings::read;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -79,16 +79,11 @@ pub fn read_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     Ok(out)
 }
 
-/// Read a whole log; the error is the library's message (file, line, column, the fix).
-pub fn read(path: &Path, opts: &ReadOptions) -> Result<(TestLog, csvlog::ReadReport), String> {
-    csvlog::read_log(path, opts).map_err(|e| gyrotherm::error_chain(&e))
-}
-
 /// Read a log into a dict of numpy arrays (extra columns: float arrays when every value is a
-/// number, else lists of str) and a report dict: a single gyro's, or an inertial unit's when
-/// the options name several columns or the file holds a unit (the library says which,
-/// [`ReadOptions::reads_unit`]); a unit's report also names its gyro and temperature columns
-/// and the table's axis.
+/// number, else lists of str) and a report dict, through the library's one entry
+/// ([`csvlog::read_log_columns`]): a single gyro's, or an inertial unit's when the options
+/// name several columns or the file holds a unit (the library says which); a unit's report
+/// also names its gyro and temperature columns and the table's axis.
 #[pyfunction]
 fn read_log<'py>(
     py: Python<'py>,
@@ -96,105 +91,28 @@ fn read_log<'py>(
     options: LogOptions,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let opts = options.read_options()?;
+    let log = py
+        .detach(|| csvlog::read_log_columns(&path, &opts, options.table_axis.as_deref()))
+        .map_err(|e| LogError::new_err(gyrotherm::error_chain(&e)))?;
     let cols = PyDict::new(py);
     let rep = PyDict::new(py);
-    let (report, sample_period) = if opts.reads_unit(&[&path]) {
-        let (log, report) = py
-            .detach(|| csvlog::read_imu_log(&path, &opts, options.table_axis.as_deref()))
-            .map_err(|e| LogError::new_err(gyrotherm::error_chain(&e)))?;
-        // As the single-axis reader states it: the first axis's view.
-        let period = match (log.gyro.is_empty(), log.temp.is_empty()) {
-            (false, false) => gyrotherm::compare::unit::axis_test_log(&log, 0, 0).sample_period_s(),
-            _ => f64::NAN,
-        };
-        unit_columns(&cols, &rep, log)?;
-        (report, period)
-    } else {
-        let (log, report) = py
-            .detach(|| read(&path, &opts))
-            .map_err(LogError::new_err)?;
-        let period = log.sample_period_s();
-        gyro_columns(&cols, &opts, log)?;
-        (report, period)
-    };
+    if log.unit {
+        rep.set_item("gyro_cols", &log.gyro_cols)?;
+        rep.set_item("temp_cols", &log.temp_cols)?;
+        rep.set_item("table_axis", &log.table_axis)?;
+    }
+    for (name, values) in log.columns {
+        match values {
+            ColumnValues::Numbers(v) => cols.set_item(name, v.into_pyarray(py))?,
+            ColumnValues::Text(t) => cols.set_item(name, t)?,
+        }
+    }
+    let report = log.report;
     rep.set_item("rows", report.rows)?;
     rep.set_item("filled_samples", report.filled_samples)?;
     rep.set_item("filled_gaps", report.filled_gaps)?;
-    rep.set_item(
-        "sample_period_s",
-        sample_period.is_finite().then_some(sample_period),
-    )?;
+    rep.set_item("sample_period_s", log.sample_period_s)?;
     rep.set_item("sample_period_estimated", report.sample_period_estimated)?;
     rep.set_item("path", path.display().to_string())?;
     Ok((cols, rep))
-}
-
-/// A single gyro's columns under the file's names (the user's columns), as a unit's are
-/// keyed; the gyro in °/s.
-fn gyro_columns(cols: &Bound<'_, PyDict>, opts: &ReadOptions, log: TestLog) -> PyResult<()> {
-    let py = cols.py();
-    let extras: Vec<(String, Option<Vec<f64>>, Vec<String>)> = log
-        .extra
-        .iter()
-        .map(|c| (c.name.clone(), log.extra_f64(&c.name), c.values.clone()))
-        .collect();
-    let TestLog {
-        time_s,
-        gyro_dps,
-        temp_c,
-        table_dps,
-        ..
-    } = log;
-    cols.set_item(&opts.time_col, time_s.into_pyarray(py))?;
-    cols.set_item(&opts.gyro_col, gyro_dps.into_pyarray(py))?;
-    cols.set_item(&opts.temp_col, temp_c.into_pyarray(py))?;
-    if let Some(t) = table_dps {
-        cols.set_item(&opts.table_col, t.into_pyarray(py))?;
-    }
-    for (name, numeric, text) in extras {
-        match numeric {
-            Some(v) => cols.set_item(name, v.into_pyarray(py))?,
-            None => cols.set_item(name, text)?,
-        }
-    }
-    Ok(())
-}
-
-/// A unit's columns: time, each gyro (°/s) and temperature under its name, the table rate as
-/// `table_dps`, the pass-through columns; the report's gyro and temperature columns and
-/// table axis.
-fn unit_columns(cols: &Bound<'_, PyDict>, rep: &Bound<'_, PyDict>, log: ImuLog) -> PyResult<()> {
-    let py = cols.py();
-    rep.set_item(
-        "gyro_cols",
-        log.gyro.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-    )?;
-    rep.set_item(
-        "temp_cols",
-        log.temp.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-    )?;
-    rep.set_item("table_axis", log.table_axis.clone())?;
-    let ImuLog {
-        time_s,
-        gyro,
-        temp,
-        table,
-        extra,
-        ..
-    } = log;
-    cols.set_item(csvlog::TIME_COL, time_s.into_pyarray(py))?;
-    for s in gyro.into_iter().chain(temp) {
-        cols.set_item(s.name, s.values.into_pyarray(py))?;
-    }
-    if let Some(t) = table {
-        cols.set_item(csvlog::DEFAULT_TABLE_COL, t.values.into_pyarray(py))?;
-    }
-    for c in extra {
-        let numeric: Option<Vec<f64>> = c.values.iter().map(|v| v.trim().parse().ok()).collect();
-        match numeric {
-            Some(v) => cols.set_item(c.name, v.into_pyarray(py))?,
-            None => cols.set_item(c.name, c.values)?,
-        }
-    }
-    Ok(())
 }

@@ -208,3 +208,70 @@ fn a_single_gyro_model_in_memory_is_a_unit_of_one_axis_with_the_compensator_s_nu
         assert_eq!(axes[0].status[i], c.status);
     }
 }
+
+/// A log as named columns through the one entry: a single gyro's under the file's own names
+/// and a unit's under its column names, each equal to what that form's reader gives (the
+/// readers tested against the file's text in `csvlog.rs` and `imu_log.rs`).
+#[test]
+fn a_log_as_columns_holds_what_the_readers_read_under_the_file_s_names() {
+    use gyrotherm::csvlog::{read_imu_log, read_log, read_log_columns, ColumnValues};
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one.csv");
+    std::fs::write(
+        &one,
+        "t,w,T,rt,note\n0,0.5,20,0,a\n1,0.25,20.5,0,b\n2,0.125,21,0,c\n",
+    )
+    .unwrap();
+    let opts = ReadOptions {
+        time_col: "t".into(),
+        gyro_col: "w".into(),
+        temp_col: "T".into(),
+        table_col: "rt".into(),
+        ..ReadOptions::default()
+    };
+    let (log, _) = read_log(&one, &opts).unwrap();
+    let mut cols = read_log_columns(&one, &opts, None).unwrap();
+    assert!(!cols.unit);
+    let names: Vec<&str> = cols.columns.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["t", "w", "T", "rt", "note"]);
+    assert_eq!(cols.sample_period_s, Some(1.0));
+    assert_eq!(
+        cols.columns[4].1,
+        ColumnValues::Text(vec!["a".into(), "b".into(), "c".into()])
+    );
+    assert_eq!(cols.take_numbers("w").unwrap(), log.gyro_dps);
+    assert_eq!(cols.take_numbers("T").unwrap(), log.temp_c);
+    assert_eq!(Some(cols.take_numbers("rt").unwrap()), log.table_dps);
+    assert!(cols.take_numbers("note").is_err());
+    let missing = cols.take_numbers("gyro_dps").unwrap_err().to_string();
+    assert!(
+        missing.contains("available: t, w, T, rt, note"),
+        "{missing}"
+    );
+
+    let unit = dir.path().join("unit.csv");
+    std::fs::write(
+        &unit,
+        "time_s,gx,gy,t0,t1\n0,1,2,20,21\n0.5,1.5,2.5,20.5,21.5\n1,2,3,21,22\n",
+    )
+    .unwrap();
+    let lists = ReadOptions {
+        gyro_col: "gx,gy".into(),
+        temp_col: "t0,t1".into(),
+        ..ReadOptions::default()
+    };
+    let (u, _) = read_imu_log(&unit, &lists, None).unwrap();
+    let mut cols = read_log_columns(&unit, &lists, None).unwrap();
+    assert!(cols.unit);
+    assert_eq!(
+        (cols.gyro_cols.clone(), cols.temp_cols.clone()),
+        (
+            vec!["gx".to_owned(), "gy".into()],
+            vec!["t0".to_owned(), "t1".into()]
+        )
+    );
+    assert_eq!(cols.sample_period_s, Some(0.5));
+    for s in u.gyro.iter().chain(&u.temp) {
+        assert_eq!(cols.take_numbers(&s.name).unwrap(), s.values, "{}", s.name);
+    }
+}

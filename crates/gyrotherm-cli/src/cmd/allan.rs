@@ -8,14 +8,14 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use gyrotherm::allan::{self, AllanPoint, DevKind, NoiseTerms, TauSet};
-use gyrotherm::csvlog::rate_column_to_dph;
+use gyrotherm::csvlog::{self, rate_column_to_dph};
 use gyrotherm::report;
 use gyrotherm::settings::allan as allan_settings;
 use gyrotherm::settings::kalibr as kalibr_settings;
 use gyrotherm::settings::{AllanAnalysis, AllanSettings};
 use serde::Serialize;
 
-use super::common::{choice, read_log_reporting, LogArgs};
+use super::common::{choice, tell, LogArgs};
 
 #[derive(Debug, clap::Args)]
 pub struct AllanArgs {
@@ -98,20 +98,23 @@ pub(crate) fn read_column(
     column: &str,
     log_args: &LogArgs,
 ) -> anyhow::Result<ReadColumn> {
-    let mut log = read_log_reporting(input, log_args)?;
     let opts = log_args.read_options();
+    let mut log = csvlog::read_log_columns(input, &opts, log_args.table_axis.as_deref())
+        .with_context(|| format!("cannot use log {}", input.display()))?;
+    for t in &log.told {
+        tell(t);
+    }
     let log_name = opts.log_column(column).to_owned();
     let name = opts.file_column(&log_name).to_owned();
     let values = log
-        .take_column(&log_name)
+        .take_numbers(&name)
         .with_context(|| input.display().to_string())?;
-    let tau0_s = log.sample_period_s();
-    if !(tau0_s.is_finite() && tau0_s > 0.0) {
+    let Some(tau0_s) = log.sample_period_s.filter(|t| *t > 0.0) else {
         bail!(
             "{}: cannot tell the sample period (need at least two samples with increasing time_s)",
             input.display()
         );
-    }
+    };
     Ok(ReadColumn {
         values,
         tau0_s,

@@ -4,9 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
 use clap::Args;
-use gyrotherm::csvlog::{self, GyroUnit, LogFormat, ReadOptions, TestLog, LOG_FORMATS};
+use gyrotherm::csvlog::{self, GyroUnit, LogFormat, ReadOptions, LOG_FORMATS};
 use gyrotherm::model::GivenColumns;
 use gyrotherm::settings::{read, Rule};
 
@@ -121,43 +120,6 @@ pub fn given_columns(matches: Option<&clap::ArgMatches>) -> GivenColumns {
         table_col: given("table_col"),
         gyro_unit: given("gyro_unit"),
     }
-}
-
-/// Read a log with these options; say on stderr how many samples gap filling made.
-pub fn read_log_reporting(path: &Path, args: &LogArgs) -> anyhow::Result<TestLog> {
-    read_log_noting_gaps(path, args).map(|(log, _)| log)
-}
-
-/// Read a log; when `--fill-gaps-max-s` made samples, say so on stderr and return that warning.
-pub fn read_log_noting_gaps(
-    path: &Path,
-    args: &LogArgs,
-) -> anyhow::Result<(TestLog, Option<String>)> {
-    read_log_with(path, &args.read_options())
-}
-
-/// [`read_log_noting_gaps`] with read options `opts` (a model's columns, for example).
-pub fn read_log_with(path: &Path, opts: &ReadOptions) -> anyhow::Result<(TestLog, Option<String>)> {
-    let (log, report) = csvlog::read_log(path, opts)
-        .with_context(|| format!("cannot use log {}", path.display()))?;
-    let warning = (report.filled_gaps > 0).then(|| {
-        format!(
-            "{}: filled {} gap(s) with {} interpolated sample(s) (--fill-gaps-max-s)",
-            path.display(),
-            report.filled_gaps,
-            report.filled_samples
-        )
-    });
-    if let Some(w) = &warning {
-        eprintln!("gyrotherm: {w}");
-    }
-    if let Some(w) = report.jitter_warning(path) {
-        eprintln!("gyrotherm: warning: {w}");
-    }
-    if let Some(w) = report.truncation_warning(path) {
-        eprintln!("gyrotherm: warning: {w}");
-    }
-    Ok((log, warning))
 }
 
 /// Read a job's logs through the library's one entry point, telling what reading did for
@@ -289,23 +251,6 @@ mod tests {
         assert_eq!(o.gyro_unit, GyroUnit::RadPerS);
         assert_eq!(o.fill_gaps_max_s, Some(5.0));
         assert_eq!(o.sample_period_s, Some(0.01));
-    }
-
-    #[test]
-    fn read_log_reporting_fills_gaps_and_names_the_file_on_error() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("gap.csv");
-        // 1 Hz, one sample missing at t = 2.
-        std::fs::write(&path, "time_s,gyro_dps,temp_c\n0,0,20\n1,0,20\n3,0,20\n").unwrap();
-        let cli = Cli::try_parse_from(["t", "--fill-gaps-max-s", "2"]).unwrap();
-        let log = read_log_reporting(&path, &cli.log).unwrap();
-        assert_eq!(log.time_s, [0.0, 1.0, 2.0, 3.0]);
-        let cli = Cli::try_parse_from(["t"]).unwrap();
-        let err = error_message(&read_log_reporting(&path, &cli.log).unwrap_err());
-        assert!(
-            err.contains("gap.csv:4: column time_s: gap of 2 s"),
-            "{err}"
-        );
     }
 
     #[test]

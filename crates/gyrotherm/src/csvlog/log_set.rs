@@ -5,7 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{read_imu_logs, read_log, ImuLog, LogError, ReadOptions, ReadReport, TestLog};
+use super::{
+    read_imu_logs, read_log, ColumnError, ImuLog, LogError, ReadOptions, ReadReport, TestLog,
+    DEFAULT_TABLE_COL, TIME_COL,
+};
 use crate::told::Told;
 
 /// The logs of one job, each with the name it is told by (its path as given).
@@ -27,6 +30,8 @@ pub(crate) enum LogSetForm {
 pub struct FileRead {
     pub path: PathBuf,
     pub told: Vec<Told>,
+    /// What reading did (None when the file could not be read).
+    pub report: Option<ReadReport>,
     pub error: Option<LogError>,
 }
 
@@ -135,16 +140,17 @@ fn keep<L>(
 ) -> Vec<(String, L)> {
     let mut logs = Vec::new();
     for (p, r) in paths.iter().zip(read) {
-        let (told, error) = match r {
+        let (told, report, error) = match r {
             Ok((log, report)) => {
                 logs.push((p.display().to_string(), log));
-                (told(p, &report), None)
+                (told(p, &report), Some(report), None)
             }
-            Err(e) => (Vec::new(), Some(e)),
+            Err(e) => (Vec::new(), None, Some(e)),
         };
         files.push(FileRead {
             path: p.clone(),
             told,
+            report,
             error,
         });
     }
@@ -228,5 +234,169 @@ impl LogSet {
 
     pub(crate) fn into_form(self) -> LogSetForm {
         self.form
+    }
+}
+
+/// A column of a log as read: numbers, or the text of a pass-through column that is not all
+/// numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ColumnValues {
+    Numbers(Vec<f64>),
+    Text(Vec<String>),
+}
+
+/// One log as named columns, for a caller that wants a table (Python's `read_log`): time, the
+/// gyro columns (°/s), the temperature columns (°C), the table rate, then the pass-through
+/// columns (numbers when every field is one).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogColumns {
+    pub columns: Vec<(String, ColumnValues)>,
+    /// The gyro and temperature columns, in order.
+    pub gyro_cols: Vec<String>,
+    pub temp_cols: Vec<String>,
+    /// The gyro column the table turns (None: a static run, or a single gyro's log).
+    pub table_axis: Option<String>,
+    /// Whether the log was read as a unit's (column lists, or a file format that holds one).
+    pub unit: bool,
+    /// Median time step, s (None for fewer than two samples).
+    pub sample_period_s: Option<f64>,
+    pub report: ReadReport,
+    /// What reading did, to tell (gaps filled, irregular steps, a cut-off file).
+    pub told: Vec<Told>,
+}
+
+impl LogColumns {
+    /// The numbers of column `name`, moved out (left empty here).
+    pub fn take_numbers(&mut self, name: &str) -> Result<Vec<f64>, ColumnError> {
+        let Some(k) = self.columns.iter().position(|(n, _)| n == name) else {
+            return Err(ColumnError::Missing {
+                name: name.to_owned(),
+                available: self.columns.iter().map(|(n, _)| n.clone()).collect(),
+            });
+        };
+        match &mut self.columns[k].1 {
+            ColumnValues::Numbers(v) => Ok(std::mem::take(v)),
+            ColumnValues::Text(_) => Err(ColumnError::NotNumeric {
+                name: name.to_owned(),
+            }),
+        }
+    }
+}
+
+fn pass_through(extra: Vec<super::ExtraColumn>) -> impl Iterator<Item = (String, ColumnValues)> {
+    extra.into_iter().map(|c| {
+        let numbers: Option<Vec<f64>> = c.values.iter().map(|v| v.trim().parse().ok()).collect();
+        let values = match numbers {
+            Some(v) => ColumnValues::Numbers(v),
+            None => ColumnValues::Text(c.values),
+        };
+        (c.name, values)
+    })
+}
+
+/// Read one log through the one entry ([`read_log_set`]) and give its columns by name: a
+/// single gyro's under the file's names (`opts`' columns), a unit's as [`ImuLog`] names them
+/// (time as `time_s`, the table rate as `table_dps`).
+pub fn read_log_columns(
+    path: &Path,
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+) -> Result<LogColumns, LogError> {
+    let read = read_log_set(&[path.to_path_buf()], opts, table_axis);
+    let mut report = ReadReport::default();
+    let mut told = Vec::new();
+    for f in read.files {
+        if let Some(e) = f.error {
+            return Err(e);
+        }
+        report = f.report.unwrap_or_default();
+        told = f.told;
+    }
+    let form = read.set.map(LogSet::into_form).ok();
+    let period =
+        |time_s: &[f64]| Some(super::repr::median_step_s(time_s)).filter(|p| p.is_finite());
+    match form {
+        Some(LogSetForm::Single(logs)) => {
+            let Some((_, log)) = logs.into_iter().next() else {
+                return Ok(empty(report, told));
+            };
+            let sample_period_s = period(&log.time_s);
+            let TestLog {
+                time_s,
+                gyro_dps,
+                temp_c,
+                table_dps,
+                extra,
+            } = log;
+            let mut columns = vec![
+                (opts.time_col.clone(), ColumnValues::Numbers(time_s)),
+                (opts.gyro_col.clone(), ColumnValues::Numbers(gyro_dps)),
+                (opts.temp_col.clone(), ColumnValues::Numbers(temp_c)),
+            ];
+            columns.extend(table_dps.map(|t| (opts.table_col.clone(), ColumnValues::Numbers(t))));
+            columns.extend(pass_through(extra));
+            Ok(LogColumns {
+                columns,
+                gyro_cols: vec![opts.gyro_col.clone()],
+                temp_cols: vec![opts.temp_col.clone()],
+                table_axis: None,
+                unit: false,
+                sample_period_s,
+                report,
+                told,
+            })
+        }
+        Some(LogSetForm::Unit(logs)) => {
+            let Some((_, log)) = logs.into_iter().next() else {
+                return Ok(empty(report, told));
+            };
+            let (gyro_cols, temp_cols) = log.column_names();
+            let sample_period_s = period(&log.time_s);
+            let ImuLog {
+                time_s,
+                gyro,
+                temp,
+                table,
+                table_axis,
+                extra,
+            } = log;
+            let mut columns = vec![(TIME_COL.to_owned(), ColumnValues::Numbers(time_s))];
+            columns.extend(
+                gyro.into_iter()
+                    .chain(temp)
+                    .map(|s| (s.name, ColumnValues::Numbers(s.values))),
+            );
+            columns.extend(table.map(|t| {
+                (
+                    DEFAULT_TABLE_COL.to_owned(),
+                    ColumnValues::Numbers(t.values),
+                )
+            }));
+            columns.extend(pass_through(extra));
+            Ok(LogColumns {
+                columns,
+                gyro_cols,
+                temp_cols,
+                table_axis,
+                unit: true,
+                sample_period_s,
+                report,
+                told,
+            })
+        }
+        None => Ok(empty(report, told)),
+    }
+}
+
+fn empty(report: ReadReport, told: Vec<Told>) -> LogColumns {
+    LogColumns {
+        columns: Vec::new(),
+        gyro_cols: Vec::new(),
+        temp_cols: Vec::new(),
+        table_axis: None,
+        unit: false,
+        sample_period_s: None,
+        report,
+        told,
     }
 }

@@ -44,7 +44,10 @@ pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub use gaps::{Sample, MAX_FILL_SAMPLES_PER_GAP};
 pub(crate) use line::{read_line_capped, record, Fields, LineRead};
 pub(crate) use log_set::{read_in_form, LogSetForm};
-pub use log_set::{read_log_set, read_log_sets, FileRead, LogSet, LogSetError, SetRead};
+pub use log_set::{
+    read_log_columns, read_log_set, read_log_sets, ColumnValues, FileRead, LogColumns, LogSet,
+    LogSetError, SetRead,
+};
 pub(crate) use number::parse_number;
 pub use reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,

@@ -57,13 +57,7 @@ impl TestLog {
     }
     /// Median of the time steps, s (NaN for fewer than two samples).
     pub fn sample_period_s(&self) -> f64 {
-        let mut d: Vec<f64> = self.time_s.windows(2).map(|w| w[1] - w[0]).collect();
-        if d.is_empty() {
-            return f64::NAN;
-        }
-        // The element a sort would put there, without the sort.
-        let mid = d.len() / 2;
-        *d.select_nth_unstable_by(mid, f64::total_cmp).1
+        median_step_s(&self.time_s)
     }
     /// A pass-through column parsed as numbers (None if absent or not all numeric).
     pub fn extra_f64(&self, name: &str) -> Option<Vec<f64>> {
@@ -108,6 +102,18 @@ impl TestLog {
             .map(str::to_owned)
             .collect()
     }
+}
+
+/// Median of the steps of `time_s`, s (NaN for fewer than two samples): the sample period
+/// of a log, single gyro's or unit's.
+pub(crate) fn median_step_s(time_s: &[f64]) -> f64 {
+    let mut d: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    if d.is_empty() {
+        return f64::NAN;
+    }
+    // The element a sort would put there, without the sort.
+    let mid = d.len() / 2;
+    *d.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// Why [`TestLog::take_column`] has no numbers for a column.
