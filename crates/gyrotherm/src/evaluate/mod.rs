@@ -122,7 +122,7 @@ enum Form {
 /// The figures of the log: a single gyro's column, or each gyro axis of a unit's log (a
 /// unit's when the options name several columns, the file's format holds a unit, or a model
 /// is given, whose columns are read and whose output is judged beside the raw one). The log
-/// is read through the one entry every job reads through ([`read_in_form`]).
+/// is read through the one entry every job reads through ([`read_log_set`](crate::csvlog::read_log_set)).
 pub fn evaluate(job: &EvaluateJob) -> Result<Evaluated, EvaluateJobError> {
     let path = job.input;
     let model = job.model.map(|m| m.to_unit(job.read));

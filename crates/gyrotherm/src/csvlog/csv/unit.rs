@@ -1,7 +1,7 @@
 //! An inertial unit's CSV log ([`ImuLog`] in memory): several gyro and temperature columns in one file
 //! ([`super::column_list`] says how they are named).
 //!
-//! Reading goes through [`read_log`](super::read_log) with the first gyro and the first
+//! Reading goes through [`read_log`](crate::csvlog::read_log) with the first gyro and the first
 //! temperature column, so time, gaps, separators and those two columns get every check of a
 //! single-axis log; the further columns are then parsed as strictly (a number, finite; the
 //! gyro unit converted; a decimal comma with `;` or tab separators) and named in their errors.
