@@ -44,10 +44,21 @@ pub use crate::metrics::BIAS_STABILITY_TAU_S;
 /// sample period it is a multiple of; a caller should say so (one sample per 15 s gives
 /// τ = 105 s). Rate-table logs count only when no log is static.
 pub(crate) fn default_tau_s(test: &[NamedLog]) -> (f64, Option<f64>) {
-    let periods = |static_only: bool| {
+    tau_of_runs(
         test.iter()
-            .filter(move |t| !static_only || t.log.is_static())
-            .map(|t| t.log.sample_period_s())
+            .map(|t| (t.log.time_s.as_slice(), t.log.is_static())),
+    )
+}
+
+/// [`default_tau_s`] over runs given as their time column and whether each is static: what
+/// the rule reads of a log, a single gyro's or a unit's.
+pub(crate) fn tau_of_runs<'a>(
+    runs: impl Iterator<Item = (&'a [f64], bool)> + Clone,
+) -> (f64, Option<f64>) {
+    let periods = |static_only: bool| {
+        runs.clone()
+            .filter(move |(_, is_static)| !static_only || *is_static)
+            .map(|(time_s, _)| crate::csvlog::repr::median_step_s(time_s))
             .filter(|p| p.is_finite() && *p > 0.0)
             .fold(None, |a: Option<f64>, p| Some(a.map_or(p, |a| a.max(p))))
     };

@@ -82,16 +82,19 @@ pub fn axis_test_log(log: &ImuLog, axis: usize, temp: usize) -> TestLog {
 /// axis shares the time column). Returns τ and, when it is not 100 s, the sample period it
 /// is a multiple of.
 pub(crate) fn default_tau_s(test: &[(String, ImuLog)]) -> (f64, Option<f64>) {
-    let axis0: Vec<(String, TestLog)> = test
-        .iter()
-        .filter(|(_, l)| !l.gyro.is_empty() && !l.temp.is_empty())
-        .map(|(n, l)| (n.clone(), axis_test_log(l, 0, 0)))
-        .collect();
-    let named: Vec<NamedLog> = axis0
-        .iter()
-        .map(|(n, l)| NamedLog { name: n, log: l })
-        .collect();
-    crate::compare::default_tau_s(&named)
+    // The first axis's view is static unless the table turns that axis with a non-zero rate
+    // (`ImuLog::axis_data`, `TestLog::is_static`); read here without copying the log.
+    let first_axis_static = |l: &ImuLog| {
+        l.table_axis_index() != Some(0)
+            || l.table
+                .as_ref()
+                .is_none_or(|t| t.values.iter().all(|v| *v == 0.0))
+    };
+    crate::compare::tau_of_runs(
+        test.iter()
+            .filter(|(_, l)| !l.gyro.is_empty() && !l.temp.is_empty())
+            .map(|(_, l)| (l.time_s.as_slice(), first_axis_static(l))),
+    )
 }
 
 /// The unit's own fit of one axis in a comparison: the model `train` with the same lists
@@ -507,6 +510,47 @@ mod tests {
         NamedSeries {
             name: name.into(),
             values: v.to_vec(),
+        }
+    }
+
+    /// The unit's τ rule reads each log as the single-gyro rule reads the first axis's view
+    /// (`axis_test_log(l, 0, 0)`): a table turning another axis leaves that view static.
+    #[test]
+    fn unit_tau_is_the_single_rule_on_the_first_axis_view() {
+        let log = |period: f64, table: Option<(&str, f64)>| {
+            let time_s: Vec<f64> = (0..8).map(|k| k as f64 * period).collect();
+            let n = time_s.len();
+            ImuLog {
+                time_s,
+                gyro: vec![series("gx", &vec![0.0; n]), series("gy", &vec![0.0; n])],
+                temp: vec![series("t", &vec![20.0; n])],
+                table: table.map(|(_, rate)| series("table_dps", &vec![rate; n])),
+                table_axis: table.map(|(a, _)| a.to_owned()),
+                extra: Vec::new(),
+            }
+        };
+        let cases = [
+            // Static at 15 s, table on y at 1 s (static for x): τ from 15 s.
+            vec![log(15.0, None), log(1.0, Some(("gy", 10.0)))],
+            // Static at 1 s, table on x at 15 s: τ from 1 s.
+            vec![log(1.0, None), log(15.0, Some(("gx", 10.0)))],
+            // Only a table log on x at 7 s: it counts, no log being static.
+            vec![log(7.0, Some(("gx", 10.0)))],
+        ];
+        let want = [(105.0, Some(15.0)), (100.0, None), (98.0, Some(7.0))];
+        for (logs, want) in cases.into_iter().zip(want) {
+            let named: Vec<(String, ImuLog)> =
+                logs.into_iter().map(|l| ("l".to_owned(), l)).collect();
+            let views: Vec<(String, TestLog)> = named
+                .iter()
+                .map(|(n, l)| (n.clone(), axis_test_log(l, 0, 0)))
+                .collect();
+            let single: Vec<NamedLog> = views
+                .iter()
+                .map(|(n, l)| NamedLog { name: n, log: l })
+                .collect();
+            assert_eq!(crate::compare::default_tau_s(&single), want);
+            assert_eq!(default_tau_s(&named), want);
         }
     }
 
