@@ -225,3 +225,50 @@ fn further_columns_name_their_first_bad_field_and_fill_empty_ones() {
     assert_eq!(log.temp[2].values[..24], v[..24]);
     assert_eq!(log.temp[2].values[25..], v[25..]);
 }
+
+/// A single gyro's log is the unit of one axis: written as a one-axis unit it is the same
+/// file byte for byte, and reads back as the same log.
+#[test]
+fn a_single_gyro_log_written_as_a_one_axis_unit_is_the_same_file() {
+    use gyrotherm::csvlog::{read_log, write_log, ExtraColumn, ImuLog, NamedSeries};
+    let mut run = SimConfig::builtin("seed-shock").unwrap();
+    run.table_rate_dps = Some(20.0);
+    run.truth = true;
+    let single = gyrotherm::sim::simulate(&run).unwrap();
+    let series = |name: &str, values: &[f64]| NamedSeries {
+        name: name.to_owned(),
+        values: values.to_vec(),
+    };
+    let unit = ImuLog {
+        time_s: single.time_s.clone(),
+        gyro: vec![series("gyro_dps", &single.gyro_dps)],
+        temp: vec![series("temp_c", &single.temp_c)],
+        table: single.table_dps.as_deref().map(|t| series("table_dps", t)),
+        table_axis: Some("gyro_dps".to_owned()),
+        extra: single.extra.clone(),
+    };
+    assert!(!single.extra.is_empty(), "the truth columns pass through");
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("single.csv"), dir.path().join("unit.csv"));
+    write_log(&a, &single).unwrap();
+    write_imu_log(&b, &unit).unwrap();
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert_eq!(read_log(&b, &ReadOptions::default()).unwrap().0, single);
+
+    // A pass-through column shorter than the log is refused, naming it, for a unit as for a
+    // single gyro (the unit's writer indexed past its end before).
+    let mut short = unit.clone();
+    short.extra.push(ExtraColumn {
+        name: "note".into(),
+        values: vec!["x".into()],
+    });
+    let e = write_imu_log(&b, &short).unwrap_err().to_string();
+    assert!(e.contains("column note") && e.contains("timestamps"), "{e}");
+    // A pass-through column named like a numeric column would read back as that column.
+    let mut twice = unit;
+    twice.extra.push(ExtraColumn {
+        name: "gyro_dps".into(),
+        values: vec!["0".into(); single.time_s.len()],
+    });
+    assert!(write_imu_log(&b, &twice).is_err());
+}

@@ -38,11 +38,11 @@ pub(crate) use csv::number::parse_number;
 pub use csv::reader::{
     LogReader, GAP_FACTOR, MAX_FILLED_SAMPLES, PERIOD_CHECK_STEPS, PERIOD_ESTIMATE_STEPS,
 };
-pub(crate) use csv::unit::write_imu_csv;
-pub use csv::unit::{read_imu_log, read_imu_logs, write_imu_log};
+pub use csv::unit::{read_imu_log, read_imu_logs};
+pub(crate) use csv::write_imu_csv;
 pub(crate) use csv::writer::short_f64;
 pub use csv::writer::LogWriter;
-pub use csv::{write_log, write_log_with, WriteOptions};
+pub use csv::{write_imu_log, write_log, write_log_with, WriteOptions};
 pub use error::{LogError, LogErrorKind};
 pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
 pub(crate) use log_set::{read_in_form, LogSetForm};

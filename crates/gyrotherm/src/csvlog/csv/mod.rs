@@ -129,82 +129,166 @@ pub struct WriteOptions {
 
 /// [`write_log`] with [`WriteOptions`].
 pub fn write_log_with(path: &Path, log: &TestLog, opts: WriteOptions) -> Result<(), LogError> {
-    check_log(path, log, opts)?;
-    crate::atomic_file::write_atomically(path, |w| -> std::io::Result<()> {
-        let mut header = vec![TIME_COL, GYRO_COL, TEMP_COL];
-        if log.table_dps.is_some() {
-            header.push(DEFAULT_TABLE_COL);
-        }
-        header.extend(log.extra.iter().map(|c| c.name.as_str()));
-        let mut out = LogWriter::new(w, header)?;
-        for i in 0..log.len() {
-            out.push_f64(log.time_s[i]);
-            out.push_f64(log.gyro_dps[i]);
-            out.push_f64(log.temp_c[i]);
-            if let Some(t) = &log.table_dps {
-                out.push_f64(t[i]);
-            }
-            for c in &log.extra {
-                out.push_raw(c.values[i].as_bytes());
-            }
-            out.end_row()?;
-        }
-        out.flush()
-    })
-    .map_err(|e| {
-        let kind = if e.kind() == std::io::ErrorKind::BrokenPipe {
-            LogErrorKind::OutputClosed
-        } else {
-            LogErrorKind::Io
-        };
-        LogError::new(kind, path, None, None, format!("cannot write: {e}"))
-    })
+    let mut numeric = vec![
+        Written::rate(GYRO_COL, &log.gyro_dps),
+        Written::temperature(TEMP_COL, &log.temp_c),
+    ];
+    numeric.extend(
+        log.table_dps
+            .as_deref()
+            .map(|t| Written::rate(DEFAULT_TABLE_COL, t)),
+    );
+    write_columns(path, &log.time_s, &numeric, &log.extra, opts)
 }
 
-fn check_log(path: &Path, log: &TestLog, opts: WriteOptions) -> Result<(), LogError> {
+/// Write an inertial unit's log (`time_s`, the gyro columns, the temperature columns, the
+/// table column, the pass-through columns), atomically, with the checks of [`write_log`]; a
+/// NaN temperature is written as `NaN` (a simulated sensor fault). A single gyro's log is
+/// the unit of one axis: [`write_log`] writes the same bytes for it.
+pub fn write_imu_log(path: &Path, log: &ImuLog) -> Result<(), LogError> {
+    let opts = WriteOptions {
+        allow_nan_temperature: true,
+    };
+    write_columns(path, &log.time_s, &unit_columns(log), &log.extra, opts)
+}
+
+/// A numeric column as written: its header, its values, and whether it is a temperature
+/// (which [`WriteOptions::allow_nan_temperature`] lets hold NaN).
+struct Written<'a> {
+    name: &'a str,
+    values: &'a [f64],
+    temperature: bool,
+}
+
+impl<'a> Written<'a> {
+    fn rate(name: &'a str, values: &'a [f64]) -> Self {
+        Written {
+            name,
+            values,
+            temperature: false,
+        }
+    }
+    fn temperature(name: &'a str, values: &'a [f64]) -> Self {
+        Written {
+            name,
+            values,
+            temperature: true,
+        }
+    }
+}
+
+/// A unit's numeric columns in the order they are written: gyros, temperatures, table.
+fn unit_columns(log: &ImuLog) -> Vec<Written<'_>> {
+    let gyro = log.gyro.iter().map(|s| Written::rate(&s.name, &s.values));
+    let temp = log
+        .temp
+        .iter()
+        .map(|s| Written::temperature(&s.name, &s.values));
+    let table = log.table.iter().map(|s| Written::rate(&s.name, &s.values));
+    gyro.chain(temp).chain(table).collect()
+}
+
+/// One writer for every log, a single gyro's and a unit's: the checks, then the CSV,
+/// atomically.
+fn write_columns(
+    path: &Path,
+    time_s: &[f64],
+    numeric: &[Written],
+    extra: &[ExtraColumn],
+    opts: WriteOptions,
+) -> Result<(), LogError> {
+    check_columns(path, time_s, numeric, extra, opts)?;
+    crate::atomic_file::write_atomically(path, |w| write_csv(w, time_s, numeric, extra)).map_err(
+        |e| {
+            let kind = if e.kind() == std::io::ErrorKind::BrokenPipe {
+                LogErrorKind::OutputClosed
+            } else {
+                LogErrorKind::Io
+            };
+            LogError::new(kind, path, None, None, format!("cannot write: {e}"))
+        },
+    )
+}
+
+/// The CSV of a unit's log, as [`write_imu_log`] writes it, into `w` (for a log the reader
+/// gave: its columns' lengths are not checked again).
+pub(crate) fn write_imu_csv<W: std::io::Write>(w: W, log: &ImuLog) -> std::io::Result<()> {
+    write_csv(w, &log.time_s, &unit_columns(log), &log.extra)
+}
+
+fn write_csv<W: std::io::Write>(
+    w: W,
+    time_s: &[f64],
+    numeric: &[Written],
+    extra: &[ExtraColumn],
+) -> std::io::Result<()> {
+    let header = std::iter::once(TIME_COL)
+        .chain(numeric.iter().map(|c| c.name))
+        .chain(extra.iter().map(|c| c.name.as_str()));
+    let mut out = LogWriter::new(w, header)?;
+    for (i, t) in time_s.iter().enumerate() {
+        out.push_f64(*t);
+        for c in numeric {
+            out.push_f64(c.values[i]);
+        }
+        for c in extra {
+            out.push_raw(c.values[i].as_bytes());
+        }
+        out.end_row()?;
+    }
+    out.flush()
+}
+
+/// Every column as long as the time column; every number finite (a temperature may be NaN
+/// when `opts` allows it); no pass-through column named like time, the table rate or a
+/// numeric column, which would read back as that column.
+fn check_columns(
+    path: &Path,
+    time_s: &[f64],
+    numeric: &[Written],
+    extra: &[ExtraColumn],
+    opts: WriteOptions,
+) -> Result<(), LogError> {
     let bad = |column: Option<&str>, message: String| {
         LogError::new(LogErrorKind::BadLog, path, None, column, message)
     };
-    let n = log.len();
-    let mut numeric = vec![
-        (GYRO_COL, &log.gyro_dps),
-        (TEMP_COL, &log.temp_c),
-        (TIME_COL, &log.time_s),
-    ];
-    if let Some(t) = &log.table_dps {
-        numeric.push((DEFAULT_TABLE_COL, t));
-    }
-    for (name, v) in numeric {
-        if v.len() != n {
+    let n = time_s.len();
+    let time = Written::rate(TIME_COL, time_s);
+    for c in numeric.iter().chain(std::iter::once(&time)) {
+        if c.values.len() != n {
             return Err(bad(
-                Some(name),
-                format!("{} values but {n} timestamps; not written", v.len()),
+                Some(c.name),
+                format!("{} values but {n} timestamps; not written", c.values.len()),
             ));
         }
         // A sensor fault reads as NaN; an infinity is a computation gone wrong, never written.
-        let may_be_nan = name == TEMP_COL && opts.allow_nan_temperature;
-        if let Some(i) = v
+        let may_be_nan = c.temperature && opts.allow_nan_temperature;
+        if let Some(i) = c
+            .values
             .iter()
             .position(|x| !(x.is_finite() || may_be_nan && x.is_nan()))
         {
             return Err(bad(
-                Some(name),
+                Some(c.name),
                 format!(
                     "row {} holds {}, not a finite number; not written",
                     i + 1,
-                    v[i]
+                    c.values[i]
                 ),
             ));
         }
     }
-    for c in &log.extra {
+    for c in extra {
         if c.values.len() != n {
             return Err(bad(
                 Some(&c.name),
                 format!("{} values but {n} timestamps; not written", c.values.len()),
             ));
         }
-        if [TIME_COL, GYRO_COL, TEMP_COL, DEFAULT_TABLE_COL].contains(&c.name.as_str()) {
+        let taken = [TIME_COL, DEFAULT_TABLE_COL]
+            .into_iter()
+            .chain(numeric.iter().map(|c| c.name));
+        if taken.clone().any(|name| name == c.name) {
             return Err(bad(
                 Some(&c.name),
                 "a pass-through column has a standard column's name; rename it".to_owned(),

@@ -13,7 +13,7 @@ use std::path::Path;
 use super::column_list::{parse_table_axis, TABLE_AXIS_SLOPE_RANGE};
 use super::error::{LogError, LogErrorKind as Kind};
 use super::number::parse_number;
-use super::{ExtraColumn, ImuLog, LogWriter, NamedSeries, ReadOptions, ReadReport, TIME_COL};
+use super::{ExtraColumn, ImuLog, NamedSeries, ReadOptions, ReadReport, TIME_COL};
 
 /// The gyro the table turns: the one whose output has a slope on the table rate within
 /// [`TABLE_AXIS_SLOPE_RANGE`] (least squares over the samples, table rate and output
@@ -303,51 +303,4 @@ impl NumberColumn {
         }
         Ok(out)
     }
-}
-
-/// Write an inertial unit's log (`time_s`, the gyro columns, the temperature columns, the
-/// table column, the pass-through columns), atomically; numbers round-trip exactly, a
-/// non-finite temperature is written as `NaN` (a simulated sensor fault).
-pub fn write_imu_log(path: &Path, log: &ImuLog) -> Result<(), LogError> {
-    let bad = |column: &str, message: String| {
-        LogError::new(Kind::BadLog, path, None, Some(column), message)
-    };
-    let n = log.len();
-    let numeric = log.gyro.iter().chain(&log.temp).chain(&log.table);
-    for s in numeric.clone() {
-        if s.values.len() != n {
-            return Err(bad(
-                &s.name,
-                format!("{} values but {n} timestamps", s.values.len()),
-            ));
-        }
-    }
-    for s in log.gyro.iter().chain(&log.table) {
-        if let Some(i) = s.values.iter().position(|v| !v.is_finite()) {
-            return Err(bad(&s.name, format!("row {} is not finite", i + 1)));
-        }
-    }
-    crate::atomic_file::write_atomically(path, |w| write_imu_csv(w, log))
-        .map_err(|e| LogError::new(Kind::Io, path, None, None, format!("cannot write: {e}")))
-}
-
-/// The CSV of a unit's log, as [`write_imu_log`] writes it, into `w` (the columns' lengths
-/// checked by the caller).
-pub(crate) fn write_imu_csv<W: std::io::Write>(w: W, log: &ImuLog) -> std::io::Result<()> {
-    let numeric = log.gyro.iter().chain(&log.temp).chain(&log.table);
-    let header = std::iter::once(TIME_COL)
-        .chain(numeric.clone().map(|s| s.name.as_str()))
-        .chain(log.extra.iter().map(|c| c.name.as_str()));
-    let mut out = LogWriter::new(w, header)?;
-    for i in 0..log.len() {
-        out.push_f64(log.time_s[i]);
-        for s in numeric.clone() {
-            out.push_f64(s.values[i]);
-        }
-        for c in &log.extra {
-            out.push_raw(c.values[i].as_bytes());
-        }
-        out.end_row()?;
-    }
-    out.flush()
 }
