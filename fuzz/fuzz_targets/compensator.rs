@@ -12,6 +12,7 @@ use std::sync::OnceLock;
 
 use arbitrary::{Result, Unstructured};
 use gyrotherm::compensate::compensator;
+use gyrotherm::flight_size::FlightCompensator;
 use gyrotherm::model::ModelFile;
 use gyrotherm_core::baseline::BaselineModel;
 use gyrotherm_core::compensator::{Compensator, Status, TargetModel};
@@ -27,8 +28,8 @@ const MODELS: [&str; 3] = [
     include_str!("../seeds/model_file/lstm.json"),
 ];
 
-fn trained() -> &'static [Compensator] {
-    static C: OnceLock<Vec<Compensator>> = OnceLock::new();
+fn trained() -> &'static [FlightCompensator] {
+    static C: OnceLock<Vec<FlightCompensator>> = OnceLock::new();
     C.get_or_init(|| {
         MODELS
             .iter()
@@ -73,7 +74,7 @@ fn run(data: &[u8]) -> Result<()> {
         let bias = arbitrary_target(&mut u, 0.0)?;
         let scale = arbitrary_target(&mut u, 1.0)?;
         match Compensator::new(FeatureSpec::PUBLISHED, bias, scale) {
-            Ok(c) => c,
+            Ok(c) => FlightCompensator::H8(Box::new(c)),
             Err(_) => return Ok(()),
         }
     };
