@@ -230,23 +230,13 @@ fn further_columns_name_their_first_bad_field_and_fill_empty_ones() {
 /// file byte for byte, and reads back as the same log.
 #[test]
 fn a_single_gyro_log_written_as_a_one_axis_unit_is_the_same_file() {
-    use gyrotherm::csvlog::{read_log, write_log, ExtraColumn, ImuLog, NamedSeries};
+    use gyrotherm::csvlog::{read_log, write_log, ExtraColumn, ImuLog};
     let mut run = SimConfig::builtin("seed-shock").unwrap();
     run.table_rate_dps = Some(20.0);
     run.truth = true;
     let single = gyrotherm::sim::simulate(&run).unwrap();
-    let series = |name: &str, values: &[f64]| NamedSeries {
-        name: name.to_owned(),
-        values: values.to_vec(),
-    };
-    let unit = ImuLog {
-        time_s: single.time_s.clone(),
-        gyro: vec![series("gyro_dps", &single.gyro_dps)],
-        temp: vec![series("temp_c", &single.temp_c)],
-        table: single.table_dps.as_deref().map(|t| series("table_dps", t)),
-        table_axis: Some("gyro_dps".to_owned()),
-        extra: single.extra.clone(),
-    };
+    let unit = ImuLog::of_axis(single.clone(), "gyro_dps", "temp_c", "table_dps");
+    assert_eq!(unit.axis_log(0, 0), single);
     assert!(!single.extra.is_empty(), "the truth columns pass through");
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("single.csv"), dir.path().join("unit.csv"));
@@ -254,6 +244,11 @@ fn a_single_gyro_log_written_as_a_one_axis_unit_is_the_same_file() {
     write_imu_log(&b, &unit).unwrap();
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     assert_eq!(read_log(&b, &ReadOptions::default()).unwrap().0, single);
+    // A static run's all-zero table column is kept too.
+    let mut zeros = single.clone();
+    zeros.table_dps = Some(vec![0.0; zeros.len()]);
+    let back = ImuLog::of_axis(zeros.clone(), "gyro_dps", "temp_c", "table_dps").axis_log(0, 0);
+    assert_eq!(back, zeros);
 
     // A pass-through column shorter than the log is refused, naming it, for a unit as for a
     // single gyro (the unit's writer indexed past its end before).

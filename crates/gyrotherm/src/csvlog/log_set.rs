@@ -254,7 +254,8 @@ pub struct LogColumns {
     /// The gyro and temperature columns, in order.
     pub gyro_cols: Vec<String>,
     pub temp_cols: Vec<String>,
-    /// The gyro column the table turns (None: a static run, or a single gyro's log).
+    /// The gyro column the table rate turns (None without a table column; a unit's all-zero
+    /// table column is read as none).
     pub table_axis: Option<String>,
     /// Whether the log was read as a unit's (column lists, or a file format that holds one).
     pub unit: bool,
@@ -312,80 +313,56 @@ pub fn read_log_columns(
         report = f.report.unwrap_or_default();
         told = f.told;
     }
-    let form = read.set.map(LogSet::into_form).ok();
-    let period =
-        |time_s: &[f64]| Some(super::repr::median_step_s(time_s)).filter(|p| p.is_finite());
-    match form {
-        Some(LogSetForm::Single(logs)) => {
-            let Some((_, log)) = logs.into_iter().next() else {
-                return Ok(empty(report, told));
-            };
-            let sample_period_s = period(&log.time_s);
-            let TestLog {
-                time_s,
-                gyro_dps,
-                temp_c,
-                table_dps,
-                extra,
-            } = log;
-            let mut columns = vec![
-                (opts.time_col.clone(), ColumnValues::Numbers(time_s)),
-                (opts.gyro_col.clone(), ColumnValues::Numbers(gyro_dps)),
-                (opts.temp_col.clone(), ColumnValues::Numbers(temp_c)),
-            ];
-            columns.extend(table_dps.map(|t| (opts.table_col.clone(), ColumnValues::Numbers(t))));
-            columns.extend(pass_through(extra));
-            Ok(LogColumns {
-                columns,
-                gyro_cols: vec![opts.gyro_col.clone()],
-                temp_cols: vec![opts.temp_col.clone()],
-                table_axis: None,
-                unit: false,
-                sample_period_s,
-                report,
-                told,
-            })
-        }
-        Some(LogSetForm::Unit(logs)) => {
-            let Some((_, log)) = logs.into_iter().next() else {
-                return Ok(empty(report, told));
-            };
-            let (gyro_cols, temp_cols) = log.column_names();
-            let sample_period_s = period(&log.time_s);
-            let ImuLog {
-                time_s,
-                gyro,
-                temp,
-                table,
-                table_axis,
-                extra,
-            } = log;
-            let mut columns = vec![(TIME_COL.to_owned(), ColumnValues::Numbers(time_s))];
-            columns.extend(
-                gyro.into_iter()
-                    .chain(temp)
-                    .map(|s| (s.name, ColumnValues::Numbers(s.values))),
-            );
-            columns.extend(table.map(|t| {
-                (
-                    DEFAULT_TABLE_COL.to_owned(),
-                    ColumnValues::Numbers(t.values),
-                )
-            }));
-            columns.extend(pass_through(extra));
-            Ok(LogColumns {
-                columns,
-                gyro_cols,
-                temp_cols,
-                table_axis,
-                unit: true,
-                sample_period_s,
-                report,
-                told,
-            })
-        }
-        None => Ok(empty(report, told)),
-    }
+    // A single gyro's log is the unit of one axis, keyed by the file's names; a unit's keys
+    // its time and table rate by their standard names.
+    let (log, unit, time_name, table_name) = match read.set.map(LogSet::into_form) {
+        Ok(LogSetForm::Single(logs)) => (
+            logs.into_iter()
+                .next()
+                .map(|(_, l)| ImuLog::of_axis(l, &opts.gyro_col, &opts.temp_col, &opts.table_col)),
+            false,
+            opts.time_col.as_str(),
+            opts.table_col.as_str(),
+        ),
+        Ok(LogSetForm::Unit(logs)) => (
+            logs.into_iter().next().map(|(_, l)| l),
+            true,
+            TIME_COL,
+            DEFAULT_TABLE_COL,
+        ),
+        Err(_) => (None, false, TIME_COL, DEFAULT_TABLE_COL),
+    };
+    let Some(log) = log else {
+        return Ok(empty(report, told));
+    };
+    let (gyro_cols, temp_cols) = log.column_names();
+    let sample_period_s = Some(super::repr::median_step_s(&log.time_s)).filter(|p| p.is_finite());
+    let ImuLog {
+        time_s,
+        gyro,
+        temp,
+        table,
+        table_axis,
+        extra,
+    } = log;
+    let mut columns = vec![(time_name.to_owned(), ColumnValues::Numbers(time_s))];
+    columns.extend(
+        gyro.into_iter()
+            .chain(temp)
+            .map(|s| (s.name, ColumnValues::Numbers(s.values))),
+    );
+    columns.extend(table.map(|t| (table_name.to_owned(), ColumnValues::Numbers(t.values))));
+    columns.extend(pass_through(extra));
+    Ok(LogColumns {
+        columns,
+        gyro_cols,
+        temp_cols,
+        table_axis,
+        unit,
+        sample_period_s,
+        report,
+        told,
+    })
 }
 
 fn empty(report: ReadReport, told: Vec<Told>) -> LogColumns {

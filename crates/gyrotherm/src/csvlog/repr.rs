@@ -181,6 +181,25 @@ impl ImuLog {
         self.time_s.is_empty()
     }
 
+    /// A single gyro's log as the unit of one axis, its columns moved, not copied: the gyro
+    /// named `gyro`, the temperature `temp`, the table rate (when the log has one, zeros
+    /// included) named `table` and turning that axis. [`ImuLog::axis_log`]`(0, 0)` gives the
+    /// log back, and the unit's file is the single gyro's, byte for byte.
+    pub fn of_axis(log: TestLog, gyro: &str, temp: &str, table: &str) -> ImuLog {
+        let named = |name: &str, values| NamedSeries {
+            name: name.to_owned(),
+            values,
+        };
+        ImuLog {
+            time_s: log.time_s,
+            table_axis: log.table_dps.as_ref().map(|_| gyro.to_owned()),
+            table: log.table_dps.map(|t| named(table, t)),
+            gyro: vec![named(gyro, log.gyro_dps)],
+            temp: vec![named(temp, log.temp_c)],
+            extra: log.extra,
+        }
+    }
+
     /// The names of its gyro and its temperature columns, in column order.
     pub(crate) fn column_names(&self) -> UnitColumns {
         (
