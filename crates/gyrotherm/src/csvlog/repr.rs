@@ -269,13 +269,8 @@ impl ImuLog {
             .chain(self.extra.iter().cloned())
             .collect();
         TestLog {
-            time_s: self.time_s.clone(),
-            gyro_dps: self.gyro[axis].values.clone(),
-            temp_c: self.temp[temp].values.clone(),
-            table_dps: (self.table_axis_index() == Some(axis))
-                .then(|| self.table.as_ref().map(|t| t.values.clone()))
-                .flatten(),
             extra,
+            ..self.axis_data(axis, temp)
         }
     }
 }

@@ -188,28 +188,6 @@ fn unit_columns(log: &ImuLog) -> Vec<Written<'_>> {
     gyro.chain(temp).chain(table).collect()
 }
 
-/// One writer for every log, a single gyro's and a unit's: the checks, then the CSV,
-/// atomically.
-fn write_columns(
-    path: &Path,
-    time_s: &[f64],
-    numeric: &[Written],
-    extra: &[ExtraColumn],
-    opts: WriteOptions,
-) -> Result<(), LogError> {
-    check_columns(path, time_s, numeric, extra, opts)?;
-    crate::atomic_file::write_atomically(path, |w| write_csv(w, time_s, numeric, extra)).map_err(
-        |e| {
-            let kind = if e.kind() == std::io::ErrorKind::BrokenPipe {
-                LogErrorKind::OutputClosed
-            } else {
-                LogErrorKind::Io
-            };
-            LogError::new(kind, path, None, None, format!("cannot write: {e}"))
-        },
-    )
-}
-
 /// The CSV of a unit's log, as [`write_imu_log`] writes it, into `w` (for a log the reader
 /// gave: its columns' lengths are not checked again).
 pub(crate) fn write_imu_csv<W: std::io::Write>(w: W, log: &ImuLog) -> std::io::Result<()> {
@@ -239,10 +217,11 @@ fn write_csv<W: std::io::Write>(
     out.flush()
 }
 
-/// Every column as long as the time column; every number finite (a temperature may be NaN
+/// One writer for every log, a single gyro's and a unit's, atomically, after its checks:
+/// every column as long as the time column; every number finite (a temperature may be NaN
 /// when `opts` allows it); no pass-through column named like time, the table rate or a
 /// numeric column, which would read back as that column.
-fn check_columns(
+fn write_columns(
     path: &Path,
     time_s: &[f64],
     numeric: &[Written],
@@ -295,5 +274,14 @@ fn check_columns(
             ));
         }
     }
-    Ok(())
+    crate::atomic_file::write_atomically(path, |w| write_csv(w, time_s, numeric, extra)).map_err(
+        |e| {
+            let kind = if e.kind() == std::io::ErrorKind::BrokenPipe {
+                LogErrorKind::OutputClosed
+            } else {
+                LogErrorKind::Io
+            };
+            LogError::new(kind, path, None, None, format!("cannot write: {e}"))
+        },
+    )
 }
