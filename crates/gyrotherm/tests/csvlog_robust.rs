@@ -163,3 +163,67 @@ fn semicolon_and_tab_logs_with_decimal_commas_read_as_the_comma_log() {
         "{e}"
     );
 }
+
+/// A gyro field finite in its unit but beyond f64 in °/s (1e308 rad/s is 5.7e309 °/s) is an
+/// error naming line and column, never an infinite sample: on the fast path, the CSV path,
+/// and a unit's further gyro columns. Found by the `csvlog` fuzz target.
+#[test]
+fn a_gyro_value_that_overflows_in_degrees_per_second_is_refused() {
+    use gyrotherm::csvlog::{read_imu_log, GyroUnit};
+    let dir = tempfile::tempdir().unwrap();
+    let rad = ReadOptions {
+        gyro_unit: GyroUnit::RadPerS,
+        ..ReadOptions::default()
+    };
+    // Plain rows (the fast path), then a quoted field (the CSV path takes the row).
+    for (name, row) in [
+        ("plain.csv", "2,1e308,25"),
+        ("quoted.csv", "2,\"1e308\",25"),
+    ] {
+        let p = write(
+            dir.path(),
+            name,
+            &format!("time_s,gyro_dps,temp_c\n0,0.5,25\n1,0.5,25\n{row}\n3,0.5,25\n"),
+        );
+        let e = read_log(&p, &rad).unwrap_err();
+        assert_eq!(e.kind, LogErrorKind::NonFinite, "{e}");
+        let text = e.to_string();
+        assert!(text.contains(":4") && text.contains("gyro_dps"), "{text}");
+        // In °/s the same number is a number.
+        assert_eq!(
+            read_log(&p, &ReadOptions::default()).unwrap().0.gyro_dps[2],
+            1e308
+        );
+    }
+    let p = write(
+        dir.path(),
+        "unit.csv",
+        "time_s,gx,gy,temp_c\n0,0.5,0.5,25\n1,0.5,1e308,25\n2,0.5,0.5,25\n",
+    );
+    let lists = ReadOptions {
+        gyro_col: "gx,gy".into(),
+        ..rad
+    };
+    let e = read_imu_log(&p, &lists, None).unwrap_err().to_string();
+    assert!(e.contains("gy") && e.contains("data row 2"), "{e}");
+}
+
+/// Gap filling between values of opposite sign near f64's limit gives finite samples (the
+/// difference of the two overflows).
+#[test]
+fn filling_a_gap_between_huge_values_stays_finite() {
+    let text = "time_s,gyro_dps,temp_c\n0,1e308,25\n1,1.7e308,25\n3,-1.7e308,25\n";
+    let opts = ReadOptions {
+        fill_gaps_max_s: Some(5.0),
+        ..ReadOptions::default()
+    };
+    let mut r = LogReader::new(Cursor::new(text.as_bytes()), "gap.csv", &opts).unwrap();
+    let mut gyro = Vec::new();
+    while let Some(s) = r.next_sample().unwrap() {
+        gyro.push(s.gyro_dps);
+    }
+    assert_eq!(gyro.len(), 4, "{gyro:?}");
+    assert!(gyro.iter().all(|g| g.is_finite()), "{gyro:?}");
+    // Halfway between 1.7e308 and -1.7e308.
+    assert!(gyro[2].abs() < 1e300, "{gyro:?}");
+}

@@ -124,7 +124,8 @@ pub(super) fn parse_lines(
         };
         // The usual row, parsed straight through to its newline.
         if let Some(([t, g, c, r], end, next)) = direct_row(block, pos, lay) {
-            if prev_time.is_some_and(|t0| t <= t0) {
+            // A gyro value that overflows in °/s is the CSV path's error to tell.
+            if prev_time.is_some_and(|t0| t <= t0) || !(g * lay.gyro_scale).is_finite() {
                 return stop;
             }
             prev_time = Some(t);
@@ -262,9 +263,13 @@ fn parse_row(text: &[u8], lay: &Layout, vals: &mut [f64; 4]) -> Option<Sample> {
             return None;
         }
     }
+    let gyro_dps = vals[1] * lay.gyro_scale;
+    if !gyro_dps.is_finite() {
+        return None;
+    }
     Some(Sample {
         time_s: vals[0],
-        gyro_dps: vals[1] * lay.gyro_scale,
+        gyro_dps,
         temp_c: vals[2],
         table_dps: lay.has_table.then_some(vals[3]),
     })

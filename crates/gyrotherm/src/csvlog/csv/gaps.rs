@@ -76,5 +76,12 @@ pub(super) fn gap_verdict(dt: f64, period: f64, fill_max_s: Option<f64>) -> GapV
 
 #[inline]
 fn lerp(a: f64, b: f64, t: f64) -> f64 {
-    a + (b - a) * t
+    let v = a + (b - a) * t;
+    // `b - a` overflows for values of opposite sign near f64's limit; only then the
+    // weighted sum, which cannot, is used (elsewhere the values stay as they were).
+    if v.is_finite() {
+        v
+    } else {
+        a * (1.0 - t) + b * t
+    }
 }

@@ -280,6 +280,19 @@ impl NumberColumn {
                 filled.push(row);
             } else {
                 *v *= scale;
+                if !v.is_finite() {
+                    return Err(LogError::new(
+                        Kind::NonFinite,
+                        path,
+                        None,
+                        Some(name),
+                        format!(
+                            "data row {}: the value is beyond any number once converted to \
+                             °/s; check it and --gyro-unit",
+                            row + 1
+                        ),
+                    ));
+                }
             }
         }
         for row in filled {

@@ -222,6 +222,9 @@ impl<R: Read> Source<R> {
         }
         let time_s = self.number(rec, self.cols.time, line)?;
         let gyro_dps = self.number(rec, self.cols.gyro, line)? * self.lay.gyro_scale;
+        if !gyro_dps.is_finite() {
+            return Err(Box::new(self.overflow_error(&rec[self.cols.gyro], line)));
+        }
         let temp_c = self.number(rec, self.cols.temp, line)?;
         let table_dps = match self.cols.table {
             Some(i) => Some(self.number(rec, i, line)?),
@@ -260,6 +263,22 @@ impl<R: Read> Source<R> {
             Some(v) if v.is_finite() => Ok(v),
             _ => Err(Box::new(self.number_error(&rec[i], i, line))),
         }
+    }
+
+    /// A gyro field, finite in its unit, beyond f64 once converted to °/s.
+    #[cold]
+    fn overflow_error(&self, raw: &[u8], line: u64) -> LogError {
+        LogError::new(
+            Kind::NonFinite,
+            &self.path,
+            Some(line),
+            Some(&self.headers[self.cols.gyro]),
+            format!(
+                "{} is beyond any number once converted to °/s; check the value and \
+                 --gyro-unit, or comment the line out with '#'",
+                quoted_field(raw)
+            ),
+        )
     }
 
     #[cold]
