@@ -28,9 +28,12 @@
 //! - [`flight_size`]: the flight LSTM's hidden size, read from a model file at run time.
 //! - [`allan`]: Allan-family deviations of rate data, with confidence intervals.
 //! - [`nn`]: the LSTM network on the ground: parameters, training, evaluation.
-//! - [`csvlog`]: the test logs (CSV, ULog, DataFlash; read, validate, write): [`read_log`] →
-//!   [`TestLog`], and a job's logs of a single gyro or a unit through one entry point
-//!   ([`csvlog::read_log_set`] → [`csvlog::LogSet`]).
+//! - [`csvlog`]: the test logs: the log in memory ([`csvlog::ImuLog`], N axes and M sensors;
+//!   [`TestLog`], one axis as a fit reads it; a single gyro's log is the unit of one axis,
+//!   [`csvlog::ImuLog::of_axis`]), each file format in its own module (CSV, ULog, DataFlash;
+//!   read, validate, write), and the one entry point every job reads through
+//!   ([`csvlog::read_log_set`] → [`csvlog::LogSet`]; one log as named columns,
+//!   [`csvlog::read_log_columns`]).
 //! - [`sim`]: the thermal-chamber + FOG simulator, a source of logs ([`simulate`]).
 //! - [`features`]: the model inputs of a log (temperature, its rate, thermal lags)
 //!   ([`FeatureSpec`], [`FeatureTable`]).

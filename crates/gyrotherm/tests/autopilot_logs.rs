@@ -197,3 +197,36 @@ fn a_damaged_header_is_an_error_naming_the_byte_and_the_fix() {
     let e = read_imu_log(&p, &ReadOptions::default(), None).unwrap_err();
     assert!(e.to_string().contains("byte 89"), "{e}");
 }
+
+/// A format definition holding a number no message could hold (an array's length past
+/// 65535) is an error naming the byte, not a panic in the decoder (whose tokenizer unwraps
+/// the number as a `usize`). Found by the `ulog` fuzz target.
+#[test]
+fn a_format_with_an_impossible_array_length_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = ulog();
+    // The file header (16 bytes) and the flag bits (3 + 40): the format message follows.
+    let head = 16 + 3 + 40;
+    for len in ["99999999999999999999999", "65536"] {
+        let mut b = good[..head].to_vec();
+        let payload = format!("other:uint64_t timestamp;float[{len}] v;");
+        b.extend_from_slice(&(payload.len() as u16).to_le_bytes());
+        b.push(b'F');
+        b.extend_from_slice(payload.as_bytes());
+        b.extend_from_slice(&good[head..]);
+        let p = write(dir.path(), "format.ulg", &b);
+        let e = read_imu_log(&p, &ReadOptions::default(), None).unwrap_err();
+        assert_eq!(e.kind, LogErrorKind::Corrupt, "{e}");
+        let m = e.to_string();
+        assert!(m.contains("format definition") && m.contains("byte"), "{m}");
+    }
+    // 65535 is a length a message could hold: read as before.
+    let mut b = good[..head].to_vec();
+    let payload = b"other:uint64_t timestamp;uint8_t[65535] v;";
+    b.extend_from_slice(&(payload.len() as u16).to_le_bytes());
+    b.push(b'F');
+    b.extend_from_slice(payload);
+    b.extend_from_slice(&good[head..]);
+    let p = write(dir.path(), "long.ulg", &b);
+    check_instance(&p, 0);
+}

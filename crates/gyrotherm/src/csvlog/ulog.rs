@@ -42,6 +42,132 @@ impl<R: Read> Read for Counted<R> {
     }
 }
 
+/// Largest number a format definition can hold: an array's length, which a message of at
+/// most 65535 bytes bounds.
+const MAX_FORMAT_NUMBER: u64 = u16::MAX as u64;
+
+/// Where a byte stands in the ULog framing: the file header, a message's 3-byte header
+/// (size, type), or its payload.
+#[derive(Debug, Clone, Copy)]
+enum Frame {
+    FileHeader { left: usize },
+    MessageHeader { got: usize, size: [u8; 2] },
+    Payload { left: usize, format: bool },
+}
+
+/// A byte source that refuses a format definition holding a number no message could hold,
+/// before the decoder sees it (the decoder's tokenizer unwraps the number as a `usize` and
+/// panics on one that overflows). Bytes pass through unchanged otherwise.
+struct CheckedFormats<R> {
+    inner: R,
+    frame: Frame,
+    /// Within a format definition: whether the last byte continued an identifier, and the
+    /// value of the number being read (None: not in a number).
+    in_identifier: bool,
+    number: Option<u64>,
+    offset: u64,
+}
+
+impl<R> CheckedFormats<R> {
+    fn new(inner: R) -> Self {
+        CheckedFormats {
+            inner,
+            // Magic (7 bytes), version (1), timestamp (8).
+            frame: Frame::FileHeader { left: 16 },
+            in_identifier: false,
+            number: None,
+            offset: 0,
+        }
+    }
+
+    /// Follow one byte through the framing; an error for a number past any array's length.
+    fn step(&mut self, b: u8) -> std::io::Result<()> {
+        self.frame = match self.frame {
+            Frame::FileHeader { left } if left > 1 => Frame::FileHeader { left: left - 1 },
+            Frame::FileHeader { .. } => Frame::MessageHeader {
+                got: 0,
+                size: [0; 2],
+            },
+            Frame::MessageHeader { got, mut size } => {
+                if got < 2 {
+                    size[got] = b;
+                    Frame::MessageHeader { got: got + 1, size }
+                } else {
+                    self.in_identifier = false;
+                    self.number = None;
+                    let left = usize::from(u16::from_le_bytes(size));
+                    if left == 0 {
+                        Frame::MessageHeader {
+                            got: 0,
+                            size: [0; 2],
+                        }
+                    } else {
+                        Frame::Payload {
+                            left,
+                            format: b == b'F',
+                        }
+                    }
+                }
+            }
+            Frame::Payload { left, format } => {
+                if format {
+                    self.format_byte(b)?;
+                }
+                if left > 1 {
+                    Frame::Payload {
+                        left: left - 1,
+                        format,
+                    }
+                } else {
+                    Frame::MessageHeader {
+                        got: 0,
+                        size: [0; 2],
+                    }
+                }
+            }
+        };
+        self.offset += 1;
+        Ok(())
+    }
+
+    /// A byte of a format definition, tokenized as the decoder does: identifiers
+    /// (`[A-Za-z_][A-Za-z0-9_]*`) and numbers (`[0-9]+`).
+    fn format_byte(&mut self, b: u8) -> std::io::Result<()> {
+        let identifier = b.is_ascii_alphabetic() || b == b'_';
+        if self.in_identifier && (identifier || b.is_ascii_digit()) {
+            return Ok(());
+        }
+        self.in_identifier = identifier;
+        if !b.is_ascii_digit() {
+            self.number = None;
+            return Ok(());
+        }
+        let n = self.number.unwrap_or(0) * 10 + u64::from(b - b'0');
+        if n > MAX_FORMAT_NUMBER {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "a format definition holds a number over {MAX_FORMAT_NUMBER} at byte {}, \
+                     longer than any message",
+                    self.offset
+                ),
+            ));
+        }
+        self.number = Some(n);
+        Ok(())
+    }
+}
+
+impl<R: Read> Read for CheckedFormats<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for &b in &buf[..n] {
+            self.step(b)?;
+        }
+        Ok(n)
+    }
+}
+
 /// Read a ULog's `sensor_gyro` instance `opts.instance` as a unit reduced to model steps.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<(ImuLog, ReadReport), LogError> {
     let file = std::fs::File::open(path)
@@ -58,7 +184,7 @@ pub(crate) fn read_from<R: Read>(
     let taken = Rc::new(Cell::new(0));
     let ran_dry = Rc::new(Cell::new(false));
     let counted = Counted {
-        inner: src,
+        inner: CheckedFormats::new(src),
         taken: Rc::clone(&taken),
         ran_dry: Rc::clone(&ran_dry),
     };
