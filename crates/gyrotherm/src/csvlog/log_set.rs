@@ -303,37 +303,17 @@ pub fn read_log_columns(
     opts: &ReadOptions,
     table_axis: Option<&str>,
 ) -> Result<LogColumns, LogError> {
-    let read = read_log_set(&[path.to_path_buf()], opts, table_axis);
-    let mut report = ReadReport::default();
-    let mut told = Vec::new();
-    for f in read.files {
-        if let Some(e) = f.error {
-            return Err(e);
-        }
-        report = f.report.unwrap_or_default();
-        told = f.told;
-    }
+    let ReadOne { log, report, told } = read_one(path, opts, table_axis, opts.reads_unit(&[path]))?;
     // A single gyro's log is the unit of one axis, keyed by the file's names; a unit's keys
     // its time and table rate by their standard names.
-    let (log, unit, time_name, table_name) = match read.set.map(LogSet::into_form) {
-        Ok(LogSetForm::Single(logs)) => (
-            logs.into_iter()
-                .next()
-                .map(|(_, l)| ImuLog::of_axis(l, &opts.gyro_col, &opts.temp_col, &opts.table_col)),
+    let (log, unit, time_name, table_name) = match log {
+        OneLog::Single(l) => (
+            ImuLog::of_axis(l, &opts.gyro_col, &opts.temp_col, &opts.table_col),
             false,
             opts.time_col.as_str(),
             opts.table_col.as_str(),
         ),
-        Ok(LogSetForm::Unit(logs)) => (
-            logs.into_iter().next().map(|(_, l)| l),
-            true,
-            TIME_COL,
-            DEFAULT_TABLE_COL,
-        ),
-        Err(_) => (None, false, TIME_COL, DEFAULT_TABLE_COL),
-    };
-    let Some(log) = log else {
-        return Ok(empty(report, told));
+        OneLog::Unit(l) => (l, true, TIME_COL, DEFAULT_TABLE_COL),
     };
     let (gyro_cols, temp_cols) = log.column_names();
     let sample_period_s = Some(super::repr::median_step_s(&log.time_s)).filter(|p| p.is_finite());
@@ -365,15 +345,51 @@ pub fn read_log_columns(
     })
 }
 
-fn empty(report: ReadReport, told: Vec<Told>) -> LogColumns {
-    LogColumns {
-        columns: Vec::new(),
-        gyro_cols: Vec::new(),
-        temp_cols: Vec::new(),
-        table_axis: None,
-        unit: false,
-        sample_period_s: None,
-        report,
-        told,
+/// One log read through the one entry, in the form it was read in.
+#[derive(Debug)]
+pub(crate) enum OneLog {
+    Single(TestLog),
+    Unit(ImuLog),
+}
+
+/// What [`read_one`] gives: the log, what reading did, and what to tell of it.
+#[derive(Debug)]
+pub(crate) struct ReadOne {
+    pub log: OneLog,
+    pub report: ReadReport,
+    pub told: Vec<Told>,
+}
+
+/// [`read_in_form`] of one path: its log, or the file's error.
+pub(crate) fn read_one(
+    path: &Path,
+    opts: &ReadOptions,
+    table_axis: Option<&str>,
+    unit: bool,
+) -> Result<ReadOne, LogError> {
+    let read = read_in_form(&[path.to_path_buf()], opts, table_axis, unit);
+    let mut file = read.files.into_iter().next();
+    if let Some(e) = file.as_mut().and_then(|f| f.error.take()) {
+        return Err(e);
+    }
+    let log = match read.set.map(LogSet::into_form) {
+        Ok(LogSetForm::Single(l)) => l.into_iter().next().map(|(_, l)| OneLog::Single(l)),
+        Ok(LogSetForm::Unit(l)) => l.into_iter().next().map(|(_, l)| OneLog::Unit(l)),
+        Err(_) => None,
+    };
+    match (log, file) {
+        (Some(log), Some(f)) => Ok(ReadOne {
+            log,
+            report: f.report.unwrap_or_default(),
+            told: f.told,
+        }),
+        // A set of one path holds its log or its error: reaching here is the reader's fault.
+        _ => Err(LogError::new(
+            super::LogErrorKind::Io,
+            path,
+            None,
+            None,
+            "internal: reading gave neither the log nor an error; please report it",
+        )),
     }
 }

@@ -45,7 +45,7 @@ pub use csv::writer::LogWriter;
 pub use csv::{write_imu_log, write_log, write_log_with, WriteOptions};
 pub use error::{LogError, LogErrorKind};
 pub use format::{read_unit_from, LogFormat, LOG_FORMATS, LOG_FORMAT_NAMES};
-pub(crate) use log_set::{read_in_form, LogSetForm};
+pub(crate) use log_set::{read_in_form, read_one, LogSetForm, OneLog};
 pub use log_set::{
     read_log_columns, read_log_set, read_log_sets, ColumnValues, FileRead, LogColumns, LogSet,
     LogSetError, SetRead,

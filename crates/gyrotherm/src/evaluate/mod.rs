@@ -6,9 +6,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::csvlog::{
-    read_in_form, ColumnError, ImuLog, LogError, LogSet, LogSetForm, ReadOptions, TestLog,
-};
+use crate::csvlog::{read_one, ColumnError, ImuLog, LogError, OneLog, ReadOptions, TestLog};
 use crate::metrics::{Evaluation, EvaluationError};
 use crate::settings::evaluate::EvaluateError;
 use crate::settings::EvaluateSettings;
@@ -46,8 +44,6 @@ pub enum EvaluateJobError {
     Column { path: PathBuf, source: ColumnError },
     /// The log at `path` has no sample period.
     Period { path: PathBuf },
-    /// Reading gave no log and no error (a reader's fault, not the file's).
-    NoLog,
     /// The figures could not be computed.
     Evaluate(EvaluateError),
     /// The figures the spec sheet needs could not be measured on the log named `log`.
@@ -75,9 +71,6 @@ impl std::fmt::Display for EvaluateJobError {
                  time_s)",
                 path.display()
             ),
-            EvaluateJobError::NoLog => f.write_str(
-                "internal: reading the log gave neither the log nor an error; please report it",
-            ),
             EvaluateJobError::Evaluate(e) => e.fmt(f),
             EvaluateJobError::Measure { log, .. } | EvaluateJobError::Unit { log, .. } => {
                 f.write_str(log)
@@ -97,7 +90,7 @@ impl std::error::Error for EvaluateJobError {
             // Transparent: these errors' own messages are this one's.
             EvaluateJobError::Evaluate(e) => e.source(),
             EvaluateJobError::Spec(e) => e.source(),
-            EvaluateJobError::Period { .. } | EvaluateJobError::NoLog => None,
+            EvaluateJobError::Period { .. } => None,
         }
     }
 }
@@ -131,29 +124,14 @@ pub fn evaluate(job: &EvaluateJob) -> Result<Evaluated, EvaluateJobError> {
         None => job.read.clone(),
     };
     let unit = model.is_some() || job.read.reads_unit(&[path]);
-    let read = read_in_form(&[path.to_path_buf()], &opts, job.table_axis, unit);
-    // One path, so one file read: its error, or the set of its one log.
-    let mut told = Vec::new();
-    for f in read.files {
-        told.extend(f.told);
-        if let Some(source) = f.error {
-            return Err(EvaluateJobError::Read {
-                path: f.path,
-                source,
-            });
-        }
-    }
-    let form = read.set.map(LogSet::into_form);
-    match form {
-        Ok(LogSetForm::Single(logs)) => match logs.into_iter().next() {
-            Some((_, log)) => evaluate_single(job, log, told),
-            None => Err(EvaluateJobError::NoLog),
-        },
-        Ok(LogSetForm::Unit(logs)) => match logs.first() {
-            Some((_, log)) => evaluate_unit(job, model.as_deref(), log, told),
-            None => Err(EvaluateJobError::NoLog),
-        },
-        Err(_) => Err(EvaluateJobError::NoLog),
+    let read =
+        read_one(path, &opts, job.table_axis, unit).map_err(|source| EvaluateJobError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    match read.log {
+        OneLog::Single(log) => evaluate_single(job, log, read.told),
+        OneLog::Unit(log) => evaluate_unit(job, model.as_deref(), &log, read.told),
     }
 }
 
