@@ -334,3 +334,39 @@ fn plan_with_lists_covers_every_axis_on_every_sensor() {
     let soak = text.lines().find(|l| l.starts_with("soaks: ")).unwrap();
     assert!(soak.contains(&format!("({slowest:.0} s)")), "{soak}");
 }
+
+/// `allan` on a unit's log read with column lists analyses the column `--column` names, the
+/// same numbers as reading that gyro alone; without `--column` it says to name one.
+#[test]
+fn allan_on_a_unit_log_analyses_the_named_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = simulate_args(dir.path(), "u.csv", &UNIT);
+    let log = log.to_str().unwrap();
+    let lists = ["--gyro-col", GYROS, "--temp-col", "temp_case_c"];
+    let (code, _, err) = outcome(&[&["allan", "--input", log][..], &lists[..]].concat());
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--column") && err.contains("gyro_y_dps"),
+        "{err}"
+    );
+    let (code, unit, err) = outcome(
+        &[
+            &["allan", "--input", log, "--column", "gyro_z_dps"][..],
+            &lists[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(code, 0, "{err}");
+    let (code, alone, err) = outcome(&[
+        "allan",
+        "--input",
+        log,
+        "--gyro-col",
+        "gyro_z_dps",
+        "--temp-col",
+        "temp_case_c",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(unit.starts_with("OADEV of gyro_z_dps"), "{unit}");
+    assert_eq!(unit, alone);
+}

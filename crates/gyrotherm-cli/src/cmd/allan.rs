@@ -106,6 +106,15 @@ pub(crate) fn read_column(
     }
     let log_name = opts.log_column(column).to_owned();
     let name = opts.file_column(&log_name).to_owned();
+    if log.gyro_cols.len() > 1 && name == opts.gyro_col {
+        // A unit's log: its gyro columns are several, and the analysis is of one.
+        bail!(
+            "{}: the log holds several gyro columns ({}); allan analyses one: name it with \
+             --column",
+            input.display(),
+            log.gyro_cols.join(", ")
+        );
+    }
     let values = log
         .take_numbers(&name)
         .with_context(|| input.display().to_string())?;
