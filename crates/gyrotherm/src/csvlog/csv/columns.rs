@@ -39,7 +39,7 @@ pub(super) fn check_options(path: &Path, opts: &ReadOptions) -> Result<(), LogEr
             format!(
                 "this reads one gyro and one temperature column, not the lists {:?} and {:?}; \
                  name one of each (column lists are for the jobs on an inertial unit: train, \
-                 compensate, evaluate, compare, report, plan and lot)",
+                 compensate, evaluate, compare, report, plan, lot and allan)",
                 opts.gyro_col, opts.temp_col
             ),
         ));
