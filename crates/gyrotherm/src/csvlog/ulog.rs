@@ -161,8 +161,32 @@ impl<R> CheckedFormats<R> {
 impl<R: Read> Read for CheckedFormats<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
-        for &b in &buf[..n] {
-            self.step(b)?;
+        let mut i = 0;
+        while i < n {
+            // Most bytes are data payloads: passed over in one step.
+            if let Frame::Payload {
+                left,
+                format: false,
+            } = self.frame
+            {
+                let k = left.min(n - i);
+                i += k;
+                self.offset += k as u64;
+                self.frame = if k < left {
+                    Frame::Payload {
+                        left: left - k,
+                        format: false,
+                    }
+                } else {
+                    Frame::MessageHeader {
+                        got: 0,
+                        size: [0; 2],
+                    }
+                };
+                continue;
+            }
+            self.step(buf[i])?;
+            i += 1;
         }
         Ok(n)
     }
