@@ -55,6 +55,23 @@ enum Frame {
     Payload { left: usize, format: bool },
 }
 
+impl Frame {
+    /// The start of the next message.
+    const NEXT_MESSAGE: Frame = Frame::MessageHeader {
+        got: 0,
+        size: [0; 2],
+    };
+
+    /// A payload with `left` bytes still to come (none: the next message starts).
+    fn payload(left: usize, format: bool) -> Frame {
+        if left == 0 {
+            Frame::NEXT_MESSAGE
+        } else {
+            Frame::Payload { left, format }
+        }
+    }
+}
+
 /// A byte source that refuses a format definition holding a number no message could hold,
 /// before the decoder sees it (the decoder's tokenizer unwraps the number as a `usize` and
 /// panics on one that overflows). Bytes pass through unchanged otherwise.
@@ -84,46 +101,21 @@ impl<R> CheckedFormats<R> {
     fn step(&mut self, b: u8) -> std::io::Result<()> {
         self.frame = match self.frame {
             Frame::FileHeader { left } if left > 1 => Frame::FileHeader { left: left - 1 },
-            Frame::FileHeader { .. } => Frame::MessageHeader {
-                got: 0,
-                size: [0; 2],
-            },
-            Frame::MessageHeader { got, mut size } => {
-                if got < 2 {
-                    size[got] = b;
-                    Frame::MessageHeader { got: got + 1, size }
-                } else {
-                    self.in_identifier = false;
-                    self.number = None;
-                    let left = usize::from(u16::from_le_bytes(size));
-                    if left == 0 {
-                        Frame::MessageHeader {
-                            got: 0,
-                            size: [0; 2],
-                        }
-                    } else {
-                        Frame::Payload {
-                            left,
-                            format: b == b'F',
-                        }
-                    }
-                }
+            Frame::FileHeader { .. } => Frame::NEXT_MESSAGE,
+            Frame::MessageHeader { got, mut size } if got < 2 => {
+                size[got] = b;
+                Frame::MessageHeader { got: got + 1, size }
+            }
+            Frame::MessageHeader { size, .. } => {
+                self.in_identifier = false;
+                self.number = None;
+                Frame::payload(usize::from(u16::from_le_bytes(size)), b == b'F')
             }
             Frame::Payload { left, format } => {
                 if format {
                     self.format_byte(b)?;
                 }
-                if left > 1 {
-                    Frame::Payload {
-                        left: left - 1,
-                        format,
-                    }
-                } else {
-                    Frame::MessageHeader {
-                        got: 0,
-                        size: [0; 2],
-                    }
-                }
+                Frame::payload(left - 1, format)
             }
         };
         self.offset += 1;
@@ -172,17 +164,7 @@ impl<R: Read> Read for CheckedFormats<R> {
                 let k = left.min(n - i);
                 i += k;
                 self.offset += k as u64;
-                self.frame = if k < left {
-                    Frame::Payload {
-                        left: left - k,
-                        format: false,
-                    }
-                } else {
-                    Frame::MessageHeader {
-                        got: 0,
-                        size: [0; 2],
-                    }
-                };
+                self.frame = Frame::payload(left - k, false);
                 continue;
             }
             self.step(buf[i])?;

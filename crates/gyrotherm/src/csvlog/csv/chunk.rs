@@ -124,13 +124,14 @@ pub(super) fn parse_lines(
         };
         // The usual row, parsed straight through to its newline.
         if let Some(([t, g, c, r], end, next)) = direct_row(block, pos, lay) {
+            let g = g * lay.gyro_scale;
             // A gyro value that overflows in °/s is the CSV path's error to tell.
-            if prev_time.is_some_and(|t0| t <= t0) || !(g * lay.gyro_scale).is_finite() {
+            if prev_time.is_some_and(|t0| t <= t0) || !g.is_finite() {
                 return stop;
             }
             prev_time = Some(t);
             rows.push(Row {
-                vals: [t, g * lay.gyro_scale, c, r],
+                vals: [t, g, c, r],
                 line,
                 start: pos as u32,
                 end: end as u32,

@@ -264,10 +264,10 @@ fn write_columns(
                 format!("{} values but {n} timestamps; not written", c.values.len()),
             ));
         }
-        let taken = [TIME_COL, DEFAULT_TABLE_COL]
+        let mut taken = [TIME_COL, DEFAULT_TABLE_COL]
             .into_iter()
             .chain(numeric.iter().map(|c| c.name));
-        if taken.clone().any(|name| name == c.name) {
+        if taken.any(|name| name == c.name) {
             return Err(bad(
                 Some(&c.name),
                 "a pass-through column has a standard column's name; rename it".to_owned(),
